@@ -1,0 +1,59 @@
+#pragma once
+// A contact law is one choice per slot: normal x tangential x rolling x cohesion
+// (DESIGN.md §3). Each combination is its own type, so a slot that is "none"
+// compiles to nothing: `if constexpr` removes its code from the force loop.
+#include <algorithm>
+
+#include "dem/contact/cohesion.hpp"
+#include "dem/contact/contact_geometry.hpp"
+#include "dem/contact/normal_hertz.hpp"
+#include "dem/contact/normal_hooke.hpp"
+#include "dem/contact/pair_coefficients.hpp"
+#include "dem/contact/rolling.hpp"
+#include "dem/contact/tangential.hpp"
+
+namespace grainflow {
+
+template <class Normal, class Tangential, class Rolling, class Cohesion>
+struct ContactLaw {
+  using normal = Normal;
+  using tangential = Tangential;
+  using rolling = Rolling;
+  using cohesion = Cohesion;
+  static constexpr bool has_history = Tangential::enabled || std::is_same_v<Rolling, EpsdRolling>;
+  static constexpr bool needs_spin = Tangential::enabled || Rolling::enabled;
+  static constexpr bool needs_roll_inertia = Rolling::needs_inertia;
+
+  // Force on i (and torques on both) for one touching pair. The normal force has
+  // no lower clamp: the contact ends when the overlap returns to zero, which is
+  // the end-of-contact definition the restitution mappings assume.
+  static ContactResult evaluate(const ContactGeometry& g, const PairCoefficients& pc,
+                                const ContactConstants& cc, ContactHistory& h, double dt) {
+    const SpringDashpot s = Normal::coefficients(pc, cc, g.r_star, g.m_star, g.overlap);
+    const double vn = g.v_rel.dot(g.n);
+    const double fn = s.kn * g.overlap - s.gn * vn;
+    const double fn_pos = std::max(fn, 0.0);
+    double fn_total = fn;
+    if constexpr (Cohesion::enabled) fn_total -= Cohesion::force(g, pc.cohesion_energy_density);
+
+    ContactResult r{fn_total * g.n, Vec3::Zero(), Vec3::Zero()};
+    if constexpr (Tangential::enabled) {
+      const Vec3 vt = g.v_rel - vn * g.n;
+      const Vec3 ft =
+          Tangential::force(vt, s.kt, s.gt, pc.friction * fn_pos, g.n, h.tangential, dt);
+      r.force += ft;
+      const Vec3 n_x_ft = g.n.cross(ft);
+      r.torque_i = -g.arm_i * n_x_ft;
+      r.torque_j = -g.arm_j * n_x_ft;
+    }
+    if constexpr (Rolling::enabled) {
+      const double m_max = pc.rolling_friction * g.r_star * fn_pos;
+      const Vec3 m = Rolling::torque(g, m_max, s.kn, pc.rolling_friction, cc, h.rolling, dt);
+      r.torque_i += m;
+      r.torque_j -= m;
+    }
+    return r;
+  }
+};
+
+}  // namespace grainflow

@@ -1,0 +1,42 @@
+#pragma once
+// Particle state as a structure of arrays: every per-particle quantity lives in its
+// own contiguous array, indexed by the local particle index. Arrays are permuted
+// together (spatial re-sorting at neighbour rebuilds) and shrunk together (removal).
+#include <cstddef>
+#include <numbers>
+#include <vector>
+
+#include "dem/core/types.hpp"
+
+namespace grainflow {
+
+struct Particles {
+  std::vector<GlobalId> id;      // global id, stable for the particle's life
+  std::vector<Vec3> x;           // position [m]
+  std::vector<Vec3> v;           // velocity [m/s]
+  std::vector<Vec3> omega;       // angular velocity [rad/s]
+  std::vector<Vec3> force;       // total force of the current step [N]
+  std::vector<Vec3> torque;      // total torque of the current step [N m]
+  std::vector<double> radius;    // [m]
+  std::vector<double> mass;      // [kg]
+  std::vector<double> inertia;   // moment of inertia of a solid sphere, 2/5 m r^2 [kg m^2]
+  std::vector<int> material;     // index into the scene's material table
+
+  std::size_t size() const { return id.size(); }
+
+  void reserve(std::size_t n);
+
+  // Appends a solid sphere of the given density; returns its local index.
+  std::size_t add(GlobalId gid, const Vec3& position, const Vec3& velocity, const Vec3& spin,
+                  double r, int mat, double density);
+
+  // Reorders every array so that new index k holds old index perm[k].
+  void permute(const std::vector<std::size_t>& perm);
+
+  // Keeps only the particles whose flag is false, preserving order.
+  void remove_if(const std::vector<char>& remove);
+};
+
+inline double sphere_volume(double r) { return 4.0 / 3.0 * std::numbers::pi * r * r * r; }
+
+}  // namespace grainflow

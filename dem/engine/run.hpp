@@ -1,0 +1,37 @@
+#pragma once
+// A whole `grain run`: set-up, time-step check, the step loop with snapshots,
+// log rows and a progress line, and a closing summary.
+#include <iosfwd>
+#include <optional>
+#include <string>
+
+#include <mpi.h>
+
+#include "dem/scene/scene.hpp"
+
+namespace grainflow {
+
+struct RunOptions {
+  std::optional<std::string> output_directory;  // overrides the scene's
+  bool progress = true;                         // AND-ed with the scene's setting
+  bool allow_large_time_step = false;           // run even when the check refuses dt
+};
+
+struct RunSummary {
+  long steps = 0;
+  long particles_start = 0, particles_end = 0;
+  long removed = 0;
+  long rebuilds = 0;
+  double wall_seconds = 0;
+  double particle_steps_per_second = 0;
+};
+
+// Prints the time-step report (`grain check`); returns the process exit code:
+// 0 fine, 1 refused.
+int check_scene(const Scene& scene, std::ostream& out);
+
+// Throws SceneError / SetupError / InsertionError / OutputError with a message for the user.
+RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm comm,
+                     std::ostream& out);
+
+}  // namespace grainflow

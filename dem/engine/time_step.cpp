@@ -1,0 +1,132 @@
+#include "dem/engine/time_step.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <sstream>
+
+#include "dem/contact/normal_hooke.hpp"
+
+namespace grainflow {
+
+double rayleigh_time(const Material& m, double radius) {
+  const double g = m.youngs_modulus / (2 * (1 + m.poisson_ratio));
+  return std::numbers::pi * radius * std::sqrt(m.density / g) /
+         (0.1631 * m.poisson_ratio + 0.8766);
+}
+
+double hertz_contact_time(double y_star, double r_star, double m_star, double speed) {
+  return 2.868 * std::pow(m_star * m_star / (r_star * y_star * y_star * speed), 0.2);
+}
+
+namespace {
+double pair_contact_time(const ContactSettings& cs, const PairCoefficients& pc,
+                         const ContactConstants& cc, double r_star, double m_star, double v) {
+  if (cs.normal == NormalModel::hertz) return hertz_contact_time(pc.y_star, r_star, m_star, v);
+  const SpringDashpot s = HookeNormal::coefficients(pc, cc, r_star, m_star, 0);
+  const double w2 = s.kn / m_star - std::pow(s.gn / (2 * m_star), 2);
+  return w2 > 0 ? std::numbers::pi / std::sqrt(w2) : std::numeric_limits<double>::infinity();
+}
+}  // namespace
+
+TimeStepReport check_time_step(const Scene& scene, const Particles& p, const PairTable& table,
+                               const ContactConstants& constants) {
+  TimeStepReport rep;
+  const int nm = static_cast<int>(scene.materials.size());
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<double> r_min(nm, inf);
+  for (std::size_t i = 0; i < p.size(); ++i)
+    r_min[p.material[i]] = std::min(r_min[p.material[i]], p.radius[i]);
+
+  rep.rayleigh_time = inf;
+  std::string rayleigh_material;
+  for (int m = 0; m < nm; ++m)
+    if (r_min[m] < inf) {
+      const double t = rayleigh_time(scene.materials[m], r_min[m]);
+      if (t < rep.rayleigh_time) {
+        rep.rayleigh_time = t;
+        rayleigh_material = scene.materials[m].name;
+      }
+    }
+
+  const double v = scene.time.expected_max_speed;
+  rep.contact_time = inf;
+  std::string contact_pair;
+  auto mass = [&](int m) { return scene.materials[m].density * sphere_volume(r_min[m]); };
+  for (int a = 0; a < nm; ++a) {
+    if (r_min[a] == inf) continue;
+    for (int b = a; b < nm; ++b) {
+      if (r_min[b] == inf) continue;
+      const double rs = r_min[a] * r_min[b] / (r_min[a] + r_min[b]);
+      const double ms = mass(a) * mass(b) / (mass(a) + mass(b));
+      const double t = pair_contact_time(scene.contact, table(a, b), constants, rs, ms, v);
+      if (t < rep.contact_time) {
+        rep.contact_time = t;
+        contact_pair = scene.materials[a].name + "-" + scene.materials[b].name;
+      }
+    }
+    for (const Wall& w : scene.walls) {
+      const double t =
+          pair_contact_time(scene.contact, table(a, w.material), constants, r_min[a], mass(a), v);
+      if (t < rep.contact_time) {
+        rep.contact_time = t;
+        contact_pair = scene.materials[a].name + "-wall '" + w.name + "'";
+      }
+    }
+  }
+
+  if (scene.time.step)
+    rep.dt = *scene.time.step;
+  else if (rep.rayleigh_time < inf)
+    rep.dt = *scene.time.rayleigh_fraction * rep.rayleigh_time;
+
+  std::ostringstream o;
+  o.precision(4);
+  if (rep.rayleigh_time < inf) {
+    o << "Rayleigh time t_R = " << rep.rayleigh_time << " s (smallest '" << rayleigh_material
+      << "' particle)";
+    rep.notes.push_back(o.str());
+    o.str("");
+  } else {
+    rep.notes.push_back("no particles: Rayleigh and contact times do not apply");
+  }
+  if (rep.contact_time < inf) {
+    o << "contact time t_c = " << rep.contact_time << " s (" << contact_pair << ", "
+      << (scene.contact.normal == NormalModel::hertz ? "Hertz" : "Hooke") << ", impact at " << v
+      << " m/s)";
+    rep.notes.push_back(o.str());
+    o.str("");
+  }
+  if (rep.dt > 0) {
+    o << "dt = " << rep.dt << " s";
+    if (rep.rayleigh_time < inf) o << " = " << rep.dt / rep.rayleigh_time << " t_R";
+    if (rep.contact_time < inf)
+      o << " = t_c / " << rep.contact_time / rep.dt << " (" << rep.contact_time / rep.dt
+        << " steps per impact)";
+    rep.notes.push_back(o.str());
+    o.str("");
+    const double fr = rep.dt / rep.rayleigh_time;
+    const double steps = rep.contact_time / rep.dt;
+    if (fr > kRefuseRayleighFraction || steps < kRefuseStepsPerContact) {
+      rep.verdict = TimeStepReport::Verdict::refuse;
+      o << "error: dt is too large to resolve contacts (limits: dt <= " << kRefuseRayleighFraction
+        << " t_R and >= " << kRefuseStepsPerContact << " steps per impact); use dt <= "
+        << std::min(kWarnRayleighFraction * rep.rayleigh_time, rep.contact_time / kWarnStepsPerContact)
+        << " s";
+      rep.notes.push_back(o.str());
+    } else if (fr > kWarnRayleighFraction || steps < kWarnStepsPerContact) {
+      rep.verdict = TimeStepReport::Verdict::warn;
+      o << "warning: "
+        << (fr > kWarnRayleighFraction ? "dt is above " + std::to_string(kWarnRayleighFraction).substr(0, 3) + " t_R"
+                                       : "fewer than " + std::to_string(int(kWarnStepsPerContact)) + " steps per impact")
+        << "; contacts will be poorly resolved; dt <= "
+        << std::min(kWarnRayleighFraction * rep.rayleigh_time, rep.contact_time / kWarnStepsPerContact)
+        << " s is recommended";
+      rep.notes.push_back(o.str());
+    }
+  }
+  return rep;
+}
+
+}  // namespace grainflow

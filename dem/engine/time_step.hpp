@@ -1,0 +1,40 @@
+#pragma once
+// Time-step limits of a scene: the Rayleigh time of the smallest particle of each
+// material, t_R = pi r sqrt(rho/G) / (0.1631 nu + 0.8766), G = Y / (2 (1 + nu))
+// (Li et al. 2005; Thornton's form), and the contact time of the fastest expected
+// impact between the smallest particles (and particle-wall):
+//   Hertz: t_c = 2.868 (m*^2 / (R* Y*^2 v))^{1/5}   (elastic; damping lengthens it)
+//   Hooke: t_c = pi / sqrt(k_n/m* - (gamma_n / 2 m*)^2)
+#include <string>
+#include <vector>
+
+#include "dem/contact/contact_geometry.hpp"
+#include "dem/contact/pair_coefficients.hpp"
+#include "dem/core/particles.hpp"
+#include "dem/scene/scene.hpp"
+
+namespace grainflow {
+
+struct TimeStepReport {
+  double rayleigh_time = 0;  // smallest over materials present
+  double contact_time = 0;   // smallest over material pairs present, at expected_max_speed
+  double dt = 0;
+  enum class Verdict { ok, warn, refuse } verdict = Verdict::ok;
+  std::vector<std::string> notes;  // human-readable findings, one per line
+};
+
+// Thresholds: warn above 0.3 t_R or below 10 steps per impact (restitution and
+// peak force then err by a few %, docs/theory/contact-models.md),
+// refuse above 1.0 t_R or t_c/5 — such a run cannot resolve a contact at all.
+constexpr double kWarnRayleighFraction = 0.3;
+constexpr double kRefuseRayleighFraction = 1.0;
+constexpr double kWarnStepsPerContact = 10;
+constexpr double kRefuseStepsPerContact = 5;
+
+double rayleigh_time(const Material& m, double radius);
+double hertz_contact_time(double y_star, double r_star, double m_star, double speed);
+
+TimeStepReport check_time_step(const Scene& scene, const Particles& p, const PairTable& table,
+                               const ContactConstants& constants);
+
+}  // namespace grainflow

@@ -1,0 +1,30 @@
+#pragma once
+// Initial particle insertion: fill a region with non-overlapping spheres
+// (random sequential addition) or read them from a CSV file.
+#include <random>
+#include <stdexcept>
+#include <string>
+
+#include "dem/core/particles.hpp"
+#include "dem/scene/scene.hpp"
+
+namespace grainflow {
+
+// A request that cannot be met (region too small, file malformed); the message
+// names the insertion entry (file:line) and what to change.
+class InsertionError : public std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Draws one radius from the distribution.
+double sample_radius(const SizeDistribution& d, std::mt19937_64& rng);
+
+// Largest radius the distribution can produce (for neighbour and insertion grids).
+double max_radius(const SizeDistribution& d);
+
+// Appends the particles of every insertion entry of the scene, ids continuing
+// from `next_id`. New particles overlap neither each other, earlier particles,
+// nor walls, and lie inside the domain.
+void insert_particles(const Scene& scene, Particles& p, GlobalId& next_id);
+
+}  // namespace grainflow

@@ -1,0 +1,52 @@
+#include "dem/io/log_table.hpp"
+
+#include <cerrno>
+#include <cstring>
+
+#include "dem/io/output_directory.hpp"
+
+namespace grainflow {
+
+LogTable::LogTable(MPI_Comm comm, const std::string& path) : comm_(comm), path_(path) {
+  MPI_Comm_rank(comm_, &rank_);
+  int err = 0;
+  if (rank_ == 0) {
+    errno = 0;
+    file_ = std::fopen(path_.c_str(), "w");
+    if (!file_)
+      err = errno ? errno : EIO;
+    else if (std::fprintf(file_, "%s\n", header) < 0 || std::fflush(file_) != 0)
+      err = errno ? errno : EIO;
+    if (err && file_) {
+      std::fclose(file_);
+      file_ = nullptr;
+    }
+  }
+  agree(err, "cannot create the log table");
+}
+
+LogTable::~LogTable() {
+  if (file_) std::fclose(file_);
+}
+
+void LogTable::write(const LogRow& r) {
+  int err = 0;
+  if (rank_ == 0) {
+    errno = 0;
+    const int n =
+        std::fprintf(file_, "%.17g,%ld,%ld,%.17g,%.17g,%.17g,%ld,%ld,%ld,%.17g\n", r.time, r.step,
+                     r.particles, r.kinetic_translational, r.kinetic_rotational,
+                     r.max_overlap_ratio, r.contacts, r.rebuilds, r.removed, r.wall_seconds);
+    if (n < 0 || std::fflush(file_) != 0) err = errno ? errno : EIO;
+  }
+  agree(err, "cannot append to the log table");
+}
+
+void LogTable::agree(int error_number, const char* what) {
+  MPI_Bcast(&error_number, 1, MPI_INT, 0, comm_);
+  if (error_number != 0)
+    throw OutputError(std::string(what) + " '" + path_ + "': " + std::strerror(error_number) +
+                      ". Check free space and permissions of the output directory.");
+}
+
+}  // namespace grainflow

@@ -1,0 +1,54 @@
+#pragma once
+// The run's log table: one CSV row per log interval, readable by any spreadsheet, by
+// numpy.genfromtxt(names=True) and by scripts/plot_log.py. Column names carry their units.
+#include <mpi.h>
+
+#include <cstdio>
+#include <string>
+
+namespace grainflow {
+
+// One row; every value is already global (reduced over ranks) when passed in.
+struct LogRow {
+  double time;                   // simulated time [s]
+  long step;                     // time-step count
+  long particles;                // particles in the domain
+  double kinetic_translational;  // sum of m v^2 / 2 [J]
+  double kinetic_rotational;     // sum of I omega^2 / 2 [J]
+  double max_overlap_ratio;      // largest contact overlap / radius of the smaller particle [-]
+  long contacts;                 // active particle-particle and particle-wall contacts
+  long rebuilds;                 // neighbour-list rebuilds since the previous row
+  long removed;                  // particles removed (left the domain) since the previous row
+  double wall_seconds;           // wall-clock time since the start of the run [s]
+};
+
+class LogTable {
+ public:
+  static constexpr const char* header =
+      "time_s,step,particles,ke_trans_J,ke_rot_J,max_overlap_ratio,contacts,rebuilds,removed,"
+      "wall_s";
+
+  // Collective: rank 0 creates (truncates) `path` and writes the header; every rank throws
+  // OutputError naming the path if that fails.
+  LogTable(MPI_Comm comm, const std::string& path);
+  ~LogTable();
+  LogTable(const LogTable&) = delete;
+  LogTable& operator=(const LogTable&) = delete;
+
+  // Collective: rank 0 appends the row (doubles with 17 significant digits, so they read back
+  // exactly) and flushes it, so a killed run keeps its log up to the last row. Every rank
+  // throws OutputError if the write fails (disk full), so no rank runs on without a log.
+  void write(const LogRow& row);
+
+  const std::string& path() const { return path_; }
+
+ private:
+  void agree(int error_number, const char* what);
+
+  MPI_Comm comm_;
+  int rank_ = 0;
+  std::string path_;
+  std::FILE* file_ = nullptr;  // open on rank 0 only
+};
+
+}  // namespace grainflow

@@ -1,0 +1,333 @@
+#include "dem/io/snapshot_writer.hpp"
+
+#include <hdf5.h>
+
+#include <cerrno>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <string_view>
+#include <utility>
+
+#include "grainflow_version.hpp"
+
+namespace grainflow {
+
+namespace {
+
+// HDF5 prints its whole error stack to stderr by default; we turn errors into OutputError
+// instead. The previous handler is restored afterwards so other HDF5 users are unaffected.
+class QuietHdf5Errors {
+ public:
+  QuietHdf5Errors() {
+    H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  }
+  ~QuietHdf5Errors() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
+  QuietHdf5Errors(const QuietHdf5Errors&) = delete;
+  QuietHdf5Errors& operator=(const QuietHdf5Errors&) = delete;
+
+ private:
+  H5E_auto2_t func_ = nullptr;
+  void* data_ = nullptr;
+};
+
+struct ErrorRecord {
+  std::string function;
+  std::string description;
+};
+
+herr_t collect_error(unsigned /*n*/, const H5E_error2_t* err, void* out) {
+  static_cast<std::vector<ErrorRecord>*>(out)->push_back(
+      {err->func_name ? err->func_name : "?", err->desc ? err->desc : ""});
+  return 0;
+}
+
+// The HDF5 error stack in one line: the most specific cause (deepest entry, e.g. the MPI-IO or
+// OS error) and the API call it surfaced in; the stack is cleared.
+std::string hdf5_reason() {
+  std::vector<ErrorRecord> stack;
+  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, collect_error, &stack);
+  H5Eclear2(H5E_DEFAULT);
+  if (stack.empty()) return "HDF5 reported no reason";
+  const ErrorRecord& cause = stack.front();
+  const ErrorRecord& api = stack.back();
+  std::string out = cause.description;
+  if (stack.size() > 1) out += " (in " + api.function + ": " + api.description + ")";
+  return out;
+}
+
+// Owns one HDF5 identifier and closes it on scope exit.
+class Hid {
+ public:
+  using Closer = herr_t (*)(hid_t);
+  Hid(hid_t id, Closer closer) : id_(id), closer_(closer) {}
+  ~Hid() {
+    if (id_ >= 0) closer_(id_);
+  }
+  Hid(const Hid&) = delete;
+  Hid& operator=(const Hid&) = delete;
+  hid_t get() const { return id_; }
+  bool valid() const { return id_ >= 0; }
+  // Closes now; closing a file flushes it, so its result matters.
+  bool close() {
+    const hid_t id = std::exchange(id_, -1);
+    return id < 0 || closer_(id) >= 0;
+  }
+
+ private:
+  hid_t id_;
+  Closer closer_;
+};
+
+// Keeps all ranks in the same sequence of collective calls: after each stage every rank learns
+// whether any rank failed, and if so all throw the lowest failing rank's message. A rank that
+// gave up alone would leave the others waiting forever inside the next collective call.
+class Agreement {
+ public:
+  Agreement(MPI_Comm comm, int rank, int size, std::string path)
+      : comm_(comm), rank_(rank), size_(size), path_(std::move(path)) {}
+
+  // For HDF5 calls: the reason is read from the HDF5 error stack.
+  void check(bool ok, const std::string& what) {
+    agree(ok ? std::string() : message(what, hdf5_reason()));
+  }
+  // For operating-system calls: the reason is errno's text.
+  void check_os(bool ok, const std::string& what, int err) {
+    agree(ok ? std::string() : message(what, std::strerror(err)));
+  }
+  // For failures already phrased as a full message.
+  void agree(const std::string& local_message) {
+    int first = local_message.empty() ? size_ : rank_;
+    MPI_Allreduce(MPI_IN_PLACE, &first, 1, MPI_INT, MPI_MIN, comm_);
+    if (first == size_) return;
+    std::string text = local_message;
+    int length = static_cast<int>(text.size());
+    MPI_Bcast(&length, 1, MPI_INT, first, comm_);
+    text.resize(static_cast<std::size_t>(length));
+    MPI_Bcast(text.data(), length, MPI_CHAR, first, comm_);
+    throw OutputError(text);
+  }
+
+ private:
+  std::string message(const std::string& what, const std::string& reason) const {
+    std::string where = size_ > 1 ? " on rank " + std::to_string(rank_) : "";
+    return "cannot write snapshot '" + path_ + "': " + what + " failed" + where + ": " + reason +
+           ". Check free space, quota and permissions of the output directory.";
+  }
+
+  MPI_Comm comm_;
+  int rank_;
+  int size_;
+  std::string path_;
+};
+
+struct HdfTypes {
+  hid_t file;
+  hid_t memory;
+};
+
+HdfTypes hdf_types(SnapshotField::Type t) {
+  switch (t) {
+    case SnapshotField::Type::Int64:
+      return {H5T_STD_I64LE, H5T_NATIVE_INT64};
+    case SnapshotField::Type::Int32:
+      return {H5T_STD_I32LE, H5T_NATIVE_INT};
+    case SnapshotField::Type::Float64:
+      break;
+  }
+  return {H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE};
+}
+
+constexpr const SnapshotField& field(std::string_view name) {
+  for (const SnapshotField& f : snapshot_fields)
+    if (name == f.name) return f;
+  throw std::logic_error("unknown snapshot field");
+}
+
+// A fixed-length ASCII string attribute (h5py reads it as bytes, h5dump prints it plainly).
+bool write_string_attribute(hid_t loc, const char* name, const std::string& value) {
+  Hid type(H5Tcopy(H5T_C_S1), H5Tclose);
+  Hid space(H5Screate(H5S_SCALAR), H5Sclose);
+  if (!type.valid() || !space.valid()) return false;
+  if (H5Tset_size(type.get(), value.size() + 1) < 0) return false;
+  if (H5Tset_strpad(type.get(), H5T_STR_NULLTERM) < 0) return false;
+  Hid attr(H5Acreate2(loc, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  if (!attr.valid()) return false;
+  if (H5Awrite(attr.get(), type.get(), value.c_str()) < 0) return false;
+  return attr.close();
+}
+
+bool write_scalar_attribute(hid_t loc, const char* name, HdfTypes types, const void* value) {
+  Hid space(H5Screate(H5S_SCALAR), H5Sclose);
+  if (!space.valid()) return false;
+  Hid attr(H5Acreate2(loc, name, types.file, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  if (!attr.valid()) return false;
+  if (H5Awrite(attr.get(), types.memory, value) < 0) return false;
+  return attr.close();
+}
+
+// This rank's slice of the global arrays: elements [offset, offset + count) of N = total.
+struct Slice {
+  hsize_t offset;
+  hsize_t count;
+  hsize_t total;
+};
+
+struct OpenFile {
+  hid_t file;
+  hid_t dcpl;  // dataset creation: no fill values (every element is written)
+  hid_t dxpl;  // transfer: collective MPI-IO
+};
+
+void write_dataset(const OpenFile& out, Agreement& agreement, const SnapshotField& f,
+                   const Slice& slice, const void* data) {
+  const std::string dset_path = std::string("/") + f.name;
+  const int rank = f.components == 1 ? 1 : 2;
+  const hsize_t comps = static_cast<hsize_t>(f.components);
+  const hsize_t file_dims[2] = {slice.total, comps};
+  const hsize_t local_dims[2] = {slice.count, comps};
+  const hsize_t start[2] = {slice.offset, 0};
+
+  Hid file_space(H5Screate_simple(rank, file_dims, nullptr), H5Sclose);
+  Hid mem_space(H5Screate_simple(rank, local_dims, nullptr), H5Sclose);
+  bool ok = file_space.valid() && mem_space.valid();
+  // A rank without particles still takes part in the collective write, selecting nothing.
+  if (ok && slice.count == 0)
+    ok = H5Sselect_none(file_space.get()) >= 0 && H5Sselect_none(mem_space.get()) >= 0;
+  else if (ok)
+    ok = H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start, nullptr, local_dims,
+                             nullptr) >= 0;
+  agreement.check(ok, "selecting this rank's slice of " + dset_path);
+
+  const HdfTypes types = hdf_types(f.type);
+  Hid dset(H5Dcreate2(out.file, dset_path.c_str(), types.file, file_space.get(), H5P_DEFAULT,
+                      out.dcpl, H5P_DEFAULT),
+           H5Dclose);
+  agreement.check(dset.valid(), "creating dataset " + dset_path);
+  agreement.check(write_string_attribute(dset.get(), "units", f.units),
+                  "writing the units attribute of " + dset_path);
+  // HDF5 allocates no storage for a dataset of zero elements, and a collective write into it
+  // fails even with empty selections (1.10.8: "addr overflow"), so an empty snapshot skips
+  // the write; total is global, so all ranks skip together. HDF5 also rejects a null buffer
+  // when nothing is selected, and an empty vector may give one.
+  static const std::int64_t nothing = 0;
+  if (slice.total > 0)
+    agreement.check(H5Dwrite(dset.get(), types.memory, mem_space.get(), file_space.get(), out.dxpl,
+                             slice.count ? data : &nothing) >= 0,
+                    "writing dataset " + dset_path);
+  agreement.check(dset.close(), "closing dataset " + dset_path);
+}
+
+std::string six_digits(std::size_t index) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%06zu", index);
+  return buf;
+}
+
+}  // namespace
+
+SnapshotWriter::SnapshotWriter(MPI_Comm comm, std::string directory, std::string basename)
+    : comm_(comm), directory_(std::move(directory)), basename_(std::move(basename)) {
+  MPI_Comm_rank(comm_, &rank_);
+  MPI_Comm_size(comm_, &size_);
+}
+
+std::string SnapshotWriter::index_path() const {
+  return (std::filesystem::path(directory_) / (basename_ + ".xdmf")).string();
+}
+
+std::string SnapshotWriter::write(const Particles& p, double time, long step) {
+  const std::string file_name = basename_ + "_" + six_digits(entries_.size()) + ".h5";
+  const std::string path = (std::filesystem::path(directory_) / file_name).string();
+  // Written under a temporary name and renamed once closed: a run killed mid-write never
+  // leaves a truncated file under a name the index lists.
+  const std::string partial = path + ".part";
+
+  // Attributes must be identical on all ranks; rank 0's values are the reference.
+  double t = time;
+  std::int64_t s = step;
+  MPI_Bcast(&t, 1, MPI_DOUBLE, 0, comm_);
+  MPI_Bcast(&s, 1, MPI_INT64_T, 0, comm_);
+
+  const std::int64_t n_local = static_cast<std::int64_t>(p.size());
+  std::int64_t offset = 0;
+  std::int64_t total = 0;
+  MPI_Exscan(&n_local, &offset, 1, MPI_INT64_T, MPI_SUM, comm_);
+  if (rank_ == 0) offset = 0;  // MPI_Exscan leaves rank 0's result undefined
+  MPI_Allreduce(&n_local, &total, 1, MPI_INT64_T, MPI_SUM, comm_);
+  const Slice slice{static_cast<hsize_t>(offset), static_cast<hsize_t>(n_local),
+                    static_cast<hsize_t>(total)};
+
+  QuietHdf5Errors quiet;
+  Agreement agreement(comm_, rank_, size_, path);
+  try {
+    Hid fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+    Hid dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+    Hid dxpl(H5Pcreate(H5P_DATASET_XFER), H5Pclose);
+    bool ok = fapl.valid() && dcpl.valid() && dxpl.valid();
+    ok = ok && H5Pset_fapl_mpio(fapl.get(), comm_, MPI_INFO_NULL) >= 0;
+    // Metadata written collectively instead of by rank 0 alone plus broadcasts (scales better).
+    ok = ok && H5Pset_coll_metadata_write(fapl.get(), true) >= 0;
+    ok = ok && H5Pset_all_coll_metadata_ops(fapl.get(), true) >= 0;
+    ok = ok && H5Pset_dxpl_mpio(dxpl.get(), H5FD_MPIO_COLLECTIVE) >= 0;
+    // Parallel HDF5 allocates datasets at creation; without this it would also write fill
+    // values there first, doubling the I/O.
+    ok = ok && H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_NEVER) >= 0;
+    agreement.check(ok, "setting up the MPI-IO property lists");
+
+    Hid file(H5Fcreate(partial.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose);
+    agreement.check(file.valid(), "creating the temporary file '" + partial + "'");
+    const OpenFile out{file.get(), dcpl.get(), dxpl.get()};
+
+    write_dataset(out, agreement, field("id"), slice, p.id.data());
+    const auto vectors = [&](const std::vector<Vec3>& a) {
+      scratch_.resize(3 * a.size());
+      for (std::size_t i = 0; i < a.size(); ++i)
+        for (int k = 0; k < 3; ++k) scratch_[3 * i + static_cast<std::size_t>(k)] = a[i][k];
+      return scratch_.data();
+    };
+    write_dataset(out, agreement, field("position"), slice, vectors(p.x));
+    write_dataset(out, agreement, field("velocity"), slice, vectors(p.v));
+    write_dataset(out, agreement, field("angular_velocity"), slice, vectors(p.omega));
+    write_dataset(out, agreement, field("radius"), slice, p.radius.data());
+    scratch_.resize(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) scratch_[i] = 2.0 * p.radius[i];
+    write_dataset(out, agreement, field("diameter"), slice, scratch_.data());
+    write_dataset(out, agreement, field("mass"), slice, p.mass.data());
+    write_dataset(out, agreement, field("material"), slice, p.material.data());
+    static_assert(snapshot_fields.size() == 8, "a new snapshot field needs its write above");
+
+    const HdfTypes f64 = hdf_types(SnapshotField::Type::Float64);
+    const HdfTypes i64 = hdf_types(SnapshotField::Type::Int64);
+    ok = write_scalar_attribute(file.get(), "time", f64, &t) &&
+         write_scalar_attribute(file.get(), "step", i64, &s) &&
+         write_scalar_attribute(file.get(), "count", i64, &total) &&
+         write_string_attribute(file.get(), "grainflow_version", GRAINFLOW_VERSION);
+    agreement.check(ok, "writing the root attributes (time, step, count)");
+    agreement.check(file.close(), "closing (flushing) the file");
+
+    const bool renamed = rank_ != 0 || std::rename(partial.c_str(), path.c_str()) == 0;
+    const int rename_errno = errno;
+    agreement.check_os(renamed, "renaming '" + partial + "' to its final name", rename_errno);
+  } catch (const OutputError&) {
+    // Every rank arrives here together, with all HDF5 handles closed by now.
+    if (rank_ == 0) std::remove(partial.c_str());
+    throw;
+  }
+
+  entries_.push_back({file_name, t, static_cast<long>(s), static_cast<long>(total)});
+  std::string index_error;
+  if (rank_ == 0) {
+    try {
+      write_file_atomically(index_path(), render_xdmf(entries_, basename_));
+    } catch (const OutputError& e) {
+      index_error = e.what();
+    }
+  }
+  agreement.agree(index_error);
+  return path;
+}
+
+}  // namespace grainflow

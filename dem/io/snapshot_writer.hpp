@@ -1,0 +1,48 @@
+#pragma once
+// Particle snapshots: one HDF5 file per output time, written collectively by all ranks through
+// MPI-IO (each rank writes its own contiguous slice, rank 0's particles first), plus an XDMF
+// index that ParaView opens as a time series of point clouds.
+//
+// File layout (see snapshot_fields in xdmf_index.hpp), N = global particle count:
+//   /id (int64, N)  /position, /velocity, /angular_velocity (double, N x 3)
+//   /radius, /diameter, /mass (double, N)  /material (int32, N)
+//   each dataset has a string attribute "units"; the root group has the attributes
+//   time (double, s), step (int64), count (int64, = N) and grainflow_version (string).
+#include <mpi.h>
+
+#include <string>
+#include <vector>
+
+#include "dem/core/particles.hpp"
+#include "dem/io/output_directory.hpp"
+#include "dem/io/xdmf_index.hpp"
+
+namespace grainflow {
+
+class SnapshotWriter {
+ public:
+  // `directory` must exist (prepare_output_directory). Files are named
+  // <directory>/<basename>_<6-digit index>.h5 and the index <directory>/<basename>.xdmf.
+  SnapshotWriter(MPI_Comm comm, std::string directory, std::string basename = "particles");
+
+  // Collective over the communicator: every rank calls it with its own particles (possibly
+  // none) and the same time and step. Writes the next snapshot file (under a temporary name,
+  // renamed when complete), then rewrites the XDMF index atomically to list every snapshot
+  // written so far. Returns the snapshot's path. On any failure every rank throws the same
+  // OutputError (naming the file, the failing operation, the HDF5/OS reason and the rank).
+  std::string write(const Particles& p, double time, long step);
+
+  std::size_t snapshots_written() const { return entries_.size(); }
+  std::string index_path() const;
+
+ private:
+  MPI_Comm comm_;
+  int rank_ = 0;
+  int size_ = 1;
+  std::string directory_;
+  std::string basename_;
+  std::vector<XdmfEntry> entries_;
+  std::vector<double> scratch_;  // one field packed for HDF5, reused across writes
+};
+
+}  // namespace grainflow

@@ -1,0 +1,144 @@
+#pragma once
+// The scene: everything a run needs, as parsed and validated from the YAML file.
+// Plain data; the parser (scene_parser.hpp) guarantees every invariant documented
+// here, so the engine never re-validates.
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "dem/core/types.hpp"
+
+namespace grainflow {
+
+struct Material {
+  std::string name;
+  double youngs_modulus = 0;  // Y > 0 [Pa]
+  double poisson_ratio = 0;   // -1 < nu < 0.5
+  double density = 0;         // > 0 [kg/m^3]
+};
+
+// Properties of a pair of materials (symmetric). Pairs not listed use the
+// scene's `interaction_defaults` if given; the parser rejects a scene where a
+// needed pair has neither.
+struct MaterialPair {
+  int a = 0, b = 0;                      // material indices
+  double restitution = 0.5;              // (0, 1]
+  double friction = 0.5;                 // sliding friction coefficient mu >= 0
+  double rolling_friction = 0.0;         // mu_r >= 0
+  double cohesion_energy_density = 0.0;  // SJKR k_c >= 0 [J/m^3]
+};
+
+enum class NormalModel { hertz, hooke };
+enum class TangentialModel { none, history };
+enum class RollingModel { none, cdt, epsd };
+enum class CohesionModel { none, sjkr };
+
+struct ContactSettings {
+  NormalModel normal = NormalModel::hertz;
+  TangentialModel tangential = TangentialModel::history;
+  RollingModel rolling = RollingModel::none;
+  CohesionModel cohesion = CohesionModel::none;
+  // Hooke: either a characteristic impact velocity (stiffness from Hertz theory at
+  // that speed) or explicit stiffnesses. Exactly one form is set when normal == hooke.
+  std::optional<double> hooke_characteristic_velocity;  // [m/s] > 0
+  std::optional<double> hooke_kn;                       // [N/m] > 0
+  std::optional<double> hooke_kt;                       // [N/m] > 0 (default: kt = kn)
+  double epsd_damping_ratio = 0.3;                      // EPSD rolling viscous damping ratio in [0, 1]
+};
+
+struct Domain {
+  Vec3 lo = Vec3::Zero();
+  Vec3 hi = Vec3::Ones();
+  std::array<bool, 3> periodic{false, false, false};
+};
+
+struct TimeSettings {
+  std::optional<double> step;                     // dt [s] > 0, or
+  std::optional<double> rayleigh_fraction;        // dt = fraction * Rayleigh time, (0, 1]
+  double end = 0;                                 // simulated end time [s] > 0
+  double expected_max_speed = 1.0;                // for the Hertz contact-time check [m/s]
+};
+
+struct PlaneWall {
+  Vec3 point = Vec3::Zero();
+  Vec3 normal = Vec3::UnitZ();  // unit; particles live on the side it points to
+};
+
+struct CylinderWall {
+  Vec3 axis_point = Vec3::Zero();
+  Vec3 axis = Vec3::UnitZ();   // unit
+  double radius = 1;           // > 0
+  bool inside = true;          // particles inside the cylinder (true) or outside (false)
+  double angular_velocity = 0; // surface rotation about `axis` (right hand) [rad/s]
+};
+
+struct Wall {
+  enum class Kind { plane, cylinder } kind = Kind::plane;
+  std::string name;
+  int material = 0;
+  PlaneWall plane;
+  CylinderWall cylinder;
+};
+
+struct SizeDistribution {
+  enum class Kind { constant, uniform, normal, discrete } kind = Kind::constant;
+  double value = 0;              // constant radius
+  double min = 0, max = 0;       // uniform bounds; normal truncation bounds
+  double mean = 0, stddev = 0;   // normal
+  std::vector<double> values;    // discrete radii
+  std::vector<double> weights;   // discrete number fractions (normalised by the parser)
+};
+
+struct Region {
+  enum class Kind { box, cylinder } kind = Kind::box;
+  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();  // box
+  Vec3 base = Vec3::Zero();                   // cylinder: centre of the base disc
+  Vec3 axis = Vec3::UnitZ();                  // cylinder: unit axis
+  double radius = 0, height = 0;              // cylinder
+};
+
+struct Insertion {
+  enum class Kind { fill, csv } kind = Kind::fill;
+  // fill
+  Region region;
+  std::optional<long> count;              // number of particles, or
+  std::optional<double> volume_fraction;  // solid volume fraction of the region, (0, 0.6]
+  SizeDistribution radius;
+  int material = 0;
+  Vec3 velocity = Vec3::Zero();
+  unsigned seed = 1;
+  // csv: columns x,y,z,radius and optionally vx,vy,vz,material (material by name)
+  std::string csv_file;  // resolved relative to the scene file's folder
+  std::string source;    // "file:line" of this entry, for messages
+};
+
+struct OutputSettings {
+  std::string directory = "output";       // relative to the working directory
+  std::optional<double> snapshot_interval; // simulated seconds between HDF5 snapshots
+  std::optional<double> log_interval;      // simulated seconds between CSV log rows
+  bool progress = true;                    // terminal progress line with ETA
+};
+
+struct NeighbourSettings {
+  std::optional<double> skin;  // [m] > 0; default 0.4 * the largest radius
+};
+
+struct Scene {
+  std::string file;  // path it was read from
+  Domain domain;
+  Vec3 gravity = Vec3::Zero();
+  TimeSettings time;
+  std::vector<Material> materials;
+  std::vector<MaterialPair> pairs;  // one entry per unordered pair (a <= b), complete
+  ContactSettings contact;
+  NeighbourSettings neighbour;
+  std::vector<Wall> walls;
+  std::vector<Insertion> insertions;
+  OutputSettings output;
+
+  int material_index(const std::string& name) const;  // -1 if absent
+  const MaterialPair& pair(int a, int b) const;       // precondition: complete table
+};
+
+}  // namespace grainflow

@@ -1,0 +1,49 @@
+#pragma once
+// Sphere-wall geometry: for each wall kind, whether a sphere touches it, the
+// unit normal pointing from the wall into the particle, the overlap, and the
+// wall's surface velocity at the contact point. Walls are treated as flat at the
+// contact (R* = particle radius), the usual DEM convention for walls much larger
+// than the particles.
+#include <cmath>
+
+#include "dem/scene/scene.hpp"
+
+namespace grainflow {
+
+struct WallTouch {
+  Vec3 n;
+  double overlap;
+  Vec3 surface_velocity;
+};
+
+inline bool touch_plane(const PlaneWall& w, const Vec3& x, double r, WallTouch& t) {
+  const double dist = (x - w.point).dot(w.normal);
+  const double overlap = r - dist;
+  if (overlap <= 0) return false;
+  t.n = w.normal;
+  t.overlap = overlap;
+  t.surface_velocity.setZero();
+  return true;
+}
+
+inline bool touch_cylinder(const CylinderWall& w, const Vec3& x, double r, WallTouch& t) {
+  const Vec3 rel = x - w.axis_point;
+  const Vec3 radial = rel - rel.dot(w.axis) * w.axis;
+  const double rho = radial.norm();
+  const double overlap = w.inside ? r - (w.radius - rho) : r - (rho - w.radius);
+  if (overlap <= 0 || rho == 0) return false;
+  const Vec3 out = radial / rho;
+  t.n = w.inside ? Vec3(-out) : out;
+  t.overlap = overlap;
+  // Contact point on the cylinder surface; the surface turns about the axis.
+  const Vec3 surface_point = w.axis_point + rel.dot(w.axis) * w.axis + w.radius * out;
+  t.surface_velocity = w.angular_velocity * w.axis.cross(surface_point - w.axis_point);
+  return true;
+}
+
+inline bool touch_wall(const Wall& w, const Vec3& x, double r, WallTouch& t) {
+  return w.kind == Wall::Kind::plane ? touch_plane(w.plane, x, r, t)
+                                     : touch_cylinder(w.cylinder, x, r, t);
+}
+
+}  // namespace grainflow

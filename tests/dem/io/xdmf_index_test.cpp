@@ -1,0 +1,94 @@
+// XDMF index text and the atomic file replacement, serially. Reference: the XDMF 2 layout
+// described in xdmf_index.hpp; no numerical tolerance (times are printed with 17 significant
+// digits and must read back exactly).
+#include "dem/io/xdmf_index.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "dem/io/output_directory.hpp"
+
+namespace grainflow {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path fresh_directory(const std::string& name) {
+  const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "xdmf_index_test" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t pos = text.find(what); pos != std::string::npos; pos = text.find(what, pos + 1))
+    ++n;
+  return n;
+}
+
+TEST(XdmfIndex, EmptySeriesIsACompleteDocument) {
+  const std::string xml = render_xdmf({}, "particles");
+  EXPECT_NE(xml.find("CollectionType=\"Temporal\""), std::string::npos);
+  EXPECT_EQ(count(xml, "<Grid "), 1u);
+  EXPECT_EQ(xml.substr(xml.size() - 8), "</Xdmf>\n");
+}
+
+TEST(XdmfIndex, TimeIsPrintedToFullPrecision) {
+  const double t = 1.0 / 3.0;
+  const std::string xml = render_xdmf({{"p_000000.h5", t, 3, 2}}, "p");
+  const std::size_t at = xml.find("<Time Value=\"");
+  ASSERT_NE(at, std::string::npos);
+  EXPECT_EQ(std::strtod(xml.c_str() + at + 13, nullptr), t);
+}
+
+TEST(XdmfIndex, EveryFieldIsReferencedWithItsShape) {
+  const std::string xml = render_xdmf({{"s_000004.h5", 0.5, 50, 12}}, "s");
+  for (const SnapshotField& f : snapshot_fields) {
+    const std::string dims = f.components == 1 ? "12" : "12 3";
+    const std::string ref = std::string("Dimensions=\"") + dims + "\">s_000004.h5:/" + f.name + "<";
+    EXPECT_EQ(count(xml, ref), 1u) << ref;
+  }
+  EXPECT_NE(xml.find("<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"12\""),
+            std::string::npos);
+}
+
+TEST(XdmfIndex, SpecialCharactersAreEscaped) {
+  const std::string xml = render_xdmf({{"a&b<c>_000000.h5", 0.0, 0, 1}}, "a&b<c>");
+  EXPECT_EQ(xml.find("a&b"), std::string::npos);
+  EXPECT_NE(xml.find("a&amp;b&lt;c&gt;_000000.h5:/position"), std::string::npos);
+}
+
+TEST(XdmfIndex, AtomicWriteReplacesAndLeavesNoTemporary) {
+  const fs::path dir = fresh_directory("atomic");
+  const fs::path path = dir / "index.xdmf";
+  write_file_atomically(path.string(), "first\n");
+  write_file_atomically(path.string(), "second\n");
+  EXPECT_EQ(slurp(path), "second\n");
+  EXPECT_FALSE(fs::exists(path.string() + ".tmp"));
+}
+
+TEST(XdmfIndex, AtomicWriteIntoMissingDirectoryNamesPath) {
+  const fs::path path = fresh_directory("missing") / "no" / "index.xdmf";
+  try {
+    write_file_atomically(path.string(), "x");
+    ADD_FAILURE() << "no OutputError";
+  } catch (const OutputError& e) {
+    EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace grainflow

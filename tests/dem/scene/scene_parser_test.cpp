@@ -1,0 +1,599 @@
+// Scene parser: every valid key lands in the Scene, and every category of user
+// mistake is reported once, as a SceneError whose file:line:column points at the
+// offending key or value and whose text says what was wrong and what is allowed.
+#include "dem/scene/scene_parser.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace grainflow {
+namespace {
+
+using ::testing::AllOf;
+using ::testing::HasSubstr;
+
+const std::string kScenes = std::string(GRAINFLOW_TEST_DATA_DIR) + "/scenes";
+// A label inside tests/data/scenes so relative CSV names resolve to real files.
+const std::string kLabel = kScenes + "/inline.yaml";
+
+// A valid scene; each error test breaks one thing in it. Line numbers below are
+// 1-based lines of this text.
+const std::string kBase =
+    "domain:\n"                        // 1
+    "  min: [0, 0, 0]\n"               // 2
+    "  max: [1, 1, 1]\n"               // 3
+    "time:\n"                          // 4
+    "  step: 1e-6\n"                   // 5
+    "  end: 0.5\n"                     // 6
+    "materials:\n"                     // 7
+    "  - name: glass\n"                // 8
+    "    youngs_modulus: 5e6\n"        // 9
+    "    poisson_ratio: 0.3\n"         // 10
+    "    density: 2500\n"              // 11
+    "interactions:\n"                  // 12
+    "  - materials: [glass, glass]\n"  // 13
+    "    restitution: 0.9\n"           // 14
+    "contact:\n"                       // 15
+    "  normal: hertz\n";               // 16
+
+// kBase with the first occurrence of `from` replaced by `to` (which must exist).
+std::string with(const std::string& from, const std::string& to, std::string text = kBase) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << "test bug: '" << from << "' not in the base scene";
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+// Parses `text`, expecting a SceneError; returns it (or a marker error if none came).
+SceneError error_of(const std::string& text) {
+  try {
+    parse_scene(text, kLabel);
+  } catch (const SceneError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "expected a SceneError for:\n" << text;
+  return SceneError("none", -1, -1, "no error thrown");
+}
+
+// Checks position and the start of what(), returns the message for substring checks.
+std::string expect_at(const SceneError& e, int line, int column) {
+  EXPECT_EQ(e.file(), kLabel);
+  EXPECT_EQ(e.line(), line) << e.what();
+  EXPECT_EQ(e.column(), column) << e.what();
+  const std::string prefix =
+      kLabel + ":" + std::to_string(line) + ":" + std::to_string(column) + ": error: ";
+  EXPECT_EQ(std::string(e.what()).rfind(prefix, 0), 0u) << e.what();
+  return e.what();
+}
+
+// ---------------------------------------------------------------------------
+// Valid scenes
+
+TEST(SceneParser, BaseSceneIsValidAndTakesDefaults) {
+  const Scene s = parse_scene(kBase, kLabel);
+  EXPECT_EQ(s.file, kLabel);
+  EXPECT_EQ(s.domain.lo, Vec3(0, 0, 0));
+  EXPECT_EQ(s.domain.hi, Vec3(1, 1, 1));
+  EXPECT_EQ(s.domain.periodic, (std::array<bool, 3>{false, false, false}));
+  EXPECT_EQ(s.gravity, Vec3::Zero());
+  ASSERT_TRUE(s.time.step.has_value());
+  EXPECT_DOUBLE_EQ(*s.time.step, 1e-6);
+  EXPECT_FALSE(s.time.rayleigh_fraction.has_value());
+  EXPECT_DOUBLE_EQ(s.time.end, 0.5);
+  EXPECT_DOUBLE_EQ(s.time.expected_max_speed, 1.0);
+  ASSERT_EQ(s.pairs.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.pairs[0].restitution, 0.9);
+  EXPECT_DOUBLE_EQ(s.pairs[0].friction, 0.5);
+  EXPECT_DOUBLE_EQ(s.pairs[0].rolling_friction, 0.0);
+  EXPECT_DOUBLE_EQ(s.pairs[0].cohesion_energy_density, 0.0);
+  EXPECT_EQ(s.contact.normal, NormalModel::hertz);
+  EXPECT_EQ(s.contact.tangential, TangentialModel::history);
+  EXPECT_EQ(s.contact.rolling, RollingModel::none);
+  EXPECT_EQ(s.contact.cohesion, CohesionModel::none);
+  EXPECT_FALSE(s.contact.hooke_characteristic_velocity || s.contact.hooke_kn || s.contact.hooke_kt);
+  EXPECT_DOUBLE_EQ(s.contact.epsd_damping_ratio, 0.3);
+  EXPECT_FALSE(s.neighbour.skin.has_value());
+  EXPECT_TRUE(s.walls.empty());
+  EXPECT_TRUE(s.insertions.empty());
+  EXPECT_EQ(s.output.directory, "output");
+  EXPECT_FALSE(s.output.snapshot_interval || s.output.log_interval);
+  EXPECT_TRUE(s.output.progress);
+}
+
+TEST(SceneParser, CompleteSceneFillsEveryField) {
+  const std::string path = kScenes + "/complete.yaml";
+  const Scene s = load_scene(path);
+  EXPECT_EQ(s.file, path);
+
+  EXPECT_EQ(s.domain.lo, Vec3(-0.06, -0.06, -0.06));
+  EXPECT_EQ(s.domain.hi, Vec3(0.06, 0.06, 0.06));
+  EXPECT_EQ(s.domain.periodic, (std::array<bool, 3>{true, false, false}));
+  EXPECT_EQ(s.gravity, Vec3(0, 0, -9.81));
+
+  EXPECT_FALSE(s.time.step.has_value());
+  ASSERT_TRUE(s.time.rayleigh_fraction.has_value());
+  EXPECT_DOUBLE_EQ(*s.time.rayleigh_fraction, 0.005);
+  EXPECT_DOUBLE_EQ(s.time.end, 0.05);
+  EXPECT_DOUBLE_EQ(s.time.expected_max_speed, 2.0);
+
+  ASSERT_EQ(s.materials.size(), 3u);
+  EXPECT_EQ(s.materials[0].name, "glass");
+  EXPECT_DOUBLE_EQ(s.materials[0].youngs_modulus, 5e6);
+  EXPECT_DOUBLE_EQ(s.materials[0].poisson_ratio, 0.3);
+  EXPECT_DOUBLE_EQ(s.materials[0].density, 2500);
+  EXPECT_EQ(s.materials[1].name, "steel");
+  EXPECT_DOUBLE_EQ(s.materials[1].youngs_modulus, 2e8);
+  EXPECT_DOUBLE_EQ(s.materials[1].poisson_ratio, 0.29);
+  EXPECT_DOUBLE_EQ(s.materials[1].density, 7800);
+  EXPECT_EQ(s.materials[2].name, "rubber");
+  EXPECT_EQ(s.material_index("steel"), 1);
+  EXPECT_EQ(s.material_index("rubber"), 2);
+  EXPECT_EQ(s.material_index("wood"), -1);
+
+  // Complete table: 3 materials -> 6 unordered pairs, each a <= b, each once.
+  ASSERT_EQ(s.pairs.size(), 6u);
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) {
+      const MaterialPair& p = s.pair(a, b);
+      EXPECT_EQ(p.a, std::min(a, b));
+      EXPECT_EQ(p.b, std::max(a, b));
+      EXPECT_EQ(&p, &s.pair(b, a)) << "lookup must be symmetric";
+    }
+  for (const MaterialPair& p : s.pairs) EXPECT_LE(p.a, p.b);
+  const MaterialPair& gg = s.pair(0, 0);
+  EXPECT_DOUBLE_EQ(gg.restitution, 0.9);
+  EXPECT_DOUBLE_EQ(gg.friction, 0.4);
+  EXPECT_DOUBLE_EQ(gg.rolling_friction, 0.01);
+  EXPECT_DOUBLE_EQ(gg.cohesion_energy_density, 1000);
+  const MaterialPair& gs = s.pair(1, 0);  // listed as [steel, glass]
+  EXPECT_DOUBLE_EQ(gs.restitution, 0.8);
+  EXPECT_DOUBLE_EQ(gs.friction, 0.3);
+  EXPECT_DOUBLE_EQ(gs.rolling_friction, 0.0);  // entry default, not interaction_defaults
+  for (const auto& [a, b] : {std::pair{0, 2}, std::pair{1, 1}, std::pair{1, 2}, std::pair{2, 2}}) {
+    const MaterialPair& d = s.pair(a, b);  // unlisted: interaction_defaults
+    EXPECT_DOUBLE_EQ(d.restitution, 0.5);
+    EXPECT_DOUBLE_EQ(d.friction, 0.6);
+    EXPECT_DOUBLE_EQ(d.rolling_friction, 0.02);
+    EXPECT_DOUBLE_EQ(d.cohesion_energy_density, 0.0);
+  }
+
+  EXPECT_EQ(s.contact.normal, NormalModel::hooke);
+  EXPECT_EQ(s.contact.tangential, TangentialModel::history);
+  EXPECT_EQ(s.contact.rolling, RollingModel::epsd);
+  EXPECT_EQ(s.contact.cohesion, CohesionModel::sjkr);
+  EXPECT_FALSE(s.contact.hooke_characteristic_velocity.has_value());
+  EXPECT_EQ(s.contact.hooke_kn, 1e4);
+  EXPECT_EQ(s.contact.hooke_kt, 8e3);
+  EXPECT_DOUBLE_EQ(s.contact.epsd_damping_ratio, 0.25);
+  EXPECT_EQ(s.neighbour.skin, 0.0005);
+
+  ASSERT_EQ(s.walls.size(), 2u);
+  const Wall& floor = s.walls[0];
+  EXPECT_EQ(floor.kind, Wall::Kind::plane);
+  EXPECT_EQ(floor.name, "floor");
+  EXPECT_EQ(floor.material, 1);
+  EXPECT_EQ(floor.plane.point, Vec3(0, 0, -0.045));
+  EXPECT_EQ(floor.plane.normal, Vec3(0, 0, 1)) << "normal [0, 0, 2] is normalised";
+  const Wall& drum = s.walls[1];
+  EXPECT_EQ(drum.kind, Wall::Kind::cylinder);
+  EXPECT_EQ(drum.name, "drum");
+  EXPECT_EQ(drum.material, 1);
+  EXPECT_EQ(drum.cylinder.axis_point, Vec3::Zero());
+  EXPECT_EQ(drum.cylinder.axis, Vec3(1, 0, 0)) << "axis [3, 0, 0] is normalised";
+  EXPECT_DOUBLE_EQ(drum.cylinder.radius, 0.05);
+  EXPECT_TRUE(drum.cylinder.inside);
+  EXPECT_DOUBLE_EQ(drum.cylinder.angular_velocity, 3.0);
+
+  ASSERT_EQ(s.insertions.size(), 3u);
+  const Insertion& box = s.insertions[0];
+  EXPECT_EQ(box.kind, Insertion::Kind::fill);
+  EXPECT_EQ(box.source, path + ":46");
+  EXPECT_EQ(box.region.kind, Region::Kind::box);
+  EXPECT_EQ(box.region.lo, Vec3(-0.025, -0.025, -0.035));
+  EXPECT_EQ(box.region.hi, Vec3(0.025, 0.025, 0));
+  EXPECT_EQ(box.count, 1000);
+  EXPECT_FALSE(box.volume_fraction.has_value());
+  EXPECT_EQ(box.material, 0);
+  EXPECT_EQ(box.radius.kind, SizeDistribution::Kind::discrete);
+  EXPECT_EQ(box.radius.values, (std::vector<double>{1e-3, 2e-3}));
+  ASSERT_EQ(box.radius.weights.size(), 2u);
+  EXPECT_DOUBLE_EQ(box.radius.weights[0], 0.75) << "weights [3, 1] normalise to sum 1";
+  EXPECT_DOUBLE_EQ(box.radius.weights[1], 0.25);
+  EXPECT_EQ(box.velocity, Vec3(0, 0, -0.5));
+  EXPECT_EQ(box.seed, 42u);
+
+  const Insertion& cyl = s.insertions[1];
+  EXPECT_EQ(cyl.source, path + ":53");
+  EXPECT_EQ(cyl.region.kind, Region::Kind::cylinder);
+  EXPECT_EQ(cyl.region.base, Vec3(0, 0, 0.005));
+  EXPECT_EQ(cyl.region.axis, Vec3(0, 0, 1));
+  EXPECT_DOUBLE_EQ(cyl.region.radius, 0.02);
+  EXPECT_DOUBLE_EQ(cyl.region.height, 0.03);
+  EXPECT_FALSE(cyl.count.has_value());
+  EXPECT_EQ(cyl.volume_fraction, 0.3);
+  EXPECT_EQ(cyl.material, 2);
+  EXPECT_EQ(cyl.radius.kind, SizeDistribution::Kind::normal);
+  EXPECT_DOUBLE_EQ(cyl.radius.mean, 1e-3);
+  EXPECT_DOUBLE_EQ(cyl.radius.stddev, 1e-4);
+  EXPECT_DOUBLE_EQ(cyl.radius.min, 7e-4) << "default truncation mean - 3 stddev";
+  EXPECT_DOUBLE_EQ(cyl.radius.max, 1.3e-3) << "default truncation mean + 3 stddev";
+  EXPECT_EQ(cyl.velocity, Vec3::Zero());
+  EXPECT_EQ(cyl.seed, 1u);
+
+  const Insertion& csv = s.insertions[2];
+  EXPECT_EQ(csv.kind, Insertion::Kind::csv);
+  EXPECT_EQ(csv.source, path + ":58");
+  EXPECT_EQ(std::filesystem::path(csv.csv_file),
+            std::filesystem::path(kScenes) / "complete_particles.csv");
+  EXPECT_TRUE(std::filesystem::exists(csv.csv_file));
+  EXPECT_EQ(csv.material, 0);
+
+  EXPECT_EQ(s.output.directory, "out/drum");
+  EXPECT_EQ(s.output.snapshot_interval, 0.01);
+  EXPECT_EQ(s.output.log_interval, 0.001);
+  EXPECT_FALSE(s.output.progress);
+}
+
+TEST(SceneParser, MinimalExampleIsValid) {
+  const Scene s = load_scene(kScenes + "/minimal.yaml");
+  EXPECT_EQ(s.insertions.at(0).radius.kind, SizeDistribution::Kind::uniform);
+  EXPECT_DOUBLE_EQ(s.insertions[0].radius.min, 4e-4);
+  EXPECT_DOUBLE_EQ(s.insertions[0].radius.max, 6e-4);
+  EXPECT_EQ(s.insertions[0].count, 500);
+}
+
+TEST(SceneParser, HookeCharacteristicVelocityAndConstantRadius) {
+  const Scene s = parse_scene(with("  normal: hertz\n",
+                                   "  normal: hooke\n"
+                                   "  hooke: {characteristic_velocity: 1.5}\n"
+                                   "insert:\n"
+                                   "  - type: fill\n"
+                                   "    region: {box: {min: [0, 0, 0], max: [1, 1, 1]}}\n"
+                                   "    count: 10\n"
+                                   "    material: glass\n"
+                                   "    radius: {distribution: constant, value: 1e-3}\n"),
+                              kLabel);
+  EXPECT_EQ(s.contact.hooke_characteristic_velocity, 1.5);
+  EXPECT_FALSE(s.contact.hooke_kn || s.contact.hooke_kt);
+  EXPECT_EQ(s.insertions.at(0).radius.kind, SizeDistribution::Kind::constant);
+  EXPECT_DOUBLE_EQ(s.insertions[0].radius.value, 1e-3);
+  EXPECT_EQ(s.insertions[0].source, kLabel + ":19");
+}
+
+TEST(SceneParser, NormalDistributionLowerBoundIsClippedPositive) {
+  const Scene s = parse_scene(kBase +
+                                  "insert:\n"
+                                  "  - type: fill\n"
+                                  "    region: {box: {min: [0, 0, 0], max: [1, 1, 1]}}\n"
+                                  "    volume_fraction: 0.1\n"
+                                  "    material: glass\n"
+                                  "    radius: {distribution: normal, mean: 1e-3, stddev: 5e-4}\n",
+                              kLabel);
+  // mean - 3 stddev < 0, so the default lower bound is clipped to mean / 10.
+  EXPECT_DOUBLE_EQ(s.insertions.at(0).radius.min, 1e-4);
+  EXPECT_DOUBLE_EQ(s.insertions[0].radius.max, 2.5e-3);
+}
+
+TEST(SceneParser, DiscreteWithoutWeightsIsUniformInNumber) {
+  const Scene s = parse_scene(
+      kBase +
+          "insert:\n"
+          "  - type: fill\n"
+          "    region: {cylinder: {base: [0.5, 0.5, 0], axis: [0, 0, 1], radius: 0.5, height: 1}}\n"
+          "    count: 3\n"
+          "    material: glass\n"
+          "    radius: {distribution: discrete, values: [1e-3, 2e-3, 3e-3, 4e-3]}\n",
+      kLabel);
+  EXPECT_EQ(s.insertions.at(0).radius.weights, (std::vector<double>{0.25, 0.25, 0.25, 0.25}));
+}
+
+TEST(SceneParser, PairLookupWorksOnHandBuiltTables) {
+  Scene s;
+  s.materials = {{"a", 1, 0.3, 1}, {"b", 1, 0.3, 1}};
+  s.pairs = {{1, 1, 0.1}, {0, 1, 0.2}, {0, 0, 0.3}};  // not in canonical order
+  EXPECT_DOUBLE_EQ(s.pair(1, 0).restitution, 0.2);
+  EXPECT_DOUBLE_EQ(s.pair(0, 0).restitution, 0.3);
+  EXPECT_DOUBLE_EQ(s.pair(1, 1).restitution, 0.1);
+}
+
+// ---------------------------------------------------------------------------
+// Errors, one category per test
+
+TEST(SceneErrors, UnknownKeyListsAllowedKeys) {
+  const std::string msg = expect_at(error_of(with("density: 2500", "densty: 2500")), 11, 5);
+  EXPECT_THAT(msg, AllOf(HasSubstr("unknown key 'densty' in materials[0]"),
+                         HasSubstr("allowed keys: name, youngs_modulus, poisson_ratio, density"),
+                         HasSubstr("did you mean 'density'?")));
+
+  const std::string top = expect_at(error_of(kBase + "gravty: [0, 0, -9.81]\n"), 17, 1);
+  EXPECT_THAT(top, AllOf(HasSubstr("unknown key 'gravty' in the top level"),
+                         HasSubstr("allowed keys: domain, gravity, time, materials, interactions, "
+                                   "interaction_defaults, contact, neighbour, walls, insert, "
+                                   "output")));
+
+  // Allowed keys depend on the kind of entry.
+  const std::string wall =
+      expect_at(error_of(kBase + "walls:\n  - {type: plane, point: [0, 0, 0], normal: [0, 0, 1], "
+                                 "radius: 1, material: glass}\n"),
+                18, 56);
+  EXPECT_THAT(wall, AllOf(HasSubstr("unknown key 'radius' in walls[0] (a plane wall)"),
+                          HasSubstr("allowed keys: type, name, point, normal, material")));
+}
+
+TEST(SceneErrors, DuplicateKey) {
+  const std::string msg =
+      expect_at(error_of(with("  end: 0.5\n", "  end: 0.5\n  end: 0.7\n")), 7, 3);
+  EXPECT_THAT(msg, AllOf(HasSubstr("key 'end' is given twice in time (first at line 6)"),
+                         HasSubstr("keep only one")));
+}
+
+TEST(SceneErrors, WrongTypeNumber) {
+  const std::string msg = expect_at(error_of(with("density: 2500", "density: abc")), 11, 14);
+  EXPECT_THAT(msg, AllOf(HasSubstr("materials[0].density: expected a number, got 'abc'")));
+}
+
+TEST(SceneErrors, WrongTypeVector) {
+  const std::string short_list = expect_at(error_of(with("max: [1, 1, 1]", "max: [1, 1]")), 3, 8);
+  EXPECT_THAT(short_list,
+              AllOf(HasSubstr("domain.max: expected a list of 3 numbers, got a list of 2"),
+                    HasSubstr("[x, y, z]")));
+
+  // A bad element is pointed at directly.
+  const std::string element = expect_at(error_of(kBase + "gravity: [0, 0, down]\n"), 17, 17);
+  EXPECT_THAT(element, HasSubstr("gravity: expected a list of 3 numbers, but item 3 is 'down'"));
+
+  const std::string scalar = expect_at(error_of(kBase + "gravity: -9.81\n"), 17, 10);
+  EXPECT_THAT(scalar, HasSubstr("gravity: expected a list of 3 numbers, got '-9.81'"));
+}
+
+TEST(SceneErrors, WrongTypeSectionAndList) {
+  const std::string map =
+      expect_at(error_of(with("time:\n  step: 1e-6\n  end: 0.5\n", "time: 0.5\n")), 4, 7);
+  EXPECT_THAT(map, HasSubstr("time: expected a map of keys, got '0.5'"));
+
+  const std::string list = expect_at(error_of(kBase + "walls: {type: plane}\n"), 17, 8);
+  EXPECT_THAT(list, HasSubstr("walls: expected a list, got a map"));
+}
+
+TEST(SceneErrors, MissingRequiredKeyNamesKeyAndParent) {
+  const std::string in_item = expect_at(error_of(with("    density: 2500\n", "")), 8, 5);
+  EXPECT_THAT(in_item, AllOf(HasSubstr("missing required key 'density' in materials[0]"),
+                             HasSubstr("add `density: <number>` with a value > 0")));
+
+  const std::string in_section = expect_at(error_of(with("  end: 0.5\n", "")), 4, 1);
+  EXPECT_THAT(in_section, HasSubstr("missing required key 'end' in time"));
+
+  const std::string top = expect_at(error_of(with("contact:\n  normal: hertz\n", "")), 1, 1);
+  EXPECT_THAT(top, HasSubstr("missing required key 'contact' in the top level"));
+
+  const std::string empty_value =
+      expect_at(error_of(with("  normal: hertz\n", "  normal:\n")), 16, 3);
+  EXPECT_THAT(empty_value, HasSubstr("contact.normal: expected a normal contact model name, got "
+                                     "nothing; allowed: hertz, hooke"));
+}
+
+TEST(SceneErrors, ValueOutOfRangeStatesRangeAndValue) {
+  const std::string poisson =
+      expect_at(error_of(with("poisson_ratio: 0.3", "poisson_ratio: 0.5")), 10, 20);
+  EXPECT_THAT(poisson,
+              HasSubstr("materials[0].poisson_ratio: value 0.5 is out of range; it must be "
+                        "in (-1, 0.5)"));
+
+  const std::string e_high =
+      expect_at(error_of(with("restitution: 0.9", "restitution: 1.5")), 14, 18);
+  EXPECT_THAT(e_high,
+              HasSubstr("interactions[0].restitution: value 1.5 is out of range; it must be "
+                        "in (0, 1]"));
+  const std::string e_zero =
+      expect_at(error_of(with("restitution: 0.9", "restitution: 0")), 14, 18);
+  EXPECT_THAT(e_zero, HasSubstr("value 0 is out of range; it must be in (0, 1]"));
+
+  const std::string radius =
+      expect_at(error_of(kBase + "insert:\n"
+                                 "  - type: fill\n"
+                                 "    region: {box: {min: [0, 0, 0], max: [1, 1, 1]}}\n"
+                                 "    count: 10\n"
+                                 "    material: glass\n"
+                                 "    radius: {distribution: constant, value: -1e-3}\n"),
+                22, 45);
+  EXPECT_THAT(radius,
+              HasSubstr("insert[0].radius.value: value -1e-3 is out of range; it must be > 0"));
+
+  const std::string end = expect_at(error_of(with("end: 0.5", "end: 0")), 6, 8);
+  EXPECT_THAT(end, HasSubstr("time.end: value 0 is out of range; it must be > 0"));
+
+  const std::string box = expect_at(error_of(with("max: [1, 1, 1]", "max: [1, -1, 1]")), 3, 12);
+  EXPECT_THAT(box, HasSubstr("domain.max[1]: value -1 is not greater than domain.min[1] = 0"));
+}
+
+TEST(SceneErrors, UnknownModelNameListsModels) {
+  const std::string msg = expect_at(error_of(with("normal: hertz", "normal: hertzz")), 16, 11);
+  EXPECT_THAT(msg, AllOf(HasSubstr("contact.normal: unknown normal contact model 'hertzz'"),
+                         HasSubstr("allowed: hertz, hooke"), HasSubstr("did you mean 'hertz'?")));
+
+  const std::string rolling = expect_at(error_of(kBase + "  rolling: friction\n"), 17, 12);
+  EXPECT_THAT(rolling, HasSubstr("unknown rolling resistance model 'friction'; allowed: none, cdt, "
+                                 "epsd"));
+}
+
+TEST(SceneErrors, UnknownMaterialReferenceListsKnownNames) {
+  const std::string msg = expect_at(error_of(with("[glass, glass]", "[glass, glas]")), 13, 24);
+  EXPECT_THAT(msg, AllOf(HasSubstr("interactions[0].materials[1]: unknown material 'glas'"),
+                         HasSubstr("known materials: glass"), HasSubstr("did you mean 'glass'?")));
+
+  const std::string wall = expect_at(
+      error_of(kBase + "walls:\n"
+                       "  - {type: plane, point: [0, 0, 0], normal: [0, 0, 1], material: steel}\n"),
+      18, 66);
+  EXPECT_THAT(wall,
+              HasSubstr("walls[0].material: unknown material 'steel'; known materials: glass"));
+}
+
+TEST(SceneErrors, DuplicateMaterialName) {
+  const std::string msg = expect_at(
+      error_of(with("interactions:\n",
+                    "  - {name: glass, youngs_modulus: 1e9, poisson_ratio: 0.2, density: 3000}\n"
+                    "interactions:\n")),
+      12, 12);
+  EXPECT_THAT(msg, AllOf(HasSubstr("materials[1].name: duplicate material name 'glass' (first "
+                                   "defined at line 8)"),
+                         HasSubstr("unique name")));
+}
+
+TEST(SceneErrors, MissingMaterialPairNamesThePair) {
+  const std::string two_materials =
+      with("interactions:\n",
+           "  - {name: steel, youngs_modulus: 2e11, poisson_ratio: 0.29, density: 7800}\n"
+           "interactions:\n");
+  const std::string msg = expect_at(error_of(two_materials), 13, 1);
+  EXPECT_THAT(msg,
+              AllOf(HasSubstr("no interaction properties for material pair (glass, steel)"),
+                    HasSubstr("materials: [glass, steel]"), HasSubstr("interaction_defaults")));
+
+  // interaction_defaults fills the gap.
+  const Scene s = parse_scene(two_materials + "interaction_defaults: {restitution: 0.7}\n", kLabel);
+  EXPECT_DOUBLE_EQ(s.pair(0, 1).restitution, 0.7);
+  EXPECT_DOUBLE_EQ(s.pair(1, 1).restitution, 0.7);
+  EXPECT_DOUBLE_EQ(s.pair(0, 0).restitution, 0.9);
+}
+
+TEST(SceneErrors, DuplicateMaterialPair) {
+  const std::string msg = expect_at(
+      error_of(with("contact:\n", "  - {materials: [glass, glass], restitution: 0.5}\ncontact:\n")),
+      15, 17);
+  EXPECT_THAT(msg, HasSubstr("the pair (glass, glass) is already given at line 13"));
+}
+
+TEST(SceneErrors, StepAndRayleighFractionExactlyOne) {
+  const std::string both =
+      expect_at(error_of(with("  end: 0.5\n", "  end: 0.5\n  rayleigh_fraction: 0.1\n")), 7, 3);
+  EXPECT_THAT(both, AllOf(HasSubstr("both 'step' and 'rayleigh_fraction' are given in time"),
+                          HasSubstr("give exactly one of them")));
+
+  const std::string neither = expect_at(error_of(with("  step: 1e-6\n", "")), 4, 1);
+  EXPECT_THAT(neither, AllOf(HasSubstr("neither 'step' nor 'rayleigh_fraction' is given in time"),
+                             HasSubstr("give exactly one of them")));
+}
+
+TEST(SceneErrors, CountAndVolumeFractionExactlyOne) {
+  const std::string fill =
+      "insert:\n"                                              // 17
+      "  - type: fill\n"                                       // 18
+      "    region: {box: {min: [0, 0, 0], max: [1, 1, 1]}}\n"  // 19
+      "    count: 10\n"                                        // 20
+      "    material: glass\n"                                  // 21
+      "    radius: {distribution: constant, value: 1e-3}\n";   // 22
+  const std::string both = expect_at(error_of(kBase + fill + "    volume_fraction: 0.3\n"), 23, 5);
+  EXPECT_THAT(both, HasSubstr("both 'count' and 'volume_fraction' are given in insert[0]"));
+
+  const std::string neither = expect_at(error_of(kBase + with("    count: 10\n", "", fill)), 18, 5);
+  EXPECT_THAT(neither, HasSubstr("neither 'count' nor 'volume_fraction' is given in insert[0]"));
+
+  const std::string fraction =
+      expect_at(error_of(kBase + with("count: 10", "volume_fraction: 0.7", fill)), 20, 22);
+  EXPECT_THAT(fraction, HasSubstr("value 0.7 is out of range; it must be in (0, 0.6]"));
+
+  const std::string whole =
+      expect_at(error_of(kBase + with("count: 10", "count: 10.5", fill)), 20, 12);
+  EXPECT_THAT(whole, HasSubstr("insert[0].count: expected a whole number, got '10.5'"));
+}
+
+TEST(SceneErrors, YamlSyntaxErrorHasPosition) {
+  const std::string msg = expect_at(error_of(with("max: [1, 1, 1]", "max: [1, 1, 1")), 4, 5);
+  EXPECT_THAT(msg, HasSubstr("YAML syntax error: end of sequence flow not found"));
+
+  const std::string indent =
+      expect_at(error_of(with("  end: 0.5\n", "  end: 0.5\n   oops: 1\n")), 7, 8);
+  EXPECT_THAT(indent, HasSubstr("YAML syntax error"));
+}
+
+TEST(SceneErrors, EmptyScene) {
+  const std::string msg = expect_at(error_of("# nothing here\n"), 1, 1);
+  EXPECT_THAT(msg, HasSubstr("the scene is empty"));
+}
+
+TEST(SceneErrors, ZeroDirection) {
+  const std::string msg = expect_at(
+      error_of(kBase + "walls:\n"
+                       "  - {type: plane, point: [0, 0, 0], normal: [0, 0, 0], material: glass}\n"),
+      18, 45);
+  EXPECT_THAT(msg, HasSubstr("walls[0].normal: the direction [0, 0, 0] has no length"));
+}
+
+TEST(SceneErrors, ModelSettingsMustMatchTheModel) {
+  const std::string no_block = expect_at(error_of(with("normal: hertz", "normal: hooke")), 15, 1);
+  EXPECT_THAT(no_block, HasSubstr("missing required key 'hooke' in contact; normal: hooke needs"));
+
+  const std::string stray =
+      expect_at(error_of(kBase + "  hooke: {characteristic_velocity: 1}\n"), 17, 3);
+  EXPECT_THAT(stray,
+              HasSubstr("contact.hooke: settings for the hooke model are given but normal is "
+                        "hertz"));
+
+  const std::string both =
+      expect_at(error_of(with("normal: hertz",
+                              "normal: hooke\n  hooke: {characteristic_velocity: 1, "
+                              "stiffness: {normal: 1e4}}")),
+                17, 39);
+  EXPECT_THAT(both, HasSubstr("both 'characteristic_velocity' and 'stiffness' are given in "
+                              "contact.hooke"));
+}
+
+TEST(SceneErrors, CsvFileMustExist) {
+  const std::string msg = expect_at(
+      error_of(kBase + "insert:\n  - {type: csv, file: no_such_file.csv, material: glass}\n"), 18,
+      23);
+  EXPECT_THAT(msg, AllOf(HasSubstr("insert[0].file: particle file 'no_such_file.csv' not found"),
+                         HasSubstr(kScenes + "/no_such_file.csv"),
+                         HasSubstr("relative to the scene file's folder")));
+}
+
+TEST(SceneErrors, FillRegionMustLieInsideDomain) {
+  const std::string msg = expect_at(
+      error_of(
+          kBase +
+          "insert:\n"
+          "  - type: fill\n"
+          "    region: {cylinder: {base: [0.5, 0.5, 0], axis: [0, 0, 1], radius: 0.6, height: 1}}\n"
+          "    count: 10\n"
+          "    material: glass\n"
+          "    radius: {distribution: constant, value: 1e-3}\n"),
+      19, 14);
+  EXPECT_THAT(msg, HasSubstr("the region reaches outside the domain along x (region from -0.1 to "
+                             "1.1, domain from 0 to 1)"));
+}
+
+TEST(SceneErrors, DiscreteWeightsMustMatchValues) {
+  const std::string msg = expect_at(
+      error_of(kBase +
+               "insert:\n"
+               "  - type: fill\n"
+               "    region: {box: {min: [0, 0, 0], max: [1, 1, 1]}}\n"
+               "    count: 10\n"
+               "    material: glass\n"
+               "    radius: {distribution: discrete, values: [1e-3, 2e-3], weights: [1, 2, 3]}\n"),
+      22, 69);
+  EXPECT_THAT(msg, HasSubstr("insert[0].radius.weights: 3 weights are given for 2 values"));
+}
+
+TEST(SceneErrors, MissingFileHasNoPosition) {
+  const std::string path = kScenes + "/does_not_exist.yaml";
+  try {
+    load_scene(path);
+    FAIL() << "expected a SceneError";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.file(), path);
+    EXPECT_EQ(e.line(), 0);
+    EXPECT_THAT(e.what(), HasSubstr(path + ": error: cannot open the scene file"));
+  }
+}
+
+}  // namespace
+}  // namespace grainflow
