@@ -10,7 +10,6 @@ set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="${GRAINFLOW_BUILD_DIR:-$ROOT/build}"
-JOBS="$(nproc 2>/dev/null || echo 2)"
 DEMO="$ROOT/tutorials/dem/pour_settle"
 
 log() { printf '[run_demo] %s\n' "$*"; }
@@ -21,16 +20,7 @@ if [ ! -f "$DEMO/Allrun" ]; then
   exit 1
 fi
 
-"$ROOT/scripts/bootstrap.sh"
-
-gen=()
-if [ ! -f "$BUILD/CMakeCache.txt" ] && command -v ninja >/dev/null 2>&1; then
-  gen=(-G Ninja)
-fi
-log "configuring $BUILD"
-cmake -S "$ROOT" -B "$BUILD" "${gen[@]}" -DCMAKE_BUILD_TYPE=Release
-log "building with $JOBS jobs"
-cmake --build "$BUILD" --parallel "$JOBS"
+GRAINFLOW_BUILD_DIR="$BUILD" "$ROOT/scripts/build.sh"
 
 log "running $DEMO/Allrun"
 cd "$DEMO"

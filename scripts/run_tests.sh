@@ -20,17 +20,7 @@ JOBS="$(nproc 2>/dev/null || echo 2)"
 
 log() { printf '[run_tests] %s\n' "$*"; }
 
-"$ROOT/scripts/bootstrap.sh"
-
-# Keep the generator of an existing build folder (CMake refuses to switch it).
-gen=()
-if [ ! -f "$BUILD/CMakeCache.txt" ] && command -v ninja >/dev/null 2>&1; then
-  gen=(-G Ninja)
-fi
-log "configuring $BUILD"
-cmake -S "$ROOT" -B "$BUILD" "${gen[@]}" -DCMAKE_BUILD_TYPE=Release
-log "building with $JOBS jobs"
-cmake --build "$BUILD" --parallel "$JOBS"
+GRAINFLOW_BUILD_DIR="$BUILD" "$ROOT/scripts/build.sh"
 
 log "testing (timeout ${TIMEOUT}s per test)"
 rc=0

@@ -84,29 +84,36 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   RunSummary sum;
   sum.particles_start = static_cast<long>(sim.particles().size());
   long snap_index = 0, log_index = 0, removed_reported = 0;
+  long snap_step = 0, log_step = 0;  // last step written, so the final step is not written twice
   snapshots.write(sim.particles(), sim.time(), 0);
   write_log();
-  const long total_steps = static_cast<long>(std::ceil(scene.time.end / dt - 1e-9));
+  // The run ends at the step nearest to t_end (within half a step).
+  const long total_steps =
+      std::max(1L, static_cast<long>(std::ceil(scene.time.end / dt - 0.5 - 1e-9)));
   long particle_steps = 0;
   for (long k = 1; k <= total_steps; ++k) {
     sim.step();
     particle_steps += static_cast<long>(sim.particles().size());
     const double t = sim.time();
-    if (sim.counters().removed > removed_reported) {
-      out << "warning: t = " << t << " s: " << sim.counters().removed - removed_reported
-          << " particle(s) left the domain through a bounded side and were removed (total "
-          << sim.counters().removed << ")\n";
-      removed_reported = sim.counters().removed;
-    }
-    if (t >= (log_index + 1) * log_every - 0.5 * dt || k == total_steps) {
+    const bool last = k == total_steps;
+    if (t >= (log_index + 1) * log_every - 0.5 * dt || (last && log_step != k)) {
+      log_step = k;
       log_index = static_cast<long>(std::floor(t / log_every + 0.5));
       write_log();
+      // Removals are reported once per log interval, not per particle.
+      if (sim.counters().removed > removed_reported) {
+        out << "warning: t = " << t << " s: " << sim.counters().removed - removed_reported
+            << " particle(s) left the domain through a bounded side and were removed (total "
+            << sim.counters().removed << "; see column 'removed' of log.csv)\n";
+        removed_reported = sim.counters().removed;
+      }
     }
-    if (t >= (snap_index + 1) * snap_every - 0.5 * dt || k == total_steps) {
+    if (t >= (snap_index + 1) * snap_every - 0.5 * dt || (last && snap_step != k)) {
+      snap_step = k;
       snap_index = static_cast<long>(std::floor(t / snap_every + 0.5));
       snapshots.write(sim.particles(), t, k);
     }
-    if ((k & 255) == 0 || k == total_steps)
+    if ((k & 255) == 0 || last)
       progress.update(t, k, static_cast<long>(sim.particles().size()));
   }
   progress.finish();

@@ -30,7 +30,11 @@ void Simulation::initialise() {
   for (double r : p_.radius) r_max = std::max(r_max, r);
   if (r_max == 0) r_max = (box_.length.minCoeff()) / 100;  // empty scene: any grid works
   skin_ = scene_.neighbour.skin.value_or(0.4 * r_max);
-  grid_ = std::make_unique<BinGrid>(box_, 2 * r_max + skin_);  // throws on a too-short periodic axis
+  try {
+    grid_ = std::make_unique<BinGrid>(box_, 2 * r_max + skin_);
+  } catch (const std::invalid_argument& e) {  // a periodic axis too short for the particles
+    throw SetupError(scene_.file + ": error: " + e.what());
+  }
 
   report_ = check_time_step(scene_, p_, table_, constants_);
   if (dt_ <= 0) dt_ = report_.dt;

@@ -39,9 +39,9 @@ for path in sorted(glob.glob(f"{out}/particles_*.h5")):
     times.append(t)
     angles.append(math.degrees(math.atan(abs(slope))))
 times, angles = np.array(times), np.array(angles)
-steady = angles[times >= 1.0]
+steady = angles[times >= 2.0]
 mean = steady.mean() if len(steady) else float("nan")
-print(f"dynamic angle of repose (t >= 1 s): {mean:.1f} deg "
+print(f"dynamic angle of repose (t >= 2 s): {mean:.1f} deg "
       f"(min {steady.min() if len(steady) else float('nan'):.1f}, "
       f"max {steady.max() if len(steady) else float('nan'):.1f}); reference band 25-30 deg")
 
@@ -50,7 +50,7 @@ ax.plot(times, angles, "o-", label="grainflow")
 ax.axhspan(25, 30, color="tab:orange", alpha=0.3, label="glass beads, rolling regime")
 ax.set_xlabel("time [s]")
 ax.set_ylabel("surface angle [deg]")
-ax.set_title(f"rotating drum, 2 rad/s: {mean:.1f} deg after 1 s")
+ax.set_title(f"rotating drum, 2 rad/s: {mean:.1f} deg after 2 s")
 ax.legend()
 fig.tight_layout()
 fig.savefig("rotating_drum.png", dpi=110)

@@ -1,0 +1,32 @@
+# Runs one command and checks its exit code and output (stdout + stderr).
+# List arguments are joined by "|".
+#   cmake -DCMD="a|b|c" -DEXPECT_CODE=2 -DEXPECT_REGEX="..." [-DFORBID_REGEX="..."]
+#         [-DWORKDIR=dir] [-DEXPECT_FILES="f1;f2"] -P expect_command.cmake
+foreach(v CMD EXPECT_REGEX EXPECT_FILES)
+  string(REPLACE "|" ";" ${v} "${${v}}")
+endforeach()
+if(WORKDIR)
+  file(MAKE_DIRECTORY ${WORKDIR})
+else()
+  set(WORKDIR ${CMAKE_CURRENT_BINARY_DIR})
+endif()
+execute_process(COMMAND ${CMD} WORKING_DIRECTORY ${WORKDIR} RESULT_VARIABLE code
+                OUTPUT_VARIABLE out ERROR_VARIABLE err)
+set(all "${out}${err}")
+message("${all}")
+if(NOT "${code}" STREQUAL "${EXPECT_CODE}")
+  message(FATAL_ERROR "exit code ${code}, expected ${EXPECT_CODE}")
+endif()
+foreach(re IN LISTS EXPECT_REGEX)
+  if(NOT all MATCHES "${re}")
+    message(FATAL_ERROR "output does not match '${re}'")
+  endif()
+endforeach()
+if(FORBID_REGEX AND all MATCHES "${FORBID_REGEX}")
+  message(FATAL_ERROR "output matches forbidden '${FORBID_REGEX}'")
+endif()
+foreach(f IN LISTS EXPECT_FILES)
+  if(NOT EXISTS ${WORKDIR}/${f})
+    message(FATAL_ERROR "expected file ${WORKDIR}/${f} was not written")
+  endif()
+endforeach()

@@ -1,0 +1,51 @@
+# Command-level tests of `grain`: what a user types and sees.
+set(_grain $<TARGET_FILE:grain>)
+set(_expect ${CMAKE_CURRENT_LIST_DIR}/expect_command.cmake)
+set(_scenes ${PROJECT_SOURCE_DIR}/tests/data/scenes)
+set(_work ${PROJECT_BINARY_DIR}/test_output/grain)
+
+function(grain_cli_test name code regex)
+  cmake_parse_arguments(ARG "" "WORKDIR;FORBID" "CMD;FILES" ${ARGN})
+  # Lists travel to the script joined by '|' (a ';' would split add_test's arguments).
+  string(REPLACE ";" "|" cmd "${ARG_CMD}")
+  string(REPLACE ";" "|" files "${ARG_FILES}")
+  string(REPLACE ";" "|" regex "${regex}")
+  add_test(NAME grain.${name}
+           COMMAND ${CMAKE_COMMAND} "-DCMD=${cmd}" -DEXPECT_CODE=${code} "-DEXPECT_REGEX=${regex}"
+                   "-DFORBID_REGEX=${ARG_FORBID}" "-DWORKDIR=${ARG_WORKDIR}" "-DEXPECT_FILES=${files}"
+                   -P ${_expect})
+  set_tests_properties(grain.${name} PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}")
+endfunction()
+
+grain_cli_test(version 0 "grain \\(grainflow\\) [0-9]+\\.[0-9]+\\.[0-9]+" CMD ${_grain} --version)
+grain_cli_test(help 0 "usage: grain" CMD ${_grain} --help)
+grain_cli_test(no_command 2 "no command given" CMD ${_grain})
+grain_cli_test(unknown_command 2 "unknown command 'frobnicate'; allowed: run, check" CMD ${_grain} frobnicate)
+grain_cli_test(unknown_option 2 "unknown option '--fast' for 'run'" CMD ${_grain} run x.yaml --fast)
+grain_cli_test(missing_scene_file 2 "no_such.yaml: error: cannot open the scene file"
+               CMD ${_grain} check ${_scenes}/no_such.yaml)
+grain_cli_test(check_minimal 0 "Rayleigh time t_R = ;contact time t_c = ;steps per impact"
+               CMD ${_grain} check ${_scenes}/minimal.yaml)
+grain_cli_test(bad_restitution 2 "bad/restitution.yaml:13:[0-9]+: error: .*restitution.*value 1.2 is out of range.*\\(0, 1\\]"
+               CMD ${_grain} check ${_scenes}/bad/restitution.yaml)
+grain_cli_test(bad_model_name 2 "bad/model_name.yaml:[0-9]+:[0-9]+: error: .*'hertzz'; allowed: hertz, hooke"
+               CMD ${_grain} run ${_scenes}/bad/model_name.yaml WORKDIR ${_work}/bad_model
+               FORBID "Rayleigh")
+grain_cli_test(refuses_huge_time_step 1 "error: dt is too large;refusing to run with this time step"
+               CMD ${_grain} run ${_scenes}/bad/huge_time_step.yaml --no-progress
+               WORKDIR ${_work}/huge_dt)
+grain_cli_test(unwritable_output 1 "/etc/hostname/out"
+               CMD ${_grain} run ${_scenes}/minimal.yaml --output /etc/hostname/out)
+grain_cli_test(run_periodic_bed 0 "done: [0-9]+ steps, 300 particles \\(0 removed\\);particles.xdmf"
+               CMD ${_grain} run ${_scenes}/periodic_bed.yaml --output out --no-progress
+               WORKDIR ${_work}/run_periodic_bed
+               FILES out/particles.xdmf out/log.csv out/particles_000000.h5 out/particles_000010.h5)
+# minimal.yaml has a floor but no side walls: beads that bounce out over the sides
+# must be removed, counted and reported, never silently dropped.
+grain_cli_test(reports_removed_particles 0
+               "particle\\(s\\) left the domain through a bounded side and were removed;done: [0-9]+ steps, [0-9]+ particles \\([1-9][0-9]* removed\\)"
+               CMD ${_grain} run ${_scenes}/minimal.yaml --output out --no-progress
+               WORKDIR ${_work}/reports_removed)
+grain_cli_test(refuses_two_ranks_for_now 2 "runs the DEM on one MPI rank only"
+               CMD ${MPIEXEC_EXECUTABLE} -np 2 --oversubscribe ${_grain} run ${_scenes}/minimal.yaml)
+set_tests_properties(grain.refuses_two_ranks_for_now PROPERTIES PROCESSORS 2)
