@@ -20,6 +20,6 @@ if [ ! -f "$BUILD/CMakeCache.txt" ] && command -v ninja >/dev/null 2>&1; then
   gen=(-G Ninja)
 fi
 log "configuring $BUILD"
-cmake -S "$ROOT" -B "$BUILD" "${gen[@]}" -DCMAKE_BUILD_TYPE=Release
+cmake -S "$ROOT" -B "$BUILD" "${gen[@]}" -DCMAKE_BUILD_TYPE=Release -DGRAINFLOW_WARNINGS_AS_ERRORS=ON
 log "building with $JOBS jobs"
 cmake --build "$BUILD" --parallel "$JOBS"
