@@ -3,6 +3,7 @@
 // (DESIGN.md §3). Each combination is its own type, so a slot that is "none"
 // compiles to nothing: `if constexpr` removes its code from the force loop.
 #include <algorithm>
+#include <type_traits>
 
 #include "dem/contact/cohesion.hpp"
 #include "dem/contact/contact_geometry.hpp"

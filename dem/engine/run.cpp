@@ -31,21 +31,12 @@ void print_report(const Simulation& sim, std::ostream& out) {
 
 int check_scene(const Scene& scene, std::ostream& out) {
   Simulation sim(scene);
-  const Particles& p = sim.particles();
-  // Report without stepping: the check needs particles and tables only.
-  const PairTable& table = sim.pair_table();
-  ContactConstants cc;
-  cc.hooke_characteristic_velocity = scene.contact.hooke_characteristic_velocity.value_or(0.0);
-  cc.hooke_kn = scene.contact.hooke_kn.value_or(0.0);
-  cc.hooke_kt = scene.contact.hooke_kt.value_or(cc.hooke_kn);
-  const TimeStepReport rep = check_time_step(scene, p, table, cc);
-  out << "scene: " << scene.file << "\n"
-      << "particles after insertion: " << p.size() << "\n"
-      << "contact law: " << sim.contact_law_name() << "\n";
-  for (const std::string& note : rep.notes) out << note << "\n";
+  sim.initialise();  // lists and first forces only: no time step is taken
+  print_report(sim, out);
+  const TimeStepReport& rep = sim.time_step_report();
   if (rep.dt > 0 && std::isfinite(rep.dt))
     out << "steps to reach t_end = " << scene.time.end << " s: "
-        << static_cast<long>(std::ceil(scene.time.end / rep.dt)) << "\n";
+        << static_cast<long>(std::ceil(scene.time.end / rep.dt - 0.5)) << "\n";
   return rep.verdict == TimeStepReport::Verdict::refuse ? 1 : 0;
 }
 

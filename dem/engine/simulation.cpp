@@ -8,10 +8,17 @@
 
 namespace grainflow {
 namespace {
-std::uint64_t pair_key(GlobalId a, GlobalId b) {
-  if (a > b) std::swap(a, b);
-  return (static_cast<std::uint64_t>(a) << 32) ^ static_cast<std::uint64_t>(b);
-}
+// Contact springs are saved across rebuilds under the pair's global ids.
+struct PairKey {
+  GlobalId lo, hi;
+  PairKey(GlobalId a, GlobalId b) : lo(std::min(a, b)), hi(std::max(a, b)) {}
+  bool operator==(const PairKey&) const = default;
+};
+struct PairKeyHash {
+  std::size_t operator()(const PairKey& k) const {
+    return std::hash<GlobalId>()(k.lo) * 0x9E3779B97F4A7C15ull ^ std::hash<GlobalId>()(k.hi);
+  }
+};
 }  // namespace
 
 Simulation::Simulation(const Scene& scene, bool insert)
@@ -81,13 +88,13 @@ bool Simulation::needs_rebuild() const {
 
 void Simulation::rebuild() {
   // Save the springs of touching pairs by global ids; indices change below.
-  std::unordered_map<std::uint64_t, ContactHistory> saved;
+  std::unordered_map<PairKey, ContactHistory, PairKeyHash> saved;
   if (sweep_.has_history) {
     for (std::size_t i = 0; i + 1 < list_.offsets.size(); ++i)
       for (int k = list_.offsets[i]; k < list_.offsets[i + 1]; ++k) {
         const ContactHistory& h = pair_history_[k];
         if (!h.tangential.isZero(0) || !h.rolling.isZero(0))
-          saved.emplace(pair_key(p_.id[i], p_.id[list_.j[k]]), h);
+          saved.emplace(PairKey(p_.id[i], p_.id[list_.j[k]]), h);
       }
   }
   if (!leaving_.empty()) {
@@ -114,7 +121,7 @@ void Simulation::rebuild() {
   if (!saved.empty())
     for (std::size_t i = 0; i < p_.size(); ++i)
       for (int k = list_.offsets[i]; k < list_.offsets[i + 1]; ++k) {
-        auto it = saved.find(pair_key(p_.id[i], p_.id[list_.j[k]]));
+        auto it = saved.find(PairKey(p_.id[i], p_.id[list_.j[k]]));
         if (it != saved.end()) pair_history_[k] = it->second;
       }
   x_at_build_ = p_.x;
