@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "dem/contact/restitution_mapping.hpp"
 #include "dem/engine/simulation.hpp"
@@ -83,6 +84,8 @@ TEST(ElasticHertzImpact, SphereSphereMatchesClosedForm) {
   const double d_max = hertz_max_overlap(y_star, kR / 2, m / 2, v);
   const double t_c = 2.9432 * d_max / v;
   // Tolerance 1 % (acceptance); the time is resolved to one step, dt = t_c/2000.
+  std::printf("sphere-sphere: overlap %.6f, contact time %.6f, rebound %.7f of closed form\n",
+              r.max_overlap / d_max, r.contact_time / t_c, r.speed_out / v);
   EXPECT_NEAR(r.max_overlap / d_max, 1.0, 0.01);
   EXPECT_NEAR(r.contact_time / t_c, 1.0, 0.01);
   EXPECT_NEAR(r.speed_out / v, 1.0, 0.001);
@@ -95,6 +98,8 @@ TEST(ElasticHertzImpact, SphereWallMatchesClosedForm) {
   const double y_star = kY / (2 * (1 - kNu * kNu));  // wall of the sphere's material
   const double d_max = hertz_max_overlap(y_star, kR, m, v);
   const double t_c = 2.9432 * d_max / v;
+  std::printf("sphere-wall: overlap %.6f, contact time %.6f, rebound %.7f of closed form\n",
+              r.max_overlap / d_max, r.contact_time / t_c, r.speed_out / v);
   EXPECT_NEAR(r.max_overlap / d_max, 1.0, 0.01);
   EXPECT_NEAR(r.contact_time / t_c, 1.0, 0.01);
   EXPECT_NEAR(r.speed_out / v, 1.0, 0.001);
@@ -112,6 +117,7 @@ class DampedImpact : public ::testing::TestWithParam<double> {};
 TEST_P(DampedImpact, HertzWallRestitutionAsRequested) {
   const double e = GetParam();
   const Impact r = head_on(NormalModel::hertz, e, 0.5, true);
+  std::printf("hertz wall: requested e = %.1f, measured %.6f\n", e, r.speed_out / 0.5);
   EXPECT_NEAR(r.speed_out / 0.5, e, 0.01 * e);  // 1 % (acceptance)
 }
 

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "dem/engine/simulation.hpp"
@@ -68,6 +69,8 @@ TEST(EnergyConservation, FrictionlessElasticBox) {
   EXPECT_EQ(sim.counters().steps, 100000);
   EXPECT_EQ(sim.particles().size(), 125u);
   EXPECT_GT(sim.counters().rebuilds, 10);  // the test really exercised list rebuilds
+  std::printf("largest relative energy error over 1e5 steps: %.3e (%ld rebuilds)\n", worst,
+              sim.counters().rebuilds);
   EXPECT_LT(worst, 1e-3);
 }
 
