@@ -139,26 +139,39 @@ void Simulation::compute_forces() {
   sweep_.run(s);
   counters_.contacts = s.contacts;
   counters_.max_overlap_ratio = s.max_overlap_ratio;
+  if (!terms_.empty()) {
+    drag_.coefficient.assign(p_.size(), 0.0);
+    drag_.fluid_velocity.assign(p_.size(), Vec3::Zero());
+    for (auto& term : terms_) term->add(p_, time_, drag_);
+  }
+}
+
+void Simulation::half_kick() {
+  const double h = 0.5 * dt_;
+  const std::size_t n = p_.size();
+  if (drag_.coefficient.empty()) {
+    for (std::size_t i = 0; i < n; ++i) p_.v[i] += (h / p_.mass[i]) * p_.force[i];
+  } else {
+    // v' = v + h/m (F + K (u - v'))  =>  v' = (v + h/m (F + K u)) / (1 + h K / m)
+    for (std::size_t i = 0; i < n; ++i) {
+      const double a = h / p_.mass[i], k = drag_.coefficient[i];
+      p_.v[i] = (p_.v[i] + a * (p_.force[i] + k * drag_.fluid_velocity[i])) / (1 + a * k);
+    }
+  }
+  if (sweep_.needs_spin)
+    for (std::size_t i = 0; i < n; ++i) p_.omega[i] += (h / p_.inertia[i]) * p_.torque[i];
 }
 
 void Simulation::step() {
   if (!initialised_) initialise();
-  const double h = 0.5 * dt_;
-  const std::size_t n = p_.size();
   // Velocity Verlet: half kick, drift, new forces, half kick.
-  for (std::size_t i = 0; i < n; ++i) {
-    p_.v[i] += (h / p_.mass[i]) * p_.force[i];
-    p_.x[i] += dt_ * p_.v[i];
-  }
-  if (sweep_.needs_spin)
-    for (std::size_t i = 0; i < n; ++i) p_.omega[i] += (h / p_.inertia[i]) * p_.torque[i];
+  half_kick();
+  for (std::size_t i = 0; i < p_.size(); ++i) p_.x[i] += dt_ * p_.v[i];
   apply_boundaries();
   if (needs_rebuild()) rebuild();
-  compute_forces();
-  for (std::size_t i = 0; i < p_.size(); ++i) p_.v[i] += (h / p_.mass[i]) * p_.force[i];
-  if (sweep_.needs_spin)
-    for (std::size_t i = 0; i < p_.size(); ++i) p_.omega[i] += (h / p_.inertia[i]) * p_.torque[i];
   time_ += dt_;
+  compute_forces();
+  half_kick();
   ++counters_.steps;
 }
 

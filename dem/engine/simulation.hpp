@@ -12,6 +12,7 @@
 #include "dem/contact/pair_coefficients.hpp"
 #include "dem/core/particles.hpp"
 #include "dem/engine/contact_sweep.hpp"
+#include "dem/engine/force_term.hpp"
 #include "dem/engine/time_step.hpp"
 #include "dem/neighbour/verlet_list.hpp"
 #include "dem/scene/scene.hpp"
@@ -36,6 +37,10 @@ class Simulation {
  public:
   // Inserts the scene's particles; `insert = false` starts empty (tests add their own).
   explicit Simulation(const Scene& scene, bool insert = true);
+
+  // Adds a non-contact force term (evaluated every step after contacts).
+  void add_force_term(std::unique_ptr<ForceTerm> term) { terms_.push_back(std::move(term)); }
+  const ImplicitDrag& implicit_drag() const { return drag_; }
 
   // Call after adding or editing particles by hand, before the first step.
   void initialise();
@@ -65,6 +70,7 @@ class Simulation {
   void compute_forces();
   bool needs_rebuild() const;
   void apply_boundaries();  // periodic wrap; removal of particles that left
+  void half_kick();         // v += dt/2 F/m (implicit in v where drag is set), same for spin
 
   Scene scene_;
   Particles p_;
@@ -80,6 +86,8 @@ class Simulation {
   std::vector<std::vector<ContactHistory>> wall_history_;
   std::vector<Vec3> x_at_build_;
   std::vector<char> leaving_;
+  std::vector<std::unique_ptr<ForceTerm>> terms_;
+  ImplicitDrag drag_;
   Counters counters_;
   TimeStepReport report_;
   bool initialised_ = false;
