@@ -121,7 +121,7 @@ int main(int argc, char** argv) {
           row.c.tangential = t;
           row.c.rolling = r;
           row.c.cohesion = c;
-          row.name = select_sweep(row.c, true).name;
+          row.name = select_sweep(row.c).name;
           rows.push_back(row);
         }
   for (int round = 0; round < rounds; ++round)

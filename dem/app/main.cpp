@@ -37,7 +37,7 @@ int usage_error(const std::string& what) {
   return 2;
 }
 
-int dispatch(const std::vector<std::string>& args, int rank, int size) {
+int dispatch(const std::vector<std::string>& args, int rank) {
   using namespace grainflow;
   if (args.empty()) return usage_error("no command given");
   const std::string& cmd = args[0];
@@ -64,31 +64,29 @@ int dispatch(const std::vector<std::string>& args, int rank, int size) {
     else
       return usage_error("unknown option '" + args[k] + "' for '" + cmd + "'");
   }
-  if (size > 1) {
-    if (rank == 0)
-      std::cerr << "grain: error: this build runs the DEM on one MPI rank only (the parallel "
-                   "decomposition is not built yet); run without mpirun or with -np 1\n";
-    return 2;
-  }
   try {
     const Scene scene = load_scene(args[1]);
     if (cmd == "check") return check_scene(scene, std::cout);
     run_scene(scene, options, MPI_COMM_WORLD, std::cout);
     return 0;
   } catch (const SceneError& e) {
-    std::cerr << e.what() << "\n";
+    if (rank == 0) std::cerr << e.what() << "\n";
     return 2;
   } catch (const InsertionError& e) {
-    std::cerr << e.what() << "\n";
+    if (rank == 0) std::cerr << e.what() << "\n";
     return 2;
   } catch (const SetupError& e) {
-    std::cerr << e.what() << "\n";
+    if (rank == 0) std::cerr << e.what() << "\n";
     return 1;
-  } catch (const OutputError& e) {
-    std::cerr << "grain: error: " << e.what() << "\n";
+  } catch (const ParallelError& e) {  // every rank holds the same message
+    if (rank == 0) std::cerr << e.what() << "\n";
     return 1;
-  } catch (const std::exception& e) {
-    std::cerr << "grain: error: " << e.what() << "\n";
+  } catch (const OutputError& e) {  // agreed on by all ranks
+    if (rank == 0) std::cerr << "grain: error: " << e.what() << "\n";
+    return 1;
+  } catch (const std::exception& e) {  // unexpected: print on every rank, with the rank
+    std::cerr << "grain: error on rank " << rank << ": " << e.what() << "\n";
+    MPI_Abort(MPI_COMM_WORLD, 1);
     return 1;
   }
 }
@@ -97,11 +95,10 @@ int dispatch(const std::vector<std::string>& args, int rank, int size) {
 
 int main(int argc, char** argv) {
   MPI_Init(&argc, &argv);
-  int rank = 0, size = 1;
+  int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
   const std::vector<std::string> args(argv + 1, argv + argc);
-  const int code = dispatch(args, rank, size);
+  const int code = dispatch(args, rank);
   MPI_Finalize();
   return code;
 }

@@ -18,6 +18,11 @@ void Particles::reserve(std::size_t n) {
 std::size_t Particles::add(GlobalId gid, const Vec3& position, const Vec3& velocity,
                            const Vec3& spin, double r, int mat, double density) {
   const double m = density * sphere_volume(r);
+  return add_raw(gid, position, velocity, spin, r, m, 0.4 * m * r * r, mat);
+}
+
+std::size_t Particles::add_raw(GlobalId gid, const Vec3& position, const Vec3& velocity,
+                               const Vec3& spin, double r, double m, double moment, int mat) {
   id.push_back(gid);
   x.push_back(position);
   v.push_back(velocity);
@@ -26,7 +31,7 @@ std::size_t Particles::add(GlobalId gid, const Vec3& position, const Vec3& veloc
   torque.push_back(Vec3::Zero());
   radius.push_back(r);
   mass.push_back(m);
-  inertia.push_back(0.4 * m * r * r);
+  inertia.push_back(moment);
   material.push_back(mat);
   return id.size() - 1;
 }

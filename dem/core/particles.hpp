@@ -30,6 +30,10 @@ struct Particles {
   std::size_t add(GlobalId gid, const Vec3& position, const Vec3& velocity, const Vec3& spin,
                   double r, int mat, double density);
 
+  // Appends a particle whose mass and inertia are known (e.g. received from a rank).
+  std::size_t add_raw(GlobalId gid, const Vec3& position, const Vec3& velocity, const Vec3& spin,
+                      double r, double m, double moment, int mat);
+
   // Reorders every array so that new index k holds old index perm[k].
   void permute(const std::vector<std::size_t>& perm);
 

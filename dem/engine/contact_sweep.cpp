@@ -3,108 +3,155 @@
 #include <algorithm>
 #include <cmath>
 
-#include "dem/contact/contact_law.hpp"
 #include "dem/engine/wall_sweep.hpp"
 
 namespace grainflow {
 namespace {
 
-template <class Law, bool Periodic>
-void pair_sweep(ContactSweep& s) {
+// The state of one body of a pair, as the pair kernel reads it.
+struct Body {
+  const Vec3& v;
+  const Vec3& w;
+  double r, m, inertia;
+  int material;
+};
+
+// Evaluates the pair (a, b) with displacement d = x_a - x_b; returns false when
+// they do not touch (and resets the spring).
+template <class Law>
+bool pair_contact(const ContactSweep& s, const Vec3& d, const Body& a, const Body& b,
+                  ContactHistory& h, ContactResult& out, double& overlap) {
+  const double rs = a.r + b.r;
+  const double r2 = d.squaredNorm();
+  if (r2 >= rs * rs) {
+    if constexpr (Law::has_history) h = ContactHistory{};
+    return false;
+  }
+  const double dist = std::sqrt(r2);
+  ContactGeometry g;
+  g.n = d / dist;
+  g.overlap = overlap = rs - dist;
+  g.distance = dist;
+  g.r_i = a.r;
+  g.r_j = b.r;
+  g.arm_i = a.r - 0.5 * g.overlap;
+  g.arm_j = b.r - 0.5 * g.overlap;
+  g.r_star = a.r * b.r / rs;
+  g.m_star = a.m * b.m / (a.m + b.m);
+  g.wall = false;
+  if constexpr (Law::needs_spin) {
+    g.v_rel = a.v - b.v - (g.arm_i * a.w + g.arm_j * b.w).cross(g.n);
+    g.w_rel = a.w - b.w;
+  } else {
+    g.v_rel = a.v - b.v;
+  }
+  if constexpr (Law::needs_roll_inertia)
+    g.roll_inertia =
+        1.0 / (1.0 / (a.inertia + a.m * a.r * a.r) + 1.0 / (b.inertia + b.m * b.r * b.r));
+  out = Law::evaluate(g, s.table(a.material, b.material), s.constants, h, s.dt);
+  return true;
+}
+
+template <class Law>
+void local_pair_sweep(ContactSweep& s) {
   Particles& p = s.p;
-  const std::size_t n = p.size();
   ContactHistory unused;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 xi = p.x[i];
-    const double ri = p.radius[i], mi = p.mass[i];
-    for (int k = s.list.offsets[i]; k < s.list.offsets[i + 1]; ++k) {
-      const int j = s.list.j[k];
-      Vec3 d = xi - p.x[j];
-      if constexpr (Periodic) d = s.box.min_image(d);
-      const double rj = p.radius[j];
-      const double rs = ri + rj;
-      const double r2 = d.squaredNorm();
-      if (r2 >= rs * rs) {
-        if constexpr (Law::has_history) s.pair_history[k] = ContactHistory{};
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    for (int k = s.local_list.offsets[i]; k < s.local_list.offsets[i + 1]; ++k) {
+      const std::size_t j = s.local_list.j[k];
+      const std::size_t a = p.id[i] < p.id[j] ? i : j, b = a == i ? j : i;
+      ContactHistory& h = Law::has_history ? s.local_history[k] : unused;
+      ContactResult r;
+      double overlap;
+      if (!pair_contact<Law>(
+              s, p.x[a] - p.x[b],
+              Body{p.v[a], p.omega[a], p.radius[a], p.mass[a], p.inertia[a], p.material[a]},
+              Body{p.v[b], p.omega[b], p.radius[b], p.mass[b], p.inertia[b], p.material[b]}, h,
+              r, overlap))
         continue;
-      }
-      const double dist = std::sqrt(r2);
-      ContactGeometry g;
-      g.n = d / dist;
-      g.overlap = rs - dist;
-      g.distance = dist;
-      g.r_i = ri;
-      g.r_j = rj;
-      g.arm_i = ri - 0.5 * g.overlap;
-      g.arm_j = rj - 0.5 * g.overlap;
-      g.r_star = ri * rj / rs;
-      const double mj = p.mass[j];
-      g.m_star = mi * mj / (mi + mj);
-      g.wall = false;
+      p.force[a] += r.force;
+      p.force[b] -= r.force;
       if constexpr (Law::needs_spin) {
-        g.v_rel = p.v[i] - p.v[j] - (g.arm_i * p.omega[i] + g.arm_j * p.omega[j]).cross(g.n);
-        g.w_rel = p.omega[i] - p.omega[j];
-      } else {
-        g.v_rel = p.v[i] - p.v[j];
-      }
-      if constexpr (Law::needs_roll_inertia)
-        g.roll_inertia = 1.0 / (1.0 / (p.inertia[i] + mi * ri * ri) +
-                                1.0 / (p.inertia[j] + mj * rj * rj));
-      ContactHistory& h = Law::has_history ? s.pair_history[k] : unused;
-      const ContactResult r =
-          Law::evaluate(g, s.table(p.material[i], p.material[j]), s.constants, h, s.dt);
-      p.force[i] += r.force;
-      p.force[j] -= r.force;
-      if constexpr (Law::needs_spin) {
-        p.torque[i] += r.torque_i;
-        p.torque[j] += r.torque_j;
+        p.torque[a] += r.torque_i;
+        p.torque[b] += r.torque_j;
       }
       ++s.contacts;
-      s.max_overlap_ratio = std::max(s.max_overlap_ratio, g.overlap / std::min(ri, rj));
+      s.max_overlap_ratio = std::max(s.max_overlap_ratio, overlap / std::min(p.radius[a], p.radius[b]));
     }
   }
 }
 
-template <class Law, bool Periodic>
+template <class Law>
+void ghost_pair_sweep(ContactSweep& s) {
+  Particles& p = s.p;
+  const Ghosts& g = s.ghosts;
+  ContactHistory unused;
+  const Vec3 zero = Vec3::Zero();
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const Body local{p.v[i], p.omega[i], p.radius[i], p.mass[i], p.inertia[i], p.material[i]};
+    for (int k = s.ghost_list.offsets[i]; k < s.ghost_list.offsets[i + 1]; ++k) {
+      const std::size_t q = s.ghost_list.j[k];
+      const Body ghost{g.v[q], g.omega[q], g.radius[q], g.mass[q], g.inertia[q], g.material[q]};
+      const bool local_first = p.id[i] < g.id[q];
+      ContactHistory& h = Law::has_history ? s.ghost_history[k] : unused;
+      ContactResult r;
+      double overlap;
+      const bool touching =
+          local_first
+              ? pair_contact<Law>(s, (p.x[i] - g.x[q]) + (zero - g.shift[q]), local, ghost, h, r,
+                                  overlap)
+              : pair_contact<Law>(s, (g.x[q] - p.x[i]) + (g.shift[q] - zero), ghost, local, h, r,
+                                  overlap);
+      if (!touching) continue;
+      p.force[i] += local_first ? r.force : Vec3(-r.force);
+      if constexpr (Law::needs_spin) p.torque[i] += local_first ? r.torque_i : r.torque_j;
+      // Both owners see this contact; the owner of the lower id counts it.
+      if (local_first) ++s.contacts;
+      s.max_overlap_ratio = std::max(s.max_overlap_ratio, overlap / std::min(local.r, ghost.r));
+    }
+  }
+}
+
+template <class Law>
 void sweep(ContactSweep& s) {
-  pair_sweep<Law, Periodic>(s);
+  local_pair_sweep<Law>(s);
+  ghost_pair_sweep<Law>(s);
   wall_sweep<Law>(s);
 }
 
 template <class Law>
-SweepChoice choice(bool periodic) {
-  return {periodic ? &sweep<Law, true> : &sweep<Law, false>, Law::has_history, Law::needs_spin,
+SweepChoice choice() {
+  return {&sweep<Law>, Law::has_history, Law::needs_spin,
           std::string(Law::normal::name) + " + " + Law::tangential::name + " + " +
               Law::rolling::name + " + " + Law::cohesion::name};
 }
 
 // Expands the run-time slot choice into one compile-time combination, one slot at a time.
 template <class N, class T, class R>
-SweepChoice pick_cohesion(const ContactSettings& c, bool periodic) {
-  if (c.cohesion == CohesionModel::sjkr) return choice<ContactLaw<N, T, R, SjkrCohesion>>(periodic);
-  return choice<ContactLaw<N, T, R, NoCohesion>>(periodic);
+SweepChoice pick_cohesion(const ContactSettings& c) {
+  if (c.cohesion == CohesionModel::sjkr) return choice<ContactLaw<N, T, R, SjkrCohesion>>();
+  return choice<ContactLaw<N, T, R, NoCohesion>>();
 }
 template <class N, class T>
-SweepChoice pick_rolling(const ContactSettings& c, bool periodic) {
+SweepChoice pick_rolling(const ContactSettings& c) {
   switch (c.rolling) {
-    case RollingModel::cdt: return pick_cohesion<N, T, CdtRolling>(c, periodic);
-    case RollingModel::epsd: return pick_cohesion<N, T, EpsdRolling>(c, periodic);
+    case RollingModel::cdt: return pick_cohesion<N, T, CdtRolling>(c);
+    case RollingModel::epsd: return pick_cohesion<N, T, EpsdRolling>(c);
     case RollingModel::none: break;
   }
-  return pick_cohesion<N, T, NoRolling>(c, periodic);
+  return pick_cohesion<N, T, NoRolling>(c);
 }
 template <class N>
-SweepChoice pick_tangential(const ContactSettings& c, bool periodic) {
-  if (c.tangential == TangentialModel::history)
-    return pick_rolling<N, HistoryTangential>(c, periodic);
-  return pick_rolling<N, NoTangential>(c, periodic);
+SweepChoice pick_tangential(const ContactSettings& c) {
+  if (c.tangential == TangentialModel::history) return pick_rolling<N, HistoryTangential>(c);
+  return pick_rolling<N, NoTangential>(c);
 }
 
 }  // namespace
 
-SweepChoice select_sweep(const ContactSettings& settings, bool periodic) {
-  if (settings.normal == NormalModel::hooke) return pick_tangential<HookeNormal>(settings, periodic);
-  return pick_tangential<HertzNormal>(settings, periodic);
+SweepChoice select_sweep(const ContactSettings& settings) {
+  if (settings.normal == NormalModel::hooke) return pick_tangential<HookeNormal>(settings);
+  return pick_tangential<HertzNormal>(settings);
 }
 
 }  // namespace grainflow

@@ -1,8 +1,14 @@
 #pragma once
-// One pass over all contacts (particle pairs from the neighbour list, then
-// particle-wall), adding forces and torques. The contact law is chosen once per
-// run: select_sweep() returns the instantiation for the scene's slot choice, so
-// the per-contact code holds no branch on model names and no virtual call.
+// One pass over all contacts (local pairs, local-ghost pairs, then particle-wall),
+// adding forces and torques to local particles. The contact law is chosen once per
+// run: select_sweep() returns the instantiation for the scene's slot choice, so the
+// per-contact code holds no branch on model names and no virtual call.
+//
+// Every pair is evaluated in canonical orientation (the particle with the lower
+// global id as "i"), with the displacement (x_a - x_b) + (shift_a - shift_b). A pair
+// whose partners live on two ranks is evaluated on both, from bit-identical inputs,
+// so both ranks apply exactly opposite forces (Newton's third law holds exactly
+// across rank boundaries, at the price of computing those pairs twice).
 #include <string>
 #include <vector>
 
@@ -10,22 +16,25 @@
 #include "dem/contact/pair_coefficients.hpp"
 #include "dem/core/particles.hpp"
 #include "dem/neighbour/verlet_list.hpp"
+#include "dem/parallel/ghosts.hpp"
 #include "dem/scene/scene.hpp"
 
 namespace grainflow {
 
 struct ContactSweep {
   Particles& p;
-  const NeighbourList& list;
-  std::vector<ContactHistory>& pair_history;               // parallel to list.j
+  const Ghosts& ghosts;
+  const NeighbourList& local_list;
+  const NeighbourList& ghost_list;
+  std::vector<ContactHistory>& local_history;              // parallel to local_list.j
+  std::vector<ContactHistory>& ghost_history;              // parallel to ghost_list.j
   const std::vector<Wall>& walls;
   std::vector<std::vector<ContactHistory>>& wall_history;  // [wall][particle]
   const PairTable& table;
   const ContactConstants& constants;
-  const Box& box;
   double dt;
   // results of the sweep
-  long contacts = 0;
+  long contacts = 0;             // each contact once over all ranks
   double max_overlap_ratio = 0;  // overlap / smaller radius
 };
 
@@ -38,6 +47,6 @@ struct SweepChoice {
   std::string name;  // e.g. "hertz + history + none + none"
 };
 
-SweepChoice select_sweep(const ContactSettings& settings, bool periodic);
+SweepChoice select_sweep(const ContactSettings& settings);
 
 }  // namespace grainflow

@@ -1,8 +1,10 @@
 #include "dem/engine/run.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <ostream>
 
 #include "dem/engine/simulation.hpp"
@@ -14,17 +16,33 @@
 namespace grainflow {
 namespace {
 
-void print_report(const Simulation& sim, std::ostream& out) {
+// Rank 0 speaks for the run; the other ranks write into this sink.
+std::ostream& speaker(MPI_Comm comm, std::ostream& out) {
+  static std::ostream silent(nullptr);
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  return rank == 0 ? out : silent;
+}
+
+void print_report(const Simulation& sim, MPI_Comm comm, std::ostream& out) {
   const Particles& p = sim.particles();
-  double r_min = p.size() ? p.radius[0] : 0, r_max = r_min;
+  double range[2] = {std::numeric_limits<double>::infinity(), 0};
   for (double r : p.radius) {
-    r_min = std::min(r_min, r);
-    r_max = std::max(r_max, r);
+    range[0] = std::min(range[0], r);
+    range[1] = std::max(range[1], r);
   }
-  out << "scene: " << sim.scene().file << "\n"
-      << "particles: " << p.size() << " (radius " << r_min << " .. " << r_max << " m)\n"
-      << "contact law: " << sim.contact_law_name() << "\n";
-  for (const std::string& note : sim.time_step_report().notes) out << note << "\n";
+  range[0] = -range[0];
+  MPI_Allreduce(MPI_IN_PLACE, range, 2, MPI_DOUBLE, MPI_MAX, comm);
+  const GlobalState g = sim.global_state();
+  const Decomposition& d = sim.decomposition();
+  std::ostream& o = speaker(comm, out);
+  o << "scene: " << sim.scene().file << "\n"
+    << "particles: " << g.particles << " (radius " << -range[0] << " .. " << range[1] << " m)\n"
+    << "contact law: " << sim.contact_law_name() << "\n";
+  if (d.size() > 1)
+    o << "MPI ranks: " << d.size() << " as a " << d.dims()[0] << " x " << d.dims()[1] << " x "
+      << d.dims()[2] << " grid\n";
+  for (const std::string& note : sim.time_step_report().notes) o << note << "\n";
 }
 
 }  // namespace
@@ -32,11 +50,12 @@ void print_report(const Simulation& sim, std::ostream& out) {
 int check_scene(const Scene& scene, std::ostream& out) {
   Simulation sim(scene);
   sim.initialise();  // lists and first forces only: no time step is taken
-  print_report(sim, out);
+  print_report(sim, MPI_COMM_WORLD, out);
   const TimeStepReport& rep = sim.time_step_report();
   if (rep.dt > 0 && std::isfinite(rep.dt))
-    out << "steps to reach t_end = " << scene.time.end << " s: "
-        << static_cast<long>(std::ceil(scene.time.end / rep.dt - 0.5)) << "\n";
+    speaker(MPI_COMM_WORLD, out) << "steps to reach t_end = " << scene.time.end << " s: "
+                                 << static_cast<long>(std::ceil(scene.time.end / rep.dt - 0.5))
+                                 << "\n";
   return rep.verdict == TimeStepReport::Verdict::refuse ? 1 : 0;
 }
 
@@ -44,10 +63,11 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
                      std::ostream& out) {
   const std::string dir = options.output_directory.value_or(scene.output.directory);
   prepare_output_directory(dir);  // before any work: an unwritable directory fails now
+  std::ostream& say = speaker(comm, out);
 
-  Simulation sim(scene);
+  Simulation sim(scene, true, comm);
   sim.initialise();
-  print_report(sim, out);
+  print_report(sim, comm, out);
   if (sim.time_step_report().verdict == TimeStepReport::Verdict::refuse &&
       !options.allow_large_time_step)
     throw SetupError(scene.file + ": error: refusing to run with this time step (see above); "
@@ -65,57 +85,60 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   auto wall = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
+  long removed_reported = 0;
   auto write_log = [&] {
-    const Counters& c = sim.counters();
-    log.write({sim.time(), c.steps, static_cast<long>(sim.particles().size()),
-               sim.kinetic_energy_translational(), sim.kinetic_energy_rotational(),
-               c.max_overlap_ratio, c.contacts, c.rebuilds, c.removed, wall()});
+    const GlobalState g = sim.global_state();
+    log.write({sim.time(), sim.counters().steps, g.particles, g.kinetic_translational,
+               g.kinetic_rotational, g.max_overlap_ratio, g.contacts, sim.counters().rebuilds,
+               g.removed, wall()});
+    // Removals are reported once per log interval, not per particle.
+    if (g.removed > removed_reported) {
+      say << "warning: t = " << sim.time() << " s: " << g.removed - removed_reported
+          << " particle(s) left the domain through a bounded side and were removed (total "
+          << g.removed << "; see column 'removed' of log.csv)\n";
+      removed_reported = g.removed;
+    }
+    return g;
   };
 
   RunSummary sum;
-  sum.particles_start = static_cast<long>(sim.particles().size());
-  long snap_index = 0, log_index = 0, removed_reported = 0;
+  long snap_index = 0, log_index = 0;
   long snap_step = 0, log_step = 0;  // last step written, so the final step is not written twice
   snapshots.write(sim.particles(), sim.time(), 0);
-  write_log();
+  sum.particles_start = write_log().particles;
+  long global_particles = sum.particles_start;
   // The run ends at the step nearest to t_end (within half a step).
   const long total_steps =
       std::max(1L, static_cast<long>(std::ceil(scene.time.end / dt - 0.5 - 1e-9)));
-  long particle_steps = 0;
+  double particle_steps = 0;  // this rank's
   for (long k = 1; k <= total_steps; ++k) {
     sim.step();
-    particle_steps += static_cast<long>(sim.particles().size());
+    particle_steps += static_cast<double>(sim.particles().size());
     const double t = sim.time();
     const bool last = k == total_steps;
     if (t >= (log_index + 1) * log_every - 0.5 * dt || (last && log_step != k)) {
       log_step = k;
       log_index = static_cast<long>(std::floor(t / log_every + 0.5));
-      write_log();
-      // Removals are reported once per log interval, not per particle.
-      if (sim.counters().removed > removed_reported) {
-        out << "warning: t = " << t << " s: " << sim.counters().removed - removed_reported
-            << " particle(s) left the domain through a bounded side and were removed (total "
-            << sim.counters().removed << "; see column 'removed' of log.csv)\n";
-        removed_reported = sim.counters().removed;
-      }
+      global_particles = write_log().particles;
     }
     if (t >= (snap_index + 1) * snap_every - 0.5 * dt || (last && snap_step != k)) {
       snap_step = k;
       snap_index = static_cast<long>(std::floor(t / snap_every + 0.5));
       snapshots.write(sim.particles(), t, k);
     }
-    if ((k & 255) == 0 || last)
-      progress.update(t, k, static_cast<long>(sim.particles().size()));
+    if ((k & 255) == 0 || last) progress.update(t, k, global_particles);
   }
   progress.finish();
 
+  MPI_Allreduce(MPI_IN_PLACE, &particle_steps, 1, MPI_DOUBLE, MPI_SUM, comm);
+  const GlobalState g = sim.global_state();
   sum.steps = sim.counters().steps;
-  sum.particles_end = static_cast<long>(sim.particles().size());
-  sum.removed = sim.counters().removed;
+  sum.particles_end = g.particles;
+  sum.removed = g.removed;
   sum.rebuilds = sim.counters().rebuilds;
   sum.wall_seconds = wall();
   sum.particle_steps_per_second = sum.wall_seconds > 0 ? particle_steps / sum.wall_seconds : 0;
-  out << "done: " << sum.steps << " steps, " << sum.particles_end << " particles ("
+  say << "done: " << sum.steps << " steps, " << sum.particles_end << " particles ("
       << sum.removed << " removed), " << sum.rebuilds << " neighbour rebuilds, "
       << sum.wall_seconds << " s wall, " << sum.particle_steps_per_second
       << " particle-steps/s\n"

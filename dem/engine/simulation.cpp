@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <memory>
+#include <sstream>
+#include <unordered_map>
 
 #include "dem/insert/insertion.hpp"
 
@@ -19,111 +20,181 @@ struct PairKeyHash {
     return std::hash<GlobalId>()(k.lo) * 0x9E3779B97F4A7C15ull ^ std::hash<GlobalId>()(k.hi);
   }
 };
+
+bool is_set(const ContactHistory& h) { return !h.tangential.isZero(0) || !h.rolling.isZero(0); }
+
+template <class T>
+void keep_unflagged(std::vector<T>& a, const std::vector<char>& drop) {
+  std::size_t w = 0;
+  for (std::size_t r = 0; r < a.size(); ++r)
+    if (!drop[r]) {
+      if (w != r) a[w] = std::move(a[r]);  // a self-move would empty a vector element
+      ++w;
+    }
+  a.resize(w);
+}
+
+template <class T>
+void reorder(std::vector<T>& a, const std::vector<std::size_t>& perm) {
+  std::vector<T> out;
+  out.reserve(perm.size());
+  for (std::size_t k : perm) out.push_back(std::move(a[k]));
+  a.swap(out);
+}
 }  // namespace
 
-Simulation::Simulation(const Scene& scene, bool insert)
-    : scene_(scene), table_(scene), box_(scene.domain) {
+Simulation::Simulation(const Scene& scene, bool insert, MPI_Comm comm,
+                       std::array<int, 3> processor_grid)
+    : scene_(scene), comm_(comm), table_(scene) {
+  try {
+    decomp_ = std::make_unique<Decomposition>(comm, scene.domain, processor_grid);
+  } catch (const std::invalid_argument& e) {
+    throw SetupError(scene_.file + ": error: " + e.what());
+  }
+  exchange_ = std::make_unique<Exchange>(*decomp_);
   constants_.hooke_characteristic_velocity =
       scene.contact.hooke_characteristic_velocity.value_or(0.0);
   constants_.hooke_kn = scene.contact.hooke_kn.value_or(0.0);
   constants_.hooke_kt = scene.contact.hooke_kt.value_or(constants_.hooke_kn);
   constants_.epsd_damping_ratio = scene.contact.epsd_damping_ratio;
-  sweep_ = select_sweep(scene.contact, box_.any_periodic);
+  sweep_ = select_sweep(scene.contact);
   if (insert) insert_particles(scene_, p_, next_id_);
 }
 
 void Simulation::initialise() {
   double r_max = 0;
   for (double r : p_.radius) r_max = std::max(r_max, r);
-  if (r_max == 0) r_max = (box_.length.minCoeff()) / 100;  // empty scene: any grid works
+  MPI_Allreduce(MPI_IN_PLACE, &r_max, 1, MPI_DOUBLE, MPI_MAX, comm_);
+  const Vec3 length = decomp_->length();
+  if (r_max == 0) r_max = length.minCoeff() / 100;  // empty scene: any grid works
   skin_ = scene_.neighbour.skin.value_or(0.4 * r_max);
-  try {
-    grid_ = std::make_unique<BinGrid>(box_, 2 * r_max + skin_);
-  } catch (const std::invalid_argument& e) {  // a periodic axis too short for the particles
-    throw SetupError(scene_.file + ": error: " + e.what());
-  }
+  cutoff_ = 2 * r_max + skin_;
+  for (int a = 0; a < 3; ++a)
+    if (scene_.domain.periodic[a] && length[a] < 2 * cutoff_) {
+      std::ostringstream msg;
+      msg << scene_.file << ": error: periodic axis " << "xyz"[a] << " is " << length[a]
+          << " m long, shorter than twice the interaction range (2 r_max + skin = " << cutoff_
+          << " m); enlarge the domain along it or reduce the skin";
+      throw SetupError(msg.str());
+    }
+  for (int a = 0; a < 3; ++a)
+    if (decomp_->dims()[a] > 1 && decomp_->thinnest_box() < cutoff_) {
+      std::ostringstream msg;
+      msg << scene_.file << ": error: with " << decomp_->dims()[0] << " x " << decomp_->dims()[1]
+          << " x " << decomp_->dims()[2] << " ranks, a subdomain is " << decomp_->thinnest_box()
+          << " m thick, thinner than the interaction range (2 r_max + skin = " << cutoff_
+          << " m); use fewer MPI ranks";
+      throw SetupError(msg.str());
+    }
 
+  // Every rank holds the same full set here: the report is the same everywhere.
   report_ = check_time_step(scene_, p_, table_, constants_);
   if (dt_ <= 0) dt_ = report_.dt;
   if (dt_ <= 0)
     throw SetupError(scene_.file +
                      ": error: time.rayleigh_fraction needs particles to size the time step; "
                      "give time.step instead");
+
+  std::vector<char> foreign(p_.size());
+  for (std::size_t i = 0; i < p_.size(); ++i) foreign[i] = !decomp_->owns(p_.x[i]);
+  p_.remove_if(foreign);
+
+  grid_ = std::make_unique<BinGrid>(decomp_->lo() - Vec3::Constant(cutoff_),
+                                    decomp_->hi() + Vec3::Constant(cutoff_), cutoff_);
   wall_history_.assign(scene_.walls.size(), std::vector<ContactHistory>(p_.size()));
   for (std::size_t i = 0; i < p_.size(); ++i) {
     p_.force[i].setZero();
     p_.torque[i].setZero();
   }
-  apply_boundaries();
+  mark_leaving();
   rebuild();
   compute_forces();
   initialised_ = true;
 }
 
-void Simulation::apply_boundaries() {
-  leaving_.assign(p_.size(), 0);
-  bool any = false;
-  for (std::size_t i = 0; i < p_.size(); ++i) {
-    Vec3& x = p_.x[i];
-    for (int a = 0; a < 3; ++a) {
-      if (box_.periodic[a]) {
-        if (x[a] < box_.lo[a]) x[a] += box_.length[a];
-        else if (x[a] >= box_.hi[a]) x[a] -= box_.length[a];
-      } else if (x[a] < box_.lo[a] || x[a] > box_.hi[a]) {
+void Simulation::mark_leaving() {
+  const Domain& d = scene_.domain;
+  leaving_.clear();
+  for (std::size_t i = 0; i < p_.size(); ++i)
+    for (int a = 0; a < 3; ++a)
+      if (!d.periodic[a] && (p_.x[i][a] < d.lo[a] || p_.x[i][a] > d.hi[a])) {
+        leaving_.resize(p_.size(), 0);
         leaving_[i] = 1;
-        any = true;
       }
-    }
-  }
-  if (!any) leaving_.clear();
 }
 
 bool Simulation::needs_rebuild() const {
-  if (!leaving_.empty()) return true;
+  int local = !leaving_.empty();
   const double limit2 = 0.25 * skin_ * skin_;
-  for (std::size_t i = 0; i < p_.size(); ++i)
-    if (box_.min_image(p_.x[i] - x_at_build_[i]).squaredNorm() > limit2) return true;
-  return false;
+  for (std::size_t i = 0; i < p_.size() && !local; ++i)
+    local = (p_.x[i] - x_at_build_[i]).squaredNorm() > limit2;
+  if (decomp_->size() == 1) return local;
+  int any = 0;
+  MPI_Allreduce(&local, &any, 1, MPI_INT, MPI_LOR, comm_);
+  return any;
+}
+
+CarriedState Simulation::save_histories() const {
+  CarriedState c;
+  c.wall = wall_history_;
+  c.pairs.resize(p_.size());
+  if (!sweep_.has_history) return c;
+  for (std::size_t i = 0; i + 1 < local_list_.offsets.size(); ++i) {
+    for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k)
+      if (is_set(local_history_[k])) {
+        const std::size_t j = local_list_.j[k];
+        c.pairs[i].push_back({p_.id[j], local_history_[k]});
+        c.pairs[j].push_back({p_.id[i], local_history_[k]});
+      }
+    for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k)
+      if (is_set(ghost_history_[k])) c.pairs[i].push_back({ghosts_.id[ghost_list_.j[k]], ghost_history_[k]});
+  }
+  return c;
+}
+
+void Simulation::restore_histories(const CarriedState& carried) {
+  wall_history_ = carried.wall;
+  local_history_.assign(local_list_.pairs(), ContactHistory{});
+  ghost_history_.assign(ghost_list_.pairs(), ContactHistory{});
+  if (!sweep_.has_history) return;
+  std::unordered_map<PairKey, ContactHistory, PairKeyHash> saved;
+  for (std::size_t i = 0; i < carried.pairs.size(); ++i)
+    for (const PartnerHistory& ph : carried.pairs[i])
+      saved.emplace(PairKey(p_.id[i], ph.partner), ph.history);
+  if (saved.empty()) return;
+  for (std::size_t i = 0; i < p_.size(); ++i) {
+    for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k) {
+      auto it = saved.find(PairKey(p_.id[i], p_.id[local_list_.j[k]]));
+      if (it != saved.end()) local_history_[k] = it->second;
+    }
+    for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k) {
+      auto it = saved.find(PairKey(p_.id[i], ghosts_.id[ghost_list_.j[k]]));
+      if (it != saved.end()) ghost_history_[k] = it->second;
+    }
+  }
+}
+
+void Simulation::apply_order(const std::vector<std::size_t>& perm, CarriedState& carried) {
+  p_.permute(perm);
+  for (auto& wh : carried.wall) reorder(wh, perm);
+  reorder(carried.pairs, perm);
 }
 
 void Simulation::rebuild() {
-  // Save the springs of touching pairs by global ids; indices change below.
-  std::unordered_map<PairKey, ContactHistory, PairKeyHash> saved;
-  if (sweep_.has_history) {
-    for (std::size_t i = 0; i + 1 < list_.offsets.size(); ++i)
-      for (int k = list_.offsets[i]; k < list_.offsets[i + 1]; ++k) {
-        const ContactHistory& h = pair_history_[k];
-        if (!h.tangential.isZero(0) || !h.rolling.isZero(0))
-          saved.emplace(PairKey(p_.id[i], p_.id[list_.j[k]]), h);
-      }
-  }
+  CarriedState carried = save_histories();  // by global ids: indices change below
   if (!leaving_.empty()) {
     const long before = static_cast<long>(p_.size());
     p_.remove_if(leaving_);
-    for (auto& wh : wall_history_) {
-      std::size_t w = 0;
-      for (std::size_t r = 0; r < wh.size(); ++r)
-        if (!leaving_[r]) wh[w++] = wh[r];
-      wh.resize(w);
-    }
+    for (auto& wh : carried.wall) keep_unflagged(wh, leaving_);
+    keep_unflagged(carried.pairs, leaving_);
     counters_.removed += before - static_cast<long>(p_.size());
     leaving_.clear();
   }
-  const std::vector<std::size_t> perm = grid_->sort_permutation(p_);
-  p_.permute(perm);
-  for (auto& wh : wall_history_) {
-    std::vector<ContactHistory> sorted(perm.size());
-    for (std::size_t k = 0; k < perm.size(); ++k) sorted[k] = wh[perm[k]];
-    wh.swap(sorted);
-  }
-  grid_->build(p_, skin_, list_);
-  pair_history_.assign(list_.pairs(), ContactHistory{});
-  if (!saved.empty())
-    for (std::size_t i = 0; i < p_.size(); ++i)
-      for (int k = list_.offsets[i]; k < list_.offsets[i + 1]; ++k) {
-        auto it = saved.find(PairKey(p_.id[i], p_.id[list_.j[k]]));
-        if (it != saved.end()) pair_history_[k] = it->second;
-      }
+  exchange_->migrate(p_, carried);
+  apply_order(grid_->sort_permutation(p_), carried);
+  exchange_->borders(p_, cutoff_, ghosts_);
+  grid_->build(p_, ghosts_, skin_, local_list_, ghost_list_);
+  restore_histories(carried);
   x_at_build_ = p_.x;
   ++counters_.rebuilds;
 }
@@ -134,7 +205,8 @@ void Simulation::compute_forces() {
     p_.force[i] = p_.mass[i] * g;
     p_.torque[i].setZero();
   }
-  ContactSweep s{p_, list_, pair_history_, scene_.walls, wall_history_, table_, constants_, box_,
+  ContactSweep s{p_,          ghosts_,        local_list_,   ghost_list_, local_history_,
+                 ghost_history_, scene_.walls, wall_history_, table_,      constants_,
                  dt_};
   sweep_.run(s);
   counters_.contacts = s.contacts;
@@ -167,8 +239,11 @@ void Simulation::step() {
   // Velocity Verlet: half kick, drift, new forces, half kick.
   half_kick();
   for (std::size_t i = 0; i < p_.size(); ++i) p_.x[i] += dt_ * p_.v[i];
-  apply_boundaries();
-  if (needs_rebuild()) rebuild();
+  mark_leaving();
+  if (needs_rebuild())
+    rebuild();
+  else
+    exchange_->forward(p_, ghosts_);
   time_ += dt_;
   compute_forces();
   half_kick();
@@ -176,6 +251,7 @@ void Simulation::step() {
 }
 
 void Simulation::advance_to(double t_end) {
+  if (!initialised_) initialise();
   while (time_ < t_end - 0.5 * dt_) step();
 }
 
@@ -189,6 +265,23 @@ double Simulation::kinetic_energy_rotational() const {
   double e = 0;
   for (std::size_t i = 0; i < p_.size(); ++i) e += 0.5 * p_.inertia[i] * p_.omega[i].squaredNorm();
   return e;
+}
+
+GlobalState Simulation::global_state() const {
+  double sums[5] = {static_cast<double>(p_.size()), static_cast<double>(counters_.contacts),
+                    static_cast<double>(counters_.removed), kinetic_energy_translational(),
+                    kinetic_energy_rotational()};
+  double overlap = counters_.max_overlap_ratio;
+  MPI_Allreduce(MPI_IN_PLACE, sums, 5, MPI_DOUBLE, MPI_SUM, comm_);
+  MPI_Allreduce(MPI_IN_PLACE, &overlap, 1, MPI_DOUBLE, MPI_MAX, comm_);
+  GlobalState s;
+  s.particles = std::lround(sums[0]);
+  s.contacts = std::lround(sums[1]);
+  s.removed = std::lround(sums[2]);
+  s.kinetic_translational = sums[3];
+  s.kinetic_rotational = sums[4];
+  s.max_overlap_ratio = overlap;
+  return s;
 }
 
 }  // namespace grainflow

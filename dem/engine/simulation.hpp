@@ -1,11 +1,14 @@
 #pragma once
-// The serial DEM engine: particles, walls, neighbour list, contact sweep and a
-// velocity-Verlet integrator for translation and rotation.
+// The DEM engine on one MPI rank's box: local particles, ghosts from neighbouring
+// ranks (and periodic images), walls, neighbour lists, the contact sweep and a
+// velocity-Verlet integrator for translation and rotation. With one rank the same
+// code runs with no neighbours but itself across periodic sides.
+#include <mpi.h>
+
 #include <cstdint>
 #include <memory>
 #include <stdexcept>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 #include "dem/contact/contact_geometry.hpp"
@@ -15,6 +18,9 @@
 #include "dem/engine/force_term.hpp"
 #include "dem/engine/time_step.hpp"
 #include "dem/neighbour/verlet_list.hpp"
+#include "dem/parallel/decomposition.hpp"
+#include "dem/parallel/exchange.hpp"
+#include "dem/parallel/ghosts.hpp"
 #include "dem/scene/scene.hpp"
 
 namespace grainflow {
@@ -25,64 +31,88 @@ class SetupError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Counters of this rank (local) — see Simulation::global_counters for run totals.
 struct Counters {
   long steps = 0;
   long rebuilds = 0;
-  long removed = 0;   // particles that left a bounded side of the domain
-  long contacts = 0;  // in the last step
+  long removed = 0;              // particles that left a bounded side of the domain
+  long contacts = 0;             // in the last step
   double max_overlap_ratio = 0;  // in the last step
+};
+
+struct GlobalState {
+  long particles = 0;
+  long contacts = 0;
+  long removed = 0;
+  double max_overlap_ratio = 0;
+  double kinetic_translational = 0;
+  double kinetic_rotational = 0;
 };
 
 class Simulation {
  public:
-  // Inserts the scene's particles; `insert = false` starts empty (tests add their own).
-  explicit Simulation(const Scene& scene, bool insert = true);
+  // Inserts the scene's particles (every rank inserts the same set; initialise()
+  // keeps each on the rank that owns it). `insert = false` starts empty: tests add
+  // particles by hand — on every rank alike — before initialise().
+  explicit Simulation(const Scene& scene, bool insert = true, MPI_Comm comm = MPI_COMM_WORLD,
+                      std::array<int, 3> processor_grid = {0, 0, 0});
 
-  // Adds a non-contact force term (evaluated every step after contacts).
+  // Adds a non-contact force term (evaluated every step after contacts); call
+  // before initialise().
   void add_force_term(std::unique_ptr<ForceTerm> term) { terms_.push_back(std::move(term)); }
   const ImplicitDrag& implicit_drag() const { return drag_; }
 
-  // Call after adding or editing particles by hand, before the first step.
+  // Checks the time step, distributes particles to their ranks, builds lists and
+  // the first forces. Collective. Called by the first step() if not before.
   void initialise();
   void step();
   void advance_to(double t_end);
 
-  Particles& particles() { return p_; }
+  Particles& particles() { return p_; }  // this rank's particles
   const Particles& particles() const { return p_; }
+  const Ghosts& ghosts() const { return ghosts_; }
   const Scene& scene() const { return scene_; }
+  const Decomposition& decomposition() const { return *decomp_; }
   double time() const { return time_; }
   double dt() const { return dt_; }
   void set_dt(double dt) { dt_ = dt; }
   double skin() const { return skin_; }
   const Counters& counters() const { return counters_; }
+  GlobalState global_state() const;  // collective
   const TimeStepReport& time_step_report() const { return report_; }
   const std::string& contact_law_name() const { return sweep_.name; }
-  const NeighbourList& neighbour_list() const { return list_; }
+  const NeighbourList& neighbour_list() const { return local_list_; }
   const PairTable& pair_table() const { return table_; }
   GlobalId next_id() const { return next_id_; }
   GlobalId& next_id() { return next_id_; }
 
-  double kinetic_energy_translational() const;
-  double kinetic_energy_rotational() const;
+  double kinetic_energy_translational() const;  // this rank
+  double kinetic_energy_rotational() const;     // this rank
 
  private:
   void rebuild();
   void compute_forces();
-  bool needs_rebuild() const;
-  void apply_boundaries();  // periodic wrap; removal of particles that left
-  void half_kick();         // v += dt/2 F/m (implicit in v where drag is set), same for spin
+  bool needs_rebuild() const;  // collective
+  void mark_leaving();         // particles beyond a bounded side of the domain
+  void half_kick();            // v += dt/2 F/m (implicit in v where drag is set), same for spin
+  CarriedState save_histories() const;
+  void restore_histories(const CarriedState& carried);
+  void apply_order(const std::vector<std::size_t>& perm, CarriedState& carried);
 
   Scene scene_;
+  MPI_Comm comm_;
+  std::unique_ptr<Decomposition> decomp_;
+  std::unique_ptr<Exchange> exchange_;
   Particles p_;
+  Ghosts ghosts_;
   GlobalId next_id_ = 1;
   PairTable table_;
   ContactConstants constants_;
-  Box box_;
   SweepChoice sweep_;
-  double dt_ = 0, time_ = 0, skin_ = 0;
+  double dt_ = 0, time_ = 0, skin_ = 0, cutoff_ = 0;
   std::unique_ptr<BinGrid> grid_;
-  NeighbourList list_;
-  std::vector<ContactHistory> pair_history_;
+  NeighbourList local_list_, ghost_list_;
+  std::vector<ContactHistory> local_history_, ghost_history_;
   std::vector<std::vector<ContactHistory>> wall_history_;
   std::vector<Vec3> x_at_build_;
   std::vector<char> leaving_;

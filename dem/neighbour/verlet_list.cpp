@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
-#include <string>
 
 namespace grainflow {
 
@@ -15,23 +13,18 @@ Box::Box(const Domain& d)
   }
 }
 
-BinGrid::BinGrid(const Box& box, double bin_edge) : box_(box), min_edge_(bin_edge) {
+BinGrid::BinGrid(const Vec3& lo, const Vec3& hi, double bin_edge)
+    : lo_(lo), hi_(hi), min_edge_(bin_edge) {
   resize_for(0);
-  for (int a = 0; a < 3; ++a) {
-    if (box.periodic[a] && box.length[a] < 2 * bin_edge)
-      throw std::invalid_argument(
-          "periodic axis " + std::string(1, "xyz"[a]) + " is " + std::to_string(box.length[a]) +
-          " m long, shorter than twice the interaction range (2 r_max + skin = " +
-          std::to_string(bin_edge) + " m); enlarge the domain along it or reduce the skin");
-  }
 }
 
 void BinGrid::resize_for(std::size_t particles) {
   // Bins no smaller than the interaction range, and no more bins than ~2 per
   // particle: a large, sparsely filled domain must not cost memory per empty bin.
   const double limit = std::max(1000.0, 2.0 * static_cast<double>(particles));
+  const Vec3 length = hi_ - lo_;
   double n[3];
-  for (int a = 0; a < 3; ++a) n[a] = std::max(1.0, std::floor(box_.length[a] / min_edge_));
+  for (int a = 0; a < 3; ++a) n[a] = std::max(1.0, std::floor(length[a] / min_edge_));
   const double total = n[0] * n[1] * n[2];
   if (total > limit) {
     const double f = std::cbrt(total / limit);
@@ -39,15 +32,15 @@ void BinGrid::resize_for(std::size_t particles) {
   }
   for (int a = 0; a < 3; ++a) {
     n_[a] = static_cast<int>(n[a]);
-    inv_edge_[a] = n_[a] / box_.length[a];
+    inv_edge_[a] = n_[a] / length[a];
   }
 }
 
 int BinGrid::bin_of(const Vec3& x) const {
   int c[3];
   for (int a = 0; a < 3; ++a) {
-    int k = static_cast<int>(std::floor((x[a] - box_.lo[a]) * inv_edge_[a]));
-    c[a] = std::clamp(k, 0, n_[a] - 1);  // particles leaving are removed by the caller
+    const int k = static_cast<int>(std::floor((x[a] - lo_[a]) * inv_edge_[a]));
+    c[a] = std::clamp(k, 0, n_[a] - 1);
   }
   return (c[2] * n_[1] + c[1]) * n_[0] + c[0];
 }
@@ -68,48 +61,50 @@ std::vector<std::size_t> BinGrid::sort_permutation(const Particles& p) {
   return perm;
 }
 
-namespace {
-// Bin indices to visit along one axis around bin c, each once.
-int axis_stencil(int c, int n, bool periodic, int out[3]) {
-  if (n < 3) {
-    for (int k = 0; k < n; ++k) out[k] = k;
-    return n;
-  }
-  int m = 0;
-  for (int d = -1; d <= 1; ++d) {
-    int k = c + d;
-    if (k < 0 || k >= n) {
-      if (!periodic) continue;
-      k = (k + n) % n;
-    }
-    out[m++] = k;
-  }
-  return m;
-}
-}  // namespace
-
-void BinGrid::build(const Particles& p, double skin, NeighbourList& out) const {
+void BinGrid::build(const Particles& p, const Ghosts& g, double skin, NeighbourList& local,
+                    NeighbourList& ghost) const {
   const std::size_t n = p.size();
-  out.offsets.assign(n + 1, 0);
-  out.j.clear();
+  const int nbins = n_[0] * n_[1] * n_[2];
+  // Ghosts by bin (CSR), in their exchange order within a bin.
+  std::vector<int> gstart(nbins + 1, 0), gbin(g.size()), gsorted(g.size());
+  for (std::size_t k = 0; k < g.size(); ++k) {
+    gbin[k] = bin_of(g.position(k));
+    ++gstart[gbin[k] + 1];
+  }
+  for (int b = 0; b < nbins; ++b) gstart[b + 1] += gstart[b];
+  {
+    std::vector<int> fill(gstart.begin(), gstart.end() - 1);
+    for (std::size_t k = 0; k < g.size(); ++k) gsorted[fill[gbin[k]]++] = static_cast<int>(k);
+  }
+  local.offsets.assign(n + 1, 0);
+  local.j.clear();
+  ghost.offsets.assign(n + 1, 0);
+  ghost.j.clear();
   for (std::size_t i = 0; i < n; ++i) {
     const int b = bin_of(p.x[i]);
-    const int cx = b % n_[0], cy = (b / n_[0]) % n_[1], cz = b / (n_[0] * n_[1]);
-    int sx[3], sy[3], sz[3];
-    const int mx = axis_stencil(cx, n_[0], box_.periodic[0], sx);
-    const int my = axis_stencil(cy, n_[1], box_.periodic[1], sy);
-    const int mz = axis_stencil(cz, n_[2], box_.periodic[2], sz);
-    for (int iz = 0; iz < mz; ++iz)
-      for (int iy = 0; iy < my; ++iy)
-        for (int ix = 0; ix < mx; ++ix) {
-          const int nb = (sz[iz] * n_[1] + sy[iy]) * n_[0] + sx[ix];
-          for (int j = bin_start_[nb]; j < bin_start_[nb + 1]; ++j) {
-            if (static_cast<std::size_t>(j) <= i) continue;
+    const int c[3] = {b % n_[0], (b / n_[0]) % n_[1], b / (n_[0] * n_[1])};
+    int lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::max(0, c[a] - 1);
+      hi[a] = std::min(n_[a] - 1, c[a] + 1);
+    }
+    for (int z = lo[2]; z <= hi[2]; ++z)
+      for (int y = lo[1]; y <= hi[1]; ++y)
+        for (int x = lo[0]; x <= hi[0]; ++x) {
+          const int nb = (z * n_[1] + y) * n_[0] + x;
+          for (int j = std::max(bin_start_[nb], static_cast<int>(i) + 1); j < bin_start_[nb + 1];
+               ++j) {
             const double cut = p.radius[i] + p.radius[j] + skin;
-            if (box_.min_image(p.x[i] - p.x[j]).squaredNorm() < cut * cut) out.j.push_back(j);
+            if ((p.x[i] - p.x[j]).squaredNorm() < cut * cut) local.j.push_back(j);
+          }
+          for (int s = gstart[nb]; s < gstart[nb + 1]; ++s) {
+            const int k = gsorted[s];
+            const double cut = p.radius[i] + g.radius[k] + skin;
+            if ((p.x[i] - g.position(k)).squaredNorm() < cut * cut) ghost.j.push_back(k);
           }
         }
-    out.offsets[i + 1] = static_cast<int>(out.j.size());
+    local.offsets[i + 1] = static_cast<int>(local.j.size());
+    ghost.offsets[i + 1] = static_cast<int>(ghost.j.size());
   }
 }
 

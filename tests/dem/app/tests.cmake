@@ -46,6 +46,9 @@ grain_cli_test(reports_removed_particles 0
                "particle\\(s\\) left the domain through a bounded side and were removed;done: [0-9]+ steps, [0-9]+ particles \\([1-9][0-9]* removed\\)"
                CMD ${_grain} run ${_scenes}/minimal.yaml --output out --no-progress
                WORKDIR ${_work}/reports_removed)
-grain_cli_test(refuses_two_ranks_for_now 2 "runs the DEM on one MPI rank only"
-               CMD ${MPIEXEC_EXECUTABLE} -np 2 --oversubscribe ${_grain} run ${_scenes}/minimal.yaml)
-set_tests_properties(grain.refuses_two_ranks_for_now PROPERTIES PROCESSORS 2)
+grain_cli_test(runs_on_two_ranks 0 "MPI ranks: 2 as a;done: [0-9]+ steps, 300 particles \\(0 removed\\)"
+               CMD ${MPIEXEC_EXECUTABLE} -np 2 --oversubscribe ${_grain} run ${_scenes}/periodic_bed.yaml
+                   --output out --no-progress
+               WORKDIR ${_work}/two_ranks
+               FILES out/particles.xdmf out/log.csv out/particles_000010.h5)
+set_tests_properties(grain.runs_on_two_ranks PROPERTIES PROCESSORS 2)

@@ -23,14 +23,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// LogTable needs MPI; this serial test runs as an MPI singleton.
-class MpiEnvironment : public ::testing::Environment {
- public:
-  void SetUp() override { MPI_Init(nullptr, nullptr); }
-  void TearDown() override { MPI_Finalize(); }
-};
-[[maybe_unused]] auto* const mpi_environment =
-    ::testing::AddGlobalTestEnvironment(new MpiEnvironment);
 
 fs::path fresh_directory(const std::string& name) {
   const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "log_table_test" / name;

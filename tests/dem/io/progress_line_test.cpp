@@ -15,13 +15,6 @@
 namespace grainflow {
 namespace {
 
-class MpiEnvironment : public ::testing::Environment {
- public:
-  void SetUp() override { MPI_Init(nullptr, nullptr); }
-  void TearDown() override { MPI_Finalize(); }
-};
-[[maybe_unused]] auto* const mpi_environment =
-    ::testing::AddGlobalTestEnvironment(new MpiEnvironment);
 
 std::vector<std::string> lines_of(const std::string& text) {
   std::vector<std::string> out;

@@ -1,0 +1,243 @@
+#include "dem/parallel/exchange.hpp"
+
+#include <bit>
+#include <cmath>
+#include <sstream>
+
+namespace grainflow {
+namespace {
+
+// Buffers are doubles; integers travel bit-exactly through std::bit_cast.
+struct Writer {
+  std::vector<double>& b;
+  void put(double v) { b.push_back(v); }
+  void put_id(GlobalId id) { b.push_back(std::bit_cast<double>(id)); }
+  void put(const Vec3& v) { b.insert(b.end(), {v[0], v[1], v[2]}); }
+  void put(const ContactHistory& h) {
+    put(h.tangential);
+    put(h.rolling);
+  }
+};
+struct Reader {
+  const std::vector<double>& b;
+  std::size_t k = 0;
+  double get() { return b[k++]; }
+  GlobalId get_id() { return std::bit_cast<GlobalId>(b[k++]); }
+  Vec3 get_vec() {
+    const Vec3 v(b[k], b[k + 1], b[k + 2]);
+    k += 3;
+    return v;
+  }
+  ContactHistory get_history() {
+    ContactHistory h;
+    h.tangential = get_vec();
+    h.rolling = get_vec();
+    return h;
+  }
+};
+
+// Sends `out` to rank `to` and receives from rank `from` (either may be MPI_PROC_NULL).
+std::vector<double> sendrecv(MPI_Comm comm, const std::vector<double>& out, int to, int from,
+                             int tag) {
+  long n_out = static_cast<long>(out.size()), n_in = 0;
+  MPI_Sendrecv(&n_out, 1, MPI_LONG, to, tag, &n_in, 1, MPI_LONG, from, tag, comm,
+               MPI_STATUS_IGNORE);
+  std::vector<double> in(static_cast<std::size_t>(n_in));
+  MPI_Sendrecv(out.data(), static_cast<int>(n_out), MPI_DOUBLE, to, tag + 1, in.data(),
+               static_cast<int>(n_in), MPI_DOUBLE, from, tag + 1, comm, MPI_STATUS_IGNORE);
+  return in;
+}
+
+}  // namespace
+
+void agree_on_error(MPI_Comm comm, const std::string& local_message) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  int mine = local_message.empty() ? size : rank, first = size;
+  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, comm);
+  if (first == size) return;
+  int length = rank == first ? static_cast<int>(local_message.size()) : 0;
+  MPI_Bcast(&length, 1, MPI_INT, first, comm);
+  std::string text = rank == first ? local_message : std::string(length, ' ');
+  MPI_Bcast(text.data(), length, MPI_CHAR, first, comm);
+  throw ParallelError(text);
+}
+
+void Exchange::migrate(Particles& p, CarriedState& carried) {
+  const Domain& dom = d_.domain();
+  const Vec3 length = d_.length();
+  for (std::size_t i = 0; i < p.size(); ++i)
+    for (int a = 0; a < 3; ++a)
+      if (dom.periodic[a]) {
+        if (p.x[i][a] < dom.lo[a]) p.x[i][a] += length[a];
+        else if (p.x[i][a] >= dom.hi[a]) p.x[i][a] -= length[a];
+      }
+
+  std::string error;
+  const std::size_t walls = carried.wall.size();
+  for (int a = 0; a < 3; ++a) {
+    if (d_.dims()[a] == 1) continue;  // after wrapping, this rank spans the whole axis
+    for (int dir = 0; dir < 2; ++dir) {
+      const int to = d_.neighbour(a, dir), from = d_.neighbour(a, 1 - dir);
+      std::vector<double> out;
+      Writer w{out};
+      std::vector<char> leaving(p.size(), 0);
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        const bool outside = dir == 0 ? p.x[i][a] < d_.lo()[a] : p.x[i][a] >= d_.hi()[a];
+        // The last box along a bounded axis keeps x == hi; beyond it particles were removed.
+        if (!outside || to == MPI_PROC_NULL) continue;
+        leaving[i] = 1;
+        w.put_id(p.id[i]);
+        w.put(p.x[i]);
+        w.put(p.v[i]);
+        w.put(p.omega[i]);
+        w.put(p.radius[i]);
+        w.put(p.mass[i]);
+        w.put(p.inertia[i]);
+        w.put(static_cast<double>(p.material[i]));
+        for (std::size_t k = 0; k < walls; ++k) w.put(carried.wall[k][i]);
+        w.put(static_cast<double>(carried.pairs[i].size()));
+        for (const PartnerHistory& ph : carried.pairs[i]) {
+          w.put_id(ph.partner);
+          w.put(ph.history);
+        }
+      }
+      p.remove_if(leaving);
+      for (auto& wh : carried.wall) {
+        std::size_t keep = 0;
+        for (std::size_t r = 0; r < wh.size(); ++r)
+          if (!leaving[r]) wh[keep++] = wh[r];
+        wh.resize(keep);
+      }
+      {
+        std::size_t keep = 0;
+        for (std::size_t r = 0; r < carried.pairs.size(); ++r)
+          if (!leaving[r]) {
+            if (keep != r) carried.pairs[keep] = std::move(carried.pairs[r]);  // no self-move
+            ++keep;
+          }
+        carried.pairs.resize(keep);
+      }
+      const std::vector<double> in = sendrecv(d_.comm(), out, to, from, 100 + 2 * a + dir);
+      Reader r{in};
+      while (r.k < in.size()) {
+        const GlobalId id = r.get_id();
+        const Vec3 x = r.get_vec(), v = r.get_vec(), w_spin = r.get_vec();
+        const double radius = r.get(), mass = r.get(), inertia = r.get();
+        const int mat = static_cast<int>(r.get());
+        p.add_raw(id, x, v, w_spin, radius, mass, inertia, mat);
+        for (std::size_t k = 0; k < walls; ++k) carried.wall[k].push_back(r.get_history());
+        const auto n = static_cast<std::size_t>(r.get());
+        std::vector<PartnerHistory> pairs(n);
+        for (auto& ph : pairs) {
+          ph.partner = r.get_id();
+          ph.history = r.get_history();
+        }
+        carried.pairs.push_back(std::move(pairs));
+      }
+    }
+    // Everything this rank now holds must lie in its slab along this axis.
+    for (std::size_t i = 0; i < p.size() && error.empty(); ++i)
+      if (d_.coordinate_of(a, p.x[i][a]) != d_.coords()[a]) {
+        std::ostringstream msg;
+        msg << "error: particle " << p.id[i] << " at (" << p.x[i][0] << ", " << p.x[i][1] << ", "
+            << p.x[i][2] << ") m, moving at " << p.v[i].norm() << " m/s, crossed more than one "
+            << "subdomain along " << "xyz"[a] << " between two neighbour-list rebuilds (this "
+            << "rank's box is " << d_.hi()[a] - d_.lo()[a] << " m wide); reduce the time step, "
+            << "or use fewer ranks along " << "xyz"[a] << " (rank " << d_.rank() << ")";
+        error = msg.str();
+      }
+  }
+  agree_on_error(d_.comm(), error);
+}
+
+void Exchange::borders(const Particles& p, double cutoff, Ghosts& g) {
+  g.clear();
+  swaps_.clear();
+  nlocal_ = p.size();
+  sent_ = 0;
+  const Vec3 length = d_.length();
+  for (int a = 0; a < 3; ++a) {
+    const std::size_t ghosts_before = g.size();  // ghosts from earlier axes are forwarded
+    for (int dir = 0; dir < 2; ++dir) {
+      Swap s;
+      s.axis = a;
+      s.dir = dir;
+      s.shift = Vec3::Zero();
+      const int to = d_.neighbour(a, dir), from = d_.neighbour(a, 1 - dir);
+      // What crosses a periodic side appears one period away on the receiver.
+      if (d_.domain().periodic[a]) {
+        if (dir == 0 && d_.coords()[a] == 0) s.shift[a] = length[a];
+        if (dir == 1 && d_.coords()[a] == d_.dims()[a] - 1) s.shift[a] = -length[a];
+      }
+      auto near = [&](double x) {
+        return dir == 0 ? x < d_.lo()[a] + cutoff : x >= d_.hi()[a] - cutoff;
+      };
+      std::vector<double> out;
+      Writer w{out};
+      if (to != MPI_PROC_NULL) {
+        for (std::size_t i = 0; i < nlocal_; ++i)
+          if (near(p.x[i][a])) s.send.push_back(static_cast<int>(i));
+        for (std::size_t k = 0; k < ghosts_before; ++k)
+          if (near(g.position(k)[a])) s.send.push_back(static_cast<int>(nlocal_ + k));
+        for (int idx : s.send) {
+          const bool local = static_cast<std::size_t>(idx) < nlocal_;
+          const std::size_t k = local ? idx : idx - nlocal_;
+          w.put_id(local ? p.id[k] : g.id[k]);
+          w.put(local ? p.x[k] : g.x[k]);
+          w.put(Vec3((local ? Vec3::Zero() : g.shift[k]) + s.shift));
+          w.put(local ? p.v[k] : g.v[k]);
+          w.put(local ? p.omega[k] : g.omega[k]);
+          w.put(local ? p.radius[k] : g.radius[k]);
+          w.put(local ? p.mass[k] : g.mass[k]);
+          w.put(local ? p.inertia[k] : g.inertia[k]);
+          w.put(static_cast<double>(local ? p.material[k] : g.material[k]));
+        }
+      }
+      sent_ += static_cast<long>(s.send.size());
+      const std::vector<double> in = sendrecv(d_.comm(), out, to, from, 200 + 2 * a + dir);
+      Reader r{in};
+      s.recv_first = g.size();
+      while (r.k < in.size()) {
+        g.id.push_back(r.get_id());
+        g.x.push_back(r.get_vec());
+        g.shift.push_back(r.get_vec());
+        g.v.push_back(r.get_vec());
+        g.omega.push_back(r.get_vec());
+        g.radius.push_back(r.get());
+        g.mass.push_back(r.get());
+        g.inertia.push_back(r.get());
+        g.material.push_back(static_cast<int>(r.get()));
+      }
+      s.recv_count = g.size() - s.recv_first;
+      swaps_.push_back(std::move(s));
+    }
+  }
+}
+
+void Exchange::forward(const Particles& p, Ghosts& g) {
+  for (const Swap& s : swaps_) {
+    const int to = d_.neighbour(s.axis, s.dir), from = d_.neighbour(s.axis, 1 - s.dir);
+    if (to == MPI_PROC_NULL && from == MPI_PROC_NULL) continue;
+    std::vector<double> out;
+    out.reserve(9 * s.send.size());
+    Writer w{out};
+    for (int idx : s.send) {
+      const bool local = static_cast<std::size_t>(idx) < nlocal_;
+      const std::size_t k = local ? idx : idx - nlocal_;
+      w.put(local ? p.x[k] : g.x[k]);
+      w.put(local ? p.v[k] : g.v[k]);
+      w.put(local ? p.omega[k] : g.omega[k]);
+    }
+    const std::vector<double> in = sendrecv(d_.comm(), out, to, from, 300 + 2 * s.axis + s.dir);
+    Reader r{in};
+    for (std::size_t k = s.recv_first; k < s.recv_first + s.recv_count; ++k) {
+      g.x[k] = r.get_vec();
+      g.v[k] = r.get_vec();
+      g.omega[k] = r.get_vec();
+    }
+  }
+}
+
+}  // namespace grainflow

@@ -1,0 +1,60 @@
+#pragma once
+// Particle exchange between neighbouring ranks of the processor grid (DESIGN.md §2):
+// - migrate(): at neighbour rebuilds, every particle moves to the rank whose box
+//   holds it, carrying its contact springs and wall histories;
+// - borders(): at rebuilds, builds the ghosts of every face, edge and corner (axis
+//   by axis: the y exchange forwards ghosts received along x, and so on) and
+//   records which particles go where;
+// - forward(): every step, refreshes the ghosts' positions and velocities along
+//   those records.
+// Periodic axes work the same way with one or more ranks: the neighbour across a
+// periodic side may be this rank itself, and what crosses gets an image shift.
+#include <string>
+#include <vector>
+
+#include "dem/core/particles.hpp"
+#include "dem/parallel/decomposition.hpp"
+#include "dem/parallel/ghosts.hpp"
+
+namespace grainflow {
+
+// A run-time failure every rank agrees on (thrown on all ranks together).
+class ParallelError : public std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// If any rank passes a non-empty message, every rank throws ParallelError with
+// the message of the lowest such rank. Collective.
+void agree_on_error(MPI_Comm comm, const std::string& local_message);
+
+class Exchange {
+ public:
+  explicit Exchange(const Decomposition& d) : d_(d) {}
+
+  // Wraps positions along periodic axes into the domain and sends every particle
+  // to its owner. A particle that crossed more than one box since the last call is
+  // an error naming it, its speed and the fix (collective ParallelError).
+  void migrate(Particles& p, CarriedState& carried);
+
+  // Rebuilds `ghosts` for interaction range `cutoff` and records the send lists.
+  void borders(const Particles& p, double cutoff, Ghosts& ghosts);
+
+  // Refreshes ghost positions, velocities and spins along the recorded lists.
+  void forward(const Particles& p, Ghosts& ghosts);
+
+  long ghosts_sent_last_borders() const { return sent_; }
+
+ private:
+  struct Swap {
+    int axis, dir;
+    std::vector<int> send;  // < nlocal: local index; else ghost index + nlocal
+    Vec3 shift;             // added to the image offset of what is sent
+    std::size_t recv_first = 0, recv_count = 0;
+  };
+  const Decomposition& d_;
+  std::vector<Swap> swaps_;
+  std::size_t nlocal_ = 0;
+  long sent_ = 0;
+};
+
+}  // namespace grainflow
