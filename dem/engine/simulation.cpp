@@ -46,10 +46,12 @@ void reorder(std::vector<T>& a, const std::vector<std::size_t>& perm) {
 Simulation::Simulation(const Scene& scene, bool insert, MPI_Comm comm,
                        std::array<int, 3> processor_grid)
     : scene_(scene), comm_(comm), table_(scene) {
+  if (processor_grid == std::array<int, 3>{0, 0, 0}) processor_grid = scene.parallel.grid;
   try {
     decomp_ = std::make_unique<Decomposition>(comm, scene.domain, processor_grid);
   } catch (const std::invalid_argument& e) {
-    throw SetupError(scene_.file + ": error: " + e.what());
+    throw SetupError(scene_.file + ": error: " + e.what() +
+                     "; change `parallel.grid` or the number of MPI ranks");
   }
   exchange_ = std::make_unique<Exchange>(*decomp_);
   constants_.hooke_characteristic_velocity =
@@ -180,8 +182,59 @@ void Simulation::apply_order(const std::vector<std::size_t>& perm, CarriedState&
   reorder(carried.pairs, perm);
 }
 
+double Simulation::load_imbalance() const {
+  double n[2] = {static_cast<double>(p_.size()), static_cast<double>(p_.size())};
+  MPI_Allreduce(MPI_IN_PLACE, &n[0], 1, MPI_DOUBLE, MPI_MAX, comm_);
+  MPI_Allreduce(MPI_IN_PLACE, &n[1], 1, MPI_DOUBLE, MPI_SUM, comm_);
+  const double mean = n[1] / decomp_->size();
+  return mean > 0 ? n[0] / mean : 1.0;
+}
+
+void Simulation::balance_cuts() {
+  // Per axis with several ranks: a global histogram of particle coordinates gives
+  // the planes that split the particles evenly. Each plane moves at most half the
+  // narrower of its two boxes per call, so that no particle ends up more than one
+  // box from its owner (migration reaches neighbours only), and no box gets
+  // thinner than the interaction range (ghosts come from neighbours only).
+  const Domain& dom = scene_.domain;
+  for (int a = 0; a < 3; ++a) {
+    const int n = decomp_->dims()[a];
+    if (n == 1) continue;
+    const int bins = 64 * n;
+    const double lo = dom.lo[a], width = (dom.hi[a] - dom.lo[a]) / bins;
+    std::vector<double> hist(bins, 0.0);
+    for (const Vec3& x : p_.x)
+      hist[std::clamp(static_cast<int>((x[a] - lo) / width), 0, bins - 1)] += 1;
+    MPI_Allreduce(MPI_IN_PLACE, hist.data(), bins, MPI_DOUBLE, MPI_SUM, comm_);
+    double total = 0;
+    for (double h : hist) total += h;
+    if (total == 0) return;
+    const std::vector<double>& old = decomp_->cuts(a);
+    std::vector<double> cuts = old;
+    double cumulative = 0;
+    int b = 0;
+    for (int k = 1; k < n; ++k) {
+      const double target = total * k / n;
+      while (b < bins && cumulative + hist[b] < target) cumulative += hist[b++];
+      const double frac = b < bins && hist[b] > 0 ? (target - cumulative) / hist[b] : 0.0;
+      const double ideal = lo + (b + frac) * width;
+      const double step = 0.5 * std::min(old[k] - old[k - 1], old[k + 1] - old[k]);
+      cuts[k] = std::clamp(ideal, old[k] - step, old[k] + step);
+    }
+    for (int k = 1; k < n; ++k) cuts[k] = std::max(cuts[k], cuts[k - 1] + cutoff_);
+    for (int k = n - 1; k >= 1; --k) cuts[k] = std::min(cuts[k], cuts[k + 1] - cutoff_);
+    decomp_->set_cuts(a, cuts);
+  }
+  grid_ = std::make_unique<BinGrid>(decomp_->lo() - Vec3::Constant(cutoff_),
+                                    decomp_->hi() + Vec3::Constant(cutoff_), cutoff_);
+}
+
 void Simulation::rebuild() {
   CarriedState carried = save_histories();  // by global ids: indices change below
+  // Rebalance every 10th rebuild, when the busiest rank holds 10 % more than the mean.
+  if (scene_.parallel.balance && decomp_->size() > 1 && counters_.rebuilds % 10 == 0 &&
+      load_imbalance() > 1.1)
+    balance_cuts();
   if (!leaving_.empty()) {
     const long before = static_cast<long>(p_.size());
     p_.remove_if(leaving_);

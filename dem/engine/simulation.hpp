@@ -54,6 +54,7 @@ class Simulation {
   // Inserts the scene's particles (every rank inserts the same set; initialise()
   // keeps each on the rank that owns it). `insert = false` starts empty: tests add
   // particles by hand — on every rank alike — before initialise().
+  // processor_grid {0,0,0} takes the scene's `parallel.grid` (itself {0,0,0}: automatic).
   explicit Simulation(const Scene& scene, bool insert = true, MPI_Comm comm = MPI_COMM_WORLD,
                       std::array<int, 3> processor_grid = {0, 0, 0});
 
@@ -86,11 +87,15 @@ class Simulation {
   GlobalId next_id() const { return next_id_; }
   GlobalId& next_id() { return next_id_; }
 
+  // Largest over mean particle count per rank (1 = perfectly balanced). Collective.
+  double load_imbalance() const;
+
   double kinetic_energy_translational() const;  // this rank
   double kinetic_energy_rotational() const;     // this rank
 
  private:
   void rebuild();
+  void balance_cuts();  // moves cut planes toward equal particle counts (collective)
   void compute_forces();
   bool needs_rebuild() const;  // collective
   void mark_leaving();         // particles beyond a bounded side of the domain

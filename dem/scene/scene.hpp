@@ -124,6 +124,12 @@ struct NeighbourSettings {
   std::optional<double> skin;  // [m] > 0; default 0.4 * the largest radius
 };
 
+// How the DEM is spread over MPI ranks (DESIGN.md §2).
+struct ParallelSettings {
+  std::array<int, 3> grid{0, 0, 0};  // ranks per axis; all 0: chosen for least cut area
+  bool balance = false;              // move cut planes to balance particle counts
+};
+
 struct Scene {
   std::string file;  // path it was read from
   Domain domain;
@@ -136,6 +142,7 @@ struct Scene {
   std::vector<Wall> walls;
   std::vector<Insertion> insertions;
   OutputSettings output;
+  ParallelSettings parallel;
 
   int material_index(const std::string& name) const;  // -1 if absent
   const MaterialPair& pair(int a, int b) const;       // precondition: complete table

@@ -641,6 +641,21 @@ ContactSettings parse_contact(const Field& f) {
   return c;
 }
 
+ParallelSettings parse_parallel(const Field& f) {
+  const Map m = f.map({"grid", "balance"});
+  ParallelSettings par;
+  if (const auto g = m.find("grid")) {
+    const std::vector<Field> items = g->items();
+    if (items.size() != 3)
+      g->fail("expected a list of 3 whole numbers (ranks along x, y, z), got " + g->got() +
+              "; write it as [nx, ny, nz] with nx * ny * nz = the number of MPI ranks");
+    for (int a = 0; a < 3; ++a)
+      par.grid[a] = static_cast<int>(items[a].integer(Range{1, 1e6, true, true}));
+  }
+  if (const auto b = m.find("balance")) par.balance = b->boolean();
+  return par;
+}
+
 NeighbourSettings parse_neighbour(const Field& f) {
   NeighbourSettings n;
   n.skin = f.map({"skin"}).maybe_number("skin", kPositive);
@@ -865,7 +880,7 @@ OutputSettings parse_output(const Field& f) {
 
 const std::vector<std::string> kTopLevelKeys = {
     "domain",  "gravity",   "time",  "materials", "interactions", "interaction_defaults",
-    "contact", "neighbour", "walls", "insert",    "output"};
+    "contact", "neighbour", "walls", "insert",    "output", "parallel"};
 
 Scene build_scene(const Field& root) {
   if (!root.node().IsDefined() || root.node().IsNull())
@@ -886,6 +901,7 @@ Scene build_scene(const Field& root) {
   if (const auto w = top.find("walls")) s.walls = parse_walls(*w, s.materials);
   if (const auto i = top.find("insert")) s.insertions = parse_insertions(*i, s);
   if (const auto o = top.find("output")) s.output = parse_output(*o);
+  if (const auto p = top.find("parallel")) s.parallel = parse_parallel(*p);
   return s;
 }
 

@@ -1,0 +1,89 @@
+// Strong scaling of the MPI DEM on one dense bed.
+//
+// The bed: N spheres (radius 0.95-1.05 mm) on a jittered face-centred-cubic lattice
+// at ~59 % solids, resting on a floor under gravity in a box periodic along x and y:
+// dense, with most particles in contact after the first few hundred steps. The run
+// times `--steps` steps after a warm-up and prints one line
+//   ranks=R particles=N steps=S seconds=T particle_steps_per_second=P contacts=C
+// (rank 0). benchmarks/strong_scaling/run.sh runs it on 1 and 2 ranks side by side.
+#include <mpi.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+#include <string>
+
+#include "dem/engine/simulation.hpp"
+
+using namespace grainflow;
+
+int main(int argc, char** argv) {
+  MPI_Init(&argc, &argv);
+  long target = 100000, steps = 300;
+  for (int k = 1; k + 1 < argc; k += 2) {
+    const std::string a = argv[k];
+    if (a == "--particles") target = std::atol(argv[k + 1]);
+    if (a == "--steps") steps = std::atol(argv[k + 1]);
+  }
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+
+  // FCC cell edge: nearest centres a/sqrt(2) = 2.16 r apart (no overlap for r <= 1.05 mm);
+  // 4 spheres per a^3 -> ~59 % solids.
+  const double r = 1e-3, a = 3.05 * r;
+  const int nxy = 16;                   // cells along x and y
+  const int nz = static_cast<int>(std::ceil(target / (4.0 * nxy * nxy)));
+  Scene s;
+  s.file = "<benchmark>";
+  s.domain.lo = Vec3::Zero();
+  s.domain.hi = Vec3(nxy * a, nxy * a, nz * a * 1.3);
+  s.domain.periodic = {true, true, false};
+  s.gravity = Vec3(0, 0, -9.81);
+  s.materials.push_back({"glass", 5e7, 0.25, 2500});
+  MaterialPair pair;
+  pair.restitution = 0.5;
+  pair.friction = 0.5;
+  s.pairs.push_back(pair);
+  Wall floor;
+  floor.name = "floor";
+  s.walls.push_back(floor);
+  s.contact.tangential = TangentialModel::history;
+  s.time.end = 1;
+
+  Simulation sim(s, false, MPI_COMM_WORLD);
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const Vec3 basis[4] = {Vec3(0, 0, 0), Vec3(0.5, 0.5, 0), Vec3(0.5, 0, 0.5), Vec3(0, 0.5, 0.5)};
+  GlobalId id = 1;
+  for (int k = 0; k < nz && id <= target; ++k)
+    for (int j = 0; j < nxy; ++j)
+      for (int i = 0; i < nxy; ++i)
+        for (const Vec3& b : basis) {
+          if (id > target) break;
+          const Vec3 x = (Vec3(i, j, k) + b + Vec3(0.25, 0.25, 0.25)) * a +
+                         Vec3(u(rng), u(rng), u(rng)) * 0.02 * r;
+          sim.particles().add(id++, x, Vec3::Zero(), Vec3::Zero(), r * (1 + 0.05 * u(rng)), 0,
+                              2500);
+        }
+  sim.set_dt(0.15 * rayleigh_time(s.materials[0], 0.95 * r));
+  sim.initialise();
+  for (int k = 0; k < 200; ++k) sim.step();  // warm-up: the bed starts to press together
+  MPI_Barrier(MPI_COMM_WORLD);
+  const auto t0 = std::chrono::steady_clock::now();
+  for (long k = 0; k < steps; ++k) sim.step();
+  MPI_Barrier(MPI_COMM_WORLD);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const GlobalState g = sim.global_state();
+  if (rank == 0)
+    std::printf("ranks=%d particles=%ld steps=%ld seconds=%.3f particle_steps_per_second=%.4g "
+                "contacts=%ld imbalance=%.3f\n",
+                size, g.particles, steps, seconds, g.particles * steps / seconds, g.contacts,
+                sim.load_imbalance());
+  else
+    sim.load_imbalance();
+  MPI_Finalize();
+  return 0;
+}
