@@ -1,8 +1,9 @@
 // Strong scaling of the MPI DEM on one dense bed.
 //
-// The bed: N spheres (radius 0.95-1.05 mm) on a jittered face-centred-cubic lattice
-// at ~59 % solids, resting on a floor under gravity in a box periodic along x and y:
-// dense, with most particles in contact after the first few hundred steps. The run
+// The bed: N spheres (radius 1 mm) on a face-centred-cubic lattice compressed so that
+// every sphere touches its 12 neighbours (74 % solids), on a floor under gravity in a
+// box periodic along x and y: the densest case a DEM bed presents (~6 contacts per
+// particle). The run
 // times `--steps` steps after a warm-up and prints one line
 //   ranks=R particles=N steps=S seconds=T particle_steps_per_second=P contacts=C
 // (rank 0). benchmarks/strong_scaling/run.sh runs it on 1 and 2 ranks side by side.
@@ -31,9 +32,9 @@ int main(int argc, char** argv) {
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &size);
 
-  // FCC cell edge: nearest centres a/sqrt(2) = 2.16 r apart (no overlap for r <= 1.05 mm);
-  // 4 spheres per a^3 -> ~59 % solids.
-  const double r = 1e-3, a = 3.05 * r;
+  // FCC cell edge: nearest centres a/sqrt(2) = 1.998 r apart, so each sphere starts
+  // touching its 12 neighbours with an overlap of 0.1 % of r: a dense bed (74 % solids).
+  const double r = 1e-3, a = std::sqrt(8.0) * r * 0.999;
   const int nxy = 16;                   // cells along x and y
   const int nz = static_cast<int>(std::ceil(target / (4.0 * nxy * nxy)));
   Scene s;
@@ -64,11 +65,10 @@ int main(int argc, char** argv) {
         for (const Vec3& b : basis) {
           if (id > target) break;
           const Vec3 x = (Vec3(i, j, k) + b + Vec3(0.25, 0.25, 0.25)) * a +
-                         Vec3(u(rng), u(rng), u(rng)) * 0.02 * r;
-          sim.particles().add(id++, x, Vec3::Zero(), Vec3::Zero(), r * (1 + 0.05 * u(rng)), 0,
-                              2500);
+                         Vec3(u(rng), u(rng), u(rng)) * 1e-4 * r;
+          sim.particles().add(id++, x, Vec3::Zero(), Vec3::Zero(), r, 0, 2500);
         }
-  sim.set_dt(0.15 * rayleigh_time(s.materials[0], 0.95 * r));
+  sim.set_dt(0.15 * rayleigh_time(s.materials[0], r));
   sim.initialise();
   for (int k = 0; k < 200; ++k) sim.step();  // warm-up: the bed starts to press together
   MPI_Barrier(MPI_COMM_WORLD);

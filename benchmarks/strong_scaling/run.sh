@@ -26,8 +26,8 @@ r0 = rows[0]
 with open(sys.argv[2], "w") as f:
     f.write("# Parallel DEM: strong scaling\n\n")
     f.write(f"Machine: {cpu}, {platform.system()} (the project's 2-core machine), {datetime.date.today()}.\n\n")
-    f.write(f"Scene: a dense bed of {r0['particles']} spheres (r = 0.95-1.05 mm, jittered FCC lattice at ~59 % "
-            "solids, resting on a floor, periodic along x and y), Hertz + tangential history, "
+    f.write(f"Scene: a dense bed of {r0['particles']} spheres (r = 1 mm, an FCC lattice compressed so that every "
+            "sphere touches its 12 neighbours, 74 % solids, on a floor, periodic along x and y), Hertz + tangential history, "
             f"dt = 0.15 t_R; {r0['steps']} timed steps after 200 warm-up steps; median of "
             f"{len(by[1])} alternating rounds (`benchmarks/strong_scaling/run.sh`).\n\n")
     f.write("| ranks | particle-steps/s (median) | all rounds | speed-up |\n|---:|---:|---|---:|\n")
