@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "dem/insert/insertion.hpp"
+#include "dem/walls/stl_reader.hpp"
 
 namespace grainflow {
 namespace {
@@ -60,12 +61,19 @@ Simulation::Simulation(const Scene& scene, bool insert, MPI_Comm comm,
   constants_.hooke_kt = scene.contact.hooke_kt.value_or(constants_.hooke_kn);
   constants_.epsd_damping_ratio = scene.contact.epsd_damping_ratio;
   sweep_ = select_sweep(scene.contact);
-  if (insert) insert_particles(scene_, p_, next_id_);
+  try {
+    walls_ = WallSet(scene_);  // reads STL meshes
+  } catch (const GeometryError& e) {
+    throw SetupError(e.what());
+  }
+  streams_ = StreamInsertion(scene_);
+  if (insert) insert_particles(scene_, p_, next_id_, &walls_);
 }
 
 void Simulation::initialise() {
   double r_max = 0;
   for (double r : p_.radius) r_max = std::max(r_max, r);
+  r_max = std::max(r_max, streams_.max_radius());  // particles still to come
   MPI_Allreduce(MPI_IN_PLACE, &r_max, 1, MPI_DOUBLE, MPI_MAX, comm_);
   const Vec3 length = decomp_->length();
   if (r_max == 0) r_max = length.minCoeff() / 100;  // empty scene: any grid works
@@ -100,17 +108,38 @@ void Simulation::initialise() {
   std::vector<char> foreign(p_.size());
   for (std::size_t i = 0; i < p_.size(); ++i) foreign[i] = !decomp_->owns(p_.x[i]);
   p_.remove_if(foreign);
+  if (!restored_springs_.empty()) {
+    CarriedState c;
+    c.wall.assign(walls_.history_columns(), std::vector<ContactHistory>(p_.size()));
+    c.pairs.resize(p_.size());
+    std::unordered_map<GlobalId, std::size_t> index;
+    for (std::size_t i = 0; i < p_.size(); ++i) index[p_.id[i]] = i;
+    for (const CheckpointSpring& sp : restored_springs_) {
+      const auto it = index.find(sp.particle);
+      if (it == index.end()) continue;
+      const ContactHistory h{sp.tangential, sp.rolling};
+      if (sp.partner >= 0)
+        c.pairs[it->second].push_back({sp.partner, h});
+      else if (static_cast<std::size_t>(-1 - sp.partner) < c.wall.size())
+        c.wall[-1 - sp.partner][it->second] = h;
+    }
+    pending_carried_ = std::move(c);
+    restored_springs_.clear();
+  }
 
   grid_ = std::make_unique<BinGrid>(decomp_->lo() - Vec3::Constant(cutoff_),
                                     decomp_->hi() + Vec3::Constant(cutoff_), cutoff_);
-  wall_history_.assign(scene_.walls.size(), std::vector<ContactHistory>(p_.size()));
-  for (std::size_t i = 0; i < p_.size(); ++i) {
-    p_.force[i].setZero();
-    p_.torque[i].setZero();
-  }
+  wall_history_.assign(walls_.history_columns(), std::vector<ContactHistory>(p_.size()));
+  walls_.move_to(time_);
+  const bool restoring = restored_;
   mark_leaving();
   rebuild();
-  compute_forces();
+  // A restored run keeps the checkpoint's forces: evaluating the contacts again
+  // would advance every spring a second time for the same step.
+  if (restoring)
+    apply_force_terms();
+  else
+    compute_forces();
   initialised_ = true;
 }
 
@@ -229,8 +258,39 @@ void Simulation::balance_cuts() {
                                     decomp_->hi() + Vec3::Constant(cutoff_), cutoff_);
 }
 
+void Simulation::restore(const CheckpointData& checkpoint) {
+  p_ = checkpoint.particles;
+  time_ = checkpoint.time;
+  if (dt_ <= 0) dt_ = checkpoint.dt;
+  counters_.steps = checkpoint.step;
+  next_id_ = checkpoint.next_id;
+  restored_springs_ = checkpoint.springs;
+  restored_ = true;
+}
+
+void Simulation::write_checkpoint(const std::string& path) const {
+  CheckpointData d;
+  d.time = time_;
+  d.dt = dt_;
+  d.step = counters_.steps;
+  d.next_id = next_id_;
+  d.particles = p_;
+  const CarriedState c = save_histories();
+  for (std::size_t i = 0; i < p_.size(); ++i)
+    for (const PartnerHistory& ph : c.pairs[i])
+      d.springs.push_back({p_.id[i], ph.partner, ph.history.tangential, ph.history.rolling});
+  for (std::size_t w = 0; w < c.wall.size(); ++w)
+    for (std::size_t i = 0; i < p_.size(); ++i)
+      if (is_set(c.wall[w][i]))
+        d.springs.push_back({p_.id[i], -1 - static_cast<GlobalId>(w), c.wall[w][i].tangential,
+                             c.wall[w][i].rolling});
+  grainflow::write_checkpoint(comm_, path, d);
+}
+
 void Simulation::rebuild() {
-  CarriedState carried = save_histories();  // by global ids: indices change below
+  // Springs by global ids (indices change below); after a restore, those of the checkpoint.
+  CarriedState carried = pending_carried_ ? std::move(*pending_carried_) : save_histories();
+  pending_carried_.reset();
   // Rebalance every 10th rebuild, when the busiest rank holds 10 % more than the mean.
   if (scene_.parallel.balance && decomp_->size() > 1 && counters_.rebuilds % 10 == 0 &&
       load_imbalance() > 1.1)
@@ -259,11 +319,15 @@ void Simulation::compute_forces() {
     p_.torque[i].setZero();
   }
   ContactSweep s{p_,          ghosts_,        local_list_,   ghost_list_, local_history_,
-                 ghost_history_, scene_.walls, wall_history_, table_,      constants_,
+                 ghost_history_, walls_,       wall_history_, table_,      constants_,
                  dt_};
   sweep_.run(s);
   counters_.contacts = s.contacts;
   counters_.max_overlap_ratio = s.max_overlap_ratio;
+  apply_force_terms();
+}
+
+void Simulation::apply_force_terms() {
   if (!terms_.empty()) {
     drag_.coefficient.assign(p_.size(), 0.0);
     drag_.fluid_velocity.assign(p_.size(), Vec3::Zero());
@@ -292,12 +356,17 @@ void Simulation::step() {
   // Velocity Verlet: half kick, drift, new forces, half kick.
   half_kick();
   for (std::size_t i = 0; i < p_.size(); ++i) p_.x[i] += dt_ * p_.v[i];
+  // Stream insertion (dem/insert/stream_insertion.hpp); new particles force a rebuild.
+  const bool inserted = !streams_.empty() && streams_.insert(time_ + dt_, p_, ghosts_, walls_,
+                                                             *decomp_, next_id_, comm_) > 0;
+  for (auto& column : wall_history_) column.resize(p_.size());
   mark_leaving();
-  if (needs_rebuild())
+  if (inserted || needs_rebuild())
     rebuild();
   else
     exchange_->forward(p_, ghosts_);
   time_ += dt_;
+  walls_.move_to(time_);
   compute_forces();
   half_kick();
   ++counters_.steps;

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -17,11 +18,14 @@
 #include "dem/engine/contact_sweep.hpp"
 #include "dem/engine/force_term.hpp"
 #include "dem/engine/time_step.hpp"
+#include "dem/insert/stream_insertion.hpp"
+#include "dem/io/checkpoint.hpp"
 #include "dem/neighbour/verlet_list.hpp"
 #include "dem/parallel/decomposition.hpp"
 #include "dem/parallel/exchange.hpp"
 #include "dem/parallel/ghosts.hpp"
 #include "dem/scene/scene.hpp"
+#include "dem/walls/wall_set.hpp"
 
 namespace grainflow {
 
@@ -63,6 +67,13 @@ class Simulation {
   void add_force_term(std::unique_ptr<ForceTerm> term) { terms_.push_back(std::move(term)); }
   const ImplicitDrag& implicit_drag() const { return drag_; }
 
+  // Continues from a checkpoint: call before initialise() with the whole checkpoint
+  // on every rank (read_checkpoint); each rank keeps what it owns, springs included.
+  // The scene must be the one the checkpoint was written with.
+  void restore(const CheckpointData& checkpoint);
+  // Writes the complete dynamic state, readable on any number of ranks. Collective.
+  void write_checkpoint(const std::string& path) const;
+
   // Checks the time step, distributes particles to their ranks, builds lists and
   // the first forces. Collective. Called by the first step() if not before.
   void initialise();
@@ -73,6 +84,8 @@ class Simulation {
   const Particles& particles() const { return p_; }
   const Ghosts& ghosts() const { return ghosts_; }
   const Scene& scene() const { return scene_; }
+  const WallSet& walls() const { return walls_; }               // current wall positions
+  const StreamInsertion& streams() const { return streams_; }  // stream insertion totals
   const Decomposition& decomposition() const { return *decomp_; }
   double time() const { return time_; }
   double dt() const { return dt_; }
@@ -96,7 +109,8 @@ class Simulation {
  private:
   void rebuild();
   void balance_cuts();  // moves cut planes toward equal particle counts (collective)
-  void compute_forces();
+  void compute_forces();     // gravity, contacts, then the force terms
+  void apply_force_terms();  // non-contact terms only
   bool needs_rebuild() const;  // collective
   void mark_leaving();         // particles beyond a bounded side of the domain
   void half_kick();            // v += dt/2 F/m (implicit in v where drag is set), same for spin
@@ -118,13 +132,18 @@ class Simulation {
   std::unique_ptr<BinGrid> grid_;
   NeighbourList local_list_, ghost_list_;
   std::vector<ContactHistory> local_history_, ghost_history_;
-  std::vector<std::vector<ContactHistory>> wall_history_;
+  std::vector<std::vector<ContactHistory>> wall_history_;  // [WallSet column][particle]
+  WallSet walls_;
+  StreamInsertion streams_;
   std::vector<Vec3> x_at_build_;
   std::vector<char> leaving_;
   std::vector<std::unique_ptr<ForceTerm>> terms_;
   ImplicitDrag drag_;
   Counters counters_;
   TimeStepReport report_;
+  std::vector<CheckpointSpring> restored_springs_;  // from restore(), until initialise()
+  std::optional<CarriedState> pending_carried_;     // springs for the first rebuild
+  bool restored_ = false;                           // initialise() keeps the forces read
   bool initialised_ = false;
 };
 

@@ -15,44 +15,18 @@
 #include <gtest/gtest.h>
 
 #include "dem/insert/insertion.hpp"
+#include "tests/dem/parallel/gas_scene.hpp"
 #include "tests/dem/parallel/support.hpp"
 #include "tests/dem/support/test_scene.hpp"
 
 namespace grainflow {
 namespace {
 
-Scene gas_scene() {
-  Scene s = test::one_material_scene(1e7, 0.3, 2500, 0.6, 0.4, 0.05);
-  s.domain.lo = Vec3(0, 0, 0);
-  s.domain.hi = Vec3(0.03, 0.015, 0.015);
-  s.domain.periodic = {true, false, false};
-  s.contact.tangential = TangentialModel::history;
-  s.contact.rolling = RollingModel::epsd;
-  s.walls = {test::plane(Vec3::Zero(), Vec3::UnitY()),
-             test::plane(Vec3(0, 0.015, 0), -Vec3::UnitY()),
-             test::plane(Vec3::Zero(), Vec3::UnitZ()),
-             test::plane(Vec3(0, 0, 0.015), -Vec3::UnitZ())};
-  s.gravity = Vec3(0, 0, -9.81);
-  Insertion fill;
-  fill.region.lo = s.domain.lo;
-  fill.region.hi = s.domain.hi;
-  fill.count = 2000;
-  fill.radius.kind = SizeDistribution::Kind::uniform;
-  fill.radius.min = 0.6e-3;
-  fill.radius.max = 0.7e-3;
-  fill.seed = 4;
-  fill.source = "test";
-  s.insertions.push_back(fill);
-  return s;
-}
-
 std::vector<test::State> run_on(int ranks, std::array<int, 3> grid) {
   MPI_Comm comm = test::first_ranks(ranks);
   if (comm == MPI_COMM_NULL) return {};
-  Simulation sim(gas_scene(), true, comm, grid);
-  std::mt19937_64 rng(9);
-  std::uniform_real_distribution<double> u(-1, 1);
-  for (auto& v : sim.particles().v) v = 0.5 / std::sqrt(3.0) * Vec3(u(rng), u(rng), u(rng));
+  Simulation sim(test::gas_scene(), true, comm, grid);
+  test::stir(sim);
   sim.set_dt(2e-6);
   sim.initialise();
   for (int k = 0; k < 2000; ++k) sim.step();

@@ -1,0 +1,305 @@
+#include "dem/io/checkpoint.hpp"
+
+#include <hdf5.h>
+
+#include <bit>
+#include <cstdio>
+#include <filesystem>
+
+namespace grainflow {
+namespace {
+
+constexpr const char* kFormat = "grainflow-checkpoint-1";
+
+// Packs per-particle and per-spring records into doubles (ids bit-exact).
+std::vector<double> pack(const CheckpointData& d) {
+  std::vector<double> b;
+  b.push_back(static_cast<double>(d.particles.size()));
+  for (std::size_t i = 0; i < d.particles.size(); ++i) {
+    const Particles& p = d.particles;
+    b.push_back(std::bit_cast<double>(p.id[i]));
+    for (const Vec3* v : {&p.x[i], &p.v[i], &p.omega[i], &p.force[i], &p.torque[i]})
+      b.insert(b.end(), v->data(), v->data() + 3);
+    b.insert(b.end(), {p.radius[i], p.mass[i], p.inertia[i], static_cast<double>(p.material[i])});
+  }
+  for (const CheckpointSpring& s : d.springs) {
+    b.push_back(std::bit_cast<double>(s.particle));
+    b.push_back(std::bit_cast<double>(s.partner));
+    b.insert(b.end(), s.tangential.data(), s.tangential.data() + 3);
+    b.insert(b.end(), s.rolling.data(), s.rolling.data() + 3);
+  }
+  return b;
+}
+
+// Appends the records of one rank's buffer to `out`.
+void unpack(const double* b, std::size_t n, CheckpointData& out) {
+  std::size_t k = 0;
+  const auto count = static_cast<std::size_t>(b[k++]);
+  auto vec = [&] {
+    const Vec3 v(b[k], b[k + 1], b[k + 2]);
+    k += 3;
+    return v;
+  };
+  for (std::size_t i = 0; i < count; ++i) {
+    const GlobalId id = std::bit_cast<GlobalId>(b[k++]);
+    const Vec3 x = vec(), v = vec(), w = vec(), f = vec(), t = vec();
+    const double r = b[k], m = b[k + 1], inertia = b[k + 2];
+    const int mat = static_cast<int>(b[k + 3]);
+    k += 4;
+    out.particles.add_raw(id, x, v, w, r, m, inertia, mat);
+    out.particles.force.back() = f;
+    out.particles.torque.back() = t;
+  }
+  while (k < n) {
+    CheckpointSpring s;
+    s.particle = std::bit_cast<GlobalId>(b[k++]);
+    s.partner = std::bit_cast<GlobalId>(b[k++]);
+    s.tangential = vec();
+    s.rolling = vec();
+    out.springs.push_back(s);
+  }
+}
+
+class File {
+ public:
+  explicit File(hid_t id) : id_(id) {}
+  ~File() {
+    if (id_ >= 0) H5Fclose(id_);
+  }
+  hid_t id() const { return id_; }
+  bool close() {
+    const bool ok = H5Fclose(id_) >= 0;
+    id_ = -1;
+    return ok;
+  }
+
+ private:
+  hid_t id_;
+};
+
+bool write_array(hid_t loc, const char* name, hid_t type, std::size_t rows, std::size_t cols,
+                 const void* data) {
+  const hsize_t dims[2] = {rows, cols};
+  const hid_t space = H5Screate_simple(cols > 1 ? 2 : 1, dims, nullptr);
+  const hid_t set = H5Dcreate2(loc, name, type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  bool ok = set >= 0 && (rows == 0 || H5Dwrite(set, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) >= 0);
+  if (set >= 0) H5Dclose(set);
+  H5Sclose(space);
+  return ok;
+}
+
+template <class T>
+bool write_attribute(hid_t loc, const char* name, hid_t type, const T& value) {
+  const hid_t space = H5Screate(H5S_SCALAR);
+  const hid_t attr = H5Acreate2(loc, name, type, space, H5P_DEFAULT, H5P_DEFAULT);
+  const bool ok = attr >= 0 && H5Awrite(attr, type, &value) >= 0;
+  if (attr >= 0) H5Aclose(attr);
+  H5Sclose(space);
+  return ok;
+}
+
+std::string write_file(const std::string& path, const CheckpointData& d) {
+  const Particles& p = d.particles;
+  const std::size_t n = p.size(), m = d.springs.size();
+  File f(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT));
+  if (f.id() < 0) return "cannot create the file";
+  const hid_t str = H5Tcopy(H5T_C_S1);
+  H5Tset_size(str, std::char_traits<char>::length(kFormat));
+  bool ok = true;
+  {
+    const hid_t space = H5Screate(H5S_SCALAR);
+    const hid_t attr = H5Acreate2(f.id(), "format", str, space, H5P_DEFAULT, H5P_DEFAULT);
+    ok = ok && attr >= 0 && H5Awrite(attr, str, kFormat) >= 0;
+    if (attr >= 0) H5Aclose(attr);
+    H5Sclose(space);
+  }
+  H5Tclose(str);
+  const long long step = d.step, next = d.next_id;
+  ok = ok && write_attribute(f.id(), "time", H5T_NATIVE_DOUBLE, d.time) &&
+       write_attribute(f.id(), "dt", H5T_NATIVE_DOUBLE, d.dt) &&
+       write_attribute(f.id(), "step", H5T_NATIVE_LLONG, step) &&
+       write_attribute(f.id(), "next_id", H5T_NATIVE_LLONG, next);
+  std::vector<long long> ids(p.id.begin(), p.id.end());
+  std::vector<int> mats(p.material.begin(), p.material.end());
+  auto flat = [](const std::vector<Vec3>& v) {
+    std::vector<double> out;
+    out.reserve(3 * v.size());
+    for (const Vec3& x : v) out.insert(out.end(), {x[0], x[1], x[2]});
+    return out;
+  };
+  const hid_t g = H5Gcreate2(f.id(), "particles", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  ok = ok && g >= 0 && write_array(g, "id", H5T_NATIVE_LLONG, n, 1, ids.data()) &&
+       write_array(g, "position", H5T_NATIVE_DOUBLE, n, 3, flat(p.x).data()) &&
+       write_array(g, "velocity", H5T_NATIVE_DOUBLE, n, 3, flat(p.v).data()) &&
+       write_array(g, "angular_velocity", H5T_NATIVE_DOUBLE, n, 3, flat(p.omega).data()) &&
+       write_array(g, "force", H5T_NATIVE_DOUBLE, n, 3, flat(p.force).data()) &&
+       write_array(g, "torque", H5T_NATIVE_DOUBLE, n, 3, flat(p.torque).data()) &&
+       write_array(g, "radius", H5T_NATIVE_DOUBLE, n, 1, p.radius.data()) &&
+       write_array(g, "mass", H5T_NATIVE_DOUBLE, n, 1, p.mass.data()) &&
+       write_array(g, "inertia", H5T_NATIVE_DOUBLE, n, 1, p.inertia.data()) &&
+       write_array(g, "material", H5T_NATIVE_INT, n, 1, mats.data());
+  if (g >= 0) H5Gclose(g);
+  std::vector<long long> a(m), b(m);
+  std::vector<Vec3> t(m), r(m);
+  for (std::size_t k = 0; k < m; ++k) {
+    a[k] = d.springs[k].particle;
+    b[k] = d.springs[k].partner;
+    t[k] = d.springs[k].tangential;
+    r[k] = d.springs[k].rolling;
+  }
+  const hid_t s = H5Gcreate2(f.id(), "springs", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  ok = ok && s >= 0 && write_array(s, "particle", H5T_NATIVE_LLONG, m, 1, a.data()) &&
+       write_array(s, "partner", H5T_NATIVE_LLONG, m, 1, b.data()) &&
+       write_array(s, "tangential", H5T_NATIVE_DOUBLE, m, 3, flat(t).data()) &&
+       write_array(s, "rolling", H5T_NATIVE_DOUBLE, m, 3, flat(r).data());
+  if (s >= 0) H5Gclose(s);
+  ok = f.close() && ok;
+  return ok ? "" : "an HDF5 write failed (disk full or quota?)";
+}
+
+template <class T>
+std::vector<T> read_array(hid_t loc, const char* name, hid_t type, std::size_t cols,
+                          std::size_t& rows, std::string& error) {
+  std::vector<T> out;
+  if (!error.empty()) return out;
+  const hid_t set = H5Dopen2(loc, name, H5P_DEFAULT);
+  if (set < 0) {
+    error = std::string("dataset '") + name + "' is missing";
+    return out;
+  }
+  const hid_t space = H5Dget_space(set);
+  hsize_t dims[2] = {0, 0};
+  const int rank = H5Sget_simple_extent_dims(space, dims, nullptr);
+  if (rank < 1 || (cols > 1 && (rank != 2 || dims[1] != cols)) || (cols == 1 && rank != 1)) {
+    error = std::string("dataset '") + name + "' has the wrong shape";
+  } else if (rows != static_cast<std::size_t>(-1) && dims[0] != rows) {
+    error = std::string("dataset '") + name + "' has " + std::to_string(dims[0]) +
+            " rows, expected " + std::to_string(rows);
+  } else {
+    rows = dims[0];
+    out.resize(rows * cols);
+    if (rows > 0 && H5Dread(set, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()) < 0)
+      error = std::string("dataset '") + name + "' cannot be read";
+  }
+  H5Sclose(space);
+  H5Dclose(set);
+  return out;
+}
+
+}  // namespace
+
+void write_checkpoint(MPI_Comm comm, const std::string& path, const CheckpointData& local) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  const std::vector<double> mine = pack(local);
+  int count = static_cast<int>(mine.size());
+  std::vector<int> counts(size), displs(size);
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm);
+  std::vector<double> all;
+  if (rank == 0) {
+    long total = 0;
+    for (int r = 0; r < size; ++r) {
+      displs[r] = static_cast<int>(total);
+      total += counts[r];
+    }
+    all.resize(total);
+  }
+  MPI_Gatherv(mine.data(), count, MPI_DOUBLE, all.data(), counts.data(), displs.data(),
+              MPI_DOUBLE, 0, comm);
+  std::string error;
+  if (rank == 0) {
+    CheckpointData d;
+    d.time = local.time;
+    d.dt = local.dt;
+    d.step = local.step;
+    d.next_id = local.next_id;
+    for (int r = 0; r < size; ++r) unpack(all.data() + displs[r], counts[r], d);
+    const std::string part = path + ".part";
+    H5E_auto2_t old_func;
+    void* old_data;
+    H5Eget_auto2(H5E_DEFAULT, &old_func, &old_data);
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+    error = write_file(part, d);
+    H5Eset_auto2(H5E_DEFAULT, old_func, old_data);
+    std::error_code ec;
+    if (error.empty()) std::filesystem::rename(part, path, ec);
+    if (error.empty() && ec) error = "cannot rename " + part + ": " + ec.message();
+    if (!error.empty()) std::filesystem::remove(part, ec);
+  }
+  int length = static_cast<int>(error.size());
+  MPI_Bcast(&length, 1, MPI_INT, 0, comm);
+  error.resize(length);
+  MPI_Bcast(error.data(), length, MPI_CHAR, 0, comm);
+  if (!error.empty())
+    throw OutputError("cannot write checkpoint '" + path + "': " + error +
+                      "; the previous checkpoint, if any, is untouched");
+}
+
+CheckpointData read_checkpoint(const std::string& path) {
+  H5E_auto2_t old_func;
+  void* old_data;
+  H5Eget_auto2(H5E_DEFAULT, &old_func, &old_data);
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  CheckpointData d;
+  std::string error;
+  const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (f < 0) {
+    error = "cannot open it as an HDF5 file";
+  } else {
+    auto attr = [&](const char* name, hid_t type, void* out) {
+      if (!error.empty()) return;
+      const hid_t a = H5Aopen(f, name, H5P_DEFAULT);
+      if (a < 0 || H5Aread(a, type, out) < 0) error = std::string("attribute '") + name + "' is missing";
+      if (a >= 0) H5Aclose(a);
+    };
+    long long step = 0, next = 1;
+    attr("time", H5T_NATIVE_DOUBLE, &d.time);
+    attr("dt", H5T_NATIVE_DOUBLE, &d.dt);
+    attr("step", H5T_NATIVE_LLONG, &step);
+    attr("next_id", H5T_NATIVE_LLONG, &next);
+    d.step = step;
+    d.next_id = next;
+    if (error.empty() && H5Aexists(f, "format") <= 0) error = "it is not a grainflow checkpoint";
+    std::size_t n = static_cast<std::size_t>(-1), m = static_cast<std::size_t>(-1);
+    const hid_t g = error.empty() ? H5Gopen2(f, "particles", H5P_DEFAULT) : -1;
+    if (error.empty() && g < 0) error = "group 'particles' is missing";
+    const auto ids = read_array<long long>(g, "id", H5T_NATIVE_LLONG, 1, n, error);
+    const auto x = read_array<double>(g, "position", H5T_NATIVE_DOUBLE, 3, n, error);
+    const auto v = read_array<double>(g, "velocity", H5T_NATIVE_DOUBLE, 3, n, error);
+    const auto w = read_array<double>(g, "angular_velocity", H5T_NATIVE_DOUBLE, 3, n, error);
+    const auto force = read_array<double>(g, "force", H5T_NATIVE_DOUBLE, 3, n, error);
+    const auto torque = read_array<double>(g, "torque", H5T_NATIVE_DOUBLE, 3, n, error);
+    const auto r = read_array<double>(g, "radius", H5T_NATIVE_DOUBLE, 1, n, error);
+    const auto mass = read_array<double>(g, "mass", H5T_NATIVE_DOUBLE, 1, n, error);
+    const auto inertia = read_array<double>(g, "inertia", H5T_NATIVE_DOUBLE, 1, n, error);
+    const auto mat = read_array<int>(g, "material", H5T_NATIVE_INT, 1, n, error);
+    if (g >= 0) H5Gclose(g);
+    const hid_t s = error.empty() ? H5Gopen2(f, "springs", H5P_DEFAULT) : -1;
+    if (error.empty() && s < 0) error = "group 'springs' is missing";
+    const auto a = read_array<long long>(s, "particle", H5T_NATIVE_LLONG, 1, m, error);
+    const auto b = read_array<long long>(s, "partner", H5T_NATIVE_LLONG, 1, m, error);
+    const auto t = read_array<double>(s, "tangential", H5T_NATIVE_DOUBLE, 3, m, error);
+    const auto ro = read_array<double>(s, "rolling", H5T_NATIVE_DOUBLE, 3, m, error);
+    if (s >= 0) H5Gclose(s);
+    H5Fclose(f);
+    if (error.empty()) {
+      for (std::size_t i = 0; i < n; ++i) {
+        d.particles.add_raw(ids[i], Vec3(x[3 * i], x[3 * i + 1], x[3 * i + 2]),
+                            Vec3(v[3 * i], v[3 * i + 1], v[3 * i + 2]),
+                            Vec3(w[3 * i], w[3 * i + 1], w[3 * i + 2]), r[i], mass[i], inertia[i],
+                            mat[i]);
+        d.particles.force.back() = Vec3(force[3 * i], force[3 * i + 1], force[3 * i + 2]);
+        d.particles.torque.back() = Vec3(torque[3 * i], torque[3 * i + 1], torque[3 * i + 2]);
+      }
+      for (std::size_t k = 0; k < m; ++k)
+        d.springs.push_back({a[k], b[k], Vec3(t[3 * k], t[3 * k + 1], t[3 * k + 2]),
+                             Vec3(ro[3 * k], ro[3 * k + 1], ro[3 * k + 2])});
+    }
+  }
+  H5Eset_auto2(H5E_DEFAULT, old_func, old_data);
+  if (!error.empty()) throw OutputError("cannot read checkpoint '" + path + "': " + error);
+  return d;
+}
+
+}  // namespace grainflow

@@ -1,0 +1,49 @@
+#pragma once
+// Checkpoints: the complete dynamic state of a run — every particle's state and
+// every contact spring — in one HDF5 file that any number of ranks can read back.
+//
+// write_checkpoint gathers the ranks' parts on rank 0, which writes
+// <path>.part and renames it to <path> once complete, so a crash mid-write never
+// leaves a truncated checkpoint under the final name. read_checkpoint lets every
+// rank read the whole file; the engine then keeps what each rank owns.
+//
+// Layout: attributes format ("grainflow-checkpoint-1"), time, dt, step, next_id;
+// /particles/{id, position, velocity, angular_velocity, force, torque, radius, mass,
+// inertia, material} — force and torque are those of the step's end, which the next
+// velocity-Verlet half kick uses (recomputing them would advance the springs twice); /springs/{particle, partner, tangential, rolling}, where a wall spring
+// has partner = -1 - wall index. A pair's spring may be listed once per partner.
+#include <mpi.h>
+
+#include <string>
+#include <vector>
+
+#include "dem/core/particles.hpp"
+#include "dem/io/output_directory.hpp"
+
+namespace grainflow {
+
+struct CheckpointSpring {
+  GlobalId particle;
+  GlobalId partner;  // global id of the other particle, or -1 - wall index
+  Vec3 tangential;
+  Vec3 rolling;
+};
+
+struct CheckpointData {
+  double time = 0;
+  double dt = 0;
+  long step = 0;
+  GlobalId next_id = 1;
+  Particles particles;
+  std::vector<CheckpointSpring> springs;
+};
+
+// Collective. `local` holds this rank's particles and springs; time, dt, step and
+// next_id are taken from rank 0. Throws OutputError (on every rank) on failure.
+void write_checkpoint(MPI_Comm comm, const std::string& path, const CheckpointData& local);
+
+// Reads the whole checkpoint (not collective). Throws OutputError naming the file
+// and what is wrong with it.
+CheckpointData read_checkpoint(const std::string& path);
+
+}  // namespace grainflow
