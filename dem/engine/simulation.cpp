@@ -258,6 +258,15 @@ void Simulation::balance_cuts() {
                                     decomp_->hi() + Vec3::Constant(cutoff_), cutoff_);
 }
 
+void Simulation::set_cut_planes(int axis, const std::vector<double>& planes) {
+  try {
+    decomp_->set_cuts(axis, planes);
+  } catch (const std::invalid_argument& e) {
+    throw SetupError(scene_.file + ": error: cut planes along " + std::string(1, "xyz"[axis]) +
+                     ": " + e.what());
+  }
+}
+
 void Simulation::restore(const CheckpointData& checkpoint) {
   p_ = checkpoint.particles;
   time_ = checkpoint.time;

@@ -67,6 +67,10 @@ class Simulation {
   void add_force_term(std::unique_ptr<ForceTerm> term) { terms_.push_back(std::move(term)); }
   const ImplicitDrag& implicit_drag() const { return drag_; }
 
+  // Imposes non-uniform cut planes along one axis (e.g. from a mesh decomposition);
+  // call before initialise(). Throws SetupError when they do not fit the grid.
+  void set_cut_planes(int axis, const std::vector<double>& planes);
+
   // Continues from a checkpoint: call before initialise() with the whole checkpoint
   // on every rank (read_checkpoint); each rank keeps what it owns, springs included.
   // The scene must be the one the checkpoint was written with.

@@ -22,10 +22,12 @@
 namespace grainflow {
 namespace {
 
-std::vector<test::State> run_on(int ranks, std::array<int, 3> grid) {
+std::vector<test::State> run_on(int ranks, std::array<int, 3> grid,
+                                const std::vector<double>& x_cuts = {}) {
   MPI_Comm comm = test::first_ranks(ranks);
   if (comm == MPI_COMM_NULL) return {};
   Simulation sim(test::gas_scene(), true, comm, grid);
+  if (!x_cuts.empty()) sim.set_cut_planes(0, x_cuts);
   test::stir(sim);
   sim.set_dt(2e-6);
   sim.initialise();
@@ -45,18 +47,23 @@ TEST(RankCountInvariance, OneTwoFourRanksAgree) {
   const auto four = run_on(4, {2, 2, 1});
   const auto two = run_on(2, {2, 1, 1});
   const auto one = run_on(1, {1, 1, 1});
+  const auto uneven = run_on(2, {2, 1, 1}, {0.0, 0.009, 0.03});  // non-uniform cut plane
   if (rank != 0) return;
   ASSERT_EQ(one.size(), 2000u);
   ASSERT_EQ(two.size(), one.size());
   ASSERT_EQ(four.size(), one.size());
+  ASSERT_EQ(uneven.size(), one.size());
   for (std::size_t i = 0; i < one.size(); ++i) {
     ASSERT_EQ(two[i].id, one[i].id);
     ASSERT_EQ(four[i].id, one[i].id);
   }
   const double d2 = test::largest_difference(one, two, 0.03, 0.5, 0.6e-3);
   const double d4 = test::largest_difference(one, four, 0.03, 0.5, 0.6e-3);
-  std::printf("largest relative difference to 1 rank: 2 ranks %.3e, 4 ranks %.3e\n", d2, d4);
+  const double du = test::largest_difference(one, uneven, 0.03, 0.5, 0.6e-3);
+  std::printf("largest relative difference to 1 rank: 2 ranks %.3e, 4 ranks %.3e, "
+              "2 ranks cut at 30 %% %.3e\n", d2, d4, du);
   EXPECT_LT(d2, 1e-9);
+  EXPECT_LT(du, 1e-9);
   EXPECT_LT(d4, 1e-9);
 }
 
