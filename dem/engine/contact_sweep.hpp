@@ -18,8 +18,28 @@
 #include "dem/neighbour/verlet_list.hpp"
 #include "dem/parallel/ghosts.hpp"
 #include "dem/scene/scene.hpp"
+#include "dem/walls/wall_set.hpp"
 
 namespace grainflow {
+
+// The contact with the largest overlap ratio of a sweep, for the overlap guard.
+struct WorstContact {
+  GlobalId a = -1, b = -1;  // particle ids; b = -1 for a wall
+  double speed = 0;         // normal approach speed [m/s]
+  double r_star = 0, m_star = 0, y_star = 0;
+  // Records the contact if it beats the current maximum of `ratio`.
+  void consider(double overlap_ratio, double& ratio, GlobalId ia, GlobalId ib, double vn,
+                double rs, double ms, double ys) {
+    if (overlap_ratio <= ratio) return;
+    ratio = overlap_ratio;
+    a = ia;
+    b = ib;
+    speed = vn;
+    r_star = rs;
+    m_star = ms;
+    y_star = ys;
+  }
+};
 
 struct ContactSweep {
   Particles& p;
@@ -28,7 +48,7 @@ struct ContactSweep {
   const NeighbourList& ghost_list;
   std::vector<ContactHistory>& local_history;              // parallel to local_list.j
   std::vector<ContactHistory>& ghost_history;              // parallel to ghost_list.j
-  const std::vector<Wall>& walls;
+  const WallSet& walls;  // current wall positions (dem/walls/wall_set.hpp)
   std::vector<std::vector<ContactHistory>>& wall_history;  // [wall][particle]
   const PairTable& table;
   const ContactConstants& constants;
@@ -36,6 +56,7 @@ struct ContactSweep {
   // results of the sweep
   long contacts = 0;             // each contact once over all ranks
   double max_overlap_ratio = 0;  // overlap / smaller radius
+  WorstContact worst;            // the contact with that overlap
 };
 
 using SweepFunction = void (*)(ContactSweep&);

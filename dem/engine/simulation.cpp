@@ -131,6 +131,7 @@ void Simulation::initialise() {
                                     decomp_->hi() + Vec3::Constant(cutoff_), cutoff_);
   wall_history_.assign(walls_.history_columns(), std::vector<ContactHistory>(p_.size()));
   walls_.move_to(time_);
+  walls_.fit_grids(r_max);  // mesh search cells of one particle diameter
   const bool restoring = restored_;
   mark_leaving();
   rebuild();
@@ -327,13 +328,43 @@ void Simulation::compute_forces() {
     p_.force[i] = p_.mass[i] * g;
     p_.torque[i].setZero();
   }
-  ContactSweep s{p_,          ghosts_,        local_list_,   ghost_list_, local_history_,
-                 ghost_history_, walls_,       wall_history_, table_,      constants_,
-                 dt_};
+  ContactSweep s{p_,     ghosts_,        local_list_, ghost_list_, local_history_, ghost_history_,
+                 walls_, wall_history_, table_,      constants_,  dt_,           0,
+                 0.0,    WorstContact{}};
   sweep_.run(s);
   counters_.contacts = s.contacts;
   counters_.max_overlap_ratio = s.max_overlap_ratio;
+  check_overlap(s.worst);
   apply_force_terms();
+}
+
+void Simulation::check_overlap(const WorstContact& w) const {
+  // Collective only when some rank is beyond the limit, which every rank learns
+  // through the same reduction: keep the common path free of communication.
+  const double limit = scene_.time.max_overlap;
+  double worst = counters_.max_overlap_ratio;
+  if (decomp_->size() > 1) MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPI_DOUBLE, MPI_MAX, comm_);
+  if (worst <= limit) return;
+  std::string message;
+  if (counters_.max_overlap_ratio == worst) {
+    const double v = std::max(w.speed, 1e-12);
+    const double tc = hertz_contact_time(w.y_star, w.r_star, w.m_star, v);
+    std::ostringstream o;
+    o.precision(4);
+    o << scene_.file << ": error: t = " << time_ << " s (step " << counters_.steps + 1 << "): ";
+    if (w.b >= 0)
+      o << "particles " << w.a << " and " << w.b;
+    else
+      o << "particle " << w.a << " and a wall";
+    o << " overlap by " << 100 * worst << " % of the smaller radius (limit "
+      << 100 * limit << " %, key time.max_overlap), approaching at " << w.speed
+      << " m/s: the time step dt = " << dt_ << " s is too large to resolve this impact. A step of "
+      << "at most " << tc / 20 << " s would (1/20 of the Hertz contact time at that speed); "
+      << "lower time.step or time.rayleigh_fraction, or raise time.expected_max_speed so that "
+      << "grain check warns about it";
+    message = o.str();
+  }
+  agree_on_error(comm_, message);  // the rank holding the worst contact speaks
 }
 
 void Simulation::apply_force_terms() {

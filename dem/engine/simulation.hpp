@@ -115,6 +115,9 @@ class Simulation {
   void balance_cuts();  // moves cut planes toward equal particle counts (collective)
   void compute_forces();     // gravity, contacts, then the force terms
   void apply_force_terms();  // non-contact terms only
+  // Stops the run (ParallelError on every rank) when a contact overlaps beyond
+  // time.max_overlap, naming the contact and a time step that would resolve it.
+  void check_overlap(const WorstContact& worst) const;
   bool needs_rebuild() const;  // collective
   void mark_leaving();         // particles beyond a bounded side of the domain
   void half_kick();            // v += dt/2 F/m (implicit in v where drag is set), same for spin

@@ -52,3 +52,8 @@ grain_cli_test(runs_on_two_ranks 0 "MPI ranks: 2 as a;done: [0-9]+ steps, 300 pa
                WORKDIR ${_work}/two_ranks
                FILES out/particles.xdmf out/log.csv out/particles_000010.h5)
 set_tests_properties(grain.runs_on_two_ranks PROPERTIES PROCESSORS 2)
+grain_cli_test(overlap_guard_stops_run 1
+               "particle [0-9]+ and a wall overlap by [0-9.]+ % of the smaller radius"
+               CMD ${_grain} run ${_scenes}/bad/huge_time_step.yaml --allow-large-dt --no-progress
+                   --output out
+               WORKDIR ${_work}/overlap_guard)
