@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "dem/engine/simulation.hpp"
 #include "tests/dem/support/test_scene.hpp"
@@ -52,6 +53,8 @@ TEST_P(GrossSliding, MatchesRigidBodyImpulse) {
   const Rebound out = oblique(GetParam(), e, mu, vn, vt);
   const double vt_ref = vt - mu * (1 + e) * vn;
   const double w_ref = 2.5 / r * mu * (1 + e) * vn;
+  std::printf("rebound / rigid-body impulse: tangential %.4f, spin %.4f, normal %.4f\n",
+              out.v[0] / vt_ref, out.omega[1] / w_ref, out.v[2] / (e * vn));
   EXPECT_NEAR(out.v[0] / vt_ref, 1.0, 0.02);
   // Friction at the bottom point acts along -x, so the spin is about -y... the torque
   // (-r e_z) x (-F e_x) = r F e_y: positive y, making the sphere roll forward.
