@@ -8,6 +8,7 @@
 #include <ostream>
 
 #include "dem/engine/simulation.hpp"
+#include "dem/fluid/fluid_forces.hpp"
 #include "dem/io/log_table.hpp"
 #include "dem/io/output_directory.hpp"
 #include "dem/io/progress_line.hpp"
@@ -43,6 +44,7 @@ void print_report(const Simulation& sim, MPI_Comm comm, std::ostream& out) {
     o << "MPI ranks: " << d.size() << " as a " << d.dims()[0] << " x " << d.dims()[1] << " x "
       << d.dims()[2] << " grid\n";
   for (const std::string& note : sim.time_step_report().notes) o << note << "\n";
+  for (const std::string& note : sim.walls().notes()) o << note << "\n";  // meshes read
 }
 
 }  // namespace
@@ -66,6 +68,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   std::ostream& say = speaker(comm, out);
 
   Simulation sim(scene, true, comm);
+  if (scene.fluid) sim.add_force_term(make_fluid_forces(*scene.fluid, scene.gravity));
   sim.initialise();
   print_report(sim, comm, out);
   if (sim.time_step_report().verdict == TimeStepReport::Verdict::refuse &&

@@ -2,18 +2,54 @@
 // Particle-wall part of the contact sweep (see contact_sweep.hpp): one loop per
 // wall, with the wall kind chosen outside the particle loop. Included only by
 // contact_sweep.cpp, where each contact law is instantiated.
+//
+// Walls may move (WallSet, wall_motion.hpp): the wall's velocity at the contact
+// point enters the relative velocity. Meshes are searched in their body frame.
 #include <algorithm>
 #include <cmath>
 
 #include "dem/contact/contact_law.hpp"
 #include "dem/engine/contact_sweep.hpp"
 #include "dem/walls/wall_contact.hpp"
+#include "dem/walls/wall_set.hpp"
 
 namespace grainflow {
 
+// Evaluates one particle-wall contact and adds its force and torque to particle i.
+template <class Law>
+void apply_wall_contact(ContactSweep& s, std::size_t i, const WallTouch& t, int material,
+                        ContactHistory& h) {
+  Particles& p = s.p;
+  ContactGeometry g;
+  g.n = t.n;
+  g.overlap = t.overlap;
+  g.distance = p.radius[i] - t.overlap;
+  g.r_i = p.radius[i];
+  g.r_j = 0;
+  g.arm_i = g.distance;
+  g.arm_j = 0;
+  g.r_star = p.radius[i];
+  g.m_star = p.mass[i];
+  g.wall = true;
+  if constexpr (Law::needs_spin) {
+    g.v_rel = p.v[i] - t.surface_velocity - g.arm_i * p.omega[i].cross(g.n);
+    g.w_rel = p.omega[i];
+  } else {
+    g.v_rel = p.v[i] - t.surface_velocity;
+  }
+  if constexpr (Law::needs_roll_inertia)
+    g.roll_inertia = p.inertia[i] + p.mass[i] * p.radius[i] * p.radius[i];
+  const ContactResult r = Law::evaluate(g, s.table(p.material[i], material), s.constants, h, s.dt);
+  p.force[i] += r.force;
+  if constexpr (Law::needs_spin) p.torque[i] += r.torque_i;
+  ++s.contacts;
+  s.worst.consider(g.overlap / p.radius[i], s.max_overlap_ratio, p.id[i], -1, -g.v_rel.dot(g.n),
+                   g.r_star, g.m_star, s.table(p.material[i], material).y_star);
+}
+
 template <class Law, class Touch>
-void wall_sweep_one(ContactSweep& s, const Wall& wall, std::vector<ContactHistory>& history,
-                Touch touch) {
+void wall_sweep_one(ContactSweep& s, const WallSet::Entry& wall,
+                    std::vector<ContactHistory>& history, Touch touch) {
   Particles& p = s.p;
   ContactHistory unused;
   for (std::size_t i = 0; i < p.size(); ++i) {
@@ -22,49 +58,87 @@ void wall_sweep_one(ContactSweep& s, const Wall& wall, std::vector<ContactHistor
       if constexpr (Law::has_history) history[i] = ContactHistory{};
       continue;
     }
-    ContactGeometry g;
-    g.n = t.n;
-    g.overlap = t.overlap;
-    g.distance = p.radius[i] - t.overlap;
-    g.r_i = p.radius[i];
-    g.r_j = 0;
-    g.arm_i = g.distance;
-    g.arm_j = 0;
-    g.r_star = p.radius[i];
-    g.m_star = p.mass[i];
-    g.wall = true;
-    if constexpr (Law::needs_spin) {
-      g.v_rel = p.v[i] - t.surface_velocity - g.arm_i * p.omega[i].cross(g.n);
-      g.w_rel = p.omega[i];
-    } else {
-      g.v_rel = p.v[i] - t.surface_velocity;
+    if (wall.pose.moving())
+      t.surface_velocity += wall.pose.velocity_at(p.x[i] - (p.radius[i] - t.overlap) * t.n);
+    apply_wall_contact<Law>(s, i, t, wall.material, Law::has_history ? history[i] : unused);
+  }
+}
+
+// A mesh: every contact of the particle with the mesh (one per touching feature,
+// triangle_mesh.hpp), each with the history slot whose key normal matches it.
+template <class Law>
+void mesh_sweep(ContactSweep& s, const WallSet::Entry& wall, const TriangleMesh& mesh) {
+  constexpr int kSlots = WallSet::kMeshSlots;
+  Particles& p = s.p;
+  const bool moving = wall.pose.moving();
+  const bool conveyor = wall.surface_velocity.squaredNorm() > 0;
+  const Vec3 belt = wall.pose.direction_to_world(wall.surface_velocity);
+  MeshTouch touch[TriangleMesh::kMaxTouches];
+  ContactHistory scratch;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double r = p.radius[i];
+    const int n = mesh.touches(moving ? wall.pose.to_body(p.x[i]) : p.x[i], r, touch);
+    bool used[kSlots] = {};
+    for (int k = 0; k < n; ++k) {
+      WallTouch t;
+      t.n = moving ? wall.pose.direction_to_world(touch[k].n) : touch[k].n;
+      t.overlap = touch[k].overlap;
+      t.surface_velocity.setZero();
+      if (moving) t.surface_velocity = wall.pose.velocity_at(p.x[i] - (r - t.overlap) * t.n);
+      if (conveyor) t.surface_velocity += belt - belt.dot(t.n) * t.n;
+      ContactHistory* h = &scratch;
+      if constexpr (Law::has_history) {
+        int best = -1;
+        double best_cos = WallSet::kSlotMatchCosine;
+        for (int j = 0; j < kSlots; ++j) {
+          const Vec3& key = s.wall_history[wall.column + 2 * j + 1][i].tangential;
+          if (!used[j] && key.dot(t.n) > best_cos) {
+            best = j;
+            best_cos = key.dot(t.n);
+          }
+        }
+        for (int j = 0; j < kSlots && best < 0; ++j)
+          if (!used[j] && s.wall_history[wall.column + 2 * j + 1][i].tangential.isZero(0))
+            best = j;
+        for (int j = 0; j < kSlots && best < 0; ++j)  // stale key of an older contact
+          if (!used[j]) best = j;
+        if (best >= 0) {
+          used[best] = true;
+          s.wall_history[wall.column + 2 * best + 1][i].tangential = t.n;
+          h = &s.wall_history[wall.column + 2 * best][i];
+        } else {
+          scratch = ContactHistory{};  // more contacts than slots: no memory
+        }
+      }
+      apply_wall_contact<Law>(s, i, t, wall.material, *h);
     }
-    if constexpr (Law::needs_roll_inertia)
-      g.roll_inertia = p.inertia[i] + p.mass[i] * p.radius[i] * p.radius[i];
-    ContactHistory& h = Law::has_history ? history[i] : unused;
-    const ContactResult r =
-        Law::evaluate(g, s.table(p.material[i], wall.material), s.constants, h, s.dt);
-    p.force[i] += r.force;
-    if constexpr (Law::needs_spin) p.torque[i] += r.torque_i;
-    ++s.contacts;
-    s.max_overlap_ratio = std::max(s.max_overlap_ratio, g.overlap / p.radius[i]);
+    if constexpr (Law::has_history)
+      for (int j = 0; j < kSlots; ++j)
+        if (!used[j]) {
+          s.wall_history[wall.column + 2 * j][i] = ContactHistory{};
+          s.wall_history[wall.column + 2 * j + 1][i] = ContactHistory{};
+        }
   }
 }
 
 template <class Law>
 void wall_sweep(ContactSweep& s) {
-  for (std::size_t w = 0; w < s.walls.size(); ++w) {
-    const Wall& wall = s.walls[w];
-    if (wall.kind == Wall::Kind::plane)
-      wall_sweep_one<Law>(s, wall, s.wall_history[w],
-                          [&wall](const Vec3& x, double r, WallTouch& t) {
-                            return touch_plane(wall.plane, x, r, t);
-                          });
-    else
-      wall_sweep_one<Law>(s, wall, s.wall_history[w],
-                          [&wall](const Vec3& x, double r, WallTouch& t) {
-                            return touch_cylinder(wall.cylinder, x, r, t);
-                          });
+  for (const WallSet::Entry& wall : s.walls.walls()) {
+    switch (wall.kind) {
+      case Wall::Kind::plane:
+        wall_sweep_one<Law>(s, wall, s.wall_history[wall.column],
+                            [&wall](const Vec3& x, double r, WallTouch& t) {
+                              return touch_plane(wall.plane, x, r, t);
+                            });
+        break;
+      case Wall::Kind::cylinder:
+        wall_sweep_one<Law>(s, wall, s.wall_history[wall.column],
+                            [&wall](const Vec3& x, double r, WallTouch& t) {
+                              return touch_cylinder(wall.cylinder, x, r, t);
+                            });
+        break;
+      case Wall::Kind::mesh: mesh_sweep<Law>(s, wall, s.walls.mesh(wall)); break;
+    }
   }
 }
 

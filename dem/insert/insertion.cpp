@@ -7,6 +7,7 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "dem/io/snapshot_reader.hpp"
 #include "dem/walls/wall_contact.hpp"
 
 namespace grainflow {
@@ -144,15 +145,16 @@ bool overlaps_with_images(const OverlapGrid& grid, const Domain& d, const Vec3& 
   return false;
 }
 
-bool touches_a_wall(const Scene& s, const Vec3& x, double r) {
+bool touches_a_wall(const Scene& s, const WallSet* walls, const Vec3& x, double r) {
+  if (walls) return walls->touches_any(x, r);
   WallTouch t;
   for (const Wall& w : s.walls)
     if (touch_wall(w, x, r, t)) return true;
   return false;
 }
 
-void fill_region(const Scene& scene, const Insertion& ins, Particles& p, GlobalId& next_id,
-                 OverlapGrid& grid) {
+void fill_region(const Scene& scene, const WallSet* walls, const Insertion& ins, Particles& p,
+                 GlobalId& next_id, OverlapGrid& grid) {
   std::mt19937_64 rng(ins.seed);
   const double density = scene.materials[ins.material].density;
   const double target_volume =
@@ -176,7 +178,7 @@ void fill_region(const Scene& scene, const Insertion& ins, Particles& p, GlobalI
     const double r = sample_radius(ins.radius, rng);
     Vec3 x;
     if (!sample_centre(ins.region, r, rng, x)) continue;
-    if (!inside_domain(scene.domain, x, r) || touches_a_wall(scene, x, r) ||
+    if (!inside_domain(scene.domain, x, r) || touches_a_wall(scene, walls, x, r) ||
         overlaps_with_images(grid, scene.domain, x, r))
       continue;
     grid.add(x, r);
@@ -254,9 +256,42 @@ void read_csv(const Scene& scene, const Insertion& ins, Particles& p, GlobalId& 
   }
 }
 
+void read_snapshot_entry(const Scene& scene, const Insertion& ins, Particles& p,
+                         GlobalId& next_id, OverlapGrid& grid) {
+  Snapshot snap;
+  try {
+    snap = read_snapshot(ins.snapshot_file);
+  } catch (const SnapshotReadError& e) {
+    throw InsertionError(std::string(e.what()) + " (snapshot insertion at " + ins.source + ")");
+  }
+  const Particles& q = snap.particles;
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    auto fail = [&](const std::string& what) {
+      throw InsertionError(ins.source + ": error: particle id " + std::to_string(q.id[i]) +
+                           " of snapshot '" + ins.snapshot_file + "' " + what);
+    };
+    if (q.material[i] < 0 || q.material[i] >= static_cast<int>(scene.materials.size()))
+      fail("has material index " + std::to_string(q.material[i]) + " but the scene has " +
+           std::to_string(scene.materials.size()) +
+           " materials; list the materials in the same order as in the scene that wrote it");
+    if (!inside_domain(scene.domain, q.x[i], q.radius[i]))
+      fail("lies outside the domain (or crosses a bounded side)");
+    // Touching neighbours of a settled bed overlap slightly: only particles of
+    // earlier entries are checked (the grid holds this snapshot's only afterwards).
+    if (overlaps_with_images(grid, scene.domain, q.x[i], q.radius[i]))
+      fail("overlaps a particle of an earlier insertion entry");
+  }
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    grid.add(q.x[i], q.radius[i]);
+    const Vec3 v = ins.keep_velocity ? q.v[i] : Vec3::Zero();
+    const Vec3 w = ins.keep_velocity ? q.omega[i] : Vec3::Zero();
+    p.add_raw(next_id++, q.x[i], v, w, q.radius[i], q.mass[i], q.inertia[i], q.material[i]);
+  }
+}
+
 }  // namespace
 
-void insert_particles(const Scene& scene, Particles& p, GlobalId& next_id) {
+void insert_particles(const Scene& scene, Particles& p, GlobalId& next_id, const WallSet* walls) {
   double r_max = 0;
   for (std::size_t i = 0; i < p.size(); ++i) r_max = std::max(r_max, p.radius[i]);
   for (const Insertion& ins : scene.insertions)
@@ -266,10 +301,12 @@ void insert_particles(const Scene& scene, Particles& p, GlobalId& next_id) {
   OverlapGrid grid(r_max > 0 ? 2 * r_max : (scene.domain.hi - scene.domain.lo).minCoeff() / 50);
   for (std::size_t i = 0; i < p.size(); ++i) grid.add(p.x[i], p.radius[i]);
   for (const Insertion& ins : scene.insertions) {
-    if (ins.kind == Insertion::Kind::fill)
-      fill_region(scene, ins, p, next_id, grid);
-    else
-      read_csv(scene, ins, p, next_id, grid);
+    switch (ins.kind) {
+      case Insertion::Kind::fill: fill_region(scene, walls, ins, p, next_id, grid); break;
+      case Insertion::Kind::csv: read_csv(scene, ins, p, next_id, grid); break;
+      case Insertion::Kind::snapshot: read_snapshot_entry(scene, ins, p, next_id, grid); break;
+      case Insertion::Kind::stream: break;  // during the run: StreamInsertion
+    }
   }
 }
 

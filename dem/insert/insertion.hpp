@@ -7,6 +7,7 @@
 
 #include "dem/core/particles.hpp"
 #include "dem/scene/scene.hpp"
+#include "dem/walls/wall_set.hpp"
 
 namespace grainflow {
 
@@ -25,6 +26,10 @@ double max_radius(const SizeDistribution& d);
 // Appends the particles of every insertion entry of the scene, ids continuing
 // from `next_id`. New particles overlap neither each other, earlier particles,
 // nor walls, and lie inside the domain.
-void insert_particles(const Scene& scene, Particles& p, GlobalId& next_id);
+// Stream entries are left to StreamInsertion; snapshot entries add the particles of
+// a grainflow HDF5 snapshot (new ids, same order). `walls`, when given, adds mesh
+// walls (and moving walls at t = 0) to the walls new particles must not touch.
+void insert_particles(const Scene& scene, Particles& p, GlobalId& next_id,
+                      const WallSet* walls = nullptr);
 
 }  // namespace grainflow

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "dem/core/types.hpp"
+#include "dem/fluid/prescribed_fluid.hpp"
 
 namespace grainflow {
 
@@ -58,6 +59,7 @@ struct TimeSettings {
   std::optional<double> rayleigh_fraction;        // dt = fraction * Rayleigh time, (0, 1]
   double end = 0;                                 // simulated end time [s] > 0
   double expected_max_speed = 1.0;                // for the Hertz contact-time check [m/s]
+  double max_overlap = 0.25;  // overlap / smaller radius that stops the run, (0, 1]
 };
 
 struct PlaneWall {
@@ -73,12 +75,33 @@ struct CylinderWall {
   double angular_velocity = 0; // surface rotation about `axis` (right hand) [rad/s]
 };
 
+// A triangle mesh read from an STL file and placed by x' = R(axis, angle)(scale x) + translate.
+struct MeshWall {
+  std::string file;                      // resolved relative to the scene file's folder
+  double scale = 1;                      // > 0
+  Vec3 rotate_axis = Vec3::UnitZ();      // unit
+  double rotate_angle = 0;               // [rad] (degrees in the scene file)
+  Vec3 translate = Vec3::Zero();
+  Vec3 surface_velocity = Vec3::Zero();  // conveyor: tangential surface speed [m/s]
+};
+
+// Prescribed rigid motion of a wall (dem/walls/wall_motion.hpp): a point x0 of the
+// wall is at P + V t + R(axis, w t)(x0 - P) at time t.
+struct WallMotion {
+  Vec3 velocity = Vec3::Zero();    // V [m/s]
+  double angular_velocity = 0;     // w [rad/s], right hand about `axis`
+  Vec3 axis_point = Vec3::Zero();  // P
+  Vec3 axis = Vec3::UnitZ();       // unit
+};
+
 struct Wall {
-  enum class Kind { plane, cylinder } kind = Kind::plane;
+  enum class Kind { plane, cylinder, mesh } kind = Kind::plane;
   std::string name;
   int material = 0;
   PlaneWall plane;
   CylinderWall cylinder;
+  MeshWall mesh;
+  WallMotion motion;
 };
 
 struct SizeDistribution {
@@ -98,8 +121,28 @@ struct Region {
   double radius = 0, height = 0;              // cylinder
 };
 
+// The planar face a stream insertion feeds particles through.
+struct InsertionFace {
+  enum class Kind { rectangle, disc } kind = Kind::rectangle;
+  Vec3 centre = Vec3::Zero();
+  Vec3 normal = Vec3::UnitZ();  // unit
+  Vec3 u = Vec3::UnitX();       // rectangle: unit direction of the side of length `length_u`
+  double length_u = 0, length_v = 0;  // rectangle sides [m]
+  double radius = 0;                  // disc [m]
+};
+
 struct Insertion {
-  enum class Kind { fill, csv } kind = Kind::fill;
+  enum class Kind { fill, csv, stream, snapshot } kind = Kind::fill;
+  // stream (dem/insert/stream_insertion.hpp): `radius`, `material`, `velocity`, `seed`
+  // as for fill; exactly one of the two rates.
+  InsertionFace face;
+  std::optional<double> mass_rate;   // [kg/s]
+  std::optional<double> count_rate;  // [1/s]
+  double start = 0;                  // [s]
+  std::optional<double> stop;        // [s]; default: the end of the run
+  // snapshot: a grainflow HDF5 snapshot (dem/io/snapshot_reader.hpp)
+  std::string snapshot_file;  // resolved relative to the scene file's folder
+  bool keep_velocity = true;  // false: particles start at rest
   // fill
   Region region;
   std::optional<long> count;              // number of particles, or
@@ -143,6 +186,7 @@ struct Scene {
   std::vector<Insertion> insertions;
   OutputSettings output;
   ParallelSettings parallel;
+  std::optional<FluidSettings> fluid;  // one-way fluid (docs/scene-reference.md, `fluid:`)
 
   int material_index(const std::string& name) const;  // -1 if absent
   const MaterialPair& pair(int a, int b) const;       // precondition: complete table

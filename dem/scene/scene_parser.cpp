@@ -1,9 +1,10 @@
 // Scene parser: YAML -> validated Scene.
 //
 // Two layers:
-//  1. A small reading layer (Field, Map, Range) that turns YAML nodes into numbers,
-//     vectors, names and model choices, checking type and range and remembering
-//     where in the file each value came from, so every error can point at it.
+//  1. A small reading layer (Field, Map, Range; dem/scene/yaml_reader.hpp) that turns
+//     YAML nodes into numbers, vectors, names and model choices, checking type and range
+//     and remembering where in the file each value came from, so every error can point
+//     at it.
 //  2. One function per scene section, which only says what the section contains.
 // The first mistake found throws a SceneError; nothing is collected or deferred.
 #include "dem/scene/scene_parser.hpp"
@@ -27,430 +28,16 @@
 #include <utility>
 #include <vector>
 
+#include "dem/scene/fluid_section.hpp"
+#include "dem/scene/yaml_reader.hpp"
+
 namespace grainflow {
 
 namespace {
 
 namespace fs = std::filesystem;
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
-// ---------------------------------------------------------------------------
-// Message helpers
-
-std::string format_number(double x) {
-  std::ostringstream s;
-  s << std::setprecision(12) << x;
-  return s.str();
-}
-
-std::string join(const std::vector<std::string>& items, std::string_view separator = ", ") {
-  std::string out;
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    if (i > 0) out += separator;
-    out += items[i];
-  }
-  return out;
-}
-
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t above = row[j];
-      const std::size_t substitute = diagonal + (a[i - 1] == b[j - 1] ? 0 : 1);
-      row[j] = std::min({above + 1, row[j - 1] + 1, substitute});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
-}
-
-// " (did you mean 'hertz'?)" when exactly one candidate is close to `given`, else "".
-std::string suggestion(std::string_view given, const std::vector<std::string>& candidates) {
-  const std::size_t limit = std::clamp<std::size_t>((given.size() + 1) / 3, 1, 3);
-  std::size_t best = limit + 1;
-  const std::string* match = nullptr;
-  bool tie = false;
-  for (const std::string& c : candidates) {
-    const std::size_t d = edit_distance(given, c);
-    if (d < best) {
-      best = d;
-      match = &c;
-      tie = false;
-    } else if (d == best) {
-      tie = true;
-    }
-  }
-  if (match == nullptr || tie) return "";
-  return " (did you mean '" + *match + "'?)";
-}
-
-// ---------------------------------------------------------------------------
-// Allowed ranges of numbers
-
-struct Range {
-  double lo = -kInf;
-  double hi = kInf;
-  bool lo_closed = true;
-  bool hi_closed = true;
-
-  bool contains(double x) const {
-    const bool above = lo_closed ? x >= lo : x > lo;
-    const bool below = hi_closed ? x <= hi : x < hi;
-    return above && below;
-  }
-
-  bool bounded() const { return lo != -kInf || hi != kInf; }
-
-  std::string describe() const {
-    if (lo != -kInf && hi != kInf)
-      return std::string("in ") + (lo_closed ? "[" : "(") + format_number(lo) + ", " +
-             format_number(hi) + (hi_closed ? "]" : ")");
-    if (lo != -kInf) return std::string(lo_closed ? ">= " : "> ") + format_number(lo);
-    if (hi != kInf) return std::string(hi_closed ? "<= " : "< ") + format_number(hi);
-    return "any number";
-  }
-};
-
-constexpr Range kAny{};
-constexpr Range kPositive{0, kInf, false, true};
-constexpr Range kNonNegative{0, kInf, true, true};
-constexpr Range kUnitOpenBelow{0, 1, false, true};  // (0, 1]
-constexpr Range kUnitClosed{0, 1, true, true};      // [0, 1]
-
-// ---------------------------------------------------------------------------
-// Reading layer
-
-// What every value needs to report an error: the file it came from.
-struct Source {
-  std::string label;  // as given by the caller; used in messages
-  fs::path folder;    // relative file names inside the scene are resolved against it
-};
-
-[[noreturn]] void raise(const Source& src, const YAML::Mark& mark, const std::string& message) {
-  // yaml-cpp marks are 0-based; ours are 1-based.
-  throw SceneError(src.label, mark.line + 1, mark.column + 1, message);
-}
-
-YAML::Mark start_of_file() {
-  YAML::Mark m;
-  m.pos = 0;
-  m.line = 0;
-  m.column = 0;
-  return m;
-}
-
-template <class E>
-struct Choice {
-  const char* name;
-  E value;
-};
-
-class Map;
-
-// One YAML value with its name in the scene ("materials[1].density") and where it is.
-class Field {
- public:
-  Field(const Source& src, YAML::Node node, std::string path, YAML::Mark key_mark)
-      : src_(&src), node_(std::move(node)), path_(std::move(path)), key_mark_(key_mark) {
-    // A missing value (`key:` alone) has no useful mark of its own; use the key's.
-    const bool has_own_mark = node_.IsDefined() && !node_.IsNull() && node_.Mark().line >= 0;
-    mark_ = has_own_mark ? node_.Mark() : key_mark_;
-  }
-
-  const Source& source() const { return *src_; }
-  const std::string& path() const { return path_; }
-  const YAML::Mark& mark() const { return mark_; }
-  const YAML::Mark& key_mark() const { return key_mark_; }
-  int line() const { return mark_.line + 1; }
-  const YAML::Node& node() const { return node_; }
-
-  // Throws at the value: "<path>: <message>".
-  [[noreturn]] void fail(const std::string& message) const {
-    raise(*src_, mark_, prefixed(message));
-  }
-  // Throws at the key that names this value (for problems with the value as a whole).
-  [[noreturn]] void fail_at_key(const std::string& message) const {
-    raise(*src_, key_mark_, prefixed(message));
-  }
-
-  double number(const Range& range = kAny) const {
-    const std::optional<double> x = as_number(node_);
-    if (!x) fail("expected a number, got " + got() + "; write a plain number such as 0.5 or 2e-3");
-    check_range(*x, range);
-    return *x;
-  }
-
-  long long integer(const Range& range) const {
-    const std::optional<double> x = as_number(node_);
-    if (!x || std::floor(*x) != *x || std::abs(*x) > 9e15)
-      fail("expected a whole number, got " + got() + "; write an integer such as 1000");
-    check_range(*x, range);
-    return static_cast<long long>(*x);
-  }
-
-  bool boolean() const {
-    bool b = false;
-    if (!node_.IsScalar() || !YAML::convert<bool>::decode(node_, b))
-      fail("expected true or false, got " + got());
-    return b;
-  }
-
-  std::string text() const {
-    if (!node_.IsScalar() || node_.Scalar().empty()) fail("expected a name or text, got " + got());
-    return node_.Scalar();
-  }
-
-  // A model or kind chosen by name from a fixed list.
-  template <class E>
-  E choice(const char* what, std::initializer_list<Choice<E>> choices) const {
-    std::vector<std::string> names;
-    for (const Choice<E>& c : choices) names.emplace_back(c.name);
-    if (!node_.IsScalar())
-      fail("expected a " + std::string(what) + " name, got " + got() + "; allowed: " + join(names));
-    for (const Choice<E>& c : choices)
-      if (node_.Scalar() == c.name) return c.value;
-    fail("unknown " + std::string(what) + " '" + node_.Scalar() + "'; allowed: " + join(names) +
-         suggestion(node_.Scalar(), names));
-  }
-
-  std::vector<Field> items() const {
-    if (!node_.IsSequence())
-      fail("expected a list, got " + got() +
-           "; write it as [a, b, ...] or as lines starting with '- '");
-    std::vector<Field> out;
-    for (std::size_t i = 0; i < node_.size(); ++i) {
-      const YAML::Node item = node_[i];
-      const YAML::Mark m = item.IsNull() || item.Mark().line < 0 ? mark_ : item.Mark();
-      out.emplace_back(*src_, item, path_ + "[" + std::to_string(i) + "]", m);
-    }
-    return out;
-  }
-
-  std::vector<Field> non_empty_items(const std::string& what_to_do) const {
-    std::vector<Field> out = items();
-    if (out.empty()) fail("the list is empty; " + what_to_do);
-    return out;
-  }
-
-  std::vector<double> numbers(const Range& range) const {
-    std::vector<double> out;
-    for (const Field& f : non_empty_items("give at least one number"))
-      out.push_back(f.number(range));
-    return out;
-  }
-
-  Vec3 vec3() const {
-    const std::array<Field, 3> e = three("numbers", "[x, y, z]");
-    Vec3 v;
-    for (int i = 0; i < 3; ++i) {
-      const std::optional<double> x = as_number(e[i].node_);
-      if (!x)
-        e[i].raise_here("expected a list of 3 numbers, but item " + std::to_string(i + 1) + " is " +
-                        e[i].got() + "; write it as [x, y, z]");
-      v[i] = *x;
-    }
-    return v;
-  }
-
-  // A direction: any non-zero vector, returned normalised.
-  Vec3 direction() const {
-    const Vec3 v = vec3();
-    if (!(v.norm() > 0)) fail("the direction [0, 0, 0] has no length; give a non-zero vector");
-    return v.normalized();
-  }
-
-  std::array<bool, 3> bool3() const {
-    const std::array<Field, 3> e = three("true/false values", "[false, false, true]");
-    std::array<bool, 3> b{};
-    for (int i = 0; i < 3; ++i) {
-      if (!e[i].node_.IsScalar() || !YAML::convert<bool>::decode(e[i].node_, b[i]))
-        e[i].raise_here("expected a list of 3 true/false values, but item " +
-                        std::to_string(i + 1) + " is " + e[i].got() +
-                        "; write it as [false, false, true]");
-    }
-    return b;
-  }
-
-  Map map() const;
-  Map map(std::vector<std::string> allowed) const;
-
-  // The value as the user wrote it, for messages.
-  std::string got() const {
-    if (!node_.IsDefined() || node_.IsNull()) return "nothing";
-    if (node_.IsSequence()) return "a list of " + std::to_string(node_.size());
-    if (node_.IsMap()) return "a map";
-    return "'" + node_.Scalar() + "'";
-  }
-
- private:
-  static std::optional<double> as_number(const YAML::Node& n) {
-    double x = 0;
-    if (!n.IsScalar() || !YAML::convert<double>::decode(n, x) || !std::isfinite(x))
-      return std::nullopt;
-    return x;
-  }
-
-  std::string prefixed(const std::string& message) const {
-    return path_.empty() ? message : path_ + ": " + message;
-  }
-
-  // Throws at this value, but names the enclosing vector (the path without "[i]").
-  [[noreturn]] void raise_here(const std::string& message) const {
-    raise(*src_, mark_, path_.substr(0, path_.rfind('[')) + ": " + message);
-  }
-
-  std::array<Field, 3> three(const std::string& what, const std::string& example) const {
-    if (!node_.IsSequence() || node_.size() != 3)
-      fail("expected a list of 3 " + what + ", got " + got() + "; write it as " + example);
-    const std::vector<Field> e = items();
-    return {e[0], e[1], e[2]};
-  }
-
-  void check_range(double x, const Range& range) const {
-    if (!range.contains(x))
-      fail("value " + node_.Scalar() + " is out of range; it must be " + range.describe());
-  }
-
-  const Source* src_;
-  YAML::Node node_;
-  std::string path_;
-  YAML::Mark key_mark_;
-  YAML::Mark mark_;
-};
-
-// A YAML map whose keys have been checked: no duplicates, and (once allow_only has
-// run) no unknown keys.
-class Map {
- public:
-  struct Entry {
-    std::string key;
-    YAML::Mark key_mark;
-    YAML::Node value;
-  };
-
-  Map(Field self, std::vector<Entry> entries)
-      : self_(std::move(self)), entries_(std::move(entries)) {}
-
-  const Field& self() const { return self_; }
-
-  void allow_only(const std::vector<std::string>& allowed, const std::string& what = "") const {
-    for (const Entry& e : entries_) {
-      if (std::find(allowed.begin(), allowed.end(), e.key) != allowed.end()) continue;
-      raise(self_.source(), e.key_mark,
-            "unknown key '" + e.key + "' in " + where() + what +
-                "; allowed keys: " + join(allowed) + suggestion(e.key, allowed));
-    }
-  }
-
-  bool has(std::string_view key) const { return entry(key) != nullptr; }
-
-  std::optional<Field> find(std::string_view key) const {
-    const Entry* e = entry(key);
-    if (e == nullptr) return std::nullopt;
-    return Field(self_.source(), e->value, child_path(key), e->key_mark);
-  }
-
-  Field get(std::string_view key, const std::string& hint = "add it") const {
-    std::optional<Field> f = find(key);
-    if (!f)
-      raise(self_.source(), self_.key_mark(),
-            "missing required key '" + std::string(key) + "' in " + where() + "; " + hint);
-    return *f;
-  }
-
-  double number(std::string_view key, const Range& range) const {
-    return get(key, value_hint(key, range)).number(range);
-  }
-  double number_or(std::string_view key, double fallback, const Range& range) const {
-    const std::optional<Field> f = find(key);
-    return f ? f->number(range) : fallback;
-  }
-  std::optional<double> maybe_number(std::string_view key, const Range& range) const {
-    const std::optional<Field> f = find(key);
-    if (!f) return std::nullopt;
-    return f->number(range);
-  }
-  Vec3 vec3(std::string_view key) const {
-    return get(key, "add `" + std::string(key) + ": [x, y, z]`").vec3();
-  }
-  Vec3 vec3_or(std::string_view key, const Vec3& fallback) const {
-    const std::optional<Field> f = find(key);
-    return f ? f->vec3() : fallback;
-  }
-  Vec3 direction(std::string_view key) const {
-    return get(key, "add `" + std::string(key) + ": [x, y, z]`").direction();
-  }
-
-  // Exactly one of two alternative keys must be present.
-  void exactly_one_of(std::string_view a, std::string_view b, const std::string& hint) const {
-    const Entry* ea = entry(a);
-    const Entry* eb = entry(b);
-    const std::string both = "'" + std::string(a) + "' and '" + std::string(b) + "'";
-    if (ea != nullptr && eb != nullptr) {
-      const Entry* later = ea->key_mark.pos > eb->key_mark.pos ? ea : eb;
-      raise(self_.source(), later->key_mark,
-            "both " + both + " are given in " + where() + "; give exactly one of them (" + hint +
-                ")");
-    }
-    if (ea == nullptr && eb == nullptr)
-      raise(self_.source(), self_.key_mark(),
-            "neither '" + std::string(a) + "' nor '" + std::string(b) + "' is given in " + where() +
-                "; give exactly one of them (" + hint + ")");
-  }
-
- private:
-  const Entry* entry(std::string_view key) const {
-    for (const Entry& e : entries_)
-      if (e.key == key) return &e;
-    return nullptr;
-  }
-
-  std::string child_path(std::string_view key) const {
-    return self_.path().empty() ? std::string(key) : self_.path() + "." + std::string(key);
-  }
-
-  std::string where() const { return self_.path().empty() ? "the top level" : self_.path(); }
-
-  static std::string value_hint(std::string_view key, const Range& range) {
-    std::string hint = "add `" + std::string(key) + ": <number>`";
-    if (range.bounded()) hint += " with a value " + range.describe();
-    return hint;
-  }
-
-  Field self_;
-  std::vector<Entry> entries_;
-};
-
-Map Field::map() const {
-  if (!node_.IsMap())
-    fail("expected a map of keys, got " + got() +
-         "; write it as `key: value` lines "
-         "or as {key: value, ...}");
-  std::vector<Map::Entry> entries;
-  for (const auto& key_value : node_) {
-    const YAML::Node key = key_value.first;  // copies: the iterator yields temporaries
-    if (!key.IsScalar()) raise(*src_, key.Mark(), "a key in " + path_ + " is not a plain name");
-    for (const Map::Entry& seen : entries)
-      if (seen.key == key.Scalar())
-        raise(*src_, key.Mark(),
-              "key '" + key.Scalar() + "' is given twice in " +
-                  (path_.empty() ? std::string("the top level") : path_) + " (first at line " +
-                  std::to_string(seen.key_mark.line + 1) + "); keep only one");
-    entries.push_back({key.Scalar(), key.Mark(), key_value.second});
-  }
-  return Map(*this, std::move(entries));
-}
-
-Map Field::map(std::vector<std::string> allowed) const {
-  Map m = map();
-  m.allow_only(allowed);
-  return m;
-}
+using namespace scene_yaml;  // the reading layer: dem/scene/yaml_reader.hpp
 
 // ---------------------------------------------------------------------------
 // Scene sections
@@ -487,7 +74,7 @@ Domain parse_domain(const Field& f) {
 }
 
 TimeSettings parse_time(const Field& f) {
-  const Map m = f.map({"step", "rayleigh_fraction", "end", "expected_max_speed"});
+  const Map m = f.map({"step", "rayleigh_fraction", "end", "expected_max_speed", "max_overlap"});
   m.exactly_one_of("step", "rayleigh_fraction",
                    "`step` is the time step in s, `rayleigh_fraction` sets it as a fraction of "
                    "the Rayleigh time");
@@ -496,6 +83,7 @@ TimeSettings parse_time(const Field& f) {
   t.rayleigh_fraction = m.maybe_number("rayleigh_fraction", kUnitOpenBelow);
   t.end = m.number("end", kPositive);
   t.expected_max_speed = m.number_or("expected_max_speed", 1.0, kPositive);
+  t.max_overlap = m.number_or("max_overlap", 0.25, Range{0, 1, false, true});
   return t;
 }
 
@@ -662,21 +250,57 @@ NeighbourSettings parse_neighbour(const Field& f) {
   return n;
 }
 
+// `motion: {velocity, angular_velocity, axis, axis_point}` of any wall kind.
+WallMotion parse_wall_motion(const Field& f) {
+  const Map m = f.map({"velocity", "angular_velocity", "axis", "axis_point"});
+  WallMotion w;
+  w.velocity = m.vec3_or("velocity", Vec3::Zero());
+  w.angular_velocity = m.number_or("angular_velocity", 0.0, kAny);
+  if (w.angular_velocity != 0) {
+    w.axis = m.direction("axis");
+    w.axis_point = m.vec3_or("axis_point", Vec3::Zero());
+  }
+  return w;
+}
+
 // `earlier` are the walls already read, to keep names unique.
 Wall parse_wall(const Field& item, const std::vector<Wall>& earlier,
                 const std::vector<Material>& materials) {
   const Map m = item.map();
   Wall w;
-  w.kind = m.get("type", "add `type: plane` or `type: cylinder`")
-               .choice<Wall::Kind>(
-                   "wall type", {{"plane", Wall::Kind::plane}, {"cylinder", Wall::Kind::cylinder}});
-  if (w.kind == Wall::Kind::plane) {
-    m.allow_only({"type", "name", "point", "normal", "material"}, " (a plane wall)");
+  w.kind = m.get("type", "add `type: plane`, `type: cylinder` or `type: mesh`")
+               .choice<Wall::Kind>("wall type", {{"plane", Wall::Kind::plane},
+                                                 {"cylinder", Wall::Kind::cylinder},
+                                                 {"mesh", Wall::Kind::mesh}});
+  if (const auto motion = m.find("motion")) w.motion = parse_wall_motion(*motion);
+  if (w.kind == Wall::Kind::mesh) {
+    m.allow_only({"type", "name", "file", "scale", "rotate", "translate", "surface_velocity",
+                  "material", "motion"},
+                 " (a mesh wall)");
+    const Field file = m.get("file", "add `file: <mesh.stl>`");
+    const fs::path given = file.text();
+    const fs::path resolved = given.is_absolute() ? given : file.source().folder / given;
+    std::error_code ec;
+    if (!fs::is_regular_file(resolved, ec))
+      file.fail("STL file '" + given.string() + "' not found (looked for '" + resolved.string() +
+                "'); file names are relative to the scene file's folder");
+    w.mesh.file = resolved.string();
+    w.mesh.scale = m.number_or("scale", 1.0, kPositive);
+    if (const auto rot = m.find("rotate")) {
+      const Map r = rot->map({"axis", "angle"});
+      w.mesh.rotate_axis = r.direction("axis");
+      w.mesh.rotate_angle = r.number("angle", kAny) * std::acos(-1.0) / 180;  // degrees
+    }
+    w.mesh.translate = m.vec3_or("translate", Vec3::Zero());
+    w.mesh.surface_velocity = m.vec3_or("surface_velocity", Vec3::Zero());
+  } else if (w.kind == Wall::Kind::plane) {
+    m.allow_only({"type", "name", "point", "normal", "material", "motion"}, " (a plane wall)");
     w.plane.point = m.vec3("point");
     w.plane.normal = m.direction("normal");
   } else {
     m.allow_only(
-        {"type", "name", "axis_point", "axis", "radius", "side", "angular_velocity", "material"},
+        {"type", "name", "axis_point", "axis", "radius", "side", "angular_velocity", "material",
+         "motion"},
         " (a cylinder wall)");
     CylinderWall& c = w.cylinder;
     c.axis_point = m.vec3("axis_point");
@@ -850,19 +474,94 @@ void parse_csv(const Map& m, const Scene& scene, Insertion& ins) {
   ins.material = material_ref(m, "material", scene.materials);
 }
 
+InsertionFace parse_face(const Field& f) {
+  const Map m = f.map({"rectangle", "disc"});
+  m.exactly_one_of("rectangle", "disc",
+                   "`rectangle: {centre, normal, u, size: [a, b]}` or `disc: {centre, normal, "
+                   "radius}`");
+  InsertionFace face;
+  if (const auto r = m.find("rectangle")) {
+    const Map q = r->map({"centre", "normal", "u", "size"});
+    face.kind = InsertionFace::Kind::rectangle;
+    face.centre = q.vec3("centre");
+    face.normal = q.direction("normal");
+    const Field u = q.get("u", "add `u: [x, y, z]`, the direction of the first side");
+    const Vec3 dir = u.direction();
+    const Vec3 in_plane = dir - dir.dot(face.normal) * face.normal;
+    if (in_plane.norm() < 1e-6)
+      u.fail("is parallel to the normal; give a direction along one side of the rectangle");
+    face.u = in_plane.normalized();
+    const Field size = q.get("size", "add `size: [a, b]` (side lengths along u and normal x u)");
+    const std::vector<double> ab = size.numbers(kPositive);
+    if (ab.size() != 2) size.fail("expected 2 side lengths [a, b], got " + size.got());
+    face.length_u = ab[0];
+    face.length_v = ab[1];
+  } else {
+    const Map q = m.find("disc")->map({"centre", "normal", "radius"});
+    face.kind = InsertionFace::Kind::disc;
+    face.centre = q.vec3("centre");
+    face.normal = q.direction("normal");
+    face.radius = q.number("radius", kPositive);
+  }
+  return face;
+}
+
+void parse_stream(const Map& m, const Scene& scene, Insertion& ins) {
+  m.allow_only({"type", "face", "mass_rate", "count_rate", "start", "stop", "material", "radius",
+                "velocity", "seed"},
+               " (a stream insertion)");
+  const Field face = m.get("face", "add `face: {disc: {centre, normal, radius}}`");
+  ins.face = parse_face(face);
+  for (int a = 0; a < 3; ++a)
+    if (ins.face.centre[a] < scene.domain.lo[a] || ins.face.centre[a] > scene.domain.hi[a])
+      face.fail("the face centre lies outside the domain; new particles would be removed at once");
+  m.exactly_one_of("mass_rate", "count_rate",
+                   "`mass_rate` in kg/s or `count_rate` in particles per second");
+  ins.mass_rate = m.maybe_number("mass_rate", kPositive);
+  ins.count_rate = m.maybe_number("count_rate", kPositive);
+  ins.start = m.number_or("start", 0.0, kNonNegative);
+  ins.stop = m.maybe_number("stop", kPositive);
+  if (ins.stop && *ins.stop <= ins.start)
+    m.get("stop").fail("stop must be later than start (" + format_number(ins.start) + " s)");
+  ins.material = material_ref(m, "material", scene.materials);
+  ins.radius = parse_size_distribution(
+      m.get("radius", "add `radius: {distribution: constant, value: <m>}`"));
+  ins.velocity = m.vec3_or("velocity", Vec3::Zero());
+  if (const auto s = m.find("seed"))
+    ins.seed = static_cast<unsigned>(s->integer(Range{0, double(UINT_MAX), true, true}));
+}
+
+void parse_snapshot(const Map& m, Insertion& ins) {
+  m.allow_only({"type", "file", "keep_velocity"}, " (a snapshot insertion)");
+  const Field file = m.get("file", "add `file: <particles_000020.h5>`");
+  const fs::path given = file.text();
+  const fs::path resolved = given.is_absolute() ? given : file.source().folder / given;
+  std::error_code ec;
+  if (!fs::is_regular_file(resolved, ec))
+    file.fail("snapshot file '" + given.string() + "' not found (looked for '" +
+              resolved.string() + "'); file names are relative to the scene file's folder");
+  ins.snapshot_file = resolved.string();
+  if (const auto k = m.find("keep_velocity")) ins.keep_velocity = k->boolean();
+}
+
 std::vector<Insertion> parse_insertions(const Field& f, const Scene& scene) {
   std::vector<Insertion> out;
   for (const Field& item : f.items()) {
     const Map m = item.map();
     Insertion ins;
     ins.source = item.source().label + ":" + std::to_string(item.line());
-    ins.kind = m.get("type", "add `type: fill` or `type: csv`")
-                   .choice<Insertion::Kind>("insertion type", {{"fill", Insertion::Kind::fill},
-                                                               {"csv", Insertion::Kind::csv}});
-    if (ins.kind == Insertion::Kind::fill)
-      parse_fill(m, scene, ins);
-    else
-      parse_csv(m, scene, ins);
+    ins.kind = m.get("type", "add `type: fill`, `csv`, `stream` or `snapshot`")
+                   .choice<Insertion::Kind>("insertion type",
+                                            {{"fill", Insertion::Kind::fill},
+                                             {"csv", Insertion::Kind::csv},
+                                             {"stream", Insertion::Kind::stream},
+                                             {"snapshot", Insertion::Kind::snapshot}});
+    switch (ins.kind) {
+      case Insertion::Kind::fill: parse_fill(m, scene, ins); break;
+      case Insertion::Kind::csv: parse_csv(m, scene, ins); break;
+      case Insertion::Kind::stream: parse_stream(m, scene, ins); break;
+      case Insertion::Kind::snapshot: parse_snapshot(m, ins); break;
+    }
     out.push_back(std::move(ins));
   }
   return out;
@@ -880,7 +579,7 @@ OutputSettings parse_output(const Field& f) {
 
 const std::vector<std::string> kTopLevelKeys = {
     "domain",  "gravity",   "time",  "materials", "interactions", "interaction_defaults",
-    "contact", "neighbour", "walls", "insert",    "output", "parallel"};
+    "contact", "neighbour", "walls", "insert",    "output", "parallel", "fluid"};
 
 Scene build_scene(const Field& root) {
   if (!root.node().IsDefined() || root.node().IsNull())
@@ -902,6 +601,7 @@ Scene build_scene(const Field& root) {
   if (const auto i = top.find("insert")) s.insertions = parse_insertions(*i, s);
   if (const auto o = top.find("output")) s.output = parse_output(*o);
   if (const auto p = top.find("parallel")) s.parallel = parse_parallel(*p);
+  if (const auto f = top.find("fluid")) s.fluid = parse_fluid_section(*f, s.gravity);
   return s;
 }
 

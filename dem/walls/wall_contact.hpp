@@ -41,9 +41,15 @@ inline bool touch_cylinder(const CylinderWall& w, const Vec3& x, double r, WallT
   return true;
 }
 
+// Planes and cylinders at their t = 0 position; meshes need their loaded geometry
+// (WallSet::touches_any) and are not seen here.
 inline bool touch_wall(const Wall& w, const Vec3& x, double r, WallTouch& t) {
-  return w.kind == Wall::Kind::plane ? touch_plane(w.plane, x, r, t)
-                                     : touch_cylinder(w.cylinder, x, r, t);
+  switch (w.kind) {
+    case Wall::Kind::plane: return touch_plane(w.plane, x, r, t);
+    case Wall::Kind::cylinder: return touch_cylinder(w.cylinder, x, r, t);
+    case Wall::Kind::mesh: break;
+  }
+  return false;
 }
 
 }  // namespace grainflow

@@ -34,8 +34,8 @@ TEST_P(ContactCombination, ConservesMomentumAndStaysFinite) {
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j)
       for (int k = 0; k < 4; ++k) {
-        const Vec3 x = Vec3(i, j, k) * 1.9e-3 + 1e-4 * Vec3(u(rng), u(rng), u(rng));
-        sim.particles().add(id++, x, 0.3 * Vec3(u(rng), u(rng), u(rng)),
+        const Vec3 x = Vec3(i, j, k) * 2.25e-3 + 2e-5 * Vec3(u(rng), u(rng), u(rng));
+        sim.particles().add(id++, x, 1.0 * Vec3(u(rng), u(rng), u(rng)),
                             100 * Vec3(u(rng), u(rng), u(rng)), 1e-3 * (1 + 0.1 * u(rng)), 0,
                             2500);
       }

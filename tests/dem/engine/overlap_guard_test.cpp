@@ -16,6 +16,7 @@ namespace {
 TEST(OverlapGuard, StopsBeforeTheContactExplodes) {
   const double r = 1e-3, rho = 2500, y = 1e7, nu = 0.3;
   Scene s = test::one_material_scene(y, nu, rho, 0.5);
+  s.time.max_overlap = 0.1;
   Simulation sim(s, false);
   sim.particles().add(1, Vec3(-1.05 * r, 0, 0), Vec3(2.5, 0, 0), Vec3::Zero(), r, 0, rho);
   sim.particles().add(2, Vec3(1.05 * r, 0, 0), Vec3(-2.5, 0, 0), Vec3::Zero(), r, 0, rho);

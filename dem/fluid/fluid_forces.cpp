@@ -1,0 +1,118 @@
+#include "dem/fluid/fluid_forces.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "dem/fluid/beetstra.hpp"
+#include "dem/fluid/di_felice.hpp"
+#include "dem/fluid/drag_law.hpp"
+#include "dem/fluid/ergun.hpp"
+#include "dem/fluid/gidaspow.hpp"
+#include "dem/fluid/koch_hill.hpp"
+#include "dem/fluid/rong.hpp"
+#include "dem/fluid/schiller_naumann.hpp"
+#include "dem/fluid/tenneti_garg_subramaniam.hpp"
+#include "dem/fluid/wen_yu.hpp"
+#include "dem/fluid/magnus_lift.hpp"
+#include "dem/fluid/rotational_drag.hpp"
+#include "dem/fluid/saffman_mei_lift.hpp"
+#include "dem/fluid/volume_forces.hpp"
+
+namespace grainflow {
+namespace {
+
+struct Enabled {
+  bool drag = false, pressure = false, viscous = false, buoyancy = false, virtual_mass = false,
+       saffman = false, magnus = false, rotation = false;
+};
+
+template <DragFunction Law>
+class FluidForcesWith final : public ForceTerm {
+ public:
+  FluidForcesWith(const FluidSettings& s, const Vec3& gravity, const Enabled& on)
+      : s_(s), gravity_(gravity), on_(on) {}
+
+  std::string name() const override { return "fluid forces (drag: " + s_.drag_law + ")"; }
+
+  void add(Particles& p, double /*time*/, ImplicitDrag& drag) override {
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const FluidSample f = s_.field.sample(p.x[i], gravity_);
+      const double d = 2 * p.radius[i];
+      const double volume = sphere_volume(p.radius[i]);
+      const Vec3 slip = f.velocity - p.v[i];
+      Vec3 force = Vec3::Zero();
+      if (on_.drag) {
+        const double k = Law({d, slip.norm(), f.void_fraction, f.density, f.viscosity});
+        const double k_sum = drag.coefficient[i] + k;
+        if (k_sum > 0)
+          drag.fluid_velocity[i] =
+              (drag.coefficient[i] * drag.fluid_velocity[i] + k * f.velocity) / k_sum;
+        drag.coefficient[i] = k_sum;
+      }
+      if (on_.pressure) force += pressure_gradient_force(volume, f.pressure_gradient);
+      if (on_.viscous) force += viscous_force(volume, f.viscous_stress_divergence);
+      if (on_.buoyancy) force += archimedes_buoyancy(f.density, volume, gravity_);
+      if (on_.saffman) force += saffman_mei_lift(d, f.density, f.viscosity, slip, f.vorticity);
+      if (on_.magnus || on_.rotation) {
+        const Vec3 relative_rotation = 0.5 * f.vorticity - p.omega[i];
+        if (on_.magnus) force += magnus_lift(d, f.density, f.viscosity, slip, relative_rotation);
+        if (on_.rotation)
+          p.torque[i] += rotational_drag_torque(d, f.density, f.viscosity, relative_rotation);
+      }
+      p.force[i] += force;
+      if (on_.virtual_mass) {
+        double scale = 1;
+        p.force[i] += virtual_mass_closure(s_.virtual_mass_coefficient * f.density * volume,
+                                           p.mass[i], p.force[i], f.material_derivative, scale);
+        drag.coefficient[i] *= scale;
+      }
+    }
+  }
+
+ private:
+  FluidSettings s_;
+  Vec3 gravity_;
+  Enabled on_;
+};
+
+// One compiled particle loop per law: the registry's function pointer picks the
+// instantiation whose template argument is that same function.
+template <DragFunction... Laws>
+std::unique_ptr<ForceTerm> instantiate(DragFunction chosen, const FluidSettings& s, const Vec3& g,
+                                       const Enabled& on) {
+  std::unique_ptr<ForceTerm> out;
+  ((out == nullptr && chosen == Laws ? (out = std::make_unique<FluidForcesWith<Laws>>(s, g, on), 0)
+                                     : 0),
+   ...);
+  return out;
+}
+
+}  // namespace
+
+std::unique_ptr<ForceTerm> make_fluid_forces(const FluidSettings& s, const Vec3& gravity) {
+  check_force_list(s.forces, {s.model, s.field.hydrostatic_pressure, gravity.norm() > 0});
+  Enabled on;
+  for (FluidForce f : s.forces) {
+    switch (f) {
+      case FluidForce::drag: on.drag = true; break;
+      case FluidForce::pressure_gradient: on.pressure = true; break;
+      case FluidForce::viscous: on.viscous = true; break;
+      case FluidForce::buoyancy: on.buoyancy = true; break;
+      case FluidForce::virtual_mass: on.virtual_mass = true; break;
+      case FluidForce::saffman_mei: on.saffman = true; break;
+      case FluidForce::magnus: on.magnus = true; break;
+      case FluidForce::rotational_drag: on.rotation = true; break;
+    }
+  }
+  const DragLaw& law = drag_law(s.drag_law);
+  std::unique_ptr<ForceTerm> term =
+      instantiate<schiller_naumann, di_felice, rong, wen_yu, ergun, gidaspow, koch_hill, beetstra,
+                  tenneti_garg_subramaniam>(law.function, s, gravity, on);
+  if (term == nullptr)
+    throw std::logic_error(std::string("drag law '") + law.name +
+                           "' is registered but not instantiated in fluid_forces.cpp");
+  return term;
+}
+
+}  // namespace grainflow

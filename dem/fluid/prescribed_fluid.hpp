@@ -1,0 +1,52 @@
+#pragma once
+// One-way mode (`grain` without a fluid solver): a fluid prescribed by the scene, and the
+// fluid-force settings. The field is steady and analytic:
+//   u(x) = u₀ + G ((x − x₀)·n_g) n_u       (uniform when G = 0; n_u ⟂ n_g, unit vectors)
+//   ε given and uniform; ∇p = ∇p_extra (+ ρ_f g when the pressure includes hydrostatics);
+//   ∇·τ = μ∇²u = 0;  ∇×u = G n_g × n_u;  Du/Dt = (u·∇)u = G (n_g·u₀) n_u.
+#include <string>
+#include <vector>
+
+#include "dem/fluid/fluid_sample.hpp"
+#include "dem/fluid/vans_model.hpp"
+#include "dem/fluid/virtual_mass.hpp"
+
+namespace grainflow {
+
+struct PrescribedFluid {
+  double density = 1000;                        // ρ_f [kg/m^3] > 0
+  double viscosity = 1e-3;                      // μ [Pa s] > 0
+  Vec3 velocity = Vec3::Zero();                 // u₀ [m/s], at x₀
+  double shear_rate = 0;                        // G [1/s]
+  Vec3 flow_direction = Vec3::UnitX();          // n_u (unit)
+  Vec3 gradient_direction = Vec3::UnitZ();      // n_g (unit, ⟂ n_u)
+  Vec3 origin = Vec3::Zero();                   // x₀ [m]
+  double void_fraction = 1;                     // ε in [kLowestVoidFraction, 1]
+  Vec3 pressure_gradient = Vec3::Zero();        // ∇p beyond hydrostatics [Pa/m]
+  bool hydrostatic_pressure = true;             // ∇p includes ρ_f g
+
+  FluidSample sample(const Vec3& x, const Vec3& gravity) const {
+    FluidSample s;
+    const double along = (x - origin).dot(gradient_direction);
+    s.velocity = velocity + shear_rate * along * flow_direction;
+    s.void_fraction = void_fraction;
+    s.pressure_gradient = pressure_gradient;
+    if (hydrostatic_pressure) s.pressure_gradient += density * gravity;
+    s.density = density;
+    s.viscosity = viscosity;
+    s.vorticity = shear_rate * gradient_direction.cross(flow_direction);
+    s.material_derivative = shear_rate * gradient_direction.dot(velocity) * flow_direction;
+    return s;
+  }
+};
+
+struct FluidSettings {
+  PrescribedFluid field;
+  std::string drag_law = "schiller_naumann";  // a name from drag_law_names()
+  std::vector<FluidForce> forces;             // validated by force_list_problem()
+  VansModel model = VansModel::B;
+  double virtual_mass_coefficient = kSphereVirtualMassCoefficient;
+  std::string source;                         // "file:line" of the block, for messages
+};
+
+}  // namespace grainflow

@@ -1,0 +1,143 @@
+#include "dem/insert/stream_insertion.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "dem/insert/insertion.hpp"
+
+namespace grainflow {
+
+StreamInsertion::StreamInsertion(const Scene& scene) {
+  for (const Insertion& ins : scene.insertions) {
+    if (ins.kind != Insertion::Kind::stream) continue;
+    Stream s;
+    s.entry = ins;
+    if (!s.entry.stop) s.entry.stop = scene.time.end;
+    s.density = scene.materials[ins.material].density;
+    s.v_dir = ins.face.normal.cross(ins.face.u);
+    // Two generators: the radius sequence must not depend on how many placement
+    // attempts failed.
+    s.radius_rng.seed(ins.seed);
+    s.place_rng.seed(ins.seed ^ 0x5bd1e995u);
+    r_max_ = std::max(r_max_, grainflow::max_radius(ins.radius));
+    streams_.push_back(std::move(s));
+  }
+}
+
+double StreamInsertion::pending_radius(Stream& s, std::size_t k) {
+  while (s.pending.size() <= k) s.pending.push_back(sample_radius(s.entry.radius, s.radius_rng));
+  return s.pending[k];
+}
+
+long StreamInsertion::due(Stream& s, double t) {
+  const Insertion& e = s.entry;
+  if (t < e.start) return 0;
+  const double elapsed = std::min(t, *e.stop) - e.start;
+  long n = 0;
+  constexpr long kMaxPerStep = 100000;
+  if (e.mass_rate) {
+    double mass = s.mass;
+    const double target = *e.mass_rate * elapsed;
+    while (n < kMaxPerStep) {
+      const double m = s.density * sphere_volume(pending_radius(s, static_cast<std::size_t>(n)));
+      if (mass + 0.5 * m > target) break;
+      mass += m;
+      ++n;
+    }
+  } else {
+    n = std::clamp(static_cast<long>(std::floor(*e.count_rate * elapsed + 0.5)) - s.count, 0L,
+                   kMaxPerStep);
+  }
+  return n;
+}
+
+Vec3 StreamInsertion::sample(Stream& s, double r) {
+  const InsertionFace& f = s.entry.face;
+  std::uniform_real_distribution<double> u(0, 1);
+  if (f.kind == InsertionFace::Kind::rectangle) {
+    const double a = std::max(0.0, f.length_u - 2 * r), b = std::max(0.0, f.length_v - 2 * r);
+    return f.centre + (u(s.place_rng) - 0.5) * a * f.u + (u(s.place_rng) - 0.5) * b * s.v_dir;
+  }
+  const Vec3 e1 =
+      (std::abs(f.normal[0]) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(f.normal).normalized();
+  const Vec3 e2 = f.normal.cross(e1);
+  const double rho = std::max(0.0, f.radius - r) * std::sqrt(u(s.place_rng));
+  const double phi = 2 * std::numbers::pi * u(s.place_rng);
+  return f.centre + rho * (std::cos(phi) * e1 + std::sin(phi) * e2);
+}
+
+long StreamInsertion::insert(double t, Particles& p, const Ghosts& ghosts, const WallSet& walls,
+                             const Decomposition& decomp, GlobalId& next_id, MPI_Comm comm) {
+  constexpr int kAttempts = 12;  // placement tries per particle and step
+  long total = 0;
+  for (Stream& s : streams_) {
+    const long need = due(s, t);
+    s.lag = need;
+    if (need == 0) continue;
+    // Existing bodies near the face: local particles and ghosts within reach.
+    const InsertionFace& f = s.entry.face;
+    std::vector<Vec3> near_x;
+    std::vector<double> near_r;
+    auto consider = [&](const Vec3& x, double r) {
+      if (std::abs((x - f.centre).dot(f.normal)) < r + r_max_) {
+        near_x.push_back(x);
+        near_r.push_back(r);
+      }
+    };
+    for (std::size_t i = 0; i < p.size(); ++i) consider(p.x[i], p.radius[i]);
+    for (std::size_t g = 0; g < ghosts.size(); ++g) consider(ghosts.position(g), ghosts.radius[g]);
+    // Candidates for each due particle; `blocked` = overlaps an existing body here.
+    std::vector<Vec3> cand(static_cast<std::size_t>(need) * kAttempts);
+    std::vector<int> blocked(cand.size(), 0);
+    for (long j = 0; j < need; ++j) {
+      const double r = pending_radius(s, static_cast<std::size_t>(j));
+      for (int a = 0; a < kAttempts; ++a) {
+        const std::size_t c = static_cast<std::size_t>(j) * kAttempts + a;
+        cand[c] = sample(s, r);
+        bool hit = walls.touches_any(cand[c], r);
+        for (std::size_t k = 0; k < near_x.size() && !hit; ++k) {
+          const double reach = r + near_r[k];
+          hit = (cand[c] - near_x[k]).squaredNorm() < reach * reach;
+        }
+        blocked[c] = hit;
+      }
+    }
+    if (decomp.size() > 1)
+      MPI_Allreduce(MPI_IN_PLACE, blocked.data(), static_cast<int>(blocked.size()), MPI_INT,
+                    MPI_LOR, comm);
+    // In order: each particle takes its first free candidate; the first particle
+    // without one waits (with its radius) for a later step.
+    std::vector<Vec3> placed_x;
+    std::vector<double> placed_r;
+    long placed = 0;
+    for (long j = 0; j < need; ++j) {
+      const double r = s.pending[static_cast<std::size_t>(j)];
+      int found = -1;
+      for (int a = 0; a < kAttempts && found < 0; ++a) {
+        const std::size_t c = static_cast<std::size_t>(j) * kAttempts + a;
+        bool hit = blocked[c] != 0;
+        for (std::size_t k = 0; k < placed_x.size() && !hit; ++k) {
+          const double reach = r + placed_r[k];
+          hit = (cand[c] - placed_x[k]).squaredNorm() < reach * reach;
+        }
+        if (!hit) found = a;
+      }
+      if (found < 0) break;
+      const Vec3 x = cand[static_cast<std::size_t>(j) * kAttempts + found];
+      if (decomp.owns(x)) p.add(next_id, x, s.entry.velocity, Vec3::Zero(), r, s.entry.material, s.density);
+      ++next_id;
+      placed_x.push_back(x);
+      placed_r.push_back(r);
+      s.mass += s.density * sphere_volume(r);
+      ++s.count;
+      ++placed;
+    }
+    s.pending.erase(s.pending.begin(), s.pending.begin() + placed);
+    s.lag = need - placed;
+    total += placed;
+  }
+  return total;
+}
+
+}  // namespace grainflow

@@ -1,0 +1,70 @@
+#pragma once
+// Stream insertion: particles enter through a planar face (rectangle or disc) at a
+// prescribed mass or number rate during [start, stop), with the entry's size
+// distribution, never overlapping existing particles or walls.
+//
+// The radii are drawn in sequence from their own random stream, so the delivered
+// size distribution is the requested one: a particle that finds no free spot keeps
+// its radius and is placed at a later step (the delivery then lags, and the lag is
+// reported by lag()). The count due by time t is the largest n with
+// m_1 + ... + m_{n-1} + m_n/2 <= rate (t - start) (mass rate) or n <= rate (t - start)
+// + 1/2 (number rate), so the delivered amount stays within half a particle of the
+// target.
+//
+// With several MPI ranks, every rank draws the same candidates; each checks them
+// against its own particles and ghosts, one reduction combines the verdicts, and
+// the rank owning a candidate's position adds it: the result does not depend on the
+// rank count.
+#include <mpi.h>
+
+#include <random>
+#include <vector>
+
+#include "dem/core/particles.hpp"
+#include "dem/parallel/decomposition.hpp"
+#include "dem/parallel/ghosts.hpp"
+#include "dem/scene/scene.hpp"
+#include "dem/walls/wall_set.hpp"
+
+namespace grainflow {
+
+class StreamInsertion {
+ public:
+  StreamInsertion() = default;
+  explicit StreamInsertion(const Scene& scene);
+
+  bool empty() const { return streams_.empty(); }
+  double max_radius() const { return r_max_; }
+
+  // Inserts what is due by time t; returns how many particles were inserted over
+  // all ranks (the same number on every rank). Collective when comm has > 1 rank.
+  long insert(double t, Particles& p, const Ghosts& ghosts, const WallSet& walls,
+              const Decomposition& decomp, GlobalId& next_id, MPI_Comm comm);
+
+  // Totals of stream k over all ranks (the same on every rank).
+  double mass_inserted(std::size_t k) const { return streams_[k].mass; }
+  long count_inserted(std::size_t k) const { return streams_[k].count; }
+  // How far stream k is behind its target at the last insert(), in particles.
+  long lag(std::size_t k) const { return streams_[k].lag; }
+  std::size_t size() const { return streams_.size(); }
+
+ private:
+  struct Stream {
+    Insertion entry;
+    double density;
+    Vec3 v_dir;  // rectangle: normal x u
+    std::mt19937_64 radius_rng, place_rng;
+    std::vector<double> pending;  // radii drawn and not yet placed, in order
+    double mass = 0;
+    long count = 0;
+    long lag = 0;
+  };
+  static Vec3 sample(Stream& s, double r);
+  static double pending_radius(Stream& s, std::size_t k);
+  static long due(Stream& s, double t);
+
+  std::vector<Stream> streams_;
+  double r_max_ = 0;
+};
+
+}  // namespace grainflow

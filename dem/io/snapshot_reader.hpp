@@ -1,0 +1,24 @@
+#pragma once
+// Reading one grainflow HDF5 snapshot (the layout of snapshot_writer.hpp) back into
+// particles, e.g. to continue a packed bed in a new scene. Serial read: every rank
+// that calls it reads the whole file.
+#include <stdexcept>
+#include <string>
+
+#include "dem/core/particles.hpp"
+
+namespace grainflow {
+
+// A snapshot that cannot be read; the message names the file and the dataset.
+class SnapshotReadError : public std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Snapshot {
+  Particles particles;  // id, x, v, omega, radius, mass, material; inertia = 2/5 m r^2
+  double time = 0;
+};
+
+Snapshot read_snapshot(const std::string& path);
+
+}  // namespace grainflow

@@ -1,0 +1,82 @@
+#include "dem/scene/fluid_section.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "dem/fluid/drag_law.hpp"
+
+namespace grainflow {
+
+using namespace scene_yaml;
+
+namespace {
+
+void parse_shear(const Field& f, PrescribedFluid& field) {
+  const Map m = f.map({"rate", "flow_direction", "gradient_direction", "origin"});
+  field.shear_rate = m.number("rate", kAny);
+  field.flow_direction = m.direction("flow_direction");
+  field.gradient_direction = m.direction("gradient_direction");
+  field.origin = m.vec3_or("origin", Vec3::Zero());
+  if (std::abs(field.flow_direction.dot(field.gradient_direction)) > 1e-12)
+    m.get("gradient_direction")
+        .fail("is not perpendicular to flow_direction; a linear shear u = G ((x − x₀)·n_g) n_u "
+              "needs n_g ⟂ n_u (e.g. flow_direction [1, 0, 0], gradient_direction [0, 0, 1])");
+}
+
+std::vector<FluidForce> parse_forces(const Field& f) {
+  std::vector<FluidForce> out;
+  for (const Field& item : f.non_empty_items("list at least drag, pressure_gradient, viscous"))
+    out.push_back(item.choice<FluidForce>(
+        "fluid force", {{"drag", FluidForce::drag},
+                        {"pressure_gradient", FluidForce::pressure_gradient},
+                        {"viscous", FluidForce::viscous},
+                        {"buoyancy", FluidForce::buoyancy},
+                        {"virtual_mass", FluidForce::virtual_mass},
+                        {"saffman_mei", FluidForce::saffman_mei},
+                        {"magnus", FluidForce::magnus},
+                        {"rotational_drag", FluidForce::rotational_drag}}));
+  return out;
+}
+
+}  // namespace
+
+FluidSettings parse_fluid_section(const Field& f, const Vec3& gravity) {
+  const Map m = f.map({"density", "viscosity", "velocity", "shear", "void_fraction", "pressure",
+                       "drag", "forces", "model", "virtual_mass_coefficient"});
+  FluidSettings s;
+  s.source = f.source().label + ":" + std::to_string(f.line());
+  PrescribedFluid& field = s.field;
+  field.density = m.number("density", kPositive);
+  field.viscosity = m.number("viscosity", kPositive);
+  field.velocity = m.vec3_or("velocity", Vec3::Zero());
+  if (const auto shear = m.find("shear")) parse_shear(*shear, field);
+  field.void_fraction =
+      m.number_or("void_fraction", 1.0, Range{kLowestVoidFraction, 1, true, true});
+  if (const auto p = m.find("pressure")) {
+    const Map pm = p->map({"hydrostatic", "gradient"});
+    if (const auto h = pm.find("hydrostatic")) field.hydrostatic_pressure = h->boolean();
+    field.pressure_gradient = pm.vec3_or("gradient", Vec3::Zero());
+  }
+
+  const Field drag = m.get("drag", "add `drag: <law>` (e.g. schiller_naumann)");
+  const std::vector<std::string> names = drag_law_names();
+  s.drag_law = drag.text();
+  if (std::find(names.begin(), names.end(), s.drag_law) == names.end())
+    drag.fail("unknown drag law '" + s.drag_law + "'; allowed: " + join(names) +
+              suggestion(s.drag_law, names));
+
+  s.model = m.get("model", "add `model: A` or `model: B` (DESIGN.md §4)")
+                .choice<VansModel>("VANS model", {{"A", VansModel::A}, {"B", VansModel::B}});
+  const Field forces = m.get("forces", "add `forces: [drag, pressure_gradient, viscous]`");
+  s.forces = parse_forces(forces);
+  if (const auto problem = force_list_problem(
+          s.forces, {s.model, field.hydrostatic_pressure, gravity.norm() > 0}))
+    forces.fail(*problem);
+  s.virtual_mass_coefficient = m.number_or("virtual_mass_coefficient",
+                                           kSphereVirtualMassCoefficient, kNonNegative);
+  return s;
+}
+
+}  // namespace grainflow

@@ -1,0 +1,96 @@
+#include "dem/walls/wall_set.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "dem/insert/insertion.hpp"
+#include "dem/walls/stl_reader.hpp"
+#include "dem/walls/wall_contact.hpp"
+
+namespace grainflow {
+
+WallSet::WallSet(const Scene& scene) {
+  double r_hint = 0;
+  for (const Insertion& ins : scene.insertions)
+    if (ins.kind == Insertion::Kind::fill || ins.kind == Insertion::Kind::stream)
+      r_hint = std::max(r_hint, max_radius(ins.radius));
+  for (const Wall& w : scene.walls) {
+    Entry e;
+    e.kind = w.kind;
+    e.name = w.name;
+    e.material = w.material;
+    e.plane = e.plane0 = w.plane;
+    e.cylinder = e.cylinder0 = w.cylinder;
+    e.pose = WallPose(w.motion);
+    e.column = static_cast<int>(columns_);
+    if (w.kind == Wall::Kind::mesh) {
+      MeshTransform t;
+      t.scale = w.mesh.scale;
+      t.rotation_axis = w.mesh.rotate_axis;
+      t.rotation_angle = w.mesh.rotate_angle;
+      t.translation = w.mesh.translate;
+      StlReport rep;
+      TriangleMesh m = read_stl(w.mesh.file, t, &rep);
+      // Cells of one particle diameter: a query visits at most 8 small cells, each
+      // holding only the few triangles that pass near it. Without a known radius
+      // (CSV or snapshot particles only), cells of the mean triangle edge.
+      m.build_grid(r_hint > 0 ? 2 * r_hint : m.mean_edge_length());
+      std::ostringstream note;
+      note << "wall '" << w.name << "': " << m.triangle_count() << " triangles, "
+           << m.vertex_count() << " vertices from " << (rep.binary ? "binary" : "ASCII")
+           << " STL " << w.mesh.file;
+      if (rep.degenerate_removed > 0)
+        note << " (" << rep.degenerate_removed << " degenerate triangles removed)";
+      notes_.push_back(note.str());
+      e.mesh = static_cast<int>(meshes_.size());
+      e.surface_velocity = w.mesh.surface_velocity;
+      meshes_.push_back(std::move(m));
+      columns_ += 2 * kMeshSlots;
+    } else {
+      columns_ += 1;
+    }
+    walls_.push_back(std::move(e));
+  }
+}
+
+void WallSet::fit_grids(double r_max) {
+  if (r_max <= 0) return;
+  for (TriangleMesh& m : meshes_)
+    if (std::abs(m.cell_size() - 2 * r_max) > 0.25 * m.cell_size()) m.build_grid(2 * r_max);
+}
+
+void WallSet::move_to(double t) {
+  for (Entry& e : walls_) {
+    if (!e.pose.moving()) continue;
+    e.pose.move_to(t);
+    if (e.kind == Wall::Kind::plane) {
+      e.plane.point = e.pose.to_world(e.plane0.point);
+      e.plane.normal = e.pose.direction_to_world(e.plane0.normal);
+    } else if (e.kind == Wall::Kind::cylinder) {
+      e.cylinder.axis_point = e.pose.to_world(e.cylinder0.axis_point);
+      e.cylinder.axis = e.pose.direction_to_world(e.cylinder0.axis);
+    }
+  }
+}
+
+bool WallSet::touches_any(const Vec3& x, double r) const {
+  WallTouch t;
+  MeshTouch m[TriangleMesh::kMaxTouches];
+  for (const Entry& e : walls_) {
+    switch (e.kind) {
+      case Wall::Kind::plane:
+        if (touch_plane(e.plane, x, r, t)) return true;
+        break;
+      case Wall::Kind::cylinder:
+        if (touch_cylinder(e.cylinder, x, r, t)) return true;
+        break;
+      case Wall::Kind::mesh:
+        if (meshes_[e.mesh].touches(e.pose.to_body(x), r, m) > 0) return true;
+        break;
+    }
+  }
+  return false;
+}
+
+}  // namespace grainflow

@@ -1,0 +1,72 @@
+#pragma once
+// All walls of a run in their current position: planes, cylinders and triangle
+// meshes, each with its prescribed motion (wall_motion.hpp), and the layout of the
+// per-particle contact histories the walls need.
+//
+// Histories are stored per particle in "columns" (Simulation's wall_history, one
+// vector of ContactHistory per column, permuted, compacted and migrated with the
+// particles): a plane or a cylinder uses one column; a mesh uses kMeshSlots slots of
+// two columns each, the slot's spring and its key, the contact normal of the last
+// step (kept in the key column's `tangential`). A mesh contact takes the slot whose
+// key is closest to its normal (within ~37 degrees), so a spring follows a particle
+// that slides or rolls across triangle boundaries of a flat or gently curved mesh.
+#include <string>
+#include <vector>
+
+#include "dem/scene/scene.hpp"
+#include "dem/walls/triangle_mesh.hpp"
+#include "dem/walls/wall_motion.hpp"
+
+namespace grainflow {
+
+class WallSet {
+ public:
+  static constexpr int kMeshSlots = 3;
+  static constexpr double kSlotMatchCosine = 0.8;
+
+  struct Entry {
+    Wall::Kind kind = Wall::Kind::plane;
+    std::string name;
+    int material = 0;
+    PlaneWall plane;        // current position (plane, cylinder)
+    CylinderWall cylinder;  // current position
+    int mesh = -1;          // index into meshes()
+    Vec3 surface_velocity = Vec3::Zero();  // mesh conveyor velocity in the body frame
+    WallPose pose;
+    int column = 0;  // first history column
+    // at t = 0
+    PlaneWall plane0;
+    CylinderWall cylinder0;
+  };
+
+  WallSet() = default;
+  // Reads every mesh's STL file (GeometryError on a bad file). The largest radius
+  // of the scene's fill and stream insertions sizes the mesh search grids.
+  explicit WallSet(const Scene& scene);
+
+  // Places every moving wall at time t.
+  void move_to(double t);
+
+  // Re-sizes the mesh search grids for particles up to radius r_max (cells of one
+  // diameter); call once the particles are known.
+  void fit_grids(double r_max);
+
+  const std::vector<Entry>& walls() const { return walls_; }
+  const TriangleMesh& mesh(const Entry& e) const { return meshes_[e.mesh]; }
+  std::size_t history_columns() const { return columns_; }
+  bool empty() const { return walls_.empty(); }
+
+  // True if a sphere at x with radius r touches any wall (insertion).
+  bool touches_any(const Vec3& x, double r) const;
+
+  // One line per mesh: triangles, vertices, repairs (for the run report).
+  const std::vector<std::string>& notes() const { return notes_; }
+
+ private:
+  std::vector<Entry> walls_;
+  std::vector<TriangleMesh> meshes_;
+  std::size_t columns_ = 0;
+  std::vector<std::string> notes_;
+};
+
+}  // namespace grainflow
