@@ -26,6 +26,8 @@ class ForceTerm {
   // contacts) and may set each particle's implicit drag. `drag` arrays are sized to
   // p.size() and zeroed before the first term of the step.
   virtual void add(Particles& p, double time, ImplicitDrag& drag) = 0;
+  // Anything the run's closing summary must say (counted clamps, ...); may be empty.
+  virtual std::string report() const { return {}; }
 };
 
 }  // namespace grainflow

@@ -68,7 +68,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   std::ostream& say = speaker(comm, out);
 
   Simulation sim(scene, true, comm);
-  if (scene.fluid) sim.add_force_term(make_fluid_forces(*scene.fluid, scene.gravity));
+  if (scene.fluid)
+    sim.add_force_term(make_fluid_forces(*scene.fluid, scene.gravity, scene.domain, comm));
   sim.initialise();
   print_report(sim, comm, out);
   if (sim.time_step_report().verdict == TimeStepReport::Verdict::refuse &&
@@ -146,6 +147,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
       << sum.wall_seconds << " s wall, " << sum.particle_steps_per_second
       << " particle-steps/s\n"
       << "output: " << dir << "/particles.xdmf (open in ParaView), " << dir << "/log.csv\n";
+  for (const std::string& line : sim.force_term_reports())
+    if (!line.empty()) say << line << "\n";
   return sum;
 }
 

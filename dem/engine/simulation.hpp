@@ -66,6 +66,11 @@ class Simulation {
   // before initialise().
   void add_force_term(std::unique_ptr<ForceTerm> term) { terms_.push_back(std::move(term)); }
   const ImplicitDrag& implicit_drag() const { return drag_; }
+  std::vector<std::string> force_term_reports() const {
+    std::vector<std::string> out;
+    for (const auto& t : terms_) out.push_back(t->report());
+    return out;
+  }
 
   // Imposes non-uniform cut planes along one axis (e.g. from a mesh decomposition);
   // call before initialise(). Throws SetupError when they do not fit the grid.

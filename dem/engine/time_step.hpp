@@ -24,7 +24,7 @@ struct TimeStepReport {
 };
 
 // Thresholds: warn above 0.3 t_R or below 10 steps per impact (restitution and
-// peak force then err by a few %, docs/theory/contact-models.md),
+// peak force then err by a few %, docs/models/contact-models.md),
 // refuse above 1.0 t_R or t_c/5 — such a run cannot resolve a contact at all.
 constexpr double kWarnRayleighFraction = 0.3;
 constexpr double kRefuseRayleighFraction = 1.0;

@@ -1,7 +1,7 @@
 #pragma once
 // What every drag law needs, and the Reynolds numbers they are written in.
 //
-// Convention shared by ALL drag laws of dem/fluid/ (docs/theory/fluid-forces.md):
+// Convention shared by ALL drag laws of dem/fluid/ (docs/models/fluid-forces.md):
 //  * A law returns the coefficient K >= 0 [kg/s] of F_drag = K (u_f - v).
 //  * F_drag is the drag alone: it EXCLUDES the mean-pressure ("buoyancy-like") part
 //    -V_p ∇p, which is always a separate force (pressure_gradient). K is therefore the

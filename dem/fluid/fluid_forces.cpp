@@ -1,6 +1,7 @@
 #include "dem/fluid/fluid_forces.hpp"
 
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -17,6 +18,7 @@
 #include "dem/fluid/magnus_lift.hpp"
 #include "dem/fluid/rotational_drag.hpp"
 #include "dem/fluid/saffman_mei_lift.hpp"
+#include "dem/fluid/void_fraction_grid.hpp"
 #include "dem/fluid/volume_forces.hpp"
 
 namespace grainflow {
@@ -30,14 +32,28 @@ struct Enabled {
 template <DragFunction Law>
 class FluidForcesWith final : public ForceTerm {
  public:
-  FluidForcesWith(const FluidSettings& s, const Vec3& gravity, const Enabled& on)
-      : s_(s), gravity_(gravity), on_(on) {}
+  FluidForcesWith(const FluidSettings& s, const Vec3& gravity, const Enabled& on,
+                  const Domain& domain, MPI_Comm comm)
+      : s_(s), gravity_(gravity), on_(on), comm_(comm) {
+    if (s.computed_void_fraction) grid_.emplace(domain, *s.computed_void_fraction);
+  }
 
   std::string name() const override { return "fluid forces (drag: " + s_.drag_law + ")"; }
 
+  std::string report() const override {
+    if (!grid_) return {};
+    return "void fraction: " + std::to_string(grid_->cells()[0]) + " x " +
+           std::to_string(grid_->cells()[1]) + " x " + std::to_string(grid_->cells()[2]) +
+           " cells; clamped to the minimum " + std::to_string(grid_->clamped_cells_total()) +
+           " times (cell-steps), removing " + std::to_string(grid_->clamped_volume_total()) +
+           " m^3 of solid volume in total";
+  }
+
   void add(Particles& p, double /*time*/, ImplicitDrag& drag) override {
+    if (grid_) grid_->update(p, comm_);
     for (std::size_t i = 0; i < p.size(); ++i) {
-      const FluidSample f = s_.field.sample(p.x[i], gravity_);
+      FluidSample f = s_.field.sample(p.x[i], gravity_);
+      if (grid_) f.void_fraction = grid_->at(p.x[i]);
       const double d = 2 * p.radius[i];
       const double volume = sphere_volume(p.radius[i]);
       const Vec3 slip = f.velocity - p.v[i];
@@ -74,23 +90,27 @@ class FluidForcesWith final : public ForceTerm {
   FluidSettings s_;
   Vec3 gravity_;
   Enabled on_;
+  MPI_Comm comm_;
+  std::optional<VoidFractionGrid> grid_;
 };
 
 // One compiled particle loop per law: the registry's function pointer picks the
 // instantiation whose template argument is that same function.
 template <DragFunction... Laws>
 std::unique_ptr<ForceTerm> instantiate(DragFunction chosen, const FluidSettings& s, const Vec3& g,
-                                       const Enabled& on) {
+                                       const Enabled& on, const Domain& domain, MPI_Comm comm) {
   std::unique_ptr<ForceTerm> out;
-  ((out == nullptr && chosen == Laws ? (out = std::make_unique<FluidForcesWith<Laws>>(s, g, on), 0)
-                                     : 0),
+  ((out == nullptr && chosen == Laws
+        ? (out = std::make_unique<FluidForcesWith<Laws>>(s, g, on, domain, comm), 0)
+        : 0),
    ...);
   return out;
 }
 
 }  // namespace
 
-std::unique_ptr<ForceTerm> make_fluid_forces(const FluidSettings& s, const Vec3& gravity) {
+std::unique_ptr<ForceTerm> make_fluid_forces(const FluidSettings& s, const Vec3& gravity,
+                                             const Domain& domain, MPI_Comm comm) {
   check_force_list(s.forces, {s.model, s.field.hydrostatic_pressure, gravity.norm() > 0});
   Enabled on;
   for (FluidForce f : s.forces) {
@@ -108,7 +128,7 @@ std::unique_ptr<ForceTerm> make_fluid_forces(const FluidSettings& s, const Vec3&
   const DragLaw& law = drag_law(s.drag_law);
   std::unique_ptr<ForceTerm> term =
       instantiate<schiller_naumann, di_felice, rong, wen_yu, ergun, gidaspow, koch_hill, beetstra,
-                  tenneti_garg_subramaniam>(law.function, s, gravity, on);
+                  tenneti_garg_subramaniam>(law.function, s, gravity, on, domain, comm);
   if (term == nullptr)
     throw std::logic_error(std::string("drag law '") + law.name +
                            "' is registered but not instantiated in fluid_forces.cpp");

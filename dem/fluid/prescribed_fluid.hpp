@@ -4,6 +4,7 @@
 //   u(x) = u₀ + G ((x − x₀)·n_g) n_u       (uniform when G = 0; n_u ⟂ n_g, unit vectors)
 //   ε given and uniform; ∇p = ∇p_extra (+ ρ_f g when the pressure includes hydrostatics);
 //   ∇·τ = μ∇²u = 0;  ∇×u = G n_g × n_u;  Du/Dt = (u·∇)u = G (n_g·u₀) n_u.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,8 +41,16 @@ struct PrescribedFluid {
   }
 };
 
+// Void fraction computed from the particles on a grid of cells (void_fraction_grid.hpp).
+struct VoidFractionGridSettings {
+  double cell_size = 0;  // requested cell edge [m] > 0 (rounded to fit the domain)
+  double minimum = 0.2;  // eps_min in [kLowestVoidFraction, 1)
+};
+
 struct FluidSettings {
   PrescribedFluid field;
+  // When set, eps comes from the particles (void_fraction_grid.hpp), not field.void_fraction.
+  std::optional<VoidFractionGridSettings> computed_void_fraction;
   std::string drag_law = "schiller_naumann";  // a name from drag_law_names()
   std::vector<FluidForce> forces;             // validated by force_list_problem()
   VansModel model = VansModel::B;

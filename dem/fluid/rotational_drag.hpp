@@ -7,7 +7,7 @@
 //                                        J. Fluid Mech. 101:257–279; fitted to Re_r < 1000).
 // The low-Re branch is exactly the Stokes torque 8πμ(d/2)³ Ω. The branches meet within
 // 0.2 % at Re_r = 32. The torque is explicit: it needs dt below ~I/(8πμ(d/2)³) =
-// ρ_p d²/(60 μ) (docs/theory/fluid-forces.md).
+// ρ_p d²/(60 μ) (docs/models/fluid-forces.md).
 #include <cmath>
 #include <numbers>
 

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <sstream>
+#include <stdexcept>
 
 #include "dem/insert/insertion.hpp"
 
@@ -138,6 +140,34 @@ long StreamInsertion::insert(double t, Particles& p, const Ghosts& ghosts, const
     total += placed;
   }
   return total;
+}
+
+std::string StreamInsertion::save_state() const {
+  std::ostringstream out;
+  out.precision(17);
+  out << streams_.size() << '\n';
+  for (const Stream& s : streams_) {
+    out << s.mass << ' ' << s.count << ' ' << s.pending.size();
+    for (double r : s.pending) out << ' ' << r;
+    out << '\n' << s.radius_rng << '\n' << s.place_rng << '\n';
+  }
+  return out.str();
+}
+
+void StreamInsertion::restore_state(const std::string& state) {
+  std::istringstream in(state);
+  std::size_t n = 0;
+  if (!(in >> n) || n != streams_.size())
+    throw std::invalid_argument("stream insertion state is for " + std::to_string(n) +
+                                " streams, the scene has " + std::to_string(streams_.size()));
+  for (Stream& s : streams_) {
+    std::size_t pending = 0;
+    in >> s.mass >> s.count >> pending;
+    s.pending.assign(pending, 0.0);
+    for (double& r : s.pending) in >> r;
+    in >> s.radius_rng >> s.place_rng;
+  }
+  if (!in) throw std::invalid_argument("stream insertion state is malformed");
 }
 
 }  // namespace grainflow

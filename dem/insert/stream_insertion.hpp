@@ -18,6 +18,7 @@
 #include <mpi.h>
 
 #include <random>
+#include <string>
 #include <vector>
 
 #include "dem/core/particles.hpp"
@@ -47,6 +48,12 @@ class StreamInsertion {
   // How far stream k is behind its target at the last insert(), in particles.
   long lag(std::size_t k) const { return streams_[k].lag; }
   std::size_t size() const { return streams_.size(); }
+
+  // The streams' progress (delivered totals, radii drawn but not placed, generator
+  // states) as text, for checkpoints: a run restored with restore_state() inserts
+  // exactly what the uninterrupted run would have. The scene must be the same.
+  std::string save_state() const;
+  void restore_state(const std::string& state);  // std::invalid_argument if malformed
 
  private:
   struct Stream {

@@ -52,8 +52,17 @@ FluidSettings parse_fluid_section(const Field& f, const Vec3& gravity) {
   field.viscosity = m.number("viscosity", kPositive);
   field.velocity = m.vec3_or("velocity", Vec3::Zero());
   if (const auto shear = m.find("shear")) parse_shear(*shear, field);
-  field.void_fraction =
-      m.number_or("void_fraction", 1.0, Range{kLowestVoidFraction, 1, true, true});
+  if (const auto vf = m.find("void_fraction"); vf && vf->node().IsMap()) {
+    // Computed from the particles on a grid: {cell_size: <m>, minimum: <eps_min>}.
+    const Map g = vf->map({"cell_size", "minimum"});
+    VoidFractionGridSettings grid;
+    grid.cell_size = g.number("cell_size", kPositive);
+    grid.minimum = g.number_or("minimum", 0.2, Range{kLowestVoidFraction, 1, true, false});
+    s.computed_void_fraction = grid;
+  } else {
+    field.void_fraction =
+        m.number_or("void_fraction", 1.0, Range{kLowestVoidFraction, 1, true, true});
+  }
   if (const auto p = m.find("pressure")) {
     const Map pm = p->map({"hydrostatic", "gradient"});
     if (const auto h = pm.find("hydrostatic")) field.hydrostatic_pressure = h->boolean();

@@ -27,8 +27,12 @@ TriangleMesh::TriangleMesh(std::vector<Vec3> vertices, std::vector<std::array<in
   std::unordered_map<std::uint64_t, int> edge_id;
   std::vector<std::pair<int, int>> edge_tri, vert_tri;
   edge_of_.resize(tris_.size());
+  normal_.resize(tris_.size());
+  offset_.resize(tris_.size());
   for (std::size_t t = 0; t < tris_.size(); ++t) {
     const auto& v = tris_[t];
+    normal_[t] = (verts_[v[1]] - verts_[v[0]]).cross(verts_[v[2]] - verts_[v[0]]).normalized();
+    offset_[t] = normal_[t].dot(verts_[v[0]]);
     for (int e = 0; e < 3; ++e) {
       const auto a = static_cast<std::uint64_t>(std::min(v[e], v[(e + 1) % 3]));
       const auto b = static_cast<std::uint64_t>(std::max(v[e], v[(e + 1) % 3]));
@@ -103,6 +107,8 @@ int TriangleMesh::resolve(const Vec3& c, double r, ForEach&& for_each_triangle,
   int n = 0;
   const double r2 = r * r;
   for_each_triangle([&](int t) {
+    // Cheap rejection: the sphere does not reach the triangle's plane.
+    if (std::abs(normal_[t].dot(c) - offset_[t]) >= r) return;
     const auto& v = tris_[t];
     TriangleFeature f;
     const Vec3 q = closest_point_on_triangle(c, verts_[v[0]], verts_[v[1]], verts_[v[2]], f);
@@ -151,8 +157,7 @@ int TriangleMesh::resolve(const Vec3& c, double r, ForEach&& for_each_triangle,
     if (d > 1e-12 * r) {
       o.n = (c - ck.q) / d;
     } else {  // centre on the surface: push along the face normal
-      const auto& v = tris_[ck.tri];
-      o.n = (verts_[v[1]] - verts_[v[0]]).cross(verts_[v[2]] - verts_[v[0]]).normalized();
+      o.n = normal_[ck.tri];
     }
     o.point = ck.q;
     o.overlap = r - d;

@@ -67,6 +67,8 @@ class TriangleMesh {
 
   std::vector<Vec3> verts_;
   std::vector<std::array<int, 3>> tris_;
+  std::vector<Vec3> normal_;                 // unit normal of each triangle
+  std::vector<double> offset_;               // normal . (a vertex): the plane is n.x = offset
   std::vector<std::array<int, 3>> edge_of_;  // edge ids of AB, BC, CA
   std::vector<int> edge_start_, edge_tris_;  // CSR: triangles around each edge
   std::vector<int> vert_start_, vert_tris_;  // CSR: triangles around each vertex

@@ -211,7 +211,7 @@ TEST(DragLaws, SchillerNaumannTendsToStokes) {
   }
 }
 
-// ε → 1, what each dense law tends to (docs/theory/fluid-forces.md, table "ε → 1"):
+// ε → 1, what each dense law tends to (docs/models/fluid-forces.md, table "ε → 1"):
 //  wen_yu, gidaspow, tenneti_garg_subramaniam: exactly Schiller–Naumann (Re < 1000);
 //  rong: exactly di_felice (both reduce to the Dallavalle single-sphere drag);
 //  di_felice: (0.63√Re + 4.8)²/24 × Stokes, 0.96 × Stokes as Re → 0;

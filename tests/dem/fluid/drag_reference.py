@@ -7,7 +7,7 @@ pressure drop, or total-force ratio F — with plain Python floats, independentl
 the C++ algebra. Run:  python3 tests/dem/fluid/drag_reference.py
 and paste the printed rows into kReference in drag_laws_test.cpp.
 
-Conventions (docs/theory/fluid-forces.md): Re = rho eps d U / mu (superficial slip);
+Conventions (docs/models/fluid-forces.md): Re = rho eps d U / mu (superficial slip);
 Re0 = rho d U / mu (single sphere); laws written for the total force F_total (Koch-Hill,
 Tenneti, Ergun's pressure drop) give the drag as eps * F_total; Beetstra's F is already
 normalised as the drag (its Carman-Kozeny limit is 10 phi/eps^2, not 10 phi/eps^3).

@@ -110,6 +110,38 @@ TEST(StreamInsertion, NeverOverlapsExistingParticles) {
   EXPECT_LT(worst, 0.05);  // only contact overlaps from settling, no insertion overlaps
 }
 
+// Saving and restoring the stream state continues the same sequence: a fresh
+// inserter restored from the state draws the radii the running simulation draws next.
+TEST(StreamInsertion, StateRoundTripContinuesTheSameSequence) {
+  Scene s = falling_stream_scene();
+  s.insertions.push_back(stream(0.05));
+  Simulation a(s);
+  a.advance_to(0.05);
+  StreamInsertion copy(s);
+  copy.restore_state(a.streams().save_state());
+  EXPECT_EQ(copy.save_state(), a.streams().save_state());
+  const GlobalId first_new = a.next_id();
+  // The running simulation goes on to t = 0.05 + 10 dt; the copy inserts up to the
+  // same time into an empty set (the stream is sparse: nothing blocks either).
+  a.advance_to(0.05 + 10 * 2e-5);
+  Particles pb;
+  Ghosts none;
+  const WallSet walls(s);
+  const Decomposition d(MPI_COMM_SELF, s.domain, {1, 1, 1});
+  GlobalId ib = first_new;
+  copy.insert(a.time(), pb, none, walls, d, ib, MPI_COMM_SELF);
+  std::vector<double> ra;
+  const Particles& p = a.particles();
+  for (GlobalId id = first_new; id < a.next_id(); ++id)
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (p.id[i] == id) ra.push_back(p.radius[i]);
+  ASSERT_GT(ra.size(), 0u);
+  ASSERT_EQ(ra.size(), pb.size());
+  for (std::size_t k = 0; k < ra.size(); ++k) EXPECT_EQ(ra[k], pb.radius[k]);
+  EXPECT_EQ(copy.count_inserted(0), a.streams().count_inserted(0));
+  EXPECT_THROW(copy.restore_state("2\n"), std::invalid_argument);
+}
+
 // A snapshot written by SnapshotWriter comes back as the same particles.
 TEST(SnapshotInsertion, ContinuesABedFromASnapshot) {
   const std::filesystem::path dir =

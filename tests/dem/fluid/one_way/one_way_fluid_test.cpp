@@ -123,5 +123,40 @@ TEST(OneWayFluid, ArchimedesRouteAndVirtualMassGiveSameTerminalVelocity) {
   EXPECT_NEAR(settle(d, added, g) / ut, 1, 0.01);
 }
 
+// 4. Void fraction computed from the particles: a cubic lattice of spheres, one per
+//    grid cell, in a periodic box with no contacts; every cell then holds exactly
+//    eps = 1 - V_p / V_cell. Reference: the same fall with that eps given as a number;
+//    the two runs must agree to round-off (1e-12).
+TEST(OneWayFluid, ComputedVoidFractionEqualsTheGivenOne) {
+  const double d = 0.2e-3, cell = 0.5e-3, L = 8 * cell;
+  const double eps = 1 - sphere_volume(d / 2) / (cell * cell * cell);
+  auto run = [&](bool computed) {
+    Scene s = scene_with(stokes_time(d) / 20, Vec3(0, 0, -kG));
+    s.domain.lo = Vec3::Zero();
+    s.domain.hi = Vec3::Constant(L);
+    s.domain.periodic = {true, true, true};
+    FluidSettings f = water({FluidForce::drag, FluidForce::pressure_gradient, FluidForce::viscous});
+    f.drag_law = "di_felice";
+    if (computed)
+      f.computed_void_fraction = VoidFractionGridSettings{cell, 0.2};
+    else
+      f.field.void_fraction = eps;
+    Simulation sim(s, false);
+    GlobalId id = 1;
+    for (int i = 0; i < 8; ++i)
+      for (int j = 0; j < 8; ++j)
+        for (int k = 0; k < 8; ++k)
+          sim.particles().add(id++, (Vec3(i, j, k) + Vec3::Constant(0.5)) * cell, Vec3::Zero(),
+                              Vec3::Zero(), d / 2, 0, kRhoP);
+    sim.add_force_term(make_fluid_forces(f, s.gravity, s.domain, MPI_COMM_WORLD));
+    sim.advance_to(5 * stokes_time(d));
+    return -sim.particles().v[0].z();
+  };
+  const double given = run(false), computed = run(true);
+  std::printf("settling with eps = %.4f: given %.9g m/s, computed %.9g m/s\n", eps, given, computed);
+  EXPECT_GT(given, 0);
+  EXPECT_NEAR(computed / given, 1, 1e-12);
+}
+
 }  // namespace
 }  // namespace grainflow
