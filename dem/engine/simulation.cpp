@@ -278,7 +278,7 @@ void Simulation::restore(const CheckpointData& checkpoint) {
   restored_ = true;
 }
 
-void Simulation::write_checkpoint(const std::string& path) const {
+void Simulation::write_checkpoint(const std::string& path) {
   CheckpointData d;
   d.time = time_;
   d.dt = dt_;
@@ -295,6 +295,8 @@ void Simulation::write_checkpoint(const std::string& path) const {
         d.springs.push_back({p_.id[i], -1 - static_cast<GlobalId>(w), c.wall[w][i].tangential,
                              c.wall[w][i].rolling});
   grainflow::write_checkpoint(comm_, path, d);
+  mark_leaving();
+  rebuild();
 }
 
 void Simulation::rebuild() {

@@ -80,8 +80,10 @@ class Simulation {
   // on every rank (read_checkpoint); each rank keeps what it owns, springs included.
   // The scene must be the one the checkpoint was written with.
   void restore(const CheckpointData& checkpoint);
-  // Writes the complete dynamic state, readable on any number of ranks. Collective.
-  void write_checkpoint(const std::string& path) const;
+  // Writes the complete dynamic state, readable on any number of ranks, then
+  // rebuilds the neighbour lists exactly as a restart from that file will, so that a
+  // run restarted on the same rank count continues bit-identically. Collective.
+  void write_checkpoint(const std::string& path);
 
   // Checks the time step, distributes particles to their ranks, builds lists and
   // the first forces. Collective. Called by the first step() if not before.

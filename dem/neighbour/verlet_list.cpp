@@ -58,6 +58,14 @@ std::vector<std::size_t> BinGrid::sort_permutation(const Particles& p) {
   std::vector<int> fill(bin_start_.begin(), bin_start_.end() - 1);
   std::vector<std::size_t> perm(p.size());
   for (std::size_t i = 0; i < p.size(); ++i) perm[fill[bin[i]]++] = i;
+  // Within a bin, order by global id: the order (and so the order in which each
+  // particle's contact forces are summed) then depends on positions and ids only,
+  // not on the order particles arrived in — a restart or another rank count
+  // rebuilds the same lists.
+  for (int b = 0; b < nbins; ++b)
+    if (bin_start_[b + 1] - bin_start_[b] > 1)
+      std::sort(perm.begin() + bin_start_[b], perm.begin() + bin_start_[b + 1],
+                [&p](std::size_t a, std::size_t c) { return p.id[a] < p.id[c]; });
   return perm;
 }
 

@@ -92,6 +92,8 @@ void Exchange::migrate(Particles& p, CarriedState& carried) {
         w.put(p.x[i]);
         w.put(p.v[i]);
         w.put(p.omega[i]);
+        w.put(p.force[i]);  // the next half kick uses them (e.g. right after a checkpoint)
+        w.put(p.torque[i]);
         w.put(p.radius[i]);
         w.put(p.mass[i]);
         w.put(p.inertia[i]);
@@ -124,9 +126,12 @@ void Exchange::migrate(Particles& p, CarriedState& carried) {
       while (r.k < in.size()) {
         const GlobalId id = r.get_id();
         const Vec3 x = r.get_vec(), v = r.get_vec(), w_spin = r.get_vec();
+        const Vec3 force = r.get_vec(), torque = r.get_vec();
         const double radius = r.get(), mass = r.get(), inertia = r.get();
         const int mat = static_cast<int>(r.get());
         p.add_raw(id, x, v, w_spin, radius, mass, inertia, mat);
+        p.force.back() = force;
+        p.torque.back() = torque;
         for (std::size_t k = 0; k < walls; ++k) carried.wall[k].push_back(r.get_history());
         const auto n = static_cast<std::size_t>(r.get());
         std::vector<PartnerHistory> pairs(n);
