@@ -67,9 +67,13 @@ void agree_on_error(MPI_Comm comm, const std::string& local_message) {
 void Exchange::migrate(Particles& p, CarriedState& carried) {
   const Domain& dom = d_.domain();
   const Vec3 length = d_.length();
+  // With one rank along a periodic axis, wrapping is all there is to do. With several,
+  // the direction is chosen from the unwrapped position (a particle past the upper
+  // periodic side goes to the +x neighbour, across the side) and the period is
+  // subtracted as it crosses.
   for (std::size_t i = 0; i < p.size(); ++i)
     for (int a = 0; a < 3; ++a)
-      if (dom.periodic[a]) {
+      if (dom.periodic[a] && d_.dims()[a] == 1) {
         if (p.x[i][a] < dom.lo[a]) p.x[i][a] += length[a];
         else if (p.x[i][a] >= dom.hi[a]) p.x[i][a] -= length[a];
       }
@@ -80,6 +84,9 @@ void Exchange::migrate(Particles& p, CarriedState& carried) {
     if (d_.dims()[a] == 1) continue;  // after wrapping, this rank spans the whole axis
     for (int dir = 0; dir < 2; ++dir) {
       const int to = d_.neighbour(a, dir), from = d_.neighbour(a, 1 - dir);
+      Vec3 shift = Vec3::Zero();  // across the periodic side: back into the domain
+      if (dom.periodic[a] && dir == 0 && d_.coords()[a] == 0) shift[a] = length[a];
+      if (dom.periodic[a] && dir == 1 && d_.coords()[a] == d_.dims()[a] - 1) shift[a] = -length[a];
       std::vector<double> out;
       Writer w{out};
       std::vector<char> leaving(p.size(), 0);
@@ -89,7 +96,7 @@ void Exchange::migrate(Particles& p, CarriedState& carried) {
         if (!outside || to == MPI_PROC_NULL) continue;
         leaving[i] = 1;
         w.put_id(p.id[i]);
-        w.put(p.x[i]);
+        w.put(Vec3(p.x[i] + shift));
         w.put(p.v[i]);
         w.put(p.omega[i]);
         w.put(p.force[i]);  // the next half kick uses them (e.g. right after a checkpoint)
