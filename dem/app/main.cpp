@@ -20,8 +20,10 @@ constexpr const char* kUsage = R"(usage: grain <command> [options]
 
 commands:
   run SCENE.yaml [--output DIR] [--no-progress] [--allow-large-dt]
+                 [--restart CHECKPOINT.h5]
                       run a DEM scene: HDF5 snapshots + XDMF index (ParaView) and a
-                      CSV log in the scene's output directory
+                      CSV log in the scene's output directory; --restart continues
+                      from a checkpoint. SIGTERM/SIGINT write a checkpoint and stop
   check SCENE.yaml    parse and validate the scene, insert its particles, and print
                       the Rayleigh time, the contact time at the expected impact
                       speed and the time step as a fraction of both
@@ -61,6 +63,8 @@ int dispatch(const std::vector<std::string>& args, int rank) {
       options.progress = false;
     else if (cmd == "run" && args[k] == "--allow-large-dt")
       options.allow_large_time_step = true;
+    else if (cmd == "run" && args[k] == "--restart" && k + 1 < args.size())
+      options.restart = args[++k];
     else
       return usage_error("unknown option '" + args[k] + "' for '" + cmd + "'");
   }

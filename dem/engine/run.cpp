@@ -3,10 +3,15 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <limits>
+#include <optional>
 #include <ostream>
+#include <sstream>
 
+#include "dem/engine/checkpoint_series.hpp"
+#include "dem/engine/finite_guard.hpp"
 #include "dem/engine/simulation.hpp"
 #include "dem/fluid/fluid_forces.hpp"
 #include "dem/io/log_table.hpp"
@@ -16,6 +21,59 @@
 
 namespace grainflow {
 namespace {
+
+// The signal that asked the run to stop (0: none). A signal handler can reach nothing but a
+// global, and may only store to a volatile sig_atomic_t (C++20 [support.signal]).
+volatile std::sig_atomic_t stop_signal = 0;
+
+extern "C" void on_stop_signal(int signal) { stop_signal = signal; }
+
+// SIGTERM and SIGINT set stop_signal while a run is in progress; the previous handlers come
+// back afterwards. SA_RESETHAND: a second signal of the same kind kills the run as usual.
+class StopSignals {
+ public:
+  explicit StopSignals(bool install) : installed_(install) {
+    stop_signal = 0;
+    if (!installed_) return;
+    struct sigaction action = {};
+    action.sa_handler = on_stop_signal;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = SA_RESETHAND;
+    sigaction(SIGTERM, &action, &old_term_);
+    sigaction(SIGINT, &action, &old_int_);
+  }
+  ~StopSignals() {
+    if (!installed_) return;
+    sigaction(SIGTERM, &old_term_, nullptr);
+    sigaction(SIGINT, &old_int_, nullptr);
+  }
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+ private:
+  bool installed_;
+  struct sigaction old_term_ = {};
+  struct sigaction old_int_ = {};
+};
+
+// Stops the run on every rank at the first non-finite particle state, after writing every
+// particle into <dir>/diagnostic_000000.h5.
+void guard_finite(const Simulation& sim, const std::string& dir, MPI_Comm comm) {
+  if (!non_finite_anywhere(sim.particles(), comm)) return;
+  std::string where;
+  try {
+    SnapshotWriter diagnostic(comm, dir, "diagnostic");
+    where = "; every particle of this step is in " +
+            diagnostic.write(sim.particles(), sim.time(), sim.counters().steps);
+  } catch (const OutputError& e) {
+    where = std::string("; the diagnostic snapshot could not be written: ") + e.what();
+  }
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  const std::string mine =
+      describe_first_non_finite(sim.particles(), sim.counters().steps, sim.time(), rank);
+  agree_on_error(comm, mine.empty() ? mine : mine + where);
+}
 
 // Rank 0 speaks for the run; the other ranks write into this sink.
 std::ostream& speaker(MPI_Comm comm, std::ostream& out) {
@@ -67,7 +125,10 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   prepare_output_directory(dir);  // before any work: an unwritable directory fails now
   std::ostream& say = speaker(comm, out);
 
-  Simulation sim(scene, true, comm);
+  // A restart takes its particles from the checkpoint instead of inserting them.
+  Simulation sim(scene, !options.restart, comm);
+  if (options.restart) sim.restore(read_checkpoint(*options.restart));
+  const long first_step = sim.counters().steps;  // 0, or the checkpoint's step
   if (scene.fluid)
     sim.add_force_term(make_fluid_forces(*scene.fluid, scene.gravity, scene.domain, comm));
   sim.initialise();
@@ -77,14 +138,30 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     throw SetupError(scene.file + ": error: refusing to run with this time step (see above); "
                                   "lower time.step / time.rayleigh_fraction, or pass "
                                   "--allow-large-dt to run anyway");
+  guard_finite(sim, dir, comm);
 
   SnapshotWriter snapshots(comm, dir);
-  LogTable log(comm, (std::filesystem::path(dir) / "log.csv").string());
+  const std::string log_path = (std::filesystem::path(dir) / "log.csv").string();
+  std::optional<LogTable> log_table;
+  if (options.restart) {
+    const std::size_t kept = snapshots.continue_series(first_step);
+    log_table.emplace(comm, log_path, first_step);
+    say << "restart: from " << *options.restart << " at step " << first_step
+        << " (t = " << sim.time() << " s); continuing " << dir
+        << "/log.csv and the snapshot series after " << kept << " earlier snapshot(s)\n";
+  } else {
+    log_table.emplace(comm, log_path);
+  }
+  LogTable& log = *log_table;
   ProgressLine progress(comm, scene.time.end, options.progress && scene.output.progress, out);
+  CheckpointSeries checkpoints(comm, dir, scene.output.checkpoint_keep,
+                               options.restart ? first_step : -1);
+  const StopSignals signals(options.handle_stop_signals);
 
   const double dt = sim.dt();
   const double snap_every = scene.output.snapshot_interval.value_or(scene.time.end / 20);
   const double log_every = scene.output.log_interval.value_or(scene.time.end / 200);
+  const double check_every = scene.output.checkpoint_interval.value_or(0);
   const auto start = std::chrono::steady_clock::now();
   auto wall = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -104,19 +181,37 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     }
     return g;
   };
+  auto write_checkpoint = [&] {
+    const std::string path = checkpoints.write(sim);
+    if (!checkpoints.warning().empty()) say << checkpoints.warning() << "\n";
+    return path;
+  };
 
   RunSummary sum;
-  long snap_index = 0, log_index = 0;
-  long snap_step = 0, log_step = 0;  // last step written, so the final step is not written twice
-  snapshots.write(sim.particles(), sim.time(), 0);
-  sum.particles_start = write_log().particles;
+  // Output counters as the uninterrupted run has them at this step: the index of the last
+  // interval written, so a restart writes the same steps as the uninterrupted run.
+  const double t0 = sim.time();
+  auto written = [&](double every) {
+    return every > 0 ? static_cast<long>(std::floor((t0 + 0.5 * dt) / every)) : 0L;
+  };
+  long snap_index = written(snap_every), log_index = written(log_every);
+  long check_index = written(check_every);
+  long snap_step = first_step, log_step = first_step;  // last step written
+  if (!options.restart) {
+    snapshots.write(sim.particles(), sim.time(), 0);
+    sum.particles_start = write_log().particles;
+  } else {
+    sum.particles_start = sim.global_state().particles;
+  }
   long global_particles = sum.particles_start;
   // The run ends at the step nearest to t_end (within half a step).
   const long total_steps =
       std::max(1L, static_cast<long>(std::ceil(scene.time.end / dt - 0.5 - 1e-9)));
   double particle_steps = 0;  // this rank's
-  for (long k = 1; k <= total_steps; ++k) {
+  std::ostringstream stop_message;
+  for (long k = first_step + 1; k <= total_steps; ++k) {
     sim.step();
+    guard_finite(sim, dir, comm);
     particle_steps += static_cast<double>(sim.particles().size());
     const double t = sim.time();
     const bool last = k == total_steps;
@@ -130,9 +225,30 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
       snap_index = static_cast<long>(std::floor(t / snap_every + 0.5));
       snapshots.write(sim.particles(), t, k);
     }
+    if (check_every > 0 && !last && t >= (check_index + 1) * check_every - 0.5 * dt) {
+      check_index = static_cast<long>(std::floor(t / check_every + 0.5));
+      write_checkpoint();
+    }
     if ((k & 255) == 0 || last) progress.update(t, k, global_particles);
+    // Stop signals are agreed on every 100 steps: one small reduction, so all ranks stop at
+    // the same step.
+    if (k % 100 == 0 && !last) {
+      int signal = stop_signal;
+      MPI_Allreduce(MPI_IN_PLACE, &signal, 1, MPI_INT, MPI_MAX, comm);
+      if (signal != 0) {
+        if (log_step != k) write_log();
+        sum.stop_checkpoint = write_checkpoint();
+        stop_message << "grain: received " << (signal == SIGINT ? "SIGINT" : "SIGTERM")
+                     << "; stopped after step " << k << " (t = " << t
+                     << " s) and wrote the checkpoint " << sum.stop_checkpoint
+                     << "; continue with: grain run " << scene.file << " --restart "
+                     << sum.stop_checkpoint << "\n";
+        break;
+      }
+    }
   }
   progress.finish();
+  say << stop_message.str();
 
   MPI_Allreduce(MPI_IN_PLACE, &particle_steps, 1, MPI_DOUBLE, MPI_SUM, comm);
   const GlobalState g = sim.global_state();
@@ -142,9 +258,9 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   sum.rebuilds = sim.counters().rebuilds;
   sum.wall_seconds = wall();
   sum.particle_steps_per_second = sum.wall_seconds > 0 ? particle_steps / sum.wall_seconds : 0;
-  say << "done: " << sum.steps << " steps, " << sum.particles_end << " particles ("
-      << sum.removed << " removed), " << sum.rebuilds << " neighbour rebuilds, "
-      << sum.wall_seconds << " s wall, " << sum.particle_steps_per_second
+  say << (sum.stop_checkpoint.empty() ? "done: " : "stopped: ") << sum.steps << " steps, "
+      << sum.particles_end << " particles (" << sum.removed << " removed), " << sum.rebuilds
+      << " neighbour rebuilds, " << sum.wall_seconds << " s wall, " << sum.particle_steps_per_second
       << " particle-steps/s\n"
       << "output: " << dir << "/particles.xdmf (open in ParaView), " << dir << "/log.csv\n";
   for (const std::string& line : sim.force_term_reports())

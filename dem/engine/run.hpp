@@ -15,6 +15,8 @@ struct RunOptions {
   std::optional<std::string> output_directory;  // overrides the scene's
   bool progress = true;                         // AND-ed with the scene's setting
   bool allow_large_time_step = false;           // run even when the check refuses dt
+  std::optional<std::string> restart;           // checkpoint to continue from (--restart)
+  bool handle_stop_signals = true;              // SIGTERM/SIGINT: checkpoint and stop
 };
 
 struct RunSummary {
@@ -24,6 +26,7 @@ struct RunSummary {
   long rebuilds = 0;
   double wall_seconds = 0;
   double particle_steps_per_second = 0;
+  std::string stop_checkpoint;  // set when a SIGTERM/SIGINT stopped the run early
 };
 
 // Prints the time-step report (`grain check`); returns the process exit code:

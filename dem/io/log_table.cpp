@@ -1,9 +1,13 @@
 #include "dem/io/log_table.hpp"
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 
 #include "dem/io/output_directory.hpp"
+#include "dem/io/xdmf_index.hpp"
 
 namespace grainflow {
 
@@ -23,6 +27,41 @@ LogTable::LogTable(MPI_Comm comm, const std::string& path) : comm_(comm), path_(
     }
   }
   agree(err, "cannot create the log table");
+}
+
+LogTable::LogTable(MPI_Comm comm, const std::string& path, long continue_after_step)
+    : comm_(comm), path_(path) {
+  MPI_Comm_rank(comm_, &rank_);
+  int err = 0;
+  if (rank_ == 0) {
+    std::ifstream in(path_);
+    std::string line;
+    std::string kept;
+    if (in && std::getline(in, line) && line == header) {
+      kept = line + "\n";
+      while (std::getline(in, line)) {
+        const auto comma = line.find(',');
+        if (comma == std::string::npos) break;  // a row cut short by a kill
+        const long step = std::strtol(line.c_str() + comma + 1, nullptr, 10);
+        if (step > continue_after_step) break;
+        kept += line + "\n";
+      }
+    } else {
+      kept = std::string(header) + "\n";
+    }
+    in.close();
+    try {
+      write_file_atomically(path_, kept);
+    } catch (const OutputError&) {
+      err = EIO;
+    }
+    if (!err) {
+      errno = 0;
+      file_ = std::fopen(path_.c_str(), "a");
+      if (!file_) err = errno ? errno : EIO;
+    }
+  }
+  agree(err, "cannot continue the log table");
 }
 
 LogTable::~LogTable() {

@@ -31,6 +31,11 @@ class LogTable {
   // Collective: rank 0 creates (truncates) `path` and writes the header; every rank throws
   // OutputError naming the path if that fails.
   LogTable(MPI_Comm comm, const std::string& path);
+  // Collective: continues the table of a restarted run. Rank 0 keeps the header and the rows
+  // with step <= `continue_after_step` (rows that a stopped run wrote after its checkpoint are
+  // dropped, the restarted run writes them again), then appends. A missing file, or one with
+  // another header, is replaced by a new table.
+  LogTable(MPI_Comm comm, const std::string& path, long continue_after_step);
   ~LogTable();
   LogTable(const LogTable&) = delete;
   LogTable& operator=(const LogTable&) = delete;

@@ -234,6 +234,31 @@ SnapshotWriter::SnapshotWriter(MPI_Comm comm, std::string directory, std::string
   MPI_Comm_size(comm_, &size_);
 }
 
+std::size_t SnapshotWriter::continue_series(long up_to_step) {
+  QuietHdf5Errors quiet;
+  entries_.clear();
+  for (;;) {
+    const std::string file_name = basename_ + "_" + six_digits(entries_.size()) + ".h5";
+    const std::string path = (std::filesystem::path(directory_) / file_name).string();
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) break;
+    Hid file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+    if (!file.valid()) break;
+    double t = 0;
+    std::int64_t s = 0, n = 0;
+    auto read = [&](const char* name, hid_t type, void* out) {
+      Hid attr(H5Aopen(file.get(), name, H5P_DEFAULT), H5Aclose);
+      return attr.valid() && H5Aread(attr.get(), type, out) >= 0;
+    };
+    if (!read("time", H5T_NATIVE_DOUBLE, &t) || !read("step", H5T_NATIVE_INT64, &s) ||
+        !read("count", H5T_NATIVE_INT64, &n) || s > up_to_step)
+      break;
+    entries_.push_back({file_name, t, static_cast<long>(s), static_cast<long>(n)});
+  }
+  H5Eclear2(H5E_DEFAULT);
+  return entries_.size();
+}
+
 std::string SnapshotWriter::index_path() const {
   return (std::filesystem::path(directory_) / (basename_ + ".xdmf")).string();
 }

@@ -32,6 +32,12 @@ class SnapshotWriter {
   // OutputError (naming the file, the failing operation, the HDF5/OS reason and the rank).
   std::string write(const Particles& p, double time, long step);
 
+  // Continues an existing series (a restarted run): takes the snapshots already in the
+  // directory, in index order, up to the first one missing, unreadable or past `up_to_step`,
+  // so the next write() gets the next number and later files of a stopped run are
+  // overwritten. Every rank reads the files' attributes (no communication). Returns how many.
+  std::size_t continue_series(long up_to_step);
+
   std::size_t snapshots_written() const { return entries_.size(); }
   std::string index_path() const;
 

@@ -161,6 +161,8 @@ struct OutputSettings {
   std::optional<double> snapshot_interval; // simulated seconds between HDF5 snapshots
   std::optional<double> log_interval;      // simulated seconds between CSV log rows
   bool progress = true;                    // terminal progress line with ETA
+  std::optional<double> checkpoint_interval; // simulated seconds between checkpoints; none: off
+  int checkpoint_keep = 2;                   // periodic checkpoints kept on disk (>= 1)
 };
 
 struct NeighbourSettings {

@@ -568,12 +568,16 @@ std::vector<Insertion> parse_insertions(const Field& f, const Scene& scene) {
 }
 
 OutputSettings parse_output(const Field& f) {
-  const Map m = f.map({"directory", "snapshot_interval", "log_interval", "progress"});
+  const Map m = f.map({"directory", "snapshot_interval", "log_interval", "progress",
+                       "checkpoint_interval", "checkpoint_keep"});
   OutputSettings o;
   if (const auto d = m.find("directory")) o.directory = d->text();
   o.snapshot_interval = m.maybe_number("snapshot_interval", kPositive);
   o.log_interval = m.maybe_number("log_interval", kPositive);
   if (const auto p = m.find("progress")) o.progress = p->boolean();
+  o.checkpoint_interval = m.maybe_number("checkpoint_interval", kPositive);
+  if (const auto k = m.find("checkpoint_keep"))
+    o.checkpoint_keep = static_cast<int>(k->integer(Range{1, 1000, true, true}));
   return o;
 }
 

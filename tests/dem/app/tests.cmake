@@ -57,3 +57,41 @@ grain_cli_test(overlap_guard_stops_run 1
                CMD ${_grain} run ${_scenes}/bad/huge_time_step.yaml --allow-large-dt --no-progress
                    --output out
                WORKDIR ${_work}/overlap_guard)
+
+# Reliability (docs/reliability.md): SIGTERM finishes the step, writes a checkpoint, exits 0.
+# These read HDF5 with h5py: use the first python3 that has it (Debian's python3-h5py).
+find_program(GRAINFLOW_H5PY_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
+if(NOT GRAINFLOW_H5PY_PYTHON)
+  find_program(GRAINFLOW_H5PY_PYTHON python3)
+endif()
+set(GRAINFLOW_PYTHON3 "")
+if(GRAINFLOW_H5PY_PYTHON)
+  execute_process(COMMAND ${GRAINFLOW_H5PY_PYTHON} -c "import h5py" RESULT_VARIABLE _no_h5py
+                  OUTPUT_QUIET ERROR_QUIET)
+  if(_no_h5py EQUAL 0)
+    set(GRAINFLOW_PYTHON3 ${GRAINFLOW_H5PY_PYTHON})
+  endif()
+endif()
+if(NOT GRAINFLOW_PYTHON3)
+  message(STATUS "python3 with h5py not found: the SIGTERM and NaN-guard tests of grain are skipped")
+else()
+  add_test(NAME grain.stop_signal_writes_checkpoint
+           COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/stop_signal.sh ${_grain}
+                   ${_scenes}/stop_signal.yaml ${_work}/stop_signal ${GRAINFLOW_PYTHON3})
+  add_test(NAME grain.stop_signal_two_ranks
+           COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/stop_signal.sh ${_grain}
+                   ${_scenes}/stop_signal.yaml ${_work}/stop_signal_2 ${GRAINFLOW_PYTHON3}
+                   ${MPIEXEC_EXECUTABLE} 2)
+  set_tests_properties(grain.stop_signal_writes_checkpoint grain.stop_signal_two_ranks
+                       PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}" TIMEOUT 60)
+  set_tests_properties(grain.stop_signal_two_ranks PROPERTIES PROCESSORS 2)
+  add_test(NAME grain.nan_guard_stops_run
+           COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/nan_guard.sh ${_grain}
+                   ${_scenes}/checkpointed_bed.yaml ${_work}/nan_guard ${GRAINFLOW_PYTHON3})
+  set_tests_properties(grain.nan_guard_stops_run
+                       PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}" TIMEOUT 60)
+endif()
+grain_cli_test(restart_missing_checkpoint 1 "no_such_checkpoint.h5"
+               CMD ${_grain} run ${_scenes}/periodic_bed.yaml --output out --no-progress
+                   --restart no_such_checkpoint.h5
+               WORKDIR ${_work}/restart_missing)

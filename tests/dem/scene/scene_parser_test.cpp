@@ -595,5 +595,29 @@ TEST(SceneErrors, MissingFileHasNoPosition) {
   }
 }
 
+// Periodic checkpoints (docs/reliability.md): off unless an interval is given; keep 2.
+TEST(SceneParser, CheckpointSettings) {
+  const Scene none = parse_scene(kBase, kLabel);
+  EXPECT_FALSE(none.output.checkpoint_interval);
+  EXPECT_EQ(none.output.checkpoint_keep, 2);
+
+  const Scene s =
+      parse_scene(kBase + "output:\n  checkpoint_interval: 0.05\n  checkpoint_keep: 3\n", kLabel);
+  EXPECT_EQ(s.output.checkpoint_interval, 0.05);
+  EXPECT_EQ(s.output.checkpoint_keep, 3);
+
+  // Lines 17-18 are the output block appended to the 16-line base.
+  EXPECT_THAT(expect_at(error_of(kBase + "output:\n  checkpoint_interval: 0\n"), 18, 24),
+              HasSubstr("output.checkpoint_interval: value 0 is out of range; it must be > 0"));
+  EXPECT_THAT(expect_at(error_of(kBase + "output:\n  checkpoint_interval: soon\n"), 18, 24),
+              HasSubstr("expected a number, got 'soon'"));
+  EXPECT_THAT(expect_at(error_of(kBase + "output:\n  checkpoint_keep: 0\n"), 18, 20),
+              HasSubstr("output.checkpoint_keep: value 0 is out of range; it must be in [1, 1000]"));
+  EXPECT_THAT(expect_at(error_of(kBase + "output:\n  checkpoint_keep: 2.5\n"), 18, 20),
+              HasSubstr("expected a whole number, got '2.5'"));
+  EXPECT_THAT(expect_at(error_of(kBase + "output:\n  checkpoint_every: 1\n"), 18, 3),
+              HasSubstr("checkpoint_interval, checkpoint_keep"));
+}
+
 }  // namespace
 }  // namespace grainflow

@@ -1,0 +1,38 @@
+#pragma once
+// Periodic checkpoints of a run: <directory>/checkpoint_<step, 9 digits>.h5, keeping the
+// newest K. An older file is deleted only after the new one has been renamed into place
+// (Simulation::write_checkpoint), so at every moment at least one complete checkpoint exists.
+#include <mpi.h>
+
+#include <deque>
+#include <string>
+
+namespace grainflow {
+
+class Simulation;
+
+class CheckpointSeries {
+ public:
+  // `adopt_up_to_step` >= 0 (a restarted run): the checkpoints already in `directory` with
+  // step <= it count as the series' oldest members. Files of other runs are left alone.
+  CheckpointSeries(MPI_Comm comm, std::string directory, int keep, long adopt_up_to_step = -1);
+
+  // Collective: writes the checkpoint of the simulation's current step (which also rebuilds
+  // its neighbour lists, see Simulation::write_checkpoint), then deletes the
+  // oldest beyond `keep` (a failed deletion is reported in the returned warning, not fatal).
+  // Returns the new checkpoint's path. Throws OutputError (every rank) if the write fails.
+  std::string write(Simulation& sim);
+
+  static std::string file_name(long step);  // checkpoint_000001234.h5
+  const std::string& warning() const { return warning_; }
+
+ private:
+  MPI_Comm comm_;
+  int rank_ = 0;
+  std::string directory_;
+  int keep_;
+  std::deque<std::string> files_;  // oldest first (rank 0 only)
+  std::string warning_;
+};
+
+}  // namespace grainflow

@@ -1,0 +1,54 @@
+#include "dem/engine/finite_guard.hpp"
+
+#include <cmath>
+#include <cstddef>
+#include <sstream>
+
+namespace grainflow {
+namespace {
+
+bool finite(const Vec3& a) {
+  return std::isfinite(a.x()) && std::isfinite(a.y()) && std::isfinite(a.z());
+}
+
+// Index of the first particle with a non-finite state, or p.size().
+std::size_t first_bad(const Particles& p) {
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (!finite(p.x[i]) || !finite(p.v[i]) || !finite(p.omega[i])) return i;
+  return p.size();
+}
+
+std::string text(const Vec3& a) {
+  std::ostringstream s;
+  s.precision(9);
+  s << "(" << a.x() << ", " << a.y() << ", " << a.z() << ")";
+  return s.str();
+}
+
+}  // namespace
+
+bool non_finite_anywhere(const Particles& p, MPI_Comm comm) {
+  int bad = first_bad(p) < p.size() ? 1 : 0;
+  MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPI_INT, MPI_MAX, comm);
+  return bad != 0;
+}
+
+std::string describe_first_non_finite(const Particles& p, long step, double time, int rank) {
+  const std::size_t i = first_bad(p);
+  if (i == p.size()) return {};
+  const char* what = !finite(p.x[i])   ? "position"
+                     : !finite(p.v[i]) ? "velocity"
+                                       : "angular velocity";
+  std::ostringstream s;
+  s.precision(9);
+  s << "error: step " << step << " (t = " << time << " s): particle " << p.id[i] << " (rank "
+    << rank << ") has a non-finite " << what << "; position " << text(p.x[i]) << " m, velocity "
+    << text(p.v[i]) << " m/s, angular velocity " << text(p.omega[i]) << " rad/s, force "
+    << text(p.force[i]) << " N, torque " << text(p.torque[i])
+    << " N m. The run stops here. Usual causes: a time step too large for the contact "
+       "stiffness (see `grain check`), particles inserted deeply overlapping, or a NaN in an "
+       "input file";
+  return s.str();
+}
+
+}  // namespace grainflow

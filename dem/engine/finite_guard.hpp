@@ -1,0 +1,21 @@
+#pragma once
+// The NaN / Inf guard: one pass over positions, velocities and spins after each step, so a
+// blow-up stops the run at the first bad step, naming the particle, instead of writing
+// snapshots full of NaN (or crashing later in the binning of a NaN position).
+#include <mpi.h>
+
+#include <string>
+
+#include "dem/core/particles.hpp"
+
+namespace grainflow {
+
+// Collective: true on every rank when any rank holds a particle whose position, velocity or
+// angular velocity is not finite. One MPI_Allreduce of an int.
+bool non_finite_anywhere(const Particles& p, MPI_Comm comm);
+
+// This rank's first such particle described for the user (id, rank, step, time, position,
+// velocity, angular velocity, force and torque), or "" when this rank has none. Local.
+std::string describe_first_non_finite(const Particles& p, long step, double time, int rank);
+
+}  // namespace grainflow
