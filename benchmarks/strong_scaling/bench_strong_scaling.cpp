@@ -64,7 +64,7 @@ int main(int argc, char** argv) {
       for (int i = 0; i < nxy; ++i)
         for (const Vec3& b : basis) {
           if (id > target) break;
-          const Vec3 x = (Vec3(i, j, k) + b + Vec3(0.25, 0.25, 0.25)) * a +
+          const Vec3 x = (Vec3(i, j, k) + b + Vec3(0.25, 0.25, 0.25)) * a + Vec3(0, 0, 0.3 * r) +
                          Vec3(u(rng), u(rng), u(rng)) * 1e-4 * r;
           sim.particles().add(id++, x, Vec3::Zero(), Vec3::Zero(), r, 0, 2500);
         }

@@ -359,11 +359,17 @@ void Simulation::check_overlap(const WorstContact& w) const {
     else
       o << "particle " << w.a << " and a wall";
     o << " overlap by " << 100 * worst << " % of the smaller radius (limit "
-      << 100 * limit << " %, key time.max_overlap), approaching at " << w.speed
-      << " m/s: the time step dt = " << dt_ << " s is too large to resolve this impact. A step of "
-      << "at most " << tc / 20 << " s would (1/20 of the Hertz contact time at that speed); "
-      << "lower time.step or time.rayleigh_fraction, or raise time.expected_max_speed so that "
-      << "grain check warns about it";
+      << 100 * limit << " %, key time.max_overlap)";
+    if (w.speed > 1e-9)
+      o << ", approaching at " << w.speed << " m/s: the time step dt = " << dt_
+        << " s is too large to resolve this impact. A step of at most " << tc / 20
+        << " s would (1/20 of the Hertz contact time at that speed); lower time.step or "
+        << "time.rayleigh_fraction, or raise time.expected_max_speed so that grain check "
+        << "warns about it";
+    else
+      o << " without approaching each other: the overlap was there at the start, or the load "
+        << "compresses a too-soft material; check the initial positions (insertion, CSV) or "
+        << "raise the Young's modulus";
     message = o.str();
   }
   agree_on_error(comm_, message);  // the rank holding the worst contact speaks
