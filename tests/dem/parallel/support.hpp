@@ -15,6 +15,28 @@ struct State {
   double x[3], v[3], w[3];
 };
 
+// Gathers every rank's records on rank 0 of `comm`, sorted by their `id` member
+// (empty on the other ranks). T must be trivially copyable.
+template <class T>
+std::vector<T> gather_by_id(const std::vector<T>& mine, MPI_Comm comm) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  const int bytes = static_cast<int>(mine.size() * sizeof(T));
+  std::vector<int> counts(size), displs(size);
+  MPI_Gather(&bytes, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm);
+  int total = 0;
+  for (int r = 0; r < size; ++r) {
+    displs[r] = total;
+    total += counts[r];
+  }
+  std::vector<T> all(rank == 0 ? total / sizeof(T) : 0);
+  MPI_Gatherv(mine.data(), bytes, MPI_BYTE, all.data(), counts.data(), displs.data(), MPI_BYTE, 0,
+              comm);
+  std::sort(all.begin(), all.end(), [](const T& a, const T& b) { return a.id < b.id; });
+  return all;
+}
+
 inline std::vector<State> gather_states(const Particles& p, MPI_Comm comm) {
   std::vector<State> mine(p.size());
   for (std::size_t i = 0; i < p.size(); ++i) {
@@ -25,22 +47,7 @@ inline std::vector<State> gather_states(const Particles& p, MPI_Comm comm) {
       mine[i].w[a] = p.omega[i][a];
     }
   }
-  int rank = 0, size = 1;
-  MPI_Comm_rank(comm, &rank);
-  MPI_Comm_size(comm, &size);
-  const int bytes = static_cast<int>(mine.size() * sizeof(State));
-  std::vector<int> counts(size), displs(size);
-  MPI_Gather(&bytes, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm);
-  int total = 0;
-  for (int r = 0; r < size; ++r) {
-    displs[r] = total;
-    total += counts[r];
-  }
-  std::vector<State> all(rank == 0 ? total / sizeof(State) : 0);
-  MPI_Gatherv(mine.data(), bytes, MPI_BYTE, all.data(), counts.data(), displs.data(), MPI_BYTE, 0,
-              comm);
-  std::sort(all.begin(), all.end(), [](const State& a, const State& b) { return a.id < b.id; });
-  return all;
+  return gather_by_id(mine, comm);
 }
 
 // Largest difference between two gathered runs: positions relative to `length`,

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "dem/engine/simulation.hpp"
+#include "tests/dem/parallel/support.hpp"
 
 namespace grainflow::test {
 
@@ -46,22 +47,7 @@ inline std::vector<Grain> gather_grains(const Particles& p, MPI_Comm comm) {
     g.m = p.mass[i];
     g.inertia = p.inertia[i];
   }
-  int rank = 0, size = 1;
-  MPI_Comm_rank(comm, &rank);
-  MPI_Comm_size(comm, &size);
-  const int bytes = static_cast<int>(mine.size() * sizeof(Grain));
-  std::vector<int> counts(size), displs(size);
-  MPI_Gather(&bytes, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm);
-  int total = 0;
-  for (int r = 0; r < size; ++r) {
-    displs[r] = total;
-    total += counts[r];
-  }
-  std::vector<Grain> all(rank == 0 ? total / sizeof(Grain) : 0);
-  MPI_Gatherv(mine.data(), bytes, MPI_BYTE, all.data(), counts.data(), displs.data(), MPI_BYTE, 0,
-              comm);
-  std::sort(all.begin(), all.end(), [](const Grain& a, const Grain& b) { return a.id < b.id; });
-  return all;
+  return gather_by_id(mine, comm);
 }
 
 inline bool all_finite(const Particles& p) {
