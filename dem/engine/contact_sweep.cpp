@@ -76,11 +76,14 @@ void local_pair_sweep(ContactSweep& s) {
         p.torque[b] += r.torque_j;
       }
       ++s.contacts;
-      const double rs = p.radius[a] * p.radius[b] / (p.radius[a] + p.radius[b]);
-      s.worst.consider(overlap / std::min(p.radius[a], p.radius[b]), s.max_overlap_ratio,
-                       p.id[a], p.id[b], (p.x[a] - p.x[b]).normalized().dot(p.v[b] - p.v[a]), rs,
-                       p.mass[a] * p.mass[b] / (p.mass[a] + p.mass[b]),
-                       s.table(p.material[a], p.material[b]).y_star);
+      // The guard's details are gathered only for a new largest overlap (rare).
+      if (const double ratio = overlap / std::min(p.radius[a], p.radius[b]);
+          ratio > s.max_overlap_ratio)
+        s.worst.consider(ratio, s.max_overlap_ratio, p.id[a], p.id[b],
+                         (p.x[a] - p.x[b]).normalized().dot(p.v[b] - p.v[a]),
+                         p.radius[a] * p.radius[b] / (p.radius[a] + p.radius[b]),
+                         p.mass[a] * p.mass[b] / (p.mass[a] + p.mass[b]),
+                         s.table(p.material[a], p.material[b]).y_star);
     }
   }
 }
@@ -111,12 +114,12 @@ void ghost_pair_sweep(ContactSweep& s) {
       if constexpr (Law::needs_spin) p.torque[i] += local_first ? r.torque_i : r.torque_j;
       // Both owners see this contact; the owner of the lower id counts it.
       if (local_first) ++s.contacts;
-      const Vec3 d = (p.x[i] - g.x[q]) - g.shift[q];
-      s.worst.consider(overlap / std::min(local.r, ghost.r), s.max_overlap_ratio, p.id[i],
-                       g.id[q], d.normalized().dot(ghost.v - local.v),
-                       local.r * ghost.r / (local.r + ghost.r),
-                       local.m * ghost.m / (local.m + ghost.m),
-                       s.table(local.material, ghost.material).y_star);
+      if (const double ratio = overlap / std::min(local.r, ghost.r); ratio > s.max_overlap_ratio)
+        s.worst.consider(ratio, s.max_overlap_ratio, p.id[i], g.id[q],
+                         ((p.x[i] - g.x[q]) - g.shift[q]).normalized().dot(ghost.v - local.v),
+                         local.r * ghost.r / (local.r + ghost.r),
+                         local.m * ghost.m / (local.m + ghost.m),
+                         s.table(local.material, ghost.material).y_star);
     }
   }
 }

@@ -43,8 +43,9 @@ void apply_wall_contact(ContactSweep& s, std::size_t i, const WallTouch& t, int 
   p.force[i] += r.force;
   if constexpr (Law::needs_spin) p.torque[i] += r.torque_i;
   ++s.contacts;
-  s.worst.consider(g.overlap / p.radius[i], s.max_overlap_ratio, p.id[i], -1, -g.v_rel.dot(g.n),
-                   g.r_star, g.m_star, s.table(p.material[i], material).y_star);
+  if (const double ratio = g.overlap / p.radius[i]; ratio > s.max_overlap_ratio)
+    s.worst.consider(ratio, s.max_overlap_ratio, p.id[i], -1, -g.v_rel.dot(g.n), g.r_star,
+                     g.m_star, s.table(p.material[i], material).y_star);
 }
 
 template <class Law, class Touch>

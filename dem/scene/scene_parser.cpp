@@ -229,6 +229,17 @@ ContactSettings parse_contact(const Field& f) {
   return c;
 }
 
+// A file named in the scene, resolved against the scene file's folder; it must exist.
+std::string existing_file(const Field& file, const std::string& what) {
+  const fs::path given = file.text();
+  const fs::path resolved = given.is_absolute() ? given : file.source().folder / given;
+  std::error_code ec;
+  if (!fs::is_regular_file(resolved, ec))
+    file.fail(what + " '" + given.string() + "' not found (looked for '" + resolved.string() +
+              "'); file names are relative to the scene file's folder");
+  return resolved.string();
+}
+
 ParallelSettings parse_parallel(const Field& f) {
   const Map m = f.map({"grid", "balance"});
   ParallelSettings par;
@@ -277,14 +288,7 @@ Wall parse_wall(const Field& item, const std::vector<Wall>& earlier,
     m.allow_only({"type", "name", "file", "scale", "rotate", "translate", "surface_velocity",
                   "material", "motion"},
                  " (a mesh wall)");
-    const Field file = m.get("file", "add `file: <mesh.stl>`");
-    const fs::path given = file.text();
-    const fs::path resolved = given.is_absolute() ? given : file.source().folder / given;
-    std::error_code ec;
-    if (!fs::is_regular_file(resolved, ec))
-      file.fail("STL file '" + given.string() + "' not found (looked for '" + resolved.string() +
-                "'); file names are relative to the scene file's folder");
-    w.mesh.file = resolved.string();
+    w.mesh.file = existing_file(m.get("file", "add `file: <mesh.stl>`"), "STL file");
     w.mesh.scale = m.number_or("scale", 1.0, kPositive);
     if (const auto rot = m.find("rotate")) {
       const Map r = rot->map({"axis", "angle"});
@@ -463,14 +467,7 @@ void parse_fill(const Map& m, const Scene& scene, Insertion& ins) {
 
 void parse_csv(const Map& m, const Scene& scene, Insertion& ins) {
   m.allow_only({"type", "file", "material"}, " (a csv insertion)");
-  const Field file = m.get("file", "add `file: <particles.csv>`");
-  const fs::path given = file.text();
-  const fs::path resolved = given.is_absolute() ? given : file.source().folder / given;
-  std::error_code ec;
-  if (!fs::is_regular_file(resolved, ec))
-    file.fail("particle file '" + given.string() + "' not found (looked for '" + resolved.string() +
-              "'); file names are relative to the scene file's folder");
-  ins.csv_file = resolved.string();
+  ins.csv_file = existing_file(m.get("file", "add `file: <particles.csv>`"), "particle file");
   ins.material = material_ref(m, "material", scene.materials);
 }
 
@@ -533,14 +530,8 @@ void parse_stream(const Map& m, const Scene& scene, Insertion& ins) {
 
 void parse_snapshot(const Map& m, Insertion& ins) {
   m.allow_only({"type", "file", "keep_velocity"}, " (a snapshot insertion)");
-  const Field file = m.get("file", "add `file: <particles_000020.h5>`");
-  const fs::path given = file.text();
-  const fs::path resolved = given.is_absolute() ? given : file.source().folder / given;
-  std::error_code ec;
-  if (!fs::is_regular_file(resolved, ec))
-    file.fail("snapshot file '" + given.string() + "' not found (looked for '" +
-              resolved.string() + "'); file names are relative to the scene file's folder");
-  ins.snapshot_file = resolved.string();
+  ins.snapshot_file =
+      existing_file(m.get("file", "add `file: <particles_000020.h5>`"), "snapshot file");
   if (const auto k = m.find("keep_velocity")) ins.keep_velocity = k->boolean();
 }
 
