@@ -98,6 +98,18 @@ class Simulation {
   const WallSet& walls() const { return walls_; }               // current wall positions
   const StreamInsertion& streams() const { return streams_; }  // stream insertion totals
   const Decomposition& decomposition() const { return *decomp_; }
+  // `width` values per local particle → the same values at each ghost (Exchange::forward_values).
+  // Collective; valid between steps, while the ghost lists of the last rebuild stand.
+  std::vector<double> ghost_values(const std::vector<double>& local, std::size_t width) const {
+    std::vector<double> out;
+    exchange_->forward_values(local, width, out);
+    return out;
+  }
+  // Adds each ghost's `width` values to its owner's `local` values (Exchange::reverse_values).
+  void add_ghost_values(std::vector<double>& local, std::size_t width,
+                        std::vector<double> ghost) const {
+    exchange_->reverse_values(local, width, ghost);
+  }
   double time() const { return time_; }
   double dt() const { return dt_; }
   void set_dt(double dt) { dt_ = dt; }

@@ -33,8 +33,8 @@ template <DragFunction Law>
 class FluidForcesWith final : public ForceTerm {
  public:
   FluidForcesWith(const FluidSettings& s, const Vec3& gravity, const Enabled& on,
-                  const Domain& domain, MPI_Comm comm)
-      : s_(s), gravity_(gravity), on_(on), comm_(comm) {
+                  const Domain& domain, MPI_Comm comm, std::shared_ptr<CoupledFluid> coupled)
+      : s_(s), gravity_(gravity), on_(on), comm_(comm), coupled_(std::move(coupled)) {
     if (s.computed_void_fraction) grid_.emplace(domain, *s.computed_void_fraction);
   }
 
@@ -51,13 +51,19 @@ class FluidForcesWith final : public ForceTerm {
 
   void add(Particles& p, double /*time*/, ImplicitDrag& drag) override {
     if (grid_) grid_->update(p, comm_);
+    const std::vector<FluidSample>* samples = nullptr;
+    if (coupled_) {
+      samples = &coupled_->at_particles(p);
+      coupled_->exchange_force.assign(p.size(), Vec3::Zero());
+    }
+    const bool b = s_.model == VansModel::B;
     for (std::size_t i = 0; i < p.size(); ++i) {
-      FluidSample f = s_.field.sample(p.x[i], gravity_);
+      FluidSample f = samples ? (*samples)[i] : s_.field.sample(p.x[i], gravity_);
       if (grid_) f.void_fraction = grid_->at(p.x[i]);
       const double d = 2 * p.radius[i];
       const double volume = sphere_volume(p.radius[i]);
       const Vec3 slip = f.velocity - p.v[i];
-      Vec3 force = Vec3::Zero();
+      Vec3 force = Vec3::Zero(), carried = Vec3::Zero();
       if (on_.drag) {
         const double k = Law({d, slip.norm(), f.void_fraction, f.density, f.viscosity});
         const double k_sum = drag.coefficient[i] + k;
@@ -68,15 +74,29 @@ class FluidForcesWith final : public ForceTerm {
       }
       if (on_.pressure) force += pressure_gradient_force(volume, f.pressure_gradient);
       if (on_.viscous) force += viscous_force(volume, f.viscous_stress_divergence);
+      // Model B returns the pressure and viscous forces to the fluid. Buoyancy is not
+      // returned: the coupled solver's pressure excludes hydrostatics, and in model B its
+      // momentum equation would then carry -(1-eps) rho_f g, which the returned
+      // buoyancy cancels exactly; both are left out (foam_solver/grainFoam/grainFoam.C).
+      if (b) carried = force;
       if (on_.buoyancy) force += archimedes_buoyancy(f.density, volume, gravity_);
-      if (on_.saffman) force += saffman_mei_lift(d, f.density, f.viscosity, slip, f.vorticity);
+      if (on_.saffman) {
+        const Vec3 lift = saffman_mei_lift(d, f.density, f.viscosity, slip, f.vorticity);
+        force += lift;
+        carried += lift;
+      }
       if (on_.magnus || on_.rotation) {
         const Vec3 relative_rotation = 0.5 * f.vorticity - p.omega[i];
-        if (on_.magnus) force += magnus_lift(d, f.density, f.viscosity, slip, relative_rotation);
+        if (on_.magnus) {
+          const Vec3 lift = magnus_lift(d, f.density, f.viscosity, slip, relative_rotation);
+          force += lift;
+          carried += lift;
+        }
         if (on_.rotation)
           p.torque[i] += rotational_drag_torque(d, f.density, f.viscosity, relative_rotation);
       }
       p.force[i] += force;
+      if (coupled_) coupled_->exchange_force[i] = carried;
       if (on_.virtual_mass) {
         double scale = 1;
         p.force[i] += virtual_mass_closure(s_.virtual_mass_coefficient * f.density * volume,
@@ -92,25 +112,26 @@ class FluidForcesWith final : public ForceTerm {
   Enabled on_;
   MPI_Comm comm_;
   std::optional<VoidFractionGrid> grid_;
+  std::shared_ptr<CoupledFluid> coupled_;  // two-way mode
 };
 
 // One compiled particle loop per law: the registry's function pointer picks the
 // instantiation whose template argument is that same function.
 template <DragFunction... Laws>
 std::unique_ptr<ForceTerm> instantiate(DragFunction chosen, const FluidSettings& s, const Vec3& g,
-                                       const Enabled& on, const Domain& domain, MPI_Comm comm) {
+                                       const Enabled& on, const Domain& domain, MPI_Comm comm,
+                                       const std::shared_ptr<CoupledFluid>& coupled) {
   std::unique_ptr<ForceTerm> out;
   ((out == nullptr && chosen == Laws
-        ? (out = std::make_unique<FluidForcesWith<Laws>>(s, g, on, domain, comm), 0)
+        ? (out = std::make_unique<FluidForcesWith<Laws>>(s, g, on, domain, comm, coupled), 0)
         : 0),
    ...);
   return out;
 }
 
-}  // namespace
-
-std::unique_ptr<ForceTerm> make_fluid_forces(const FluidSettings& s, const Vec3& gravity,
-                                             const Domain& domain, MPI_Comm comm) {
+std::unique_ptr<ForceTerm> make_term(const FluidSettings& s, const Vec3& gravity,
+                                     const Domain& domain, MPI_Comm comm,
+                                     const std::shared_ptr<CoupledFluid>& coupled) {
   check_force_list(s.forces, {s.model, s.field.hydrostatic_pressure, gravity.norm() > 0});
   Enabled on;
   for (FluidForce f : s.forces) {
@@ -128,11 +149,33 @@ std::unique_ptr<ForceTerm> make_fluid_forces(const FluidSettings& s, const Vec3&
   const DragLaw& law = drag_law(s.drag_law);
   std::unique_ptr<ForceTerm> term =
       instantiate<schiller_naumann, di_felice, rong, wen_yu, ergun, gidaspow, koch_hill, beetstra,
-                  tenneti_garg_subramaniam>(law.function, s, gravity, on, domain, comm);
+                  tenneti_garg_subramaniam>(law.function, s, gravity, on, domain, comm, coupled);
   if (term == nullptr)
     throw std::logic_error(std::string("drag law '") + law.name +
                            "' is registered but not instantiated in fluid_forces.cpp");
   return term;
+}
+
+}  // namespace
+
+std::unique_ptr<ForceTerm> make_fluid_forces(const FluidSettings& s, const Vec3& gravity,
+                                             const Domain& domain, MPI_Comm comm) {
+  return make_term(s, gravity, domain, comm, nullptr);
+}
+
+std::unique_ptr<ForceTerm> make_coupled_fluid_forces(const FluidSettings& settings,
+                                                     const Vec3& gravity,
+                                                     std::shared_ptr<CoupledFluid> coupled) {
+  if (coupled == nullptr) throw std::invalid_argument("make_coupled_fluid_forces: no CoupledFluid");
+  for (FluidForce f : settings.forces)
+    if (f == FluidForce::virtual_mass)
+      throw std::invalid_argument(
+          "virtual_mass is not available in coupled runs yet (the coupling does not sample the "
+          "fluid's material derivative Du/Dt); remove it from fluid.forces");
+  FluidSettings s = settings;
+  s.computed_void_fraction.reset();        // the coupling computes eps on the mesh
+  s.field.hydrostatic_pressure = false;    // the solver's p excludes rho_f g.x
+  return make_term(s, gravity, Domain{}, MPI_COMM_NULL, coupled);
 }
 
 }  // namespace grainflow

@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "dem/engine/force_term.hpp"
+#include "dem/fluid/coupled_fluid.hpp"
 #include "dem/fluid/prescribed_fluid.hpp"
 #include "dem/scene/scene.hpp"
 
@@ -21,5 +22,13 @@ namespace grainflow {
 std::unique_ptr<ForceTerm> make_fluid_forces(const FluidSettings& settings, const Vec3& gravity,
                                              const Domain& domain = Domain{},
                                              MPI_Comm comm = MPI_COMM_WORLD);
+
+// Two-way mode: the fluid state comes from `coupled` (sampled by the coupling once per
+// fluid step), not from settings.field, and the term writes back coupled->exchange_force.
+// The coupled solver's pressure excludes the hydrostatic part, so the list must have
+// buoyancy. virtual_mass is refused (the coupling does not sample Du/Dt yet).
+std::unique_ptr<ForceTerm> make_coupled_fluid_forces(const FluidSettings& settings,
+                                                     const Vec3& gravity,
+                                                     std::shared_ptr<CoupledFluid> coupled);
 
 }  // namespace grainflow

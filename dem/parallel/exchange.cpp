@@ -1,5 +1,6 @@
 #include "dem/parallel/exchange.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <sstream>
@@ -248,6 +249,44 @@ void Exchange::forward(const Particles& p, Ghosts& g) {
       g.x[k] = r.get_vec();
       g.v[k] = r.get_vec();
       g.omega[k] = r.get_vec();
+    }
+  }
+}
+
+void Exchange::forward_values(const std::vector<double>& local, std::size_t width,
+                              std::vector<double>& ghost) const {
+  std::size_t ghosts = 0;
+  for (const Swap& s : swaps_) ghosts = std::max(ghosts, s.recv_first + s.recv_count);
+  ghost.assign(ghosts * width, 0.0);
+  for (const Swap& s : swaps_) {
+    const int to = d_.neighbour(s.axis, s.dir), from = d_.neighbour(s.axis, 1 - s.dir);
+    if (to == MPI_PROC_NULL && from == MPI_PROC_NULL) continue;
+    std::vector<double> out;
+    out.reserve(width * s.send.size());
+    for (int idx : s.send) {
+      const bool is_local = static_cast<std::size_t>(idx) < nlocal_;
+      const double* v = is_local ? &local[idx * width] : &ghost[(idx - nlocal_) * width];
+      out.insert(out.end(), v, v + width);
+    }
+    const std::vector<double> in = sendrecv(d_.comm(), out, to, from, 400 + 2 * s.axis + s.dir);
+    std::copy(in.begin(), in.end(), ghost.begin() + static_cast<std::ptrdiff_t>(s.recv_first * width));
+  }
+}
+
+void Exchange::reverse_values(std::vector<double>& local, std::size_t width,
+                              std::vector<double>& ghost) const {
+  for (auto it = swaps_.rbegin(); it != swaps_.rend(); ++it) {
+    const Swap& s = *it;
+    const int to = d_.neighbour(s.axis, s.dir), from = d_.neighbour(s.axis, 1 - s.dir);
+    if (to == MPI_PROC_NULL && from == MPI_PROC_NULL) continue;
+    const auto first = ghost.begin() + static_cast<std::ptrdiff_t>(s.recv_first * width);
+    const std::vector<double> out(first, first + static_cast<std::ptrdiff_t>(s.recv_count * width));
+    const std::vector<double> in = sendrecv(d_.comm(), out, from, to, 500 + 2 * s.axis + s.dir);
+    std::size_t k = 0;
+    for (int idx : s.send) {
+      const bool is_local = static_cast<std::size_t>(idx) < nlocal_;
+      double* v = is_local ? &local[idx * width] : &ghost[(idx - nlocal_) * width];
+      for (std::size_t c = 0; c < width; ++c) v[c] += in[k++];
     }
   }
 }

@@ -42,6 +42,19 @@ class Exchange {
   // Refreshes ghost positions, velocities and spins along the recorded lists.
   void forward(const Particles& p, Ghosts& ghosts);
 
+  // Sends `width` doubles per particle along the same lists as forward(): `local` holds
+  // width values for each of this rank's particles (in local order), and `ghost` is
+  // resized and filled with the values of each ghost (in ghost order). Collective. Used
+  // by the coupling to give ghosts their owner's drag coefficient and exchange force.
+  void forward_values(const std::vector<double>& local, std::size_t width,
+                      std::vector<double>& ghost) const;
+  // The reverse of forward_values: every ghost's `width` values (`ghost`, as sized by
+  // forward_values) are sent back along the same lists and added to the values of the
+  // particle they copy (`local`; ghosts of ghosts pass through). Collective. Used by
+  // the coupling to collect what a particle's footprint sees in neighbours' cells.
+  void reverse_values(std::vector<double>& local, std::size_t width,
+                      std::vector<double>& ghost) const;
+
   long ghosts_sent_last_borders() const { return sent_; }
 
  private:

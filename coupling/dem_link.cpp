@@ -1,0 +1,264 @@
+#include "coupling/dem_link.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+
+#include "dem/engine/simulation.hpp"
+#include "dem/fluid/coupled_fluid.hpp"
+#include "dem/fluid/fluid_forces.hpp"
+#include "dem/io/output_directory.hpp"
+#include "dem/io/snapshot_writer.hpp"
+#include "dem/scene/scene_parser.hpp"
+
+namespace grainflow::coupling {
+namespace {
+
+Vec3 vec(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
+std::array<double, 3> arr(const Vec3& v) { return {v[0], v[1], v[2]}; }
+
+bool close(double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(std::abs(a), std::abs(b)); }
+
+}  // namespace
+
+struct DemLink::Impl {
+  Scene scene;
+  double fluid_density = 0, fluid_viscosity = 0;
+  MPI_Comm world = MPI_COMM_NULL;
+  MPI_Comm dem_comm = MPI_COMM_NULL;  // ordered to match the fluid's processor boxes
+  std::optional<ProcessorGrid> grid;
+  std::unique_ptr<Simulation> sim;
+  std::shared_ptr<CoupledFluid> fluid = std::make_shared<CoupledFluid>();
+  std::unique_ptr<SnapshotWriter> snapshots;
+  std::string snapshot_directory;
+
+  ~Impl() {
+    sim.reset();
+    if (dem_comm != MPI_COMM_NULL) MPI_Comm_free(&dem_comm);
+  }
+
+  Simulation& simulation() const {
+    if (!sim) throw std::logic_error("DemLink: initialise() has not been called");
+    return *sim;
+  }
+
+  FluidSample to_sample(const FluidAtParticle& f) const {
+    FluidSample s;
+    s.velocity = vec(f.velocity);
+    s.void_fraction = f.void_fraction;
+    s.pressure_gradient = vec(f.pressure_gradient);
+    s.viscous_stress_divergence = vec(f.viscous_stress_divergence);
+    s.vorticity = vec(f.vorticity);
+    s.density = fluid_density;
+    s.viscosity = fluid_viscosity;
+    return s;
+  }
+};
+
+DemLink::DemLink(const std::string& scene_file, double fluid_density, double fluid_viscosity,
+                 MPI_Comm world)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.world = world;
+  m.fluid_density = fluid_density;
+  m.fluid_viscosity = fluid_viscosity;
+  try {
+    m.scene = load_scene(scene_file);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(e.what());
+  }
+  if (!m.scene.fluid)
+    throw std::runtime_error(scene_file +
+                             ": error: a coupled run needs a `fluid:` block (drag law, VANS "
+                             "model, force list); see docs/scene-reference.md");
+  const FluidSettings& f = *m.scene.fluid;
+  std::ostringstream why;
+  if (!close(f.field.density, fluid_density))
+    why << f.source << ": error: fluid.density is " << f.field.density
+        << " kg/m^3 but the fluid solver's rho is " << fluid_density
+        << " kg/m^3 (constant/transportProperties); make them equal\n";
+  if (!close(f.field.viscosity, fluid_viscosity))
+    why << f.source << ": error: fluid.viscosity is " << f.field.viscosity
+        << " Pa s but the fluid solver's rho*nu is " << fluid_viscosity
+        << " Pa s (constant/transportProperties); make them equal\n";
+  if (f.field.hydrostatic_pressure)
+    why << f.source
+        << ": error: grainFoam's pressure excludes the hydrostatic part (rho_f g.x); add "
+           "`pressure: {hydrostatic: false}` to the fluid block and list buoyancy in "
+           "fluid.forces\n";
+  if (!why.str().empty()) throw std::runtime_error(why.str());
+  // Checks the force list against the coupled solver (pressure without hydrostatics).
+  try {
+    (void)make_coupled_fluid_forces(f, m.scene.gravity, m.fluid);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(f.source + ": error: fluid.forces: " + e.what() +
+                             " (the coupled solver's pressure excludes the hydrostatic part)");
+  }
+}
+
+DemLink::~DemLink() = default;
+
+Box DemLink::domain() const {
+  return {arr(impl_->scene.domain.lo), arr(impl_->scene.domain.hi)};
+}
+std::array<bool, 3> DemLink::periodic() const { return impl_->scene.domain.periodic; }
+std::array<double, 3> DemLink::gravity() const { return arr(impl_->scene.gravity); }
+char DemLink::vans_model() const { return impl_->scene.fluid->model == VansModel::A ? 'A' : 'B'; }
+bool DemLink::needs_vorticity() const {
+  for (FluidForce f : impl_->scene.fluid->forces)
+    if (f == FluidForce::saffman_mei || f == FluidForce::magnus ||
+        f == FluidForce::rotational_drag)
+      return true;
+  return false;
+}
+std::string DemLink::drag_law() const { return impl_->scene.fluid->drag_law; }
+double DemLink::end_time() const { return impl_->scene.time.end; }
+
+void DemLink::use_processor_grid(const ProcessorGrid& grid) { impl_->grid = grid; }
+
+void DemLink::initialise() {
+  Impl& m = *impl_;
+  std::array<int, 3> dims{0, 0, 0};
+  if (m.grid) {
+    dims = m.grid->dims;
+    // Rank order of MPI_Cart_create without reordering: z fastest.
+    const auto& c = m.grid->coords;
+    const int key = (c[0] * dims[1] + c[1]) * dims[2] + c[2];
+    MPI_Comm_split(m.world, 0, key, &m.dem_comm);
+  } else {
+    MPI_Comm_dup(m.world, &m.dem_comm);
+  }
+  try {
+    m.sim = std::make_unique<Simulation>(m.scene, true, m.dem_comm, dims);
+    if (m.grid)
+      for (int a = 0; a < 3; ++a)
+        if (dims[a] > 1) m.sim->set_cut_planes(a, m.grid->cuts[a]);
+    m.sim->add_force_term(make_coupled_fluid_forces(*m.scene.fluid, m.scene.gravity, m.fluid));
+    // The first force evaluation, before the fluid is sampled, sees fluid at rest, eps = 1.
+    Impl* self = &m;
+    m.fluid->set_sampler([self](const Vec3&) { return self->to_sample(FluidAtParticle{}); });
+    m.sim->initialise();
+    m.fluid->reset_late_samples();
+  } catch (const std::exception& e) {
+    throw std::runtime_error(e.what());
+  }
+  if (m.grid) {
+    const Decomposition& d = m.sim->decomposition();
+    if (d.coords() != m.grid->coords)
+      throw std::logic_error("DemLink: the DEM box of this rank is not the fluid's");
+  }
+}
+
+double DemLink::time_step() const { return impl_->simulation().dt(); }
+double DemLink::time() const { return impl_->simulation().time(); }
+
+ParticleSet DemLink::particles(bool with_ghosts_and_exchange) const {
+  const Simulation& sim = impl_->simulation();
+  const Particles& p = sim.particles();
+  ParticleSet out;
+  out.local = p.size();
+  const std::size_t n = p.size() + (with_ghosts_and_exchange ? sim.ghosts().size() : 0);
+  out.id.reserve(n);
+  out.x.reserve(n);
+  out.v.reserve(n);
+  out.radius.reserve(n);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    out.id.push_back(static_cast<long long>(p.id[i]));
+    out.x.push_back(arr(p.x[i]));
+    out.v.push_back(arr(p.v[i]));
+    out.radius.push_back(p.radius[i]);
+  }
+  if (!with_ghosts_and_exchange) return out;
+  // K and the exchange force of the last step, local first, then forwarded to ghosts.
+  const ImplicitDrag& drag = sim.implicit_drag();
+  const std::vector<Vec3>& carried = impl_->fluid->exchange_force;
+  std::vector<double> values(4 * p.size(), 0.0);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    values[4 * i] = i < drag.coefficient.size() ? drag.coefficient[i] : 0.0;
+    if (i < carried.size())
+      for (int c = 0; c < 3; ++c) values[4 * i + 1 + c] = carried[i][c];
+  }
+  const std::vector<double> ghost_values = sim.ghost_values(values, 4);
+  const Ghosts& g = sim.ghosts();
+  for (std::size_t k = 0; k < g.size(); ++k) {
+    out.id.push_back(static_cast<long long>(g.id[k]));
+    out.x.push_back(arr(g.position(k)));
+    out.v.push_back(arr(g.v[k]));
+    out.radius.push_back(g.radius[k]);
+  }
+  out.drag_coefficient.resize(n);
+  out.exchange_force.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double* v = i < p.size() ? &values[4 * i] : &ghost_values[4 * (i - p.size())];
+    out.drag_coefficient[i] = v[0];
+    out.exchange_force[i] = {v[1], v[2], v[3]};
+  }
+  return out;
+}
+
+std::vector<double> DemLink::sum_onto_owners(const std::vector<double>& values,
+                                             std::size_t width) const {
+  const Simulation& sim = impl_->simulation();
+  const std::size_t nlocal = sim.particles().size();
+  std::vector<double> local(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(nlocal * width));
+  std::vector<double> ghost(values.begin() + static_cast<std::ptrdiff_t>(nlocal * width), values.end());
+  sim.add_ghost_values(local, width, std::move(ghost));
+  return local;
+}
+
+void DemLink::set_fluid(std::vector<FluidAtParticle> samples,
+                        std::function<FluidAtParticle(const std::array<double, 3>&)> late) {
+  Impl& m = *impl_;
+  const Particles& p = m.simulation().particles();
+  if (samples.size() != p.size())
+    throw std::logic_error("DemLink::set_fluid: " + std::to_string(samples.size()) +
+                           " samples for " + std::to_string(p.size()) + " particles");
+  std::vector<FluidSample> s;
+  s.reserve(samples.size());
+  for (const FluidAtParticle& f : samples) s.push_back(m.to_sample(f));
+  m.fluid->set(p.id, std::move(s));
+  Impl* self = &m;
+  m.fluid->set_sampler([self, late = std::move(late)](const Vec3& x) {
+    return self->to_sample(late(arr(x)));
+  });
+}
+
+void DemLink::advance(int steps) {
+  Simulation& sim = impl_->simulation();
+  try {
+    for (int k = 0; k < steps; ++k) sim.step();
+  } catch (const std::exception& e) {
+    throw std::runtime_error(e.what());
+  }
+}
+
+DemSummary DemLink::summary() const {
+  const Simulation& sim = impl_->simulation();
+  const GlobalState g = sim.global_state();
+  DemSummary s;
+  s.particles = g.particles;
+  s.contacts = g.contacts;
+  s.removed = g.removed;
+  s.max_overlap_ratio = g.max_overlap_ratio;
+  s.kinetic_energy = g.kinetic_translational + g.kinetic_rotational;
+  long late = impl_->fluid->late_samples();
+  MPI_Allreduce(MPI_IN_PLACE, &late, 1, MPI_LONG, MPI_SUM, impl_->dem_comm);
+  s.late_samples = late;
+  return s;
+}
+
+void DemLink::write_snapshot(const std::string& directory, long step) {
+  Impl& m = *impl_;
+  if (!m.snapshots || m.snapshot_directory != directory) {
+    prepare_output_directory(directory);
+    m.snapshots = std::make_unique<SnapshotWriter>(m.dem_comm, directory);
+    m.snapshot_directory = directory;
+  }
+  m.snapshots->write(m.simulation().particles(), m.simulation().time(), step);
+}
+
+std::vector<std::string> DemLink::reports() const { return impl_->simulation().force_term_reports(); }
+
+}  // namespace grainflow::coupling

@@ -1,0 +1,114 @@
+#pragma once
+// The DEM as the fluid solver sees it. This header is C++17-clean (the OpenFOAM side
+// compiles as C++17, the DEM core as C++20) and exposes only plain data: the
+// implementation (dem_link.cpp) owns a grainflow::Simulation behind a pointer.
+//
+// One coupled step (DESIGN.md §1), driven by grainFoam through coupling/foam/:
+//   particles(false) → sample the fluid at each local particle → set_fluid(...) →
+//   advance(N) → particles(true) → void fraction and momentum source on the mesh.
+#include <mpi.h>
+
+#include <array>
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace grainflow::coupling {
+
+struct Box {
+  std::array<double, 3> lo{}, hi{};
+};
+
+// The fluid at one particle, SI units (pressure gradient in Pa/m, not kinematic).
+struct FluidAtParticle {
+  std::array<double, 3> velocity{};
+  double void_fraction = 1;
+  std::array<double, 3> pressure_gradient{};
+  std::array<double, 3> viscous_stress_divergence{};
+  std::array<double, 3> vorticity{};
+};
+
+// Particles as flat arrays: entries [0, local) are this rank's particles, entries
+// [local, size) ghosts (copies of neighbours' particles, or periodic images, at their
+// image position), present only when asked for.
+struct ParticleSet {
+  std::size_t local = 0;
+  std::vector<long long> id;
+  std::vector<std::array<double, 3>> x, v;
+  std::vector<double> radius;
+  // Filled by particles(true) only, from the last DEM step: drag coefficient K [kg/s] of
+  // F = K (u_f − v), and the explicit force on the particle that the fluid gets back
+  // through the exchange term (model dependent) [N].
+  std::vector<double> drag_coefficient;
+  std::vector<std::array<double, 3>> exchange_force;
+  std::size_t size() const { return id.size(); }
+};
+
+// The processor grid the fluid mesh decomposition implies (shared_decomposition.hpp).
+struct ProcessorGrid {
+  std::array<int, 3> dims{1, 1, 1};
+  std::array<std::vector<double>, 3> cuts;  // dims[a] + 1 planes per axis
+  std::array<int, 3> coords{0, 0, 0};       // this rank's box
+};
+
+struct DemSummary {
+  long particles = 0, contacts = 0, removed = 0, late_samples = 0;
+  double max_overlap_ratio = 0, kinetic_energy = 0;
+};
+
+class DemLink {
+ public:
+  // Reads and checks the scene (errors name the scene file, line and key; thrown as
+  // std::runtime_error). The scene must have a `fluid:` block whose density and
+  // viscosity agree with the fluid solver's (rho_f [kg/m^3], mu [Pa s]).
+  DemLink(const std::string& scene_file, double fluid_density, double fluid_viscosity,
+          MPI_Comm world);
+  ~DemLink();
+  DemLink(const DemLink&) = delete;
+  DemLink& operator=(const DemLink&) = delete;
+
+  Box domain() const;
+  std::array<bool, 3> periodic() const;
+  std::array<double, 3> gravity() const;
+  char vans_model() const;  // 'A' or 'B'
+  bool needs_vorticity() const;
+  std::string drag_law() const;
+  double end_time() const;
+
+  // Takes the processor grid of the fluid's decomposition (call before initialise());
+  // the DEM then runs on a communicator ordered so that this rank owns exactly the box
+  // of its fluid cells. Throws std::runtime_error if the grid does not fit the scene.
+  void use_processor_grid(const ProcessorGrid& grid);
+  // Inserts particles, checks the time step, builds lists (collective). Throws
+  // std::runtime_error with the DEM's message.
+  void initialise();
+  double time_step() const;  // dt_DEM [s]
+  double time() const;
+
+  ParticleSet particles(bool with_ghosts_and_exchange) const;
+
+  // Adds each ghost's `width` values (after the local ones, as in `values` sized
+  // set.size()·width for the set of particles(true)) to its owner's entry; returns the
+  // local part (local·width). Collective.
+  std::vector<double> sum_onto_owners(const std::vector<double>& values, std::size_t width) const;
+
+  // The fluid at each local particle, in the order of particles(false) taken right before.
+  // `late` samples a particle that reaches this rank during the next advance().
+  void set_fluid(std::vector<FluidAtParticle> samples,
+                 std::function<FluidAtParticle(const std::array<double, 3>&)> late);
+  // `steps` DEM steps (collective). Throws std::runtime_error with the DEM's message.
+  void advance(int steps);
+
+  DemSummary summary() const;  // collective
+  // Writes a particle snapshot (HDF5 + XDMF index) into `directory` (created if missing).
+  void write_snapshot(const std::string& directory, long step);
+  std::vector<std::string> reports() const;  // the force terms' closing remarks
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace grainflow::coupling

@@ -1,0 +1,504 @@
+#include "coupling/foam/particleCoupling.H"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <mpi.h>
+
+#include "coupling/shared_decomposition.hpp"
+#include "zeroGradientFvPatchFields.H"
+#include "interpolationCellPoint.H"
+
+namespace grainflow::foam {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// Patch types for a derived field: constraint patches (processor, cyclic, empty, ...)
+// keep their type, every other patch is zeroGradient.
+Foam::wordList derivedPatchTypes(const Foam::fvMesh& mesh) {
+  const Foam::polyBoundaryMesh& patches = mesh.boundaryMesh();
+  Foam::wordList types(patches.size());
+  forAll(patches, i) {
+    types[i] = Foam::polyPatch::constraintType(patches[i].type())
+                   ? patches[i].type()
+                   : Foam::word(Foam::zeroGradientFvPatchScalarField::typeName);
+  }
+  return types;
+}
+
+Foam::IOobject derivedField(const Foam::fvMesh& mesh, const Foam::word& name, bool write) {
+  return Foam::IOobject(name, mesh.time().timeName(), mesh, Foam::IOobject::NO_READ,
+                        write ? Foam::IOobject::AUTO_WRITE : Foam::IOobject::NO_WRITE);
+}
+
+std::array<double, 3> toArray(const Foam::vector& v) { return {v.x(), v.y(), v.z()}; }
+
+}  // namespace
+
+ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVectorField& U,
+                                   const Foam::volScalarField& p, double rho, double nu)
+    : mesh_(mesh),
+      U_(U),
+      p_(p),
+      rho_(rho),
+      nu_(nu),
+      footprint_(coupling::VoidFractionMethod::centre),
+      voidFraction_(derivedField(mesh, "voidfraction", true), mesh,
+                    Foam::dimensionedScalar("one", Foam::dimless, 1), derivedPatchTypes(mesh)),
+      Ksl_(derivedField(mesh, "Ksl", true), mesh,
+           Foam::dimensionedScalar("zero", Foam::dimensionSet(1, -3, -1, 0, 0), 0),
+           derivedPatchTypes(mesh)),
+      KslUs_(derivedField(mesh, "KslUs", false), mesh,
+             Foam::dimensionedVector("zero", Foam::dimensionSet(1, -2, -2, 0, 0), Foam::Zero),
+             derivedPatchTypes(mesh)),
+      fExplicit_(derivedField(mesh, "fParticles", false), mesh,
+                 Foam::dimensionedVector("zero", Foam::dimensionSet(1, -2, -2, 0, 0), Foam::Zero),
+                 derivedPatchTypes(mesh)) {
+  using namespace Foam;
+  IOdictionary dict(IOobject("couplingProperties", mesh.time().constant(), mesh,
+                             IOobject::MUST_READ_IF_MODIFIED, IOobject::NO_WRITE));
+
+  // --- settings -------------------------------------------------------------------
+  // The scene, relative to the case folder (not processorN/).
+  const fileName scene = dict.get<fileName>("scene");
+  fileName sceneFile = scene.isAbsolute()
+                           ? scene
+                           : mesh.time().rootPath() / mesh.time().globalCaseName() / scene;
+
+  const word method = dict.lookupOrDefault<word>("voidFraction", "divided");
+  coupling::VoidFractionMethod vf = coupling::VoidFractionMethod::divided;
+  try {
+    vf = coupling::parse_void_fraction_method(method);
+  } catch (const std::invalid_argument& e) {
+    FatalIOErrorInFunction(dict) << "voidFraction: " << e.what() << exit(FatalIOError);
+  }
+  const label resolution = dict.lookupOrDefault<label>("dividedResolution", 5);
+  const scalar smoothing = dict.lookupOrDefault<scalar>("smoothingFactor", 2.0);
+  if (resolution < 2 || resolution > 15)
+    FatalIOErrorInFunction(dict) << "dividedResolution " << resolution
+                                 << " is outside [2, 15] (points across a diameter)"
+                                 << exit(FatalIOError);
+  if (smoothing < 1 || smoothing > 2)
+    FatalIOErrorInFunction(dict) << "smoothingFactor " << smoothing
+                                 << " is outside [1, 2] (kernel radius in particle radii; "
+                                    "the ghost range covers at most 2 radii)"
+                                 << exit(FatalIOError);
+  footprint_ = coupling::Footprint(vf, static_cast<int>(resolution), smoothing);
+
+  const word sampling = dict.lookupOrDefault<word>("sampling", "cell");
+  if (sampling == "cell")
+    sampling_ = Sampling::cell;
+  else if (sampling == "cellPoint")
+    sampling_ = Sampling::cellPoint;
+  else
+    FatalIOErrorInFunction(dict) << "sampling " << sampling
+                                 << " is not one of: cell (footprint-weighted cell values, "
+                                    "exact exchange balance), cellPoint (interpolated at the "
+                                    "particle centre)"
+                                 << exit(FatalIOError);
+  minVoidFraction_ = dict.lookupOrDefault<scalar>("minVoidFraction", 0.2);
+  if (minVoidFraction_ < 0.2 || minVoidFraction_ >= 1)
+    FatalIOErrorInFunction(dict) << "minVoidFraction " << minVoidFraction_
+                                 << " is outside [0.2, 1) (the drag laws are tested down to "
+                                    "0.2)"
+                                 << exit(FatalIOError);
+  ddtVoidFraction_ = dict.lookupOrDefault<Switch>("ddtVoidFraction", true);
+
+  // --- the DEM ----------------------------------------------------------------------
+  if (!sceneFile.isAbsolute()) sceneFile = cwd() / sceneFile;
+  try {
+    dem_ = std::make_unique<coupling::DemLink>(sceneFile, rho_, rho_ * nu_, MPI_COMM_WORLD);
+  } catch (const std::exception& e) {
+    FatalErrorInFunction << "\n" << e.what() << exit(FatalError);
+  }
+  model_ = dem_->vans_model();
+  domain_ = dem_->domain();
+  periodic_ = dem_->periodic();
+
+  // --- the shared decomposition -----------------------------------------------------
+  boundBox local(mesh.points(), false);
+  coupling::Box mine{toArray(local.min()), toArray(local.max())};
+  int ranks = 1, rank = 0;
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  std::vector<double> flat(6 * static_cast<std::size_t>(ranks));
+  double mine_flat[6] = {mine.lo[0], mine.lo[1], mine.lo[2], mine.hi[0], mine.hi[1], mine.hi[2]};
+  MPI_Allgather(mine_flat, 6, MPI_DOUBLE, flat.data(), 6, MPI_DOUBLE, MPI_COMM_WORLD);
+  std::vector<coupling::Box> boxes(static_cast<std::size_t>(ranks));
+  for (int r = 0; r < ranks; ++r)
+    for (int a = 0; a < 3; ++a) {
+      boxes[r].lo[a] = flat[6 * r + a];
+      boxes[r].hi[a] = flat[6 * r + 3 + a];
+    }
+  coupling::ProcessorGrid grid;
+  try {
+    grid = coupling::processor_grid_from_boxes(boxes, rank, domain_);
+  } catch (const coupling::DecompositionMismatch& e) {
+    FatalErrorInFunction << "shared decomposition: " << e.what() << exit(FatalError);
+  }
+  // The rank's cells must fill its box (no holes: a box-shaped mesh).
+  const double boxVolume = (mine.hi[0] - mine.lo[0]) * (mine.hi[1] - mine.lo[1]) *
+                           (mine.hi[2] - mine.lo[2]);
+  const double localVolume = sum(mesh.V().field());
+  if (std::abs(localVolume - boxVolume) > 1e-9 * boxVolume)
+    FatalErrorInFunction << "shared decomposition: processor " << rank << "'s cells have volume "
+                         << localVolume << " m^3 but their bounding box has " << boxVolume
+                         << " m^3; the coupling needs a box-shaped mesh whose processor "
+                            "meshes are boxes (decomposeParDict method simple or hierarchical)"
+                         << exit(FatalError);
+  dem_->use_processor_grid(grid);
+  try {
+    dem_->initialise();
+  } catch (const std::exception& e) {
+    FatalErrorInFunction << "\n" << e.what() << exit(FatalError);
+  }
+
+  // --- the time-step ratio ----------------------------------------------------------
+  const Time& time = mesh.time();
+  if (time.controlDict().lookupOrDefault<Switch>("adjustTimeStep", false))
+    FatalIOErrorInFunction(time.controlDict())
+        << "adjustTimeStep yes: the coupling needs a fixed deltaT, an integer multiple of "
+           "the DEM time step"
+        << exit(FatalIOError);
+  const double dtFluid = time.deltaTValue(), dtDem = dem_->time_step();
+  const double ratio = dtFluid / dtDem;
+  subSteps_ = static_cast<int>(std::lround(ratio));
+  if (subSteps_ < 1 || std::abs(ratio - subSteps_) > 1e-6 * ratio)
+    FatalIOErrorInFunction(time.controlDict())
+        << "deltaT " << dtFluid << " s is " << ratio << " DEM steps of " << dtDem
+        << " s (the scene's time step); dt_CFD / dt_DEM must be an integer: use deltaT "
+        << std::max(1L, std::lround(std::floor(ratio))) * dtDem << " or "
+        << std::max(1L, std::lround(std::ceil(ratio))) * dtDem
+        << ", or change the scene's time.step" << exit(FatalIOError);
+
+  // --- cell location: structured fast path when the local mesh is a uniform grid ----
+  {
+    const cellList& cells = mesh.cells();
+    const label n = mesh.nCells();
+    if (n > 0) {
+      const boundBox first(mesh.points(), cells[0].labels(mesh.faces()), false);
+      std::array<double, 3> h = toArray(first.max() - first.min());
+      bool ok = true;
+      for (int a = 0; a < 3; ++a) {
+        gridLo_[a] = mine.lo[a];
+        gridH_[a] = h[a];
+        gridN_[a] = static_cast<int>(std::lround((mine.hi[a] - mine.lo[a]) / h[a]));
+        if (gridN_[a] < 1 || std::abs(gridN_[a] * h[a] - (mine.hi[a] - mine.lo[a])) >
+                                 1e-9 * (mine.hi[a] - mine.lo[a]))
+          ok = false;
+      }
+      if (ok && static_cast<long>(gridN_[0]) * gridN_[1] * gridN_[2] == n) {
+        gridCell_.assign(static_cast<std::size_t>(n), -1);
+        for (label c = 0; c < n && ok; ++c) {
+          if (cells[c].size() != 6) ok = false;
+          const boundBox bb(mesh.points(), cells[c].labels(mesh.faces()), false);
+          std::array<int, 3> idx{};
+          for (int a = 0; a < 3 && ok; ++a) {
+            idx[a] = static_cast<int>(std::floor((bb.min()[a] - gridLo_[a]) / h[a] + 0.5));
+            if (idx[a] < 0 || idx[a] >= gridN_[a] ||
+                std::abs(bb.min()[a] - (gridLo_[a] + idx[a] * h[a])) > 1e-9 * h[a] ||
+                std::abs(bb.max()[a] - bb.min()[a] - h[a]) > 1e-9 * h[a])
+              ok = false;
+          }
+          if (!ok) break;
+          const std::size_t k =
+              (static_cast<std::size_t>(idx[2]) * gridN_[1] + idx[1]) * gridN_[0] + idx[0];
+          if (gridCell_[k] != -1) ok = false;
+          gridCell_[k] = c;
+        }
+      } else {
+        ok = false;
+      }
+      structured_ = ok;
+      if (!ok) gridCell_.clear();
+    }
+  }
+  const label structuredRanks = returnReduce(label(structured_ ? 1 : 0), sumOp<label>());
+
+  snapshotDir_ = time.rootPath() / time.globalCaseName() / "particles";
+  Info << "grainFoam coupling: scene " << sceneFile << "\n"
+       << "  VANS model " << model_ << ", drag " << dem_->drag_law().c_str()
+       << ", void fraction " << coupling::void_fraction_method_name(vf) << " ("
+       << label(footprint_.size()) << " points per particle), sampling " << sampling
+       << ", minVoidFraction " << minVoidFraction_ << ", ddt(voidfraction) "
+       << (ddtVoidFraction_ ? "on" : "off") << "\n"
+       << "  dt_CFD " << dtFluid << " s = " << subSteps_ << " x dt_DEM " << dtDem << " s\n"
+       << "  processor grid " << grid.dims[0] << " x " << grid.dims[1] << " x "
+       << grid.dims[2] << "; cell location "
+       << (structuredRanks == Pstream::nProcs() ? "uniform grid (direct)"
+                                               : "octree search on some ranks")
+       << endl;
+
+  buildFootprints();
+  deposit();
+  voidFraction_.oldTime();  // keep old times for ddt(voidfraction)
+}
+
+ParticleCoupling::~ParticleCoupling() = default;
+
+Foam::label ParticleCoupling::locate(const Foam::point& x) const {
+  if (structured_) {
+    std::array<int, 3> idx{};
+    for (int a = 0; a < 3; ++a) {
+      const double s = (x[a] - gridLo_[a]) / gridH_[a];
+      idx[a] = static_cast<int>(std::floor(s));
+      // A point on the domain's upper face belongs to the last cell.
+      if (idx[a] == gridN_[a] && std::abs(x[a] - domain_.hi[a]) <= 1e-12 * gridH_[a] * gridN_[a])
+        idx[a] = gridN_[a] - 1;
+      if (s < 0 || idx[a] < 0 || idx[a] >= gridN_[a]) return -1;
+    }
+    return gridCell_[(static_cast<std::size_t>(idx[2]) * gridN_[1] + idx[1]) * gridN_[0] +
+                     idx[0]];
+  }
+  return mesh_.findCell(x);
+}
+
+void ParticleCoupling::buildFootprints() {
+  particles_ = dem_->particles(true);
+  const std::size_t n = particles_.size();
+  first_.assign(n + 1, 0);
+  points_.clear();
+  centreCell_.assign(particles_.local, -1);
+  std::vector<coupling::FootprintPoint> pts;
+  for (std::size_t i = 0; i < n; ++i) {
+    footprint_.points(particles_.radius[i], pts);
+    for (const coupling::FootprintPoint& q : pts) {
+      Foam::point x;
+      for (int a = 0; a < 3; ++a) {
+        double s = particles_.x[i][a] + q.offset[a];
+        // A bounded side reflects the part of a footprint that pokes through it.
+        if (!periodic_[a]) {
+          if (s < domain_.lo[a]) s = 2 * domain_.lo[a] - s;
+          if (s > domain_.hi[a]) s = 2 * domain_.hi[a] - s;
+        }
+        x[a] = s;
+      }
+      const Foam::label c = locate(x);
+      if (c >= 0) points_.push_back({c, q.weight});
+    }
+    first_[i + 1] = points_.size();
+    if (i < particles_.local) {
+      Foam::point x(particles_.x[i][0], particles_.x[i][1], particles_.x[i][2]);
+      centreCell_[i] = locate(x);
+    }
+  }
+}
+
+void ParticleCoupling::deposit() {
+  using namespace Foam;
+  const scalarField& V = mesh_.V().field();
+  scalarField solid(mesh_.nCells(), 0.0), K(mesh_.nCells(), 0.0);
+  vectorField KU(mesh_.nCells(), Zero), F(mesh_.nCells(), Zero);
+  const bool exchange = !particles_.drag_coefficient.empty();
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    const double r = particles_.radius[i];
+    const double volume = 4.0 / 3.0 * constant::mathematical::pi * r * r * r;
+    const vector v(particles_.v[i][0], particles_.v[i][1], particles_.v[i][2]);
+    const double k = exchange ? particles_.drag_coefficient[i] : 0.0;
+    const vector f = exchange ? vector(particles_.exchange_force[i][0],
+                                       particles_.exchange_force[i][1],
+                                       particles_.exchange_force[i][2])
+                              : vector::zero;
+    for (std::size_t j = first_[i]; j < first_[i + 1]; ++j) {
+      const label c = points_[j].cell;
+      const double w = points_[j].weight;
+      solid[c] += w * volume;
+      K[c] += w * k;
+      KU[c] += w * k * v;
+      F[c] -= w * f;
+    }
+  }
+  scalarField& eps = voidFraction_.primitiveFieldRef();
+  stepClampedVolume_ = 0;
+  forAll(eps, c) {
+    const double raw = 1 - solid[c] / V[c];
+    if (raw < minVoidFraction_) {
+      ++clampedCells_;
+      clampedVolume_ += (minVoidFraction_ - raw) * V[c];
+      stepClampedVolume_ += (minVoidFraction_ - raw) * V[c];
+      eps[c] = minVoidFraction_;
+    } else {
+      eps[c] = raw;
+    }
+  }
+  voidFraction_.correctBoundaryConditions();
+  Ksl_.primitiveFieldRef() = K / V;
+  Ksl_.correctBoundaryConditions();
+  KslUs_.primitiveFieldRef() = KU / V;
+  KslUs_.correctBoundaryConditions();
+  fExplicit_.primitiveFieldRef() = F / V;
+  fExplicit_.correctBoundaryConditions();
+
+  // Volume not deposited anywhere (footprint points outside every rank's cells).
+  double particleVolume = 0;
+  for (std::size_t i = 0; i < particles_.local; ++i) {
+    const double r = particles_.radius[i];
+    particleVolume += 4.0 / 3.0 * constant::mathematical::pi * r * r * r;
+  }
+  double sums[4] = {particleVolume, sum(solid), sum((1 - eps) * V), stepClampedVolume_};
+  MPI_Allreduce(MPI_IN_PLACE, sums, 4, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  lostVolume_ = std::max(0.0, sums[0] - sums[1]);
+  particleVolume_ = sums[0];
+  meshSolidVolume_ = sums[2];
+  stepClampedVolume_ = sums[3];
+}
+
+std::vector<coupling::FluidAtParticle> ParticleCoupling::sample() const {
+  using namespace Foam;
+  const volVectorField gradP(rho_ * fvc::grad(p_));
+  const volVectorField divTau(rho_ * fvc::laplacian(dimensionedScalar("nu", dimViscosity, nu_), U_));
+  const bool curl = dem_->needs_vorticity();
+  tmp<volVectorField> tCurlU;
+  if (curl) tCurlU = fvc::curl(U_);
+  const std::size_t local = particles_.local;
+  std::vector<coupling::FluidAtParticle> out(local);
+  if (sampling_ == Sampling::cellPoint) {
+    interpolationCellPoint<vector> iU(U_), iG(gradP), iT(divTau);
+    std::unique_ptr<interpolationCellPoint<vector>> iC;
+    if (curl) iC = std::make_unique<interpolationCellPoint<vector>>(tCurlU());
+    interpolationCellPoint<scalar> iE(voidFraction_);
+    for (std::size_t i = 0; i < local; ++i) {
+      const label c = centreCell_[i];
+      if (c < 0) continue;
+      const point x(particles_.x[i][0], particles_.x[i][1], particles_.x[i][2]);
+      coupling::FluidAtParticle& f = out[i];
+      f.velocity = toArray(iU.interpolate(x, c));
+      f.void_fraction = std::max(minVoidFraction_, std::min(1.0, double(iE.interpolate(x, c))));
+      f.pressure_gradient = toArray(iG.interpolate(x, c));
+      f.viscous_stress_divergence = toArray(iT.interpolate(x, c));
+      if (curl) f.vorticity = toArray(iC->interpolate(x, c));
+    }
+    return out;
+  }
+  // Footprint-weighted cell values; ghosts' shares go back to their owners.
+  constexpr std::size_t W = 14;
+  std::vector<double> acc(W * particles_.size(), 0.0);
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    double* a = &acc[W * i];
+    for (std::size_t j = first_[i]; j < first_[i + 1]; ++j) {
+      const label c = points_[j].cell;
+      const double w = points_[j].weight;
+      for (int d = 0; d < 3; ++d) {
+        a[d] += w * U_[c][d];
+        a[4 + d] += w * gradP[c][d];
+        a[7 + d] += w * divTau[c][d];
+        if (curl) a[10 + d] += w * tCurlU()[c][d];
+      }
+      a[3] += w * voidFraction_[c];
+      a[13] += w;
+    }
+  }
+  const std::vector<double> sums = dem_->sum_onto_owners(acc, W);
+  for (std::size_t i = 0; i < local; ++i) {
+    const double* a = &sums[W * i];
+    const double norm = a[13] > 0 ? 1 / a[13] : 0;
+    coupling::FluidAtParticle& f = out[i];
+    for (int d = 0; d < 3; ++d) {
+      f.velocity[d] = a[d] * norm;
+      f.pressure_gradient[d] = a[4 + d] * norm;
+      f.viscous_stress_divergence[d] = a[7 + d] * norm;
+      f.vorticity[d] = a[10 + d] * norm;
+    }
+    f.void_fraction = a[13] > 0 ? a[3] * norm : 1.0;
+  }
+  return out;
+}
+
+coupling::FluidAtParticle ParticleCoupling::sampleAt(const std::array<double, 3>& x) const {
+  // A particle that reached this rank during the DEM sub-steps: the cell holding it.
+  coupling::FluidAtParticle f;
+  const Foam::label c = locate(Foam::point(x[0], x[1], x[2]));
+  if (c < 0) return f;
+  f.velocity = toArray(U_[c]);
+  f.void_fraction = voidFraction_[c];
+  return f;
+}
+
+void ParticleCoupling::checkBalance() {
+  using namespace Foam;
+  // Particle side: K (u_p - v) + F_exchange, with u_p the footprint-weighted U.
+  constexpr std::size_t W = 4;
+  std::vector<double> acc(W * particles_.size(), 0.0);
+  for (std::size_t i = 0; i < particles_.size(); ++i)
+    for (std::size_t j = first_[i]; j < first_[i + 1]; ++j) {
+      const label c = points_[j].cell;
+      const double w = points_[j].weight;
+      for (int d = 0; d < 3; ++d) acc[W * i + d] += w * U_[c][d];
+      acc[W * i + 3] += w;
+    }
+  const std::vector<double> u = dem_->sum_onto_owners(acc, W);
+  double totals[7] = {0, 0, 0, 0, 0, 0, 0};  // particle force, fluid source, magnitude
+  for (std::size_t i = 0; i < particles_.local; ++i)
+    for (int d = 0; d < 3; ++d) {
+      const double f = particles_.drag_coefficient[i] * (u[W * i + d] - particles_.v[i][d]) +
+                       particles_.exchange_force[i][d];
+      totals[d] += f;
+      totals[6] += std::abs(f);
+    }
+  const scalarField& V = mesh_.V().field();
+  forAll(V, c)
+    for (int d = 0; d < 3; ++d)
+      totals[3 + d] += V[c] * (-Ksl_[c] * U_[c][d] + KslUs_[c][d] + fExplicit_[c][d]);
+  MPI_Allreduce(MPI_IN_PLACE, totals, 7, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  double worst = 0;
+  for (int d = 0; d < 3; ++d) worst = std::max(worst, std::abs(totals[d] + totals[3 + d]));
+  balanceError_ = totals[6] > 0 ? worst / totals[6] : 0.0;
+  const double volumeError =
+      particleVolume_ > 0
+          ? std::abs(meshSolidVolume_ + stepClampedVolume_ - particleVolume_) / particleVolume_
+          : 0.0;
+  Info << "grainFoam void fraction: sum (1-eps) V = " << meshSolidVolume_
+       << " m^3, clamped away " << stepClampedVolume_ << " m^3, particles " << particleVolume_
+       << " m^3, relative difference " << volumeError << endl;
+  Info << "grainFoam exchange balance: particles (" << totals[0] << " " << totals[1] << " "
+       << totals[2] << ") N, fluid (" << totals[3] << " " << totals[4] << " " << totals[5]
+       << ") N, relative imbalance " << balanceError_ << endl;
+}
+
+void ParticleCoupling::evolve() {
+  auto t0 = Clock::now();
+  std::vector<coupling::FluidAtParticle> samples = sample();
+  dem_->set_fluid(std::move(samples), [this](const std::array<double, 3>& x) { return sampleAt(x); });
+  couplingSeconds_ += seconds_since(t0);
+  t0 = Clock::now();
+  try {
+    dem_->advance(subSteps_);
+  } catch (const std::exception& e) {
+    FatalErrorInFunction << "\n" << e.what() << Foam::exit(Foam::FatalError);
+  }
+  demSeconds_ += seconds_since(t0);
+  t0 = Clock::now();
+  buildFootprints();
+  deposit();
+  if (mesh_.time().writeTime() || mesh_.time().timeIndex() == 1) checkBalance();
+  couplingSeconds_ += seconds_since(t0);
+}
+
+void ParticleCoupling::write() {
+  auto t0 = Clock::now();
+  dem_->write_snapshot(snapshotDir_, mesh_.time().timeIndex());
+  couplingSeconds_ += seconds_since(t0);
+  const coupling::DemSummary s = dem_->summary();
+  double counts[3] = {double(clampedCells_), clampedVolume_, 0};
+  MPI_Allreduce(MPI_IN_PLACE, counts, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  double times[3] = {demSeconds_, couplingSeconds_, fluidSeconds_};
+  MPI_Allreduce(MPI_IN_PLACE, times, 3, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  const double total = times[0] + times[1] + times[2];
+  Foam::Info << "grainFoam particles: " << s.particles << " particles, " << s.contacts
+             << " contacts, max overlap " << s.max_overlap_ratio << " r, removed " << s.removed
+             << ", sampled on arrival " << s.late_samples << "; void fraction clamped "
+             << label(counts[0]) << " cell-steps (" << counts[1]
+             << " m^3 solid volume removed), volume not deposited " << lostVolume_ << " m^3\n"
+             << "grainFoam time split: DEM " << times[0] << " s ("
+             << (total > 0 ? 100 * times[0] / total : 0) << " %), coupling " << times[1]
+             << " s (" << (total > 0 ? 100 * times[1] / total : 0) << " %), fluid " << times[2]
+             << " s (" << (total > 0 ? 100 * times[2] / total : 0) << " %)" << Foam::endl;
+}
+
+void ParticleCoupling::report(Foam::Ostream&) const {}
+
+}  // namespace grainflow::foam

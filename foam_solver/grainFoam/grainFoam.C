@@ -1,0 +1,144 @@
+// grainFoam: incompressible volume-averaged Navier–Stokes (VANS) for unresolved CFD-DEM,
+// PIMPLE, coupled to the grainflow DEM through grainflow::foam::ParticleCoupling.
+//
+// U is the interstitial fluid velocity, phi the superficial volumetric flux (eps U)_f.S,
+// p the kinematic pressure WITHOUT its hydrostatic part (so gravity does not appear: the
+// particles get Archimedes' buoyancy as a listed force). Per unit fluid density:
+//
+//   continuity   d(eps)/dt + div(eps U) = 0          (d(eps)/dt switchable)
+//   momentum     d(eps U)/dt + div(phi U) - div(eps_nu nu grad U)
+//                   = - c grad p - Ksl/rho (U - Us) + f/rho
+//   model A: c = eps, eps_nu = eps;  model B: c = 1, eps_nu = 1   (DESIGN.md §4;
+//   Zhou, Kuang, Chu & Yu 2010, J. Fluid Mech. 661:482).
+//
+// Gravity is absent from both models: in model A, -eps grad(P) + eps rho g = -eps grad(p)
+// for P = p + rho g.x; in model B the remaining -(1-eps) rho g is cancelled exactly by the
+// particles' buoyancy returned through the exchange, so neither is applied.
+// Ksl = sum K / V_cell goes on the matrix diagonal (implicit), Ksl Us = sum K v / V_cell
+// and f (explicit forces the model returns to the fluid) are explicit sources.
+// Pressure–velocity coupling: U = HbyA - rAU c grad p inserted into continuity gives
+//   laplacian(eps_f c_f rAU_f, p) = div(eps_f phiHbyA) + d(eps)/dt.
+#include <mpi.h>
+
+#include <chrono>
+
+#include "coupling/foam/particleCoupling.H"
+#include "fvCFD.H"
+#include "pimpleControl.H"
+
+namespace {
+
+// The solver proper; everything it creates (the DEM included) is gone when it returns,
+// before MPI is finalised.
+void solve(const Foam::argList& args) {
+  using namespace Foam;
+  Time runTime(Time::controlDictName, args);
+  fvMesh mesh(IOobject(fvMesh::defaultRegion, runTime.timeName(), runTime, IOobject::MUST_READ));
+  pimpleControl pimple(mesh);
+
+  IOdictionary transport(IOobject("transportProperties", runTime.constant(), mesh,
+                                  IOobject::MUST_READ_IF_MODIFIED, IOobject::NO_WRITE));
+  const dimensionedScalar rho("rho", dimDensity, transport);
+  const dimensionedScalar nu("nu", dimViscosity, transport);
+
+  volScalarField p(IOobject("p", runTime.timeName(), mesh, IOobject::MUST_READ,
+                            IOobject::AUTO_WRITE),
+                   mesh);
+  volVectorField U(IOobject("U", runTime.timeName(), mesh, IOobject::MUST_READ,
+                            IOobject::AUTO_WRITE),
+                   mesh);
+  label pRefCell = 0;
+  scalar pRefValue = 0;
+  setRefCell(p, pimple.dict(), pRefCell, pRefValue);
+  mesh.setFluxRequired(p.name());
+
+  grainflow::foam::ParticleCoupling particles(mesh, U, p, rho.value(), nu.value());
+  const volScalarField& eps = particles.voidFraction();
+  const bool modelA = particles.model() == 'A';
+
+  // The superficial flux, from the initial U and eps.
+  surfaceScalarField phi(IOobject("phi", runTime.timeName(), mesh, IOobject::READ_IF_PRESENT,
+                                  IOobject::AUTO_WRITE),
+                         fvc::interpolate(eps) * fvc::flux(U));
+
+  Info << "\nStarting time loop\n" << endl;
+  while (runTime.run()) {
+    ++runTime;
+    Info << "Time = " << runTime.timeName() << nl << endl;
+
+    particles.evolve();
+    const auto fluidStart = std::chrono::steady_clock::now();
+
+    const surfaceScalarField epsf(fvc::interpolate(eps));
+    volScalarField c("c", eps);    // coefficient of grad p (and of the viscous term)
+    surfaceScalarField cf("cf", epsf);
+    if (!modelA) {
+      c = dimensionedScalar("one", dimless, 1);
+      cf = dimensionedScalar("one", dimless, 1);
+    }
+    volScalarField ddtEps(IOobject("ddtEps", runTime.timeName(), mesh), mesh,
+                          dimensionedScalar("zero", dimless / dimTime, 0));
+    if (particles.ddtVoidFraction()) ddtEps = fvc::ddt(eps);
+
+    while (pimple.loop()) {
+      fvVectorMatrix UEqn(
+          fvm::ddt(eps, U) + fvm::div(phi, U) - fvm::Sp(ddtEps + fvc::div(phi), U) -
+              fvm::laplacian(c * nu, U) - fvc::div(c * nu * dev2(T(fvc::grad(U))))
+          == -fvm::Sp(particles.Ksl() / rho, U) + particles.KslUs() / rho +
+                 particles.fExplicit() / rho);
+      UEqn.relax();
+      if (pimple.momentumPredictor()) solve(UEqn == -c * fvc::grad(p));
+
+      while (pimple.correct()) {
+        const volScalarField rAU(1.0 / UEqn.A());
+        const surfaceScalarField rAUf(fvc::interpolate(rAU));
+        volVectorField HbyA(constrainHbyA(rAU * UEqn.H(), U, p));
+        surfaceScalarField phiHbyA("phiHbyA", epsf * fvc::flux(HbyA));
+        if (p.needReference()) adjustPhi(phiHbyA, U, p);
+        const surfaceScalarField Dp(epsf * cf * rAUf);
+        while (pimple.correctNonOrthogonal()) {
+          fvScalarMatrix pEqn(fvm::laplacian(Dp, p) == fvc::div(phiHbyA) + ddtEps);
+          pEqn.setReference(pRefCell, pRefValue);
+          pEqn.solve(mesh.solver(p.select(pimple.finalInnerIter())));
+          if (pimple.finalNonOrthogonalIter()) {
+            phi = phiHbyA - pEqn.flux();
+            p.relax();
+            U = HbyA - fvc::reconstruct(pEqn.flux() / epsf);
+            U.correctBoundaryConditions();
+          }
+        }
+        // Continuity error of the volume-averaged equation.
+        const volScalarField contErr(fvc::div(phi) + ddtEps);
+        Info << "continuity error: sum local = "
+             << runTime.deltaTValue() * mag(contErr)().weightedAverage(mesh.V()).value()
+             << endl;
+      }
+    }
+    particles.addFluidTime(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - fluidStart).count());
+
+    runTime.write();
+    if (runTime.writeTime()) particles.write();
+    runTime.printExecutionTime(Info);
+  }
+  Info << "End\n" << endl;
+}
+
+}  // namespace
+
+int main(int argc, char* argv[]) {
+  using namespace Foam;
+  argList::addNote(
+      "CFD-DEM solver: volume-averaged incompressible Navier-Stokes (PIMPLE) coupled to the "
+      "grainflow DEM. Needs constant/couplingProperties and the DEM scene it names.");
+  argList args(argc, argv);
+  if (!args.checkRootCase()) FatalError.exit();
+  // A serial run has no MPI from OpenFOAM; the DEM needs it.
+  int mpiReady = 0;
+  MPI_Initialized(&mpiReady);
+  const bool ownMpi = !mpiReady;
+  if (ownMpi) MPI_Init(&argc, &argv);
+  solve(args);
+  if (ownMpi) MPI_Finalize();
+  return 0;
+}
