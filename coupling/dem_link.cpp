@@ -171,29 +171,35 @@ ParticleSet DemLink::particles(bool with_ghosts_and_exchange) const {
     out.radius.push_back(p.radius[i]);
   }
   if (!with_ghosts_and_exchange) return out;
-  // K and the exchange force of the last step, local first, then forwarded to ghosts.
+  // K, the exchange force and the velocity at the end of the last step, local first, then
+  // forwarded to ghosts (the ghosts' own velocities were forwarded mid-step, before the
+  // second half kick).
   const ImplicitDrag& drag = sim.implicit_drag();
   const std::vector<Vec3>& carried = impl_->fluid->exchange_force;
-  std::vector<double> values(4 * p.size(), 0.0);
+  constexpr std::size_t W = 7;
+  std::vector<double> values(W * p.size(), 0.0);
   for (std::size_t i = 0; i < p.size(); ++i) {
-    values[4 * i] = i < drag.coefficient.size() ? drag.coefficient[i] : 0.0;
-    if (i < carried.size())
-      for (int c = 0; c < 3; ++c) values[4 * i + 1 + c] = carried[i][c];
+    values[W * i] = i < drag.coefficient.size() ? drag.coefficient[i] : 0.0;
+    for (int c = 0; c < 3; ++c) {
+      if (i < carried.size()) values[W * i + 1 + c] = carried[i][c];
+      values[W * i + 4 + c] = p.v[i][c];
+    }
   }
-  const std::vector<double> ghost_values = sim.ghost_values(values, 4);
+  const std::vector<double> ghost_values = sim.ghost_values(values, W);
   const Ghosts& g = sim.ghosts();
   for (std::size_t k = 0; k < g.size(); ++k) {
     out.id.push_back(static_cast<long long>(g.id[k]));
     out.x.push_back(arr(g.position(k)));
-    out.v.push_back(arr(g.v[k]));
+    out.v.push_back({0, 0, 0});
     out.radius.push_back(g.radius[k]);
   }
   out.drag_coefficient.resize(n);
   out.exchange_force.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const double* v = i < p.size() ? &values[4 * i] : &ghost_values[4 * (i - p.size())];
+    const double* v = i < p.size() ? &values[W * i] : &ghost_values[W * (i - p.size())];
     out.drag_coefficient[i] = v[0];
     out.exchange_force[i] = {v[1], v[2], v[3]};
+    out.v[i] = {v[4], v[5], v[6]};
   }
   return out;
 }

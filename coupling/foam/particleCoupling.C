@@ -268,15 +268,19 @@ void ParticleCoupling::buildFootprints() {
     footprint_.points(particles_.radius[i], pts);
     for (const coupling::FootprintPoint& q : pts) {
       Foam::point x;
+      bool image = false;  // beyond a periodic side: the particle's image deposits it
       for (int a = 0; a < 3; ++a) {
         double s = particles_.x[i][a] + q.offset[a];
         // A bounded side reflects the part of a footprint that pokes through it.
         if (!periodic_[a]) {
           if (s < domain_.lo[a]) s = 2 * domain_.lo[a] - s;
           if (s > domain_.hi[a]) s = 2 * domain_.hi[a] - s;
+        } else if (s < domain_.lo[a] || s >= domain_.hi[a]) {
+          image = true;  // periodic axes are half-open, [lo, hi), as in the DEM
         }
         x[a] = s;
       }
+      if (image) continue;
       const Foam::label c = locate(x);
       if (c >= 0) points_.push_back({c, q.weight});
     }

@@ -23,6 +23,7 @@
 #include <chrono>
 
 #include "coupling/foam/particleCoupling.H"
+#include "fixedFluxPressureFvPatchScalarField.H"
 #include "fvCFD.H"
 #include "pimpleControl.H"
 
@@ -96,6 +97,24 @@ void solve(const Foam::argList& args) {
         surfaceScalarField phiHbyA("phiHbyA", epsf * fvc::flux(HbyA));
         if (p.needReference()) adjustPhi(phiHbyA, U, p);
         const surfaceScalarField Dp(epsf * cf * rAUf);
+        // fixedFluxPressure patches: the normal pressure gradient that balances the
+        // particles' drag on the fluid at the face, c dp/dn = (-Ksl U + Ksl Us + f)/rho . n
+        // (steady momentum next to the wall or inlet). A zero gradient there would put
+        // the face at the first cell's pressure and lose the drop across the half cell
+        // of a bed resting on the inlet.
+        forAll(p.boundaryField(), patch) {
+          if (!isA<fixedFluxPressureFvPatchScalarField>(p.boundaryField()[patch])) continue;
+          const fvPatch& fp = mesh.boundary()[patch];
+          const vectorField force(-particles.Ksl().boundaryField()[patch] *
+                                      U.boundaryField()[patch] +
+                                  particles.KslUs().boundaryField()[patch] +
+                                  particles.fExplicit().boundaryField()[patch]);
+          const scalarField snGrad((fp.nf() & force) / (rho.value() * c.boundaryField()[patch]));
+          refCast<fixedFluxPressureFvPatchScalarField>(p.boundaryFieldRef()[patch])
+              .updateSnGrad(snGrad);
+          // The flux the pressure equation takes off again, so the face keeps eps_b U_b.S.
+          phiHbyA.boundaryFieldRef()[patch] += Dp.boundaryField()[patch] * snGrad * fp.magSf();
+        }
         while (pimple.correctNonOrthogonal()) {
           fvScalarMatrix pEqn(fvm::laplacian(Dp, p) == fvc::div(phiHbyA) + ddtEps);
           pEqn.setReference(pRefCell, pRefValue);

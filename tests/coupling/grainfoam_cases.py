@@ -1,0 +1,383 @@
+#!/usr/bin/env python3
+"""Command-level tests of grainFoam's coupling (tests/coupling/tests.cmake).
+
+    grainfoam_cases.py TEST --foam-env scripts/foam_env.sh --solver bin/grainFoam
+                            --mpiexec mpiexec --cases tests/coupling/cases --work <scratch>
+
+TEST is one of the functions in TESTS below; each copies a case from tests/coupling/cases/
+into <scratch>, edits it (the edits are listed in the test), runs the OpenFOAM programs
+through foam_env.sh and checks the solver's log lines, written fields and particle
+snapshots against references that do not come from the coupling itself:
+
+  void_fraction_volume  conservation: sum over cells (1 - eps) V = sum over particles V_p,
+                        and rank independence: eps on 2 ranks = eps on 1 rank;
+  exchange_balance      Newton's third law: the fluid's exchange source is minus the sum
+                        of the fluid forces on the particles;
+  neutrally_buoyant     closed form: a particle as dense as the fluid, in fluid at rest,
+                        feels no net force and stays where it is;
+  refuses_bad_setup     three set-ups grainFoam must refuse, with the message it must give.
+
+Exit status 0 when every check holds; otherwise each failed check is printed and the exit
+status is 1. Logs stay in the case folders (log.<program>).
+"""
+import argparse
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+
+# Round-off of one fluid step: the printed sums add a few hundred cell and particle volumes
+# (relative error ~1e-16 each; 4.4e-15 is the worst measured); 1e-12 leaves room for that
+# and for nothing physical (one bead counted twice or not at all is 8e-4 to 8e-3 of the
+# total, the middle layer of its divided footprint 2e-4).
+ROUND_OFF = 1e-12
+
+FLOAT = r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
+VOID_LINE = re.compile(
+    r"grainFoam void fraction: sum \(1-eps\) V = " + FLOAT + r" m\^3, clamped away " + FLOAT +
+    r" m\^3, particles " + FLOAT + r" m\^3, relative difference " + FLOAT)
+VEC = r"\(" + FLOAT + " " + FLOAT + " " + FLOAT + r"\)"
+BALANCE_LINE = re.compile(r"grainFoam exchange balance: particles " + VEC + r" N, fluid " +
+                          VEC + r" N, relative imbalance " + FLOAT)
+
+
+class Checks:
+    """Collects failed checks so that one run reports all of them."""
+
+    def __init__(self):
+        self.failures = []
+
+    def expect(self, ok, what):
+        print(("  ok    " if ok else "  FAIL  ") + what)
+        if not ok:
+            self.failures.append(what)
+
+
+class Runner:
+    def __init__(self, args):
+        self.foam_env = args.foam_env
+        self.solver = args.solver
+        self.mpiexec = args.mpiexec
+        self.cases = args.cases
+        self.work = args.work
+
+    def fresh_case(self, source, name, edits=()):
+        """A fresh copy of cases/<source> as <work>/<name>, with text edits applied:
+        each edit is (file, old, new) and `old` must occur in the file."""
+        case = os.path.join(self.work, name)
+        shutil.rmtree(case, ignore_errors=True)
+        shutil.copytree(os.path.join(self.cases, source), case)
+        for path, old, new in edits:
+            full = os.path.join(case, path)
+            with open(full) as f:
+                text = f.read()
+            if old not in text:
+                raise RuntimeError(f"{full}: no '{old}' to replace")
+            with open(full, "w") as f:
+                f.write(text.replace(old, new, 1))
+        return case
+
+    def run(self, case, log, *command, ranks=1, expect_failure=False):
+        """Runs an OpenFOAM program in `case`; returns its output (stdout + stderr)."""
+        cmd = [self.foam_env]
+        if ranks > 1:
+            cmd += [self.mpiexec, "-np", str(ranks), "--oversubscribe"]
+        cmd += list(command) + ["-case", case]
+        if ranks > 1:
+            cmd.append("-parallel")
+        t0 = time.monotonic()
+        r = subprocess.run(cmd, cwd=case, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                           text=True, timeout=120)
+        with open(os.path.join(case, "log." + log), "w") as f:
+            f.write(r.stdout)
+        print(f"  ran   {log} ({time.monotonic() - t0:.1f} s, exit {r.returncode})")
+        if expect_failure:
+            if r.returncode == 0:
+                raise RuntimeError(f"{log} should have failed but exited 0; see {case}/log.{log}")
+        elif r.returncode != 0:
+            raise RuntimeError(f"{log} failed (exit {r.returncode}); {case}/log.{log}:\n"
+                               + r.stdout[-3000:])
+        return r.stdout
+
+    def solve(self, case, ranks=1):
+        """blockMesh, [decomposePar,] grainFoam, [reconstructPar]; returns grainFoam's log."""
+        self.run(case, "blockMesh", "blockMesh")
+        if ranks == 1:
+            return self.run(case, "grainFoam", self.solver)
+        self.run(case, "decomposePar", "decomposePar")
+        out = self.run(case, "grainFoam", self.solver, ranks=ranks)
+        self.run(case, "reconstructPar", "reconstructPar", "-fields", "(voidfraction)")
+        return out
+
+
+def void_lines(log):
+    return [tuple(float(x) for x in m.groups()) for m in VOID_LINE.finditer(log)]
+
+
+def balance_lines(log):
+    out = []
+    for m in BALANCE_LINE.finditer(log):
+        v = [float(x) for x in m.groups()]
+        out.append((np.array(v[0:3]), np.array(v[3:6]), v[6]))
+    return out
+
+
+def read_scalar_field(path):
+    """internalField of an ASCII volScalarField (uniform or nonuniform List<scalar>)."""
+    with open(path) as f:
+        text = f.read()
+    m = re.search(r"internalField\s+uniform\s+" + FLOAT, text)
+    if m:
+        return np.array([float(m.group(1))])
+    m = re.search(r"internalField\s+nonuniform\s+List<scalar>\s*(\d+)\s*\(([^)]*)\)", text)
+    if not m:
+        raise RuntimeError(f"{path}: no internalField")
+    values = np.array(m.group(2).split(), dtype=float)
+    if len(values) != int(m.group(1)):
+        raise RuntimeError(f"{path}: {len(values)} values, header says {m.group(1)}")
+    return values
+
+
+def snapshots(case):
+    """Particle snapshots of a case, sorted by time: [(time, {dataset: array})]."""
+    folder = os.path.join(case, "particles")
+    out = []
+    for name in sorted(os.listdir(folder)):
+        if name.endswith(".h5"):
+            with h5py.File(os.path.join(folder, name), "r") as f:
+                order = np.argsort(f["id"][:])
+                data = {k: f[k][:][order] for k in ("id", "position", "velocity", "radius")}
+                out.append((float(f.attrs["time"]), data))
+    return sorted(out, key=lambda s: s[0])
+
+
+# --- coupling.void_fraction_volume ------------------------------------------------------
+
+BOX = 0.02        # cases/periodic_box: a 20 mm cube, periodic along x and y
+CELL = BOX / 8    # 8 x 8 x 8 cells
+PROCESSOR_PLANE = BOX / 2  # decomposeParDict: simple (2 1 1)
+TIME_FOLDERS = ("0.0001", "0.0002")  # controlDict: two steps of 1e-4 s, each written
+
+
+def check_straddling(checks, particles):
+    """The case must really put beads across the faces the test is about."""
+    x, r = particles["position"], particles["radius"]
+    across_x = np.sum((x[:, 0] < r) | (x[:, 0] > BOX - r))
+    across_y = np.sum((x[:, 1] < r) | (x[:, 1] > BOX - r))
+    across_plane = np.sum(np.abs(x[:, 0] - PROCESSOR_PLANE) < r)
+    faces = np.abs(x / CELL - np.round(x / CELL)) * CELL < r[:, None]
+    across_cells = np.sum(np.any(faces, axis=1))
+    on_face = np.sum(x[:, 0] == 0)  # still exactly there after the first step (u_x = 0)
+    checks.expect(across_x >= 2 and across_y >= 2 and across_plane >= 10 and
+                  across_cells >= len(r) // 2 and on_face == 1,
+                  f"beads across the periodic faces x: {across_x}, y: {across_y}, the "
+                  f"processor plane: {across_plane}, a cell face: {across_cells} of {len(r)}; "
+                  f"centred on x = 0: {on_face}")
+
+
+def void_fraction_volume(runner, checks):
+    """Sum (1 - eps) V + clamped = sum V_p to round-off, printed by grainFoam and
+    recomputed here from the written voidfraction and the snapshot radii; eps on 2 ranks
+    (simple (2 1 1): the processor plane x = 10 mm cuts beads, and each rank is its own
+    periodic neighbour) equals eps on 1 rank to 1e-12 (round-off: the same footprint
+    points are summed in another order)."""
+    for method in ("centre", "divided", "smoothed"):
+        print(f"voidFraction {method}:")
+        edit = [("constant/couplingProperties", "voidFraction    divided;",
+                 f"voidFraction    {method};")]
+        eps = {}
+        for ranks in (1, 2):
+            case = runner.fresh_case("periodic_box", f"{method}_np{ranks}", edit)
+            log = runner.solve(case, ranks)
+            lines = void_lines(log)
+            checks.expect(len(lines) == 2, f"np {ranks}: {len(lines)} void fraction lines "
+                                           "(one per fluid step expected: every step is written)")
+            for mesh_solid, clamped, particles, relative in lines:
+                checks.expect(relative < ROUND_OFF,
+                              f"np {ranks}: printed relative difference {relative:.3g} < 1e-12 "
+                              f"(sum (1-eps) V = {mesh_solid:.17g}, clamped {clamped:.3g})")
+            snaps = snapshots(case)
+            checks.expect(len(snaps) == 2, f"np {ranks}: {len(snaps)} particle snapshots, 2 expected")
+            # Fluid step k: its log line, its snapshot and its time folder.
+            for (t, particles), line, folder in zip(snaps, lines, TIME_FOLDERS):
+                checks.expect(abs(t - float(folder)) < 1e-12,
+                              f"np {ranks}: snapshot at t = {t:g} s, fields at {folder} s")
+                if ranks == 1 and folder == TIME_FOLDERS[0]:
+                    check_straddling(checks, particles)
+                vp = float(np.sum(4.0 / 3.0 * math.pi * particles["radius"] ** 3))
+                checks.expect(abs(line[2] - vp) <= ROUND_OFF * vp,
+                              f"np {ranks}, t = {folder}: particles {line[2]:.17g} m^3 = "
+                              f"sum 4/3 pi r^3 of the snapshot {vp:.17g} m^3")
+                field = read_scalar_field(os.path.join(case, folder, "voidfraction"))
+                solid = float(np.sum((1 - field) * CELL ** 3))
+                # The field is written with 17 digits: the recomputed sum is as exact as
+                # the printed one. Nothing is clamped in this loose bed (checked).
+                checks.expect(line[1] == 0 and abs(solid - vp) <= ROUND_OFF * vp,
+                              f"np {ranks}, t = {folder}: from the written field, sum (1-eps) V "
+                              f"= {solid:.17g} m^3, relative difference {abs(solid - vp) / vp:.3g}")
+                eps[(ranks, folder)] = field
+        for folder in TIME_FOLDERS:
+            a, b = eps.get((1, folder)), eps.get((2, folder))
+            if a is None or b is None or a.shape != b.shape:
+                checks.expect(False, f"t = {folder}: voidfraction of 1 and 2 ranks to compare")
+                continue
+            diff = float(np.max(np.abs(a - b)))
+            checks.expect(diff < ROUND_OFF, f"t = {folder}: max |eps(np 1) - eps(np 2)| = "
+                                            f"{diff:.3g} < 1e-12 (min eps {a.min():.4f})")
+
+
+# --- coupling.exchange_balance ----------------------------------------------------------
+
+
+def exchange_balance(runner, checks):
+    """The same bed in a flow (initial U = (0.05 0.02 0) m/s, cyclic along x and y):
+    drag is the main force. grainFoam prints the sum of the fluid forces on the particles
+    (K (u_p - v) + the model's explicit part) and the fluid's exchange source summed over
+    the cells; Newton's third law makes them opposite, to round-off, when the fluid is
+    sampled with the same footprint weights it is deposited with (sampling cell)."""
+    edits = [("0/U", "internalField   uniform (0 0 0);", "internalField   uniform (0.05 0.02 0);")]
+    for ranks in (1, 2):
+        case = runner.fresh_case("periodic_box", f"exchange_np{ranks}", edits)
+        log = runner.solve(case, ranks)
+        checks.expect("sampling cell," in log, f"np {ranks}: the solver samples with `cell`")
+        lines = balance_lines(log)
+        checks.expect(len(lines) == 2, f"np {ranks}: {len(lines)} exchange balance lines, 2 expected")
+        for step, (particles, fluid, imbalance) in enumerate(lines, start=1):
+            # Reference for the size: Stokes drag 3 pi mu d |u| (1 + 0.15 Re^0.687) on 307
+            # beads at 0.05 m/s is ~1e-3 N along x; at least 1e-4 N shows the drag is on.
+            checks.expect(particles[0] > 1e-4,
+                          f"np {ranks}, step {step}: drag on the particles along the flow "
+                          f"{particles[0]:.4g} N (> 1e-4 N)")
+            checks.expect(imbalance < ROUND_OFF,
+                          f"np {ranks}, step {step}: relative imbalance {imbalance:.3g} < 1e-12 "
+                          f"(particles {particles}, fluid {fluid})")
+
+
+# --- coupling.neutrally_buoyant ---------------------------------------------------------
+
+# Where cases/neutral_particle/particle.csv puts the bead.
+START = np.array([0.00437, 0.00512, 0.00463])
+
+
+def neutrally_buoyant(runner, checks):
+    """One bead with the fluid's density, at rest in fluid at rest, model A and model B:
+    gravity m g and buoyancy -rho_f V g cancel, drag, pressure-gradient and viscous forces
+    vanish in fluid at rest, so it must not move. After 0.1 s (100 fluid steps of 50 DEM
+    steps) its displacement must be < 1e-9 m and its speed < 1e-8 m/s: a residual force of
+    round-off size (1e-16 of m g) would move it by ~1e-17 m (0 is measured: the forces
+    cancel exactly and the fluid stays exactly at rest); a density 1 % off already moves
+    it by 0.3 mm (the control below), a missing buoyancy or a hydrostatic pressure counted
+    twice by far more."""
+    for model in ("A", "B"):
+        case = runner.fresh_case("neutral_particle", f"neutral_{model}",
+                                 [("particle.yaml", "model: B", f"model: {model}")])
+        log = runner.solve(case, 1)
+        checks.expect(f"VANS model {model}" in log, f"model {model}: the solver says VANS model {model}")
+        snaps = snapshots(case)
+        t, last = snaps[-1] if snaps else (0.0, None)
+        if last is None or len(last["id"]) != 1:
+            checks.expect(False, f"model {model}: a snapshot with one particle")
+            continue
+        moved = float(np.linalg.norm(last["position"][0] - START))
+        speed = float(np.linalg.norm(last["velocity"][0]))
+        checks.expect(abs(t - 0.1) < 1e-9, f"model {model}: last snapshot at t = {t:g} s (0.1 s)")
+        checks.expect(moved < 1e-9, f"model {model}: displacement {moved:.3g} m < 1e-9 m")
+        checks.expect(speed < 1e-8, f"model {model}: speed {speed:.3g} m/s < 1e-8 m/s")
+
+    # Control: 1 % denser, the bead must sink (so a bead that never moves fails the test).
+    # Stokes: terminal speed 2/9 (rho_p - rho_f) g r^2 / mu = 7.8 mm/s, relaxation time
+    # rho_p d^2 / (18 mu) = 0.081 s, so it sinks ~0.33 mm in 0.1 s; > 0.01 mm is asked.
+    case = runner.fresh_case("neutral_particle", "denser", [
+        ("particle.yaml", "poisson_ratio: 0.3, density: 1000", "poisson_ratio: 0.3, density: 1010")])
+    runner.solve(case, 1)
+    t, last = snapshots(case)[-1]
+    sunk = START[2] - last["position"][0][2]
+    checks.expect(sunk > 1e-5, f"control, 1 % denser: sinks {sunk:.3g} m in {t:g} s (> 1e-5 m)")
+
+
+# --- coupling.refuses_bad_setup ---------------------------------------------------------
+
+
+def staircase_decomposition(case):
+    """constant/cellDecomposition for method manual: rank 1 holds x > 10 mm in the lower
+    half (z < 10 mm) and x > 7.5 mm in the upper half, a cut with a step in it, as a graph
+    partitioner (scotch, metis) makes on a box. blockMesh numbers the 8 x 8 x 8 cells with
+    i (along x) fastest, then j, then k."""
+    ranks = [int(i >= (4 if k < 4 else 3)) for k in range(8) for j in range(8) for i in range(8)]
+    with open(os.path.join(case, "constant", "cellDecomposition"), "w") as f:
+        f.write("FoamFile { version 2.0; format ascii; class labelList; "
+                "object cellDecomposition; }\n")
+        f.write(f"{len(ranks)}\n(\n" + "\n".join(map(str, ranks)) + "\n)\n")
+
+
+def refuses_bad_setup(runner, checks):
+    """Three set-ups grainFoam must stop on, each with a message that says what to do."""
+    # 1. A decomposition that is not a grid of boxes. Debian's OpenFOAM v1912 ships
+    # libscotchDecomp.so as the stub ("Attempted to use <scotch> without the scotchDecomp
+    # library loaded"), and metis and kahip likewise, so a graph partitioner's layout is
+    # given by hand (method manual): a cut plane with a step, boxes that overlap.
+    case = runner.fresh_case("periodic_box", "not_boxes", [
+        ("system/decomposeParDict", "method          simple;",
+         'method          manual;\nmanualCoeffs    { dataFile "cellDecomposition"; }')])
+    staircase_decomposition(case)
+    runner.run(case, "blockMesh", "blockMesh")
+    runner.run(case, "decomposePar", "decomposePar")
+    log = runner.run(case, "grainFoam", runner.solver, ranks=2, expect_failure=True)
+    checks.expect("shared decomposition: the 2 processor meshes do not form a grid of boxes"
+                  in log and "`simple`" in log and "`hierarchical`" in log,
+                  "processor meshes that are not boxes: refused; the message names methods "
+                  "simple and hierarchical")
+
+    # 2. deltaT = 1.5 DEM steps.
+    case = runner.fresh_case("periodic_box", "deltaT", [
+        ("system/controlDict", "deltaT          1e-4;", "deltaT          1.5e-5;")])
+    runner.run(case, "blockMesh", "blockMesh")
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    checks.expect("must be an integer" in log and "1.5e-05" in log,
+                  "deltaT 1.5e-5 s with a 1e-5 s DEM step: refused, 'must be an integer'")
+
+    # 3. The scene's fluid density differs from transportProperties' rho.
+    case = runner.fresh_case("periodic_box", "density", [
+        ("particles.yaml", "density: 1000", "density: 1100")])
+    runner.run(case, "blockMesh", "blockMesh")
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    named = re.search(r"particles\.yaml:32: error: fluid\.density is 1100 kg/m\^3 but the fluid "
+                      r"solver's rho is 1000 kg/m\^3 \(constant/transportProperties\)", log)
+    checks.expect(named is not None,
+                  "fluid.density 1100 vs rho 1000: refused; the message names both values, "
+                  "particles.yaml:32 (the density key) and constant/transportProperties")
+
+
+TESTS = {f.__name__: f for f in (void_fraction_volume, exchange_balance, neutrally_buoyant,
+                                 refuses_bad_setup)}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("test", choices=sorted(TESTS))
+    parser.add_argument("--foam-env", required=True)
+    parser.add_argument("--solver", required=True)
+    parser.add_argument("--mpiexec", default="mpiexec")
+    parser.add_argument("--cases", required=True)
+    parser.add_argument("--work", required=True)
+    args = parser.parse_args()
+    os.makedirs(args.work, exist_ok=True)
+    checks = Checks()
+    t0 = time.monotonic()
+    try:
+        TESTS[args.test](Runner(args), checks)
+    except (RuntimeError, subprocess.TimeoutExpired) as e:
+        checks.expect(False, str(e))
+    print(f"coupling.{args.test}: {len(checks.failures)} failed checks, "
+          f"{time.monotonic() - t0:.1f} s")
+    return 1 if checks.failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,56 @@
+# Command-level tests of grainFoam's two-way coupling (included by tests/CMakeLists.txt).
+# Each runs tests/coupling/grainfoam_cases.py on a fresh copy of a case from
+# tests/coupling/cases/ in the build tree; the references, tolerances and edits to the case
+# are stated in that script, one function per test. Run time on 2 cores: each under 15 s.
+#
+#   coupling.void_fraction_volume  cases/periodic_box (307 beads of 3 radii in a 20 mm box of
+#       8^3 cells, periodic along x and y, 7 of them placed across the periodic faces and the
+#       processor plane): for voidFraction centre, divided and smoothed, on 1 rank and on
+#       2 (simple (2 1 1)), sum (1 - eps) V = sum 4/3 pi r^3 to 1e-12 (printed by grainFoam
+#       and recomputed from the written field and snapshot), and eps(2 ranks) = eps(1 rank)
+#       to 1e-12 (reconstructPar).
+#   coupling.exchange_balance      the same bed in a flow of 0.05 m/s, sampling cell: the
+#       fluid's exchange source is minus the sum of the fluid forces on the particles
+#       (Newton's third law) to 1e-12 relative, 1 and 2 ranks.
+#   coupling.neutrally_buoyant     cases/neutral_particle: one bead as dense as water at rest
+#       in water at rest, models A and B: after 0.1 s it has moved < 1e-9 m, speed < 1e-8 m/s.
+#   coupling.refuses_bad_setup     processor meshes that are not boxes (2 ranks), deltaT not
+#       a whole number of DEM steps, fluid.density != rho: each stops with its message.
+if(NOT TARGET grainFoam)
+  return()
+endif()
+
+# h5py reads the particle snapshots: Debian's python3-h5py, as in tests/dem/app/tests.cmake.
+find_program(GRAINFLOW_COUPLING_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
+if(GRAINFLOW_COUPLING_PYTHON)
+  execute_process(COMMAND ${GRAINFLOW_COUPLING_PYTHON} -c "import h5py, numpy"
+                  RESULT_VARIABLE _coupling_no_h5py OUTPUT_QUIET ERROR_QUIET)
+endif()
+if(NOT GRAINFLOW_COUPLING_PYTHON OR NOT _coupling_no_h5py EQUAL 0)
+  message(STATUS "python3 with h5py and numpy not found: the coupling.* command tests are skipped")
+  return()
+endif()
+
+function(grainflow_coupling_test name ranks)
+  add_test(NAME coupling.${name}
+           COMMAND ${GRAINFLOW_COUPLING_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/grainfoam_cases.py ${name}
+                   --foam-env ${PROJECT_SOURCE_DIR}/scripts/foam_env.sh
+                   --solver $<TARGET_FILE:grainFoam>
+                   --mpiexec ${MPIEXEC_EXECUTABLE}
+                   --cases ${CMAKE_CURRENT_LIST_DIR}/cases
+                   --work ${CMAKE_CURRENT_BINARY_DIR}/coupling/${name})
+  set_tests_properties(coupling.${name} PROPERTIES
+    ENVIRONMENT "GRAINFLOW_FOAM_BASHRC=${OpenFOAM_BASHRC};${GRAINFLOW_MPIEXEC_ENV}"
+    TIMEOUT 60)
+  if(ranks GREATER 1)
+    set_tests_properties(coupling.${name} PROPERTIES LABELS "foam;coupling;mpi"
+                         PROCESSORS ${ranks})
+  else()
+    set_tests_properties(coupling.${name} PROPERTIES LABELS "foam;coupling")
+  endif()
+endfunction()
+
+grainflow_coupling_test(void_fraction_volume 2)
+grainflow_coupling_test(exchange_balance 2)
+grainflow_coupling_test(neutrally_buoyant 1)
+grainflow_coupling_test(refuses_bad_setup 2)
