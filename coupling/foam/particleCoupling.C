@@ -5,6 +5,8 @@
 #include <cmath>
 #include <mpi.h>
 
+#include <sstream>
+
 #include "coupling/shared_decomposition.hpp"
 #include "zeroGradientFvPatchFields.H"
 #include "interpolationCellPoint.H"
@@ -491,16 +493,27 @@ void ParticleCoupling::write() {
   MPI_Allreduce(MPI_IN_PLACE, counts, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
   double times[3] = {demSeconds_, couplingSeconds_, fluidSeconds_};
   MPI_Allreduce(MPI_IN_PLACE, times, 3, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-  const double total = times[0] + times[1] + times[2];
+  double interval[3];
+  for (int k = 0; k < 3; ++k) {
+    interval[k] = times[k] - reportedSeconds_[k];
+    reportedSeconds_[k] = times[k];
+  }
+  const auto split = [](const double* t) {
+    const double total = t[0] + t[1] + t[2];
+    const auto share = [total](double x) { return total > 0 ? 100 * x / total : 0.0; };
+    std::ostringstream text;
+    text.precision(3);
+    text << "DEM " << t[0] << " s (" << share(t[0]) << " %), coupling " << t[1] << " s ("
+         << share(t[1]) << " %), fluid " << t[2] << " s (" << share(t[2]) << " %)";
+    return text.str();
+  };
   Foam::Info << "grainFoam particles: " << s.particles << " particles, " << s.contacts
              << " contacts, max overlap " << s.max_overlap_ratio << " r, removed " << s.removed
              << ", sampled on arrival " << s.late_samples << "; void fraction clamped "
-             << label(counts[0]) << " cell-steps (" << counts[1]
+             << Foam::label(counts[0]) << " cell-steps (" << counts[1]
              << " m^3 solid volume removed), volume not deposited " << lostVolume_ << " m^3\n"
-             << "grainFoam time split: DEM " << times[0] << " s ("
-             << (total > 0 ? 100 * times[0] / total : 0) << " %), coupling " << times[1]
-             << " s (" << (total > 0 ? 100 * times[1] / total : 0) << " %), fluid " << times[2]
-             << " s (" << (total > 0 ? 100 * times[2] / total : 0) << " %)" << Foam::endl;
+             << "grainFoam time split since the last write: " << split(interval).c_str() << "\n"
+             << "grainFoam time split: " << split(times).c_str() << Foam::endl;
 }
 
 void ParticleCoupling::report(Foam::Ostream&) const {}

@@ -96,8 +96,6 @@ for u, t0, t1 in stages:
 
 fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4))
 a1.plot(t, dp, lw=0.8, label="grainFoam: inlet - outlet")
-for u, m, ref, name in results:
-    pass
 a1.axhline(weight, color="k", ls="--", lw=0.8, label="bed weight / area")
 a1.set_xlabel("t [s]")
 a1.set_ylabel("pressure drop [Pa]")
