@@ -116,11 +116,13 @@ bool sample_centre(const Region& reg, double r, std::mt19937_64& rng, Vec3& x) {
   return true;
 }
 
-bool inside_domain(const Domain& d, const Vec3& x, double r) {
+// `tolerance`: how far a sphere may poke through a bounded side (a settled particle overlaps
+// a wall that lies on that side by a little).
+bool inside_domain(const Domain& d, const Vec3& x, double r, double tolerance = 0) {
   for (int a = 0; a < 3; ++a) {
     if (d.periodic[a]) {
       if (x[a] < d.lo[a] || x[a] >= d.hi[a]) return false;
-    } else if (x[a] - r < d.lo[a] || x[a] + r > d.hi[a]) {
+    } else if (x[a] - r + tolerance < d.lo[a] || x[a] + r - tolerance > d.hi[a]) {
       return false;
     }
   }
@@ -274,8 +276,11 @@ void read_snapshot_entry(const Scene& scene, const Insertion& ins, Particles& p,
       fail("has material index " + std::to_string(q.material[i]) + " but the scene has " +
            std::to_string(scene.materials.size()) +
            " materials; list the materials in the same order as in the scene that wrote it");
-    if (!inside_domain(scene.domain, q.x[i], q.radius[i]))
-      fail("lies outside the domain (or crosses a bounded side)");
+    // A snapshot of a settled bed has particles overlapping walls on the domain's sides by
+    // up to the overlap the run allowed.
+    if (!inside_domain(scene.domain, q.x[i], q.radius[i], scene.time.max_overlap * q.radius[i]))
+      fail("lies outside the domain (or crosses a bounded side by more than time.max_overlap "
+           "of its radius)");
     // Touching neighbours of a settled bed overlap slightly: only particles of
     // earlier entries are checked (the grid holds this snapshot's only afterwards).
     if (overlaps_with_images(grid, scene.domain, q.x[i], q.radius[i]))
