@@ -7,6 +7,7 @@
 
 #include <sstream>
 
+#include "coupling/accuracy_table.hpp"
 #include "coupling/shared_decomposition.hpp"
 #include "zeroGradientFvPatchFields.H"
 #include "interpolationCellPoint.H"
@@ -234,6 +235,21 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
        << (structuredRanks == Pstream::nProcs() ? "uniform grid (direct)"
                                                : "octree search on some ranks")
        << endl;
+
+  // Where these settings sit on the measured curves: cell edge over mean diameter.
+  {
+    const coupling::ParticleSet mine_particles = dem_->particles(false);
+    double sums[3] = {0, double(mine_particles.local), 0};
+    for (double r : mine_particles.radius) sums[0] += 2 * r;
+    sums[2] = sum(mesh.V().field());
+    MPI_Allreduce(MPI_IN_PLACE, sums, 3, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+    const double cells = double(returnReduce(mesh.nCells(), sumOp<label>()));
+    if (sums[1] > 0) {
+      const double cellOverD = std::cbrt(sums[2] / cells) / (sums[0] / sums[1]);
+      Info << "  " << coupling::describe_coupled_accuracy(method, sampling, cellOverD, subSteps_).c_str()
+           << endl;
+    }
+  }
 
   buildFootprints();
   deposit();
