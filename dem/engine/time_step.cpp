@@ -28,6 +28,53 @@ double pair_contact_time(const ContactSettings& cs, const PairCoefficients& pc,
   const double w2 = s.kn / m_star - std::pow(s.gn / (2 * m_star), 2);
   return w2 > 0 ? std::numbers::pi / std::sqrt(w2) : std::numeric_limits<double>::infinity();
 }
+
+struct PairImpact {
+  std::string pair;
+  double contact_time, restitution;
+};
+
+// Where dt sits on the measured curve (time_step_accuracy.hpp), for the pair whose
+// restitution suffers most (fewest steps per impact, lowest e).
+void accuracy_note(const Scene& scene, TimeStepReport& rep,
+                   const std::vector<PairImpact>& impacts) {
+  const PairImpact* worst = nullptr;
+  ImpactAccuracy acc;
+  for (const PairImpact& im : impacts) {
+    if (!std::isfinite(im.contact_time)) continue;
+    const ImpactAccuracy a =
+        impact_accuracy(scene.contact.normal, im.restitution, im.contact_time / rep.dt);
+    if (!worst || a.restitution_rms > acc.restitution_rms) {
+      worst = &im;
+      acc = a;
+    }
+  }
+  if (!worst) return;
+  rep.accuracy = acc;
+  auto percent = [](double x) {
+    std::ostringstream p;
+    p.precision(2);
+    p << 100 * x;
+    return p.str();
+  };
+  std::ostringstream o;
+  o.precision(3);
+  o << "dt = ";
+  if (std::isfinite(rep.rayleigh_time)) o << rep.dt / rep.rayleigh_time << " t_R, ";
+  const char* about = acc.coarser_than_measured ? " > " : " ≈ ";
+  o << worst->contact_time / rep.dt << " steps per impact: restitution error" << about
+    << percent(acc.restitution_rms) << " % (worst" << about << percent(acc.restitution_max)
+    << " %), contact-time error" << about << percent(acc.contact_time_rms) << " % (" << worst->pair
+    << " at " << scene.time.expected_max_speed << " m/s, e = " << worst->restitution;
+  const auto [lo, hi] = measured_steps_per_impact(scene.contact.normal);
+  if (acc.coarser_than_measured)
+    o << "; fewer steps per impact than the measured minimum of " << lo;
+  else if (acc.extrapolated)
+    o << "; extrapolated beyond the measured " << lo << "-" << hi << " steps per impact";
+  o << "; measured, docs/accuracy-vs-cost.md)";
+  rep.notes.push_back(o.str());
+}
+
 }  // namespace
 
 TimeStepReport check_time_step(const Scene& scene, const Particles& p, const PairTable& table,
@@ -53,6 +100,7 @@ TimeStepReport check_time_step(const Scene& scene, const Particles& p, const Pai
   const double v = scene.time.expected_max_speed;
   rep.contact_time = inf;
   std::string contact_pair;
+  std::vector<PairImpact> impacts;  // every pair present, for the accuracy estimate
   auto mass = [&](int m) { return scene.materials[m].density * sphere_volume(r_min[m]); };
   for (int a = 0; a < nm; ++a) {
     if (r_min[a] == inf) continue;
@@ -61,17 +109,21 @@ TimeStepReport check_time_step(const Scene& scene, const Particles& p, const Pai
       const double rs = r_min[a] * r_min[b] / (r_min[a] + r_min[b]);
       const double ms = mass(a) * mass(b) / (mass(a) + mass(b));
       const double t = pair_contact_time(scene.contact, table(a, b), constants, rs, ms, v);
+      const std::string name = scene.materials[a].name + "-" + scene.materials[b].name;
+      impacts.push_back({name, t, table(a, b).restitution});
       if (t < rep.contact_time) {
         rep.contact_time = t;
-        contact_pair = scene.materials[a].name + "-" + scene.materials[b].name;
+        contact_pair = name;
       }
     }
     for (const Wall& w : scene.walls) {
       const double t =
           pair_contact_time(scene.contact, table(a, w.material), constants, r_min[a], mass(a), v);
+      const std::string name = scene.materials[a].name + "-wall '" + w.name + "'";
+      impacts.push_back({name, t, table(a, w.material).restitution});
       if (t < rep.contact_time) {
         rep.contact_time = t;
-        contact_pair = scene.materials[a].name + "-wall '" + w.name + "'";
+        contact_pair = name;
       }
     }
   }
@@ -106,6 +158,7 @@ TimeStepReport check_time_step(const Scene& scene, const Particles& p, const Pai
         << " steps per impact)";
     rep.notes.push_back(o.str());
     o.str("");
+    accuracy_note(scene, rep, impacts);
     const double fr = rep.dt / rep.rayleigh_time;
     const double steps = rep.contact_time / rep.dt;
     if (fr > kRefuseRayleighFraction || steps < kRefuseStepsPerContact) {

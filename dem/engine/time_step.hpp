@@ -5,12 +5,14 @@
 // impact between the smallest particles (and particle-wall):
 //   Hertz: t_c = 2.868 (m*^2 / (R* Y*^2 v))^{1/5}   (elastic; damping lengthens it)
 //   Hooke: t_c = pi / sqrt(k_n/m* - (gamma_n / 2 m*)^2)
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "dem/contact/contact_geometry.hpp"
 #include "dem/contact/pair_coefficients.hpp"
 #include "dem/core/particles.hpp"
+#include "dem/engine/time_step_accuracy.hpp"
 #include "dem/scene/scene.hpp"
 
 namespace grainflow {
@@ -19,6 +21,9 @@ struct TimeStepReport {
   double rayleigh_time = 0;  // smallest over materials present
   double contact_time = 0;   // smallest over material pairs present, at expected_max_speed
   double dt = 0;
+  // Measured impact errors at dt (docs/accuracy-vs-cost.md) for the material pair (or
+  // particle-wall pair) whose restitution suffers most at its steps per impact and e.
+  std::optional<ImpactAccuracy> accuracy;
   enum class Verdict { ok, warn, refuse } verdict = Verdict::ok;
   std::vector<std::string> notes;  // human-readable findings, one per line
 };

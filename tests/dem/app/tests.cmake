@@ -26,6 +26,12 @@ grain_cli_test(missing_scene_file 2 "no_such.yaml: error: cannot open the scene 
                CMD ${_grain} check ${_scenes}/no_such.yaml)
 grain_cli_test(check_minimal 0 "Rayleigh time t_R = ;contact time t_c = ;steps per impact"
                CMD ${_grain} check ${_scenes}/minimal.yaml)
+# The time step placed on the measured accuracy curve (docs/accuracy-vs-cost.md):
+# minimal.yaml runs at 0.07 t_R with e = 0.9 between its glass beads. (';' separates the
+# regexes that must all match.)
+grain_cli_test(check_reports_accuracy 0
+               "dt = 0.07 t_R, [0-9.]+ steps per impact: restitution error .+ [0-9.e-]+ % \\(worst .+ [0-9.e-]+ %\\), contact-time error .+ [0-9.e-]+ % \\(glass-glass at 1 m/s, e = 0.9;measured, docs/accuracy-vs-cost.md\\)"
+               CMD ${_grain} check ${_scenes}/minimal.yaml)
 grain_cli_test(bad_restitution 2 "bad/restitution.yaml:13:[0-9]+: error: .*restitution.*value 1.2 is out of range.*\\(0, 1\\]"
                CMD ${_grain} check ${_scenes}/bad/restitution.yaml)
 grain_cli_test(bad_model_name 2 "bad/model_name.yaml:[0-9]+:[0-9]+: error: .*'hertzz'; allowed: hertz, hooke"
