@@ -112,8 +112,14 @@ void solve(const Foam::argList& args) {
           const scalarField snGrad((fp.nf() & force) / (rho.value() * c.boundaryField()[patch]));
           refCast<fixedFluxPressureFvPatchScalarField>(p.boundaryFieldRef()[patch])
               .updateSnGrad(snGrad);
-          // The flux the pressure equation takes off again, so the face keeps eps_b U_b.S.
-          phiHbyA.boundaryFieldRef()[patch] += Dp.boundaryField()[patch] * snGrad * fp.magSf();
+          // The boundary flux before the pressure correction, set so that the corrected one
+          // is eps_b U_b.S (whatever HbyA holds there: fixedFluxExtrapolatedPressure, a
+          // fixedFluxPressure type too, does not pin HbyA to the inlet velocity).
+          const fixedFluxPressureFvPatchScalarField& pb =
+              refCast<const fixedFluxPressureFvPatchScalarField>(p.boundaryField()[patch]);
+          phiHbyA.boundaryFieldRef()[patch] =
+              eps.boundaryField()[patch] * (fp.Sf() & U.boundaryField()[patch]) +
+              Dp.boundaryField()[patch] * pb.gradient() * fp.magSf();
         }
         while (pimple.correctNonOrthogonal()) {
           fvScalarMatrix pEqn(fvm::laplacian(Dp, p) == fvc::div(phiHbyA) + ddtEps);

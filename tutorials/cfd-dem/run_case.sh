@@ -22,7 +22,9 @@ run_case() {
   rm -rf processor* particles postProcessing log.* [1-9]* 0.[0-9]* constant/polyMesh
   "$foam" blockMesh > log.blockMesh 2>&1 || { tail -20 log.blockMesh; return 1; }
   if [ "$np" -gt 1 ]; then
-    sed -i "s/^numberOfSubdomains .*/numberOfSubdomains $np;/" system/decomposeParDict
+    # N slabs along x for method simple (each case's file is set up for 2).
+    sed -i -e "s/^numberOfSubdomains .*/numberOfSubdomains $np;/" \
+           -e "s/n ([0-9]* 1 1);/n ($np 1 1);/" system/decomposeParDict
     "$foam" decomposePar -force > log.decomposePar 2>&1 || { tail -20 log.decomposePar; return 1; }
     echo "Allrun: grainFoam on $np ranks (log.grainFoam)"
     OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 \
