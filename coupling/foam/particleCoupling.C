@@ -188,7 +188,10 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
       bool ok = true;
       for (int a = 0; a < 3; ++a) {
         gridLo_[a] = mine.lo[a];
-        gridH_[a] = h[a];
+        // One spacing for all ranks: the domain length over the global cell count.
+        const double length = domain_.hi[a] - domain_.lo[a];
+        gridH_[a] = length / static_cast<double>(std::max(1L, std::lround(length / h[a])));
+        gridOffset_[a] = static_cast<int>(std::lround((mine.lo[a] - domain_.lo[a]) / gridH_[a]));
         gridN_[a] = static_cast<int>(std::lround((mine.hi[a] - mine.lo[a]) / h[a]));
         if (gridN_[a] < 1 || std::abs(gridN_[a] * h[a] - (mine.hi[a] - mine.lo[a])) >
                                  1e-9 * (mine.hi[a] - mine.lo[a]))
@@ -262,8 +265,10 @@ Foam::label ParticleCoupling::locate(const Foam::point& x) const {
   if (structured_) {
     std::array<int, 3> idx{};
     for (int a = 0; a < 3; ++a) {
-      const double s = (x[a] - gridLo_[a]) / gridH_[a];
-      idx[a] = static_cast<int>(std::floor(s));
+      // The global cell index, from the domain's corner and one spacing on every rank, so a
+      // point on a cell face falls in the same cell whatever the rank layout; then local.
+      const double s = (x[a] - domain_.lo[a]) / gridH_[a];
+      idx[a] = static_cast<int>(std::floor(s)) - gridOffset_[a];
       // A point on the domain's upper face belongs to the last cell.
       if (idx[a] == gridN_[a] && std::abs(x[a] - domain_.hi[a]) <= 1e-12 * gridH_[a] * gridN_[a])
         idx[a] = gridN_[a] - 1;
