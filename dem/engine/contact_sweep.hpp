@@ -16,6 +16,7 @@
 #include "dem/contact/pair_coefficients.hpp"
 #include "dem/core/particles.hpp"
 #include "dem/neighbour/verlet_list.hpp"
+#include "dem/neighbour/wall_neighbours.hpp"
 #include "dem/parallel/ghosts.hpp"
 #include "dem/scene/scene.hpp"
 #include "dem/walls/wall_set.hpp"
@@ -50,6 +51,7 @@ struct ContactSweep {
   std::vector<ContactHistory>& ghost_history;              // parallel to ghost_list.j
   const WallSet& walls;  // current wall positions (dem/walls/wall_set.hpp)
   std::vector<std::vector<ContactHistory>>& wall_history;  // [wall][particle]
+  const WallNeighbours& wall_neighbours;                   // the particles each wall may touch
   const PairTable& table;
   const ContactConstants& constants;
   double dt;

@@ -320,6 +320,8 @@ void Simulation::rebuild() {
   exchange_->borders(p_, cutoff_, ghosts_);
   grid_->build(p_, ghosts_, skin_, local_list_, ghost_list_);
   restore_histories(carried);
+  wall_neighbours_.build(p_, walls_, skin_);
+  wall_neighbours_.end_unlisted_springs(walls_, wall_history_);
   x_at_build_ = p_.x;
   ++counters_.rebuilds;
 }
@@ -330,9 +332,10 @@ void Simulation::compute_forces() {
     p_.force[i] = p_.mass[i] * g;
     p_.torque[i].setZero();
   }
-  ContactSweep s{p_,     ghosts_,        local_list_, ghost_list_, local_history_, ghost_history_,
-                 walls_, wall_history_, table_,      constants_,  dt_,           0,
-                 0.0,    WorstContact{}};
+  ContactSweep s{
+      p_,     ghosts_,       local_list_,      ghost_list_, local_history_, ghost_history_,
+      walls_, wall_history_, wall_neighbours_, table_,      constants_,     dt_,
+      0,      0.0,           WorstContact{}};
   sweep_.run(s);
   counters_.contacts = s.contacts;
   counters_.max_overlap_ratio = s.max_overlap_ratio;

@@ -21,6 +21,7 @@
 #include "dem/insert/stream_insertion.hpp"
 #include "dem/io/checkpoint.hpp"
 #include "dem/neighbour/verlet_list.hpp"
+#include "dem/neighbour/wall_neighbours.hpp"
 #include "dem/parallel/decomposition.hpp"
 #include "dem/parallel/exchange.hpp"
 #include "dem/parallel/ghosts.hpp"
@@ -159,6 +160,7 @@ class Simulation {
   NeighbourList local_list_, ghost_list_;
   std::vector<ContactHistory> local_history_, ghost_history_;
   std::vector<std::vector<ContactHistory>> wall_history_;  // [WallSet column][particle]
+  WallNeighbours wall_neighbours_;                         // rebuilt with the Verlet lists
   WallSet walls_;
   StreamInsertion streams_;
   std::vector<Vec3> x_at_build_;

@@ -48,12 +48,16 @@ void apply_wall_contact(ContactSweep& s, std::size_t i, const WallTouch& t, int 
                      g.m_star, s.table(p.material[i], material).y_star);
 }
 
+// A plane or a cylinder, against the particles of its neighbour list (all of them when
+// `list.all`; the others cannot touch it, and their springs were ended at the rebuild).
 template <class Law, class Touch>
-void wall_sweep_one(ContactSweep& s, const WallSet::Entry& wall,
+void wall_sweep_one(ContactSweep& s, const WallSet::Entry& wall, const WallNeighbours::List& list,
                     std::vector<ContactHistory>& history, Touch touch) {
   Particles& p = s.p;
   ContactHistory unused;
-  for (std::size_t i = 0; i < p.size(); ++i) {
+  const std::size_t n = list.all ? p.size() : list.i.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = list.all ? k : static_cast<std::size_t>(list.i[k]);
     WallTouch t;
     if (!touch(p.x[i], p.radius[i], t)) {
       if constexpr (Law::has_history) history[i] = ContactHistory{};
@@ -124,16 +128,18 @@ void mesh_sweep(ContactSweep& s, const WallSet::Entry& wall, const TriangleMesh&
 
 template <class Law>
 void wall_sweep(ContactSweep& s) {
-  for (const WallSet::Entry& wall : s.walls.walls()) {
+  for (std::size_t w = 0; w < s.walls.walls().size(); ++w) {
+    const WallSet::Entry& wall = s.walls.walls()[w];
+    const WallNeighbours::List& list = s.wall_neighbours.lists[w];
     switch (wall.kind) {
       case Wall::Kind::plane:
-        wall_sweep_one<Law>(s, wall, s.wall_history[wall.column],
+        wall_sweep_one<Law>(s, wall, list, s.wall_history[wall.column],
                             [&wall](const Vec3& x, double r, WallTouch& t) {
                               return touch_plane(wall.plane, x, r, t);
                             });
         break;
       case Wall::Kind::cylinder:
-        wall_sweep_one<Law>(s, wall, s.wall_history[wall.column],
+        wall_sweep_one<Law>(s, wall, list, s.wall_history[wall.column],
                             [&wall](const Vec3& x, double r, WallTouch& t) {
                               return touch_cylinder(wall.cylinder, x, r, t);
                             });
