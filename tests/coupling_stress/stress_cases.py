@@ -22,166 +22,19 @@ voidfraction; particle count conserved with none removed; every printed relative
 difference and exchange imbalance < 1e-12.
 
 Exit status 0 when every check holds; otherwise each failed check is printed and the exit
-status is 1. Logs stay in the case folders (log.<program>). Helpers are copied from
-tests/coupling/grainfoam_cases.py.
+status is 1. Logs stay in the case folders (log.<program>). Shared helpers:
+tests/support/grainfoam_driver.py.
 """
-import argparse
 import math
 import os
-import re
-import shutil
-import subprocess
 import sys
 import time
 
-import h5py
 import numpy as np
 
-# Round-off of one fluid step: the printed sums add a few hundred to a few thousand cell
-# and particle volumes (relative error ~1e-16 each); 1e-12 leaves room for that and for
-# nothing physical (one 1 mm bead of 300 is 3e-3 of the total).
-ROUND_OFF = 1e-12
-
-FLOAT = r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?nan|[-+]?inf)"
-VOID_LINE = re.compile(
-    r"grainFoam void fraction: sum \(1-eps\) V = " + FLOAT + r" m\^3, clamped away " + FLOAT +
-    r" m\^3, particles " + FLOAT + r" m\^3, relative difference " + FLOAT)
-VEC = r"\(" + FLOAT + " " + FLOAT + " " + FLOAT + r"\)"
-BALANCE_LINE = re.compile(r"grainFoam exchange balance: particles " + VEC + r" N, fluid " +
-                          VEC + r" N, relative imbalance " + FLOAT)
-PARTICLES_LINE = re.compile(r"grainFoam particles: (\d+) particles, .*?removed (\d+)"
-                            r".*?void fraction clamped (\d+) cell-steps")
-NAN_WORD = re.compile(r"\b(nan|inf)\b", re.IGNORECASE)
-
-
-class Checks:
-    """Collects failed checks so that one run reports all of them."""
-
-    def __init__(self):
-        self.failures = []
-
-    def expect(self, ok, what):
-        print(("  ok    " if ok else "  FAIL  ") + what)
-        if not ok:
-            self.failures.append(what)
-
-
-class Runner:
-    def __init__(self, args):
-        self.foam_env = args.foam_env
-        self.solver = args.solver
-        self.mpiexec = args.mpiexec
-        self.cases = args.cases
-        self.work = args.work
-        # superficialVelocityInlet (dense_bed): OpenFOAM's `libs` dlopen()s the bare name.
-        self.env = dict(os.environ)
-        if args.lib_dir:
-            self.env["LD_LIBRARY_PATH"] = os.pathsep.join(
-                p for p in (args.lib_dir, os.environ.get("LD_LIBRARY_PATH", "")) if p)
-
-    def fresh_case(self, source, name, edits=()):
-        """A fresh copy of cases/<source> as <work>/<name>, with text edits applied:
-        each edit is (file, old, new) and `old` must occur in the file."""
-        case = os.path.join(self.work, name)
-        shutil.rmtree(case, ignore_errors=True)
-        shutil.copytree(os.path.join(self.cases, source), case)
-        for path, old, new in edits:
-            full = os.path.join(case, path)
-            with open(full) as f:
-                text = f.read()
-            if old not in text:
-                raise RuntimeError(f"{full}: no '{old}' to replace")
-            with open(full, "w") as f:
-                f.write(text.replace(old, new, 1))
-        return case
-
-    def run(self, case, log, *command, ranks=1):
-        """Runs an OpenFOAM program in `case`; returns its output (stdout + stderr)."""
-        cmd = [self.foam_env]
-        if ranks > 1:
-            cmd += [self.mpiexec, "-np", str(ranks), "--oversubscribe"]
-        cmd += list(command) + ["-case", case]
-        if ranks > 1:
-            cmd.append("-parallel")
-        t0 = time.monotonic()
-        r = subprocess.run(cmd, cwd=case, env=self.env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                           text=True, timeout=120)
-        with open(os.path.join(case, "log." + log), "w") as f:
-            f.write(r.stdout)
-        print(f"  ran   {log} ({time.monotonic() - t0:.1f} s, exit {r.returncode})")
-        if r.returncode != 0:
-            raise RuntimeError(f"{log} failed (exit {r.returncode}); {case}/log.{log}:\n"
-                               + r.stdout[-3000:])
-        return r.stdout
-
-    def solve(self, case, ranks=1):
-        """blockMesh, [decomposePar,] grainFoam, [reconstructPar]; returns grainFoam's log."""
-        self.run(case, "blockMesh", "blockMesh")
-        if ranks == 1:
-            return self.run(case, "grainFoam", self.solver)
-        self.run(case, "decomposePar", "decomposePar")
-        out = self.run(case, "grainFoam", self.solver, ranks=ranks)
-        self.run(case, "reconstructPar", "reconstructPar", "-fields", "(voidfraction)")
-        return out
-
-
-def void_lines(log):
-    return [tuple(float(x) for x in m.groups()) for m in VOID_LINE.finditer(log)]
-
-
-def balance_lines(log):
-    out = []
-    for m in BALANCE_LINE.finditer(log):
-        v = [float(x) for x in m.groups()]
-        out.append((np.array(v[0:3]), np.array(v[3:6]), v[6]))
-    return out
-
-
-def particle_lines(log):
-    """(count, removed, clamped cell-steps) of every `grainFoam particles:` line."""
-    return [tuple(int(x) for x in m.groups()) for m in PARTICLES_LINE.finditer(log)]
-
-
-def read_scalar_field(path):
-    """internalField of an ASCII volScalarField (uniform or nonuniform List<scalar>)."""
-    with open(path) as f:
-        text = f.read()
-    m = re.search(r"internalField\s+uniform\s+" + FLOAT, text)
-    if m:
-        return np.array([float(m.group(1))])
-    m = re.search(r"internalField\s+nonuniform\s+List<scalar>\s*(\d+)\s*\(([^)]*)\)", text)
-    if not m:
-        raise RuntimeError(f"{path}: no internalField")
-    values = np.array(m.group(2).split(), dtype=float)
-    if len(values) != int(m.group(1)):
-        raise RuntimeError(f"{path}: {len(values)} values, header says {m.group(1)}")
-    return values
-
-
-def snapshots(case):
-    """Particle snapshots of a case, sorted by time: [(time, {dataset: array})]."""
-    folder = os.path.join(case, "particles")
-    out = []
-    for name in sorted(os.listdir(folder)):
-        if name.endswith(".h5"):
-            with h5py.File(os.path.join(folder, name), "r") as f:
-                order = np.argsort(f["id"][:])
-                data = {k: f[k][:][order] for k in ("id", "position", "velocity", "radius")}
-                out.append((float(f.attrs["time"]), data))
-    return sorted(out, key=lambda s: s[0])
-
-
-def time_folders(case):
-    """Written time folders of a (reconstructed) case, except 0, sorted by time."""
-    out = []
-    for name in os.listdir(case):
-        try:
-            t = float(name)
-        except ValueError:
-            continue
-        if t > 0 and os.path.exists(os.path.join(case, name, "voidfraction")):
-            out.append(name)
-    return sorted(out, key=float)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from grainfoam_driver import (ROUND_OFF, NAN_WORD, balance_lines, main, particle_lines,  # noqa: E402
+                              read_scalar_field, snapshots, time_folders, void_lines)
 
 
 def check_run(checks, label, case, log, count, min_eps, cell_volume=None):
@@ -374,27 +227,5 @@ TESTS = {f.__name__: f for f in (dense_bed_10x_umf, particles_larger_than_cells,
                                  on_faces_and_corners_2ranks)}
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("test", choices=sorted(TESTS))
-    parser.add_argument("--foam-env", required=True)
-    parser.add_argument("--solver", required=True)
-    parser.add_argument("--mpiexec", default="mpiexec")
-    parser.add_argument("--lib-dir", default="", help="folder of libgrainflowFoamBCs.so")
-    parser.add_argument("--cases", required=True)
-    parser.add_argument("--work", required=True)
-    args = parser.parse_args()
-    os.makedirs(args.work, exist_ok=True)
-    checks = Checks()
-    t0 = time.monotonic()
-    try:
-        TESTS[args.test](Runner(args), checks)
-    except (RuntimeError, subprocess.TimeoutExpired) as e:
-        checks.expect(False, str(e))
-    print(f"coupling_stress.{args.test}: {len(checks.failures)} failed checks, "
-          f"{time.monotonic() - t0:.1f} s")
-    return 1 if checks.failures else 0
-
-
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(main(TESTS, "coupling_stress", __doc__))
