@@ -66,6 +66,15 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
                              IOobject::MUST_READ_IF_MODIFIED, IOobject::NO_WRITE));
 
   // --- settings -------------------------------------------------------------------
+  // A misspelt key would silently fall back to its default: refuse unknown keys.
+  {
+    const wordList allowed{"scene", "voidFraction", "dividedResolution", "smoothingFactor",
+                           "sampling", "minVoidFraction", "ddtVoidFraction"};
+    for (const word& key : dict.toc())
+      if (!allowed.found(key))
+        FatalIOErrorInFunction(dict) << "unknown key '" << key << "'; allowed: " << allowed
+                                     << exit(FatalIOError);
+  }
   // The scene, relative to the case folder (not processorN/).
   const fileName scene = dict.get<fileName>("scene");
   fileName sceneFile = scene.isAbsolute()
