@@ -136,9 +136,10 @@ void Simulation::initialise() {
   mark_leaving();
   rebuild();
   // A restored run keeps the checkpoint's forces: evaluating the contacts again
-  // would advance every spring a second time for the same step.
+  // would advance every spring a second time for the same step, and the force terms
+  // are already in them. Only the implicit drag is set, from the checkpoint.
   if (restoring)
-    apply_force_terms();
+    restore_implicit_drag();
   else
     compute_forces();
   initialised_ = true;
@@ -210,6 +211,7 @@ void Simulation::apply_order(const std::vector<std::size_t>& perm, CarriedState&
   p_.permute(perm);
   for (auto& wh : carried.wall) reorder(wh, perm);
   reorder(carried.pairs, perm);
+  if (carried.carries_drag) reorder(carried.drag, perm);
 }
 
 double Simulation::load_imbalance() const {
@@ -270,6 +272,10 @@ void Simulation::set_cut_planes(int axis, const std::vector<double>& planes) {
 
 void Simulation::restore(const CheckpointData& checkpoint) {
   p_ = checkpoint.particles;
+  restored_drag_.clear();
+  for (std::size_t i = 0; i < checkpoint.drag_coefficient.size(); ++i)
+    restored_drag_[checkpoint.particles.id[i]] = {checkpoint.drag_coefficient[i],
+                                                  checkpoint.drag_fluid_velocity[i]};
   time_ = checkpoint.time;
   if (dt_ <= 0) dt_ = checkpoint.dt;
   counters_.steps = checkpoint.step;
@@ -285,6 +291,10 @@ void Simulation::write_checkpoint(const std::string& path) {
   d.step = counters_.steps;
   d.next_id = next_id_;
   d.particles = p_;
+  if (!terms_.empty()) {
+    d.drag_coefficient = drag_.coefficient;
+    d.drag_fluid_velocity = drag_.fluid_velocity;
+  }
   const CarriedState c = save_histories();
   for (std::size_t i = 0; i < p_.size(); ++i)
     for (const PartnerHistory& ph : c.pairs[i])
@@ -296,13 +306,19 @@ void Simulation::write_checkpoint(const std::string& path) {
                              c.wall[w][i].rolling});
   grainflow::write_checkpoint(comm_, path, d);
   mark_leaving();
-  rebuild();
+  rebuild(/*keep_drag=*/true);  // the next half kick uses the drag of this step's end
 }
 
-void Simulation::rebuild() {
+void Simulation::rebuild(bool keep_drag) {
   // Springs by global ids (indices change below); after a restore, those of the checkpoint.
   CarriedState carried = pending_carried_ ? std::move(*pending_carried_) : save_histories();
   pending_carried_.reset();
+  carried.carries_drag = keep_drag && !terms_.empty();
+  if (carried.carries_drag)
+    for (std::size_t i = 0; i < p_.size(); ++i) {
+      const Vec3& u = drag_.fluid_velocity[i];
+      carried.drag.push_back({drag_.coefficient[i], u[0], u[1], u[2]});
+    }
   // Rebalance every 10th rebuild, when the busiest rank holds 10 % more than the mean.
   if (scene_.parallel.balance && decomp_->size() > 1 && counters_.rebuilds % 10 == 0 &&
       load_imbalance() > 1.1)
@@ -312,6 +328,7 @@ void Simulation::rebuild() {
     p_.remove_if(leaving_);
     for (auto& wh : carried.wall) keep_unflagged(wh, leaving_);
     keep_unflagged(carried.pairs, leaving_);
+    if (carried.carries_drag) keep_unflagged(carried.drag, leaving_);
     counters_.removed += before - static_cast<long>(p_.size());
     leaving_.clear();
   }
@@ -320,6 +337,15 @@ void Simulation::rebuild() {
   exchange_->borders(p_, cutoff_, ghosts_);
   grid_->build(p_, ghosts_, skin_, local_list_, ghost_list_);
   restore_histories(carried);
+  if (carried.carries_drag) {
+    drag_.coefficient.resize(p_.size());
+    drag_.fluid_velocity.resize(p_.size());
+    for (std::size_t i = 0; i < p_.size(); ++i) {
+      const std::array<double, 4>& k = carried.drag[i];
+      drag_.coefficient[i] = k[0];
+      drag_.fluid_velocity[i] = Vec3(k[1], k[2], k[3]);
+    }
+  }
   wall_neighbours_.build(p_, walls_, skin_);
   wall_neighbours_.end_unlisted_springs(walls_, wall_history_);
   x_at_build_ = p_.x;
@@ -376,6 +402,29 @@ void Simulation::check_overlap(const WorstContact& w) const {
     message = o.str();
   }
   agree_on_error(comm_, message);  // the rank holding the worst contact speaks
+}
+
+void Simulation::restore_implicit_drag() {
+  if (terms_.empty()) return;
+  if (restored_drag_.empty()) {
+    // A checkpoint without drag (written by a run without fluid forces; every rank
+    // reads the whole file, so all take this branch): the terms' drag at the restored
+    // state, without adding their forces a second time.
+    const std::vector<Vec3> force = p_.force, torque = p_.torque;
+    apply_force_terms();
+    p_.force = force;
+    p_.torque = torque;
+    return;
+  }
+  drag_.coefficient.assign(p_.size(), 0.0);
+  drag_.fluid_velocity.assign(p_.size(), Vec3::Zero());
+  for (std::size_t i = 0; i < p_.size(); ++i) {
+    const auto it = restored_drag_.find(p_.id[i]);
+    if (it == restored_drag_.end()) continue;
+    drag_.coefficient[i] = it->second.first;
+    drag_.fluid_velocity[i] = it->second.second;
+  }
+  restored_drag_.clear();
 }
 
 void Simulation::apply_force_terms() {

@@ -10,6 +10,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "dem/contact/contact_geometry.hpp"
@@ -131,10 +132,11 @@ class Simulation {
   double kinetic_energy_rotational() const;     // this rank
 
  private:
-  void rebuild();
+  void rebuild(bool keep_drag = false);
   void balance_cuts();  // moves cut planes toward equal particle counts (collective)
   void compute_forces();     // gravity, contacts, then the force terms
   void apply_force_terms();  // non-contact terms only
+  void restore_implicit_drag();  // initialise() after restore()
   // Stops the run (ParallelError on every rank) when a contact overlaps beyond
   // time.max_overlap, naming the contact and a time step that would resolve it.
   void check_overlap(const WorstContact& worst) const;
@@ -170,6 +172,8 @@ class Simulation {
   Counters counters_;
   TimeStepReport report_;
   std::vector<CheckpointSpring> restored_springs_;  // from restore(), until initialise()
+  // The checkpoint's implicit drag by global id (K, u), until initialise().
+  std::unordered_map<GlobalId, std::pair<double, Vec3>> restored_drag_;
   std::optional<CarriedState> pending_carried_;     // springs for the first rebuild
   bool restored_ = false;                           // initialise() keeps the forces read
   bool initialised_ = false;

@@ -14,13 +14,19 @@ constexpr const char* kFormat = "grainflow-checkpoint-1";
 // Packs per-particle and per-spring records into doubles (ids bit-exact).
 std::vector<double> pack(const CheckpointData& d) {
   std::vector<double> b;
+  const bool drag = !d.drag_coefficient.empty();
   b.push_back(static_cast<double>(d.particles.size()));
+  b.push_back(drag ? 1.0 : 0.0);
   for (std::size_t i = 0; i < d.particles.size(); ++i) {
     const Particles& p = d.particles;
     b.push_back(std::bit_cast<double>(p.id[i]));
     for (const Vec3* v : {&p.x[i], &p.v[i], &p.omega[i], &p.force[i], &p.torque[i]})
       b.insert(b.end(), v->data(), v->data() + 3);
     b.insert(b.end(), {p.radius[i], p.mass[i], p.inertia[i], static_cast<double>(p.material[i])});
+    if (drag) {
+      b.push_back(d.drag_coefficient[i]);
+      b.insert(b.end(), d.drag_fluid_velocity[i].data(), d.drag_fluid_velocity[i].data() + 3);
+    }
   }
   for (const CheckpointSpring& s : d.springs) {
     b.push_back(std::bit_cast<double>(s.particle));
@@ -35,6 +41,7 @@ std::vector<double> pack(const CheckpointData& d) {
 void unpack(const double* b, std::size_t n, CheckpointData& out) {
   std::size_t k = 0;
   const auto count = static_cast<std::size_t>(b[k++]);
+  const bool drag = b[k++] != 0;
   auto vec = [&] {
     const Vec3 v(b[k], b[k + 1], b[k + 2]);
     k += 3;
@@ -49,6 +56,10 @@ void unpack(const double* b, std::size_t n, CheckpointData& out) {
     out.particles.add_raw(id, x, v, w, r, m, inertia, mat);
     out.particles.force.back() = f;
     out.particles.torque.back() = t;
+    if (drag) {
+      out.drag_coefficient.push_back(b[k++]);
+      out.drag_fluid_velocity.push_back(vec());
+    }
   }
   while (k < n) {
     CheckpointSpring s;
@@ -101,6 +112,11 @@ bool write_attribute(hid_t loc, const char* name, hid_t type, const T& value) {
 std::string write_file(const std::string& path, const CheckpointData& d) {
   const Particles& p = d.particles;
   const std::size_t n = p.size(), m = d.springs.size();
+  if (!d.drag_coefficient.empty() &&
+      (d.drag_coefficient.size() != n || d.drag_fluid_velocity.size() != n))
+    return "the ranks disagree on whether particles have an implicit drag (" +
+           std::to_string(d.drag_coefficient.size()) + " drag entries for " + std::to_string(n) +
+           " particles)";
   File f(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT));
   if (f.id() < 0) return "cannot create the file";
   const hid_t str = H5Tcopy(H5T_C_S1);
@@ -138,6 +154,11 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
        write_array(g, "mass", H5T_NATIVE_DOUBLE, n, 1, p.mass.data()) &&
        write_array(g, "inertia", H5T_NATIVE_DOUBLE, n, 1, p.inertia.data()) &&
        write_array(g, "material", H5T_NATIVE_INT, n, 1, mats.data());
+  if (!d.drag_coefficient.empty())
+    ok = ok && write_array(g, "drag_coefficient", H5T_NATIVE_DOUBLE, n, 1,
+                           d.drag_coefficient.data()) &&
+         write_array(g, "drag_fluid_velocity", H5T_NATIVE_DOUBLE, n, 3,
+                     flat(d.drag_fluid_velocity).data());
   if (g >= 0) H5Gclose(g);
   std::vector<long long> a(m), b(m);
   std::vector<Vec3> t(m), r(m);
@@ -274,6 +295,13 @@ CheckpointData read_checkpoint(const std::string& path) {
     const auto mass = read_array<double>(g, "mass", H5T_NATIVE_DOUBLE, 1, n, error);
     const auto inertia = read_array<double>(g, "inertia", H5T_NATIVE_DOUBLE, 1, n, error);
     const auto mat = read_array<int>(g, "material", H5T_NATIVE_INT, 1, n, error);
+    // Optional: present when the run had fluid forces.
+    const bool has_drag = error.empty() && H5Lexists(g, "drag_coefficient", H5P_DEFAULT) > 0;
+    std::vector<double> drag_k, drag_u;
+    if (has_drag) {
+      drag_k = read_array<double>(g, "drag_coefficient", H5T_NATIVE_DOUBLE, 1, n, error);
+      drag_u = read_array<double>(g, "drag_fluid_velocity", H5T_NATIVE_DOUBLE, 3, n, error);
+    }
     if (g >= 0) H5Gclose(g);
     const hid_t s = error.empty() ? H5Gopen2(f, "springs", H5P_DEFAULT) : -1;
     if (error.empty() && s < 0) error = "group 'springs' is missing";
@@ -291,6 +319,10 @@ CheckpointData read_checkpoint(const std::string& path) {
                             mat[i]);
         d.particles.force.back() = Vec3(force[3 * i], force[3 * i + 1], force[3 * i + 2]);
         d.particles.torque.back() = Vec3(torque[3 * i], torque[3 * i + 1], torque[3 * i + 2]);
+        if (has_drag) {
+          d.drag_coefficient.push_back(drag_k[i]);
+          d.drag_fluid_velocity.emplace_back(drag_u[3 * i], drag_u[3 * i + 1], drag_u[3 * i + 2]);
+        }
       }
       for (std::size_t k = 0; k < m; ++k)
         d.springs.push_back({a[k], b[k], Vec3(t[3 * k], t[3 * k + 1], t[3 * k + 2]),

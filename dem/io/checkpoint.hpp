@@ -10,7 +10,11 @@
 // Layout: attributes format ("grainflow-checkpoint-1"), time, dt, step, next_id;
 // /particles/{id, position, velocity, angular_velocity, force, torque, radius, mass,
 // inertia, material} — force and torque are those of the step's end, which the next
-// velocity-Verlet half kick uses (recomputing them would advance the springs twice); /springs/{particle, partner, tangential, rolling}, where a wall spring
+// velocity-Verlet half kick uses (recomputing them would advance the springs twice);
+// with fluid forces also /particles/{drag_coefficient, drag_fluid_velocity}, the
+// implicit drag K and u of the step's end, which that half kick uses too (a coupled
+// run cannot recompute them: they come from the fluid of the step before);
+// /springs/{particle, partner, tangential, rolling}, where a wall spring
 // has partner = -1 - wall index. A pair's spring may be listed once per partner.
 #include <mpi.h>
 
@@ -35,6 +39,10 @@ struct CheckpointData {
   long step = 0;
   GlobalId next_id = 1;
   Particles particles;
+  // The implicit drag of the step's end, aligned with `particles`; empty when the run
+  // has no fluid forces.
+  std::vector<double> drag_coefficient;
+  std::vector<Vec3> drag_fluid_velocity;
   std::vector<CheckpointSpring> springs;
 };
 

@@ -112,6 +112,8 @@ void Exchange::migrate(Particles& p, CarriedState& carried) {
           w.put_id(ph.partner);
           w.put(ph.history);
         }
+        if (carried.carries_drag)
+          for (double x : carried.drag[i]) w.put(x);
       }
       p.remove_if(leaving);
       for (auto& wh : carried.wall) {
@@ -128,6 +130,12 @@ void Exchange::migrate(Particles& p, CarriedState& carried) {
             ++keep;
           }
         carried.pairs.resize(keep);
+      }
+      if (carried.carries_drag) {
+        std::size_t keep = 0;
+        for (std::size_t r = 0; r < carried.drag.size(); ++r)
+          if (!leaving[r]) carried.drag[keep++] = carried.drag[r];
+        carried.drag.resize(keep);
       }
       const std::vector<double> in = sendrecv(d_.comm(), out, to, from, 100 + 2 * a + dir);
       Reader r{in};
@@ -148,6 +156,7 @@ void Exchange::migrate(Particles& p, CarriedState& carried) {
           ph.history = r.get_history();
         }
         carried.pairs.push_back(std::move(pairs));
+        if (carried.carries_drag) carried.drag.push_back({r.get(), r.get(), r.get(), r.get()});
       }
     }
     // Everything this rank now holds must lie in its slab along this axis.

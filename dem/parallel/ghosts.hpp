@@ -7,6 +7,7 @@
 // geometry is then computed as (x_a - x_b) + (shift_a - shift_b) on every rank, so
 // both ranks of a pair that crosses a rank boundary get bit-identical forces.
 #include <cstddef>
+#include <array>
 #include <vector>
 
 #include "dem/contact/contact_geometry.hpp"
@@ -47,6 +48,11 @@ struct PartnerHistory {
 struct CarriedState {
   std::vector<std::vector<ContactHistory>> wall;  // [wall][particle]
   std::vector<std::vector<PartnerHistory>> pairs; // [particle]
+  // The implicit drag (K, u) of the step's end, [particle]; carried only across the
+  // rebuild after a checkpoint, where the next half kick still needs it. The flag is
+  // the same on every rank (a rank may hold no particles).
+  bool carries_drag = false;
+  std::vector<std::array<double, 4>> drag;
 };
 
 }  // namespace grainflow
