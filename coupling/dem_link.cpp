@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "dem/engine/checkpoint_series.hpp"
 #include "dem/engine/simulation.hpp"
 #include "dem/fluid/coupled_fluid.hpp"
 #include "dem/fluid/fluid_forces.hpp"
@@ -33,6 +34,9 @@ struct DemLink::Impl {
   std::shared_ptr<CoupledFluid> fluid = std::make_shared<CoupledFluid>();
   std::unique_ptr<SnapshotWriter> snapshots;
   std::string snapshot_directory;
+  std::optional<CheckpointData> restart;  // until initialise()
+  long restored_step = -1;                // the checkpoint's DEM step, after a restart
+  std::unique_ptr<CheckpointSeries> checkpoints;
 
   ~Impl() {
     sim.reset();
@@ -131,7 +135,12 @@ void DemLink::initialise() {
     MPI_Comm_dup(m.world, &m.dem_comm);
   }
   try {
-    m.sim = std::make_unique<Simulation>(m.scene, true, m.dem_comm, dims);
+    m.sim = std::make_unique<Simulation>(m.scene, !m.restart, m.dem_comm, dims);
+    if (m.restart) {
+      m.sim->restore(*m.restart);
+      m.restored_step = m.restart->step;
+      m.restart.reset();
+    }
     if (m.grid)
       for (int a = 0; a < 3; ++a)
         if (dims[a] > 1) m.sim->set_cut_planes(a, m.grid->cuts[a]);
@@ -151,8 +160,21 @@ void DemLink::initialise() {
   }
 }
 
+void DemLink::restore(const std::string& checkpoint) {
+  if (!std::filesystem::exists(checkpoint))
+    throw std::runtime_error("the DEM checkpoint '" + checkpoint +
+                             "' does not exist (a coupled run writes one at every write time; "
+                             "was it deleted or moved?)");
+  try {
+    impl_->restart = read_checkpoint(checkpoint);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(e.what());
+  }
+}
+
 double DemLink::time_step() const { return impl_->simulation().dt(); }
 double DemLink::time() const { return impl_->simulation().time(); }
+long DemLink::steps() const { return impl_->simulation().counters().steps; }
 
 ParticleSet DemLink::particles(bool with_ghosts_and_exchange) const {
   const Simulation& sim = impl_->simulation();
@@ -255,14 +277,37 @@ DemSummary DemLink::summary() const {
   return s;
 }
 
-void DemLink::write_snapshot(const std::string& directory, long step) {
+void DemLink::write_snapshot(const std::string& directory, long step, long continue_after) {
   Impl& m = *impl_;
-  if (!m.snapshots || m.snapshot_directory != directory) {
-    prepare_output_directory(directory);
-    m.snapshots = std::make_unique<SnapshotWriter>(m.dem_comm, directory);
-    m.snapshot_directory = directory;
+  try {
+    if (!m.snapshots || m.snapshot_directory != directory) {
+      prepare_output_directory(directory);
+      m.snapshots = std::make_unique<SnapshotWriter>(m.dem_comm, directory);
+      m.snapshot_directory = directory;
+      if (continue_after >= 0) m.snapshots->continue_series(continue_after);
+    }
+    m.snapshots->write(m.simulation().particles(), m.simulation().time(), step);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(e.what());
   }
-  m.snapshots->write(m.simulation().particles(), m.simulation().time(), step);
+}
+
+std::string DemLink::write_checkpoint(const std::string& directory, int keep) {
+  Impl& m = *impl_;
+  try {
+    if (!m.checkpoints) {
+      prepare_output_directory(directory);
+      m.checkpoints =
+          std::make_unique<CheckpointSeries>(m.dem_comm, directory, keep, m.restored_step);
+    }
+    const std::string path = m.checkpoints->write(m.simulation());
+    // The rebuild reordered the particles: the exchange forces of the last step are
+    // stale until the next advance() recomputes them (only deposits read them).
+    m.fluid->exchange_force.clear();
+    return std::filesystem::path(path).filename().string();
+  } catch (const std::exception& e) {
+    throw std::runtime_error(e.what());
+  }
 }
 
 std::vector<std::string> DemLink::reports() const { return impl_->simulation().force_term_reports(); }

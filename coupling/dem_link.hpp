@@ -81,11 +81,15 @@ class DemLink {
   // the DEM then runs on a communicator ordered so that this rank owns exactly the box
   // of its fluid cells. Throws std::runtime_error if the grid does not fit the scene.
   void use_processor_grid(const ProcessorGrid& grid);
-  // Inserts particles, checks the time step, builds lists (collective). Throws
-  // std::runtime_error with the DEM's message.
+  // Continues from a checkpoint instead of inserting the scene's particles (call before
+  // initialise()). Throws std::runtime_error naming the file if it cannot be read.
+  void restore(const std::string& checkpoint);
+  // Inserts particles (or takes the checkpoint's), checks the time step, builds lists
+  // (collective). Throws std::runtime_error with the DEM's message.
   void initialise();
   double time_step() const;  // dt_DEM [s]
   double time() const;
+  long steps() const;  // DEM steps since the start of the run (the checkpoint's count)
 
   ParticleSet particles(bool with_ghosts_and_exchange) const;
 
@@ -103,7 +107,15 @@ class DemLink {
 
   DemSummary summary() const;  // collective
   // Writes a particle snapshot (HDF5 + XDMF index) into `directory` (created if missing).
-  void write_snapshot(const std::string& directory, long step);
+  // After restore(), the first call continues the series there: snapshots with step <=
+  // `continue_after` are kept, later ones (of the stopped run) are overwritten.
+  void write_snapshot(const std::string& directory, long step, long continue_after = -1);
+  // Writes the complete DEM state to <directory>/checkpoint_<DEM step>.h5 and deletes the
+  // oldest beyond `keep` (after restore(), the directory's checkpoints up to the restored
+  // step count as the oldest). Rebuilds the neighbour lists as a restart will, so that a
+  // restarted run continues bit-identically. Returns the file name (without directory).
+  // Collective; throws std::runtime_error if the write fails.
+  std::string write_checkpoint(const std::string& directory, int keep);
   std::vector<std::string> reports() const;  // the force terms' closing remarks
 
  private:

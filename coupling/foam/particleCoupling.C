@@ -1,6 +1,7 @@
 #include "coupling/foam/particleCoupling.H"
 
 #include <algorithm>
+#include <climits>
 #include <chrono>
 #include <cmath>
 #include <mpi.h>
@@ -163,6 +164,32 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
                             "meshes are boxes (decomposeParDict method simple or hierarchical)"
                          << exit(FatalError);
   dem_->use_processor_grid(grid);
+  snapshotDir_ = mesh.time().rootPath() / mesh.time().globalCaseName() / "particles";
+
+  // --- restart: a time that grainFoam wrote names its DEM checkpoint ------------------
+  restartIndex_ = mesh.time().timeIndex();
+  if (restartIndex_ > 0) {
+    const IOdictionary info(IOobject("grainflowCheckpoint", mesh.time().timeName(), "uniform",
+                                     mesh.time(), IOobject::READ_IF_PRESENT,
+                                     IOobject::NO_WRITE, false));
+    if (!info.found("checkpoint"))
+      FatalErrorInFunction
+          << "starting at time " << mesh.time().timeName() << " (time index " << restartIndex_
+          << "), but " << info.objectPath()
+          << " is missing: grainFoam restarts from a time that it wrote itself (at every "
+             "write time it writes the DEM checkpoint particles/checkpoint_<DEM step>.h5 and "
+             "names it there). Start from time 0, or from a time written by grainFoam"
+          << exit(FatalError);
+    const fileName checkpoint = snapshotDir_ / info.get<word>("checkpoint");
+    try {
+      dem_->restore(checkpoint);
+    } catch (const std::exception& e) {
+      FatalErrorInFunction << "restart from time " << mesh.time().timeName() << ":\n"
+                           << e.what() << exit(FatalError);
+    }
+    Info << "grainFoam coupling: restart at time " << mesh.time().timeName() << " (time index "
+         << restartIndex_ << ") from the DEM checkpoint " << checkpoint << endl;
+  }
   try {
     dem_->initialise();
   } catch (const std::exception& e) {
@@ -186,6 +213,16 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
         << std::max(1L, std::lround(std::floor(ratio))) * dtDem << " or "
         << std::max(1L, std::lround(std::ceil(ratio))) * dtDem
         << ", or change the scene's time.step" << exit(FatalIOError);
+  if (restartIndex_ > 0 && (dem_->steps() != restartIndex_ * subSteps_ ||
+                            std::abs(dem_->time() - time.value()) > 1e-6 * dtFluid))
+    FatalErrorInFunction << "the DEM checkpoint is at step " << dem_->steps() << " (t = "
+                         << dem_->time() << " s) but the fluid restarts at time "
+                         << time.timeName() << ", time index " << restartIndex_ << " = DEM step "
+                         << restartIndex_ * subSteps_ << " (" << subSteps_
+                         << " DEM steps per fluid step): the checkpoint belongs to another "
+                            "time, or deltaT or the scene's time step changed"
+                         << exit(FatalError);
+  checkpointKeep_ = time.controlDict().lookupOrDefault<label>("purgeWrite", 0);
 
   // --- cell location: structured fast path when the local mesh is a uniform grid ----
   {
@@ -234,7 +271,6 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
   }
   const label structuredRanks = returnReduce(label(structured_ ? 1 : 0), sumOp<label>());
 
-  snapshotDir_ = time.rootPath() / time.globalCaseName() / "particles";
   Info << "grainFoam coupling: scene " << sceneFile << "\n"
        << "  VANS model " << model_ << ", drag " << dem_->drag_law().c_str()
        << ", void fraction " << coupling::void_fraction_method_name(vf) << " ("
@@ -265,7 +301,43 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
 
   buildFootprints();
   deposit();
+  if (restartIndex_ > 0) continueVoidFraction();
   voidFraction_.oldTime();  // keep old times for ddt(voidfraction)
+}
+
+void ParticleCoupling::continueVoidFraction() {
+  // The uninterrupted run deposited eps at this time before writing the checkpoint, whose
+  // rebuild reorders the particles: the deposit above sums the same volumes in another
+  // order. Where the written field is that deposit to round-off, it is taken as it is, so
+  // that d(eps)/dt of the next step (and everything after) is bit-identical.
+  using namespace Foam;
+  IOobject io("voidfraction", mesh_.time().timeName(), mesh_, IOobject::MUST_READ,
+              IOobject::NO_WRITE, false);
+  if (!io.typeHeaderOk<volScalarField>(true)) {
+    Info << "grainFoam coupling: restart without a written voidfraction field; it is "
+            "rebuilt from the particles (the restart is not bit-identical)"
+         << endl;
+    return;
+  }
+  const volScalarField written(io, mesh_);
+  const scalar difference =
+      gMax(mag(written.primitiveField() - voidFraction_.primitiveField())());
+  if (difference <= 1e-9) {
+    voidFraction_.primitiveFieldRef() = written.primitiveField();
+    voidFraction_.correctBoundaryConditions();
+    Info << "grainFoam coupling: restart void fraction: the written field and the "
+            "particles' deposit differ by "
+         << difference << "; continuing with the written one, as the uninterrupted run does"
+         << endl;
+  } else {
+    WarningInFunction << "the written voidfraction differs from the particles' deposit by "
+                      << difference
+                      << " (fields written with fewer than 17 digits, or another particle "
+                         "state): continuing from the deposit; the restart is not "
+                         "bit-identical. Use writeFormat binary (or writePrecision 17) in "
+                         "system/controlDict for exact restarts"
+                      << endl;
+  }
 }
 
 ParticleCoupling::~ParticleCoupling() = default;
@@ -515,8 +587,27 @@ void ParticleCoupling::evolve() {
 }
 
 void ParticleCoupling::write() {
+  using namespace Foam;
   auto t0 = Clock::now();
-  dem_->write_snapshot(snapshotDir_, mesh_.time().timeIndex());
+  const Time& time = mesh_.time();
+  std::string checkpoint;
+  try {
+    dem_->write_snapshot(snapshotDir_, time.timeIndex(), restartIndex_ > 0 ? restartIndex_ : -1);
+    checkpoint = dem_->write_checkpoint(
+        snapshotDir_, checkpointKeep_ > 0 ? static_cast<int>(checkpointKeep_) : INT_MAX);
+  } catch (const std::exception& e) {
+    FatalErrorInFunction << "\n" << e.what() << exit(FatalError);
+  }
+  // The time directory names its checkpoint (a restart from this time reads it).
+  IOdictionary info(IOobject("grainflowCheckpoint", time.timeName(), "uniform", time,
+                             IOobject::NO_READ, IOobject::NO_WRITE, false));
+  info.add("checkpoint", word(checkpoint));
+  info.add("demStep", label(dem_->steps()));
+  info.add("demTime", dem_->time());
+  info.regIOobject::write();
+  // Writing the checkpoint rebuilt the DEM's lists and reordered its particles: the next
+  // fluid samples must follow the new order.
+  buildFootprints();
   couplingSeconds_ += seconds_since(t0);
   const coupling::DemSummary s = dem_->summary();
   double counts[3] = {double(clampedCells_), clampedVolume_, 0};

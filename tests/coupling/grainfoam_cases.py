@@ -230,8 +230,120 @@ def refuses_bad_setup(runner, checks):
                   "particles.yaml:32 (the density key) and constant/transportProperties")
 
 
+# --- coupling.restart -------------------------------------------------------------------
+
+
+def read_foam_binary_or_ascii(case, folder, name):
+    """The internal field of a written volume field, as raw bytes of its values (binary
+    files) or their text (ascii), so that two runs compare exactly, digit for digit."""
+    with open(os.path.join(case, folder, name), "rb") as f:
+        text = f.read()
+    start = text.index(b"internalField")
+    end = text.index(b"boundaryField")
+    return text[start:end]
+
+
+def restart(runner, checks):
+    """Restart of a coupled run: cases/periodic_box in a flow of (0.05 0.02 0) m/s under
+    10 g, so that the 307 beads rain through the water onto the floor, with over a hundred
+    frictional contacts by the end. 400 fluid steps of 10 DEM steps, written every 200
+    (binary), against 200 steps and a restart from the time written at step 200
+    (startFrom latestTime) for 200 more, in a copy of the stopped run. Reference: the
+    uninterrupted run; on the same rank count every particle's position and velocity at
+    the end and the written U, p, phi and voidfraction must be the same to the last bit
+    (1 and 2 ranks). A restart on another rank count (1-rank checkpoint, decomposePar,
+    2 ranks) cannot be bit-identical (sums in another order, which a colliding bed
+    amplifies), but must continue the same flow: the same beads, the momentum balance to
+    round-off, and the bed's centre of mass within 2 % of the distance it fell."""
+    end_time, half_time = "0.04", "0.02"
+    edits = [("0/U", "internalField   uniform (0 0 0);", "internalField   uniform (0.05 0.02 0);"),
+             ("particles.yaml", "gravity: [0, 0, -9.81]", "gravity: [0, 0, -98.1]"),
+             ("system/controlDict", "endTime         2e-4;", "endTime         4e-2;"),
+             ("system/controlDict", "writeInterval   1;", "writeInterval   200;"),
+             ("system/controlDict", "writeFormat     ascii;", "writeFormat     binary;")]
+    finals = {}
+    for ranks in (1, 2):
+        whole = runner.fresh_case("periodic_box", f"restart_whole_np{ranks}", edits)
+        runner.solve(whole, ranks)
+        # The stopped run: the same case stopped after the first write (as if killed before
+        # the second), then restarted from its latest time.
+        part = runner.fresh_case("periodic_box", f"restart_part_np{ranks}", edits + [
+            ("system/controlDict", "endTime         4e-2;", "endTime         2e-2;")])
+        runner.solve(part, ranks)
+        with open(os.path.join(part, "system", "controlDict")) as f:
+            text = f.read()
+        text = text.replace("endTime         2e-2;", "endTime         4e-2;").replace(
+            "startFrom       startTime;", "startFrom       latestTime;")
+        with open(os.path.join(part, "system", "controlDict"), "w") as f:
+            f.write(text)
+        if ranks == 1:
+            log = runner.run(part, "grainFoam.restart", runner.solver)
+        else:
+            log = runner.run(part, "grainFoam.restart", runner.solver, ranks=ranks)
+            for case in (whole, part):
+                runner.run(case, "reconstructPar.all", "reconstructPar", "-latestTime")
+        checks.expect(f"restart at time {half_time} (time index 200)" in log,
+                      f"np {ranks}: the solver says it restarts at {half_time}, time index 200")
+        contacts = [int(m) for m in re.findall(r"particles, (\d+) contacts", log)]
+        checks.expect(contacts and max(contacts) > 100,
+                      f"np {ranks}: contacts after the restart {contacts} (> 100 at some write)")
+        checks.expect("continuing with the written one, as the uninterrupted run does" in log,
+                      f"np {ranks}: the written void fraction is taken")
+        a, b = snapshots(whole)[-1], snapshots(part)[-1]
+        checks.expect(abs(a[0] - 0.04) < 1e-12 and a[0] == b[0],
+                      f"np {ranks}: last snapshots at t = {a[0]} and {b[0]} s (0.04)")
+        for key in ("id", "position", "velocity"):
+            same = a[1][key].shape == b[1][key].shape and np.array_equal(a[1][key], b[1][key])
+            diff = (float(np.max(np.abs(a[1][key] - b[1][key])))
+                    if a[1][key].shape == b[1][key].shape else float("nan"))
+            checks.expect(same, f"np {ranks}: every particle's {key} equal to the last bit "
+                                f"(max difference {diff:.3g})")
+        moved = float(np.max(np.linalg.norm(a[1]["position"] - snapshots(whole)[0][1]["position"],
+                                            axis=1)))
+        checks.expect(moved > 1e-3, f"np {ranks}: the beads moved (up to {moved:.3g} m > 1 mm)")
+        for field in ("U", "p", "phi", "voidfraction"):
+            same = (read_foam_binary_or_ascii(whole, end_time, field) ==
+                    read_foam_binary_or_ascii(part, end_time, field))
+            checks.expect(same, f"np {ranks}: {field} at t = {end_time} equal byte for byte")
+        finals[ranks] = a[1]
+
+    # Another rank count: the 1-rank checkpoint restarted on 2 ranks.
+    case = runner.fresh_case("periodic_box", "restart_np1_to_np2", edits + [
+        ("system/controlDict", "endTime         4e-2;", "endTime         2e-2;")])
+    runner.solve(case, 1)
+    with open(os.path.join(case, "system", "controlDict")) as f:
+        text = f.read()
+    with open(os.path.join(case, "system", "controlDict"), "w") as f:
+        f.write(text.replace("endTime         2e-2;", "endTime         4e-2;").replace(
+            "startFrom       startTime;", "startFrom       latestTime;"))
+    runner.run(case, "decomposePar", "decomposePar", "-latestTime")
+    log = runner.run(case, "grainFoam.restart", runner.solver, ranks=2)
+    lines = balance_lines(log)
+    checks.expect(len(lines) >= 1 and all(imb < ROUND_OFF for _, _, imb in lines),
+                  f"1 -> 2 ranks: exchange balance to round-off ({len(lines)} lines)")
+    snaps = snapshots(case)
+    last, first = snaps[-1][1], snaps[0][1]
+    ref = finals.get(1)
+    if ref is not None and np.array_equal(ref["id"], last["id"]):
+        fell = float(np.mean(first["position"][:, 2]) - np.mean(ref["position"][:, 2]))
+        off = float(abs(np.mean(last["position"][:, 2]) - np.mean(ref["position"][:, 2])))
+        spread = float(np.max(np.abs(ref["position"] - last["position"])))
+        checks.expect(fell > 1e-3 and off < 0.02 * fell,
+                      f"1 -> 2 ranks: centre of mass {off:.3g} m from the 1-rank run's, < 2 % "
+                      f"of the {fell:.3g} m it fell (largest bead difference {spread:.3g} m)")
+    else:
+        checks.expect(False, "1 -> 2 ranks: the same particles as the 1-rank run")
+
+    # A time whose DEM checkpoint is gone: refused, naming the file.
+    checkpoint = os.path.join(case, "particles", "checkpoint_000002000.h5")
+    os.remove(checkpoint)
+    log = runner.run(case, "grainFoam.missing", runner.solver, expect_failure=True)
+    checks.expect("restart from time 0.02" in log and checkpoint in log,
+                  "a missing DEM checkpoint: refused; the message names the time and the file")
+
+
 TESTS = {f.__name__: f for f in (void_fraction_volume, exchange_balance, neutrally_buoyant,
-                                 refuses_bad_setup)}
+                                 refuses_bad_setup, restart)}
 
 
 if __name__ == "__main__":

@@ -16,6 +16,11 @@
 #       in water at rest, models A and B: after 0.1 s it has moved < 1e-9 m, speed < 1e-8 m/s.
 #   coupling.refuses_bad_setup     processor meshes that are not boxes (2 ranks), deltaT not
 #       a whole number of DEM steps, fluid.density != rho: each stops with its message.
+#   coupling.restart               cases/periodic_box under 10 g in a flow: 400 fluid steps vs
+#       200 + restart (startFrom latestTime) + 200, on 1 and on 2 ranks: every particle and
+#       U, p, phi, voidfraction bit-identical; a 1-rank checkpoint restarted on 2 ranks
+#       continues the same flow (centre of mass within 2 % of its fall); a missing DEM
+#       checkpoint is refused naming the file. About 45 s.
 if(NOT TARGET grainFoam)
   return()
 endif()
@@ -54,3 +59,5 @@ grainflow_coupling_test(void_fraction_volume 2)
 grainflow_coupling_test(exchange_balance 2)
 grainflow_coupling_test(neutrally_buoyant 1)
 grainflow_coupling_test(refuses_bad_setup 2)
+grainflow_coupling_test(restart 2)
+set_tests_properties(coupling.restart PROPERTIES TIMEOUT 240)  # ~45 s on a quiet machine

@@ -141,7 +141,7 @@ def snapshots(case):
     folder = os.path.join(case, "particles")
     out = []
     for name in sorted(os.listdir(folder)):
-        if name.endswith(".h5"):
+        if name.startswith("particles_") and name.endswith(".h5"):  # not the checkpoints
             with h5py.File(os.path.join(folder, name), "r") as f:
                 order = np.argsort(f["id"][:])
                 data = {k: f[k][:][order] for k in ("id", "position", "velocity", "radius")}
