@@ -126,6 +126,11 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   std::ostream& say = speaker(comm, out);
 
   // A restart takes its particles from the checkpoint instead of inserting them.
+  if (options.restart && options.restart->ends_with(".part"))
+    throw OutputError("cannot restart from '" + *options.restart +
+                      "': a .part file is a checkpoint that was being written when its run "
+                      "was killed, possibly incomplete; restart from a complete "
+                      "checkpoint_<step>.h5");
   Simulation sim(scene, !options.restart, comm);
   if (options.restart) sim.restore(read_checkpoint(*options.restart));
   const long first_step = sim.counters().steps;  // 0, or the checkpoint's step
@@ -156,6 +161,10 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   ProgressLine progress(comm, scene.time.end, options.progress && scene.output.progress, out);
   CheckpointSeries checkpoints(comm, dir, scene.output.checkpoint_keep,
                                options.restart ? first_step : -1);
+  for (const std::string& partial : checkpoints.removed_partial())
+    say << "note: deleted the partial checkpoint " << partial
+        << " (left by a run killed while writing it; never a complete checkpoint)\n";
+  if (!checkpoints.warning().empty()) say << checkpoints.warning() << "\n";
   const StopSignals signals(options.handle_stop_signals);
 
   const double dt = sim.dt();
@@ -263,6 +272,15 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
       << " neighbour rebuilds, " << sum.wall_seconds << " s wall, " << sum.particle_steps_per_second
       << " particle-steps/s\n"
       << "output: " << dir << "/particles.xdmf (open in ParaView), " << dir << "/log.csv\n";
+  const StreamInsertion& streams = sim.streams();
+  for (std::size_t k = 0; k < streams.size(); ++k) {
+    sum.streams.push_back({streams.count_inserted(k), streams.mass_inserted(k), streams.lag(k)});
+    say << "stream " << streams.source(k) << ": " << streams.count_inserted(k)
+        << " particles, " << streams.mass_inserted(k) << " kg delivered since t = 0"
+        << (streams.lag(k) > 0 ? ", " + std::to_string(streams.lag(k)) + " behind (face blocked)"
+                               : std::string())
+        << "\n";
+  }
   for (const std::string& line : sim.force_term_reports())
     if (!line.empty()) say << line << "\n";
   return sum;

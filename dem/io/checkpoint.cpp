@@ -6,10 +6,13 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "dem/io/hdf5_errors.hpp"
+
 namespace grainflow {
 namespace {
 
-constexpr const char* kFormat = "grainflow-checkpoint-1";
+// Format 2 added the group 'streams'; format 1 files are read (without it).
+constexpr const char* kFormat = "grainflow-checkpoint-2";
 
 // Packs per-particle and per-spring records into doubles (ids bit-exact).
 std::vector<double> pack(const CheckpointData& d) {
@@ -98,27 +101,43 @@ bool write_attribute(hid_t loc, const char* name, hid_t type, const T& value) {
   return ok;
 }
 
+// Records the first failure with HDF5's reason, read at once: every later HDF5 call (closing the
+// file included) starts a new error stack.
+class FirstFailure {
+ public:
+  bool check(bool ok, const std::string& what) {
+    if (!ok && error_.empty()) error_ = what + " failed: " + hdf5_reason();
+    return ok;
+  }
+  bool ok() const { return error_.empty(); }
+  const std::string& error() const { return error_; }
+
+ private:
+  std::string error_;
+};
+
 std::string write_file(const std::string& path, const CheckpointData& d) {
   const Particles& p = d.particles;
   const std::size_t n = p.size(), m = d.springs.size();
+  FirstFailure fail;
   File f(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT));
-  if (f.id() < 0) return "cannot create the file";
+  if (!fail.check(f.id() >= 0, "creating '" + path + "'")) return fail.error();
   const hid_t str = H5Tcopy(H5T_C_S1);
   H5Tset_size(str, std::char_traits<char>::length(kFormat));
-  bool ok = true;
   {
     const hid_t space = H5Screate(H5S_SCALAR);
     const hid_t attr = H5Acreate2(f.id(), "format", str, space, H5P_DEFAULT, H5P_DEFAULT);
-    ok = ok && attr >= 0 && H5Awrite(attr, str, kFormat) >= 0;
+    fail.check(attr >= 0 && H5Awrite(attr, str, kFormat) >= 0, "writing the attribute 'format'");
     if (attr >= 0) H5Aclose(attr);
     H5Sclose(space);
   }
   H5Tclose(str);
   const long long step = d.step, next = d.next_id;
-  ok = ok && write_attribute(f.id(), "time", H5T_NATIVE_DOUBLE, d.time) &&
-       write_attribute(f.id(), "dt", H5T_NATIVE_DOUBLE, d.dt) &&
-       write_attribute(f.id(), "step", H5T_NATIVE_LLONG, step) &&
-       write_attribute(f.id(), "next_id", H5T_NATIVE_LLONG, next);
+  fail.check(fail.ok() && write_attribute(f.id(), "time", H5T_NATIVE_DOUBLE, d.time) &&
+                 write_attribute(f.id(), "dt", H5T_NATIVE_DOUBLE, d.dt) &&
+                 write_attribute(f.id(), "step", H5T_NATIVE_LLONG, step) &&
+                 write_attribute(f.id(), "next_id", H5T_NATIVE_LLONG, next),
+             "writing the attributes time, dt, step, next_id");
   std::vector<long long> ids(p.id.begin(), p.id.end());
   std::vector<int> mats(p.material.begin(), p.material.end());
   auto flat = [](const std::vector<Vec3>& v) {
@@ -127,18 +146,22 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
     for (const Vec3& x : v) out.insert(out.end(), {x[0], x[1], x[2]});
     return out;
   };
-  const hid_t g = H5Gcreate2(f.id(), "particles", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-  ok = ok && g >= 0 && write_array(g, "id", H5T_NATIVE_LLONG, n, 1, ids.data()) &&
-       write_array(g, "position", H5T_NATIVE_DOUBLE, n, 3, flat(p.x).data()) &&
-       write_array(g, "velocity", H5T_NATIVE_DOUBLE, n, 3, flat(p.v).data()) &&
-       write_array(g, "angular_velocity", H5T_NATIVE_DOUBLE, n, 3, flat(p.omega).data()) &&
-       write_array(g, "force", H5T_NATIVE_DOUBLE, n, 3, flat(p.force).data()) &&
-       write_array(g, "torque", H5T_NATIVE_DOUBLE, n, 3, flat(p.torque).data()) &&
-       write_array(g, "radius", H5T_NATIVE_DOUBLE, n, 1, p.radius.data()) &&
-       write_array(g, "mass", H5T_NATIVE_DOUBLE, n, 1, p.mass.data()) &&
-       write_array(g, "inertia", H5T_NATIVE_DOUBLE, n, 1, p.inertia.data()) &&
-       write_array(g, "material", H5T_NATIVE_INT, n, 1, mats.data());
-  if (g >= 0) H5Gclose(g);
+  if (fail.ok()) {
+    const hid_t g = H5Gcreate2(f.id(), "particles", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    fail.check(g >= 0 && write_array(g, "id", H5T_NATIVE_LLONG, n, 1, ids.data()) &&
+                   write_array(g, "position", H5T_NATIVE_DOUBLE, n, 3, flat(p.x).data()) &&
+                   write_array(g, "velocity", H5T_NATIVE_DOUBLE, n, 3, flat(p.v).data()) &&
+                   write_array(g, "angular_velocity", H5T_NATIVE_DOUBLE, n, 3,
+                               flat(p.omega).data()) &&
+                   write_array(g, "force", H5T_NATIVE_DOUBLE, n, 3, flat(p.force).data()) &&
+                   write_array(g, "torque", H5T_NATIVE_DOUBLE, n, 3, flat(p.torque).data()) &&
+                   write_array(g, "radius", H5T_NATIVE_DOUBLE, n, 1, p.radius.data()) &&
+                   write_array(g, "mass", H5T_NATIVE_DOUBLE, n, 1, p.mass.data()) &&
+                   write_array(g, "inertia", H5T_NATIVE_DOUBLE, n, 1, p.inertia.data()) &&
+                   write_array(g, "material", H5T_NATIVE_INT, n, 1, mats.data()),
+               "writing the group 'particles'");
+    if (g >= 0) H5Gclose(g);
+  }
   std::vector<long long> a(m), b(m);
   std::vector<Vec3> t(m), r(m);
   for (std::size_t k = 0; k < m; ++k) {
@@ -147,14 +170,25 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
     t[k] = d.springs[k].tangential;
     r[k] = d.springs[k].rolling;
   }
-  const hid_t s = H5Gcreate2(f.id(), "springs", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-  ok = ok && s >= 0 && write_array(s, "particle", H5T_NATIVE_LLONG, m, 1, a.data()) &&
-       write_array(s, "partner", H5T_NATIVE_LLONG, m, 1, b.data()) &&
-       write_array(s, "tangential", H5T_NATIVE_DOUBLE, m, 3, flat(t).data()) &&
-       write_array(s, "rolling", H5T_NATIVE_DOUBLE, m, 3, flat(r).data());
-  if (s >= 0) H5Gclose(s);
-  ok = f.close() && ok;
-  return ok ? "" : "an HDF5 write failed (disk full or quota?)";
+  if (fail.ok()) {
+    const hid_t s = H5Gcreate2(f.id(), "springs", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    fail.check(s >= 0 && write_array(s, "particle", H5T_NATIVE_LLONG, m, 1, a.data()) &&
+                   write_array(s, "partner", H5T_NATIVE_LLONG, m, 1, b.data()) &&
+                   write_array(s, "tangential", H5T_NATIVE_DOUBLE, m, 3, flat(t).data()) &&
+                   write_array(s, "rolling", H5T_NATIVE_DOUBLE, m, 3, flat(r).data()),
+               "writing the group 'springs'");
+    if (s >= 0) H5Gclose(s);
+  }
+  if (fail.ok() && d.streams) {
+    const hid_t s = H5Gcreate2(f.id(), "streams", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    fail.check(s >= 0 && write_array(s, "state", H5T_NATIVE_UCHAR, d.streams->size(), 1,
+                                     d.streams->data()),
+               "writing the group 'streams'");
+    if (s >= 0) H5Gclose(s);
+  }
+  // Closing flushes HDF5's metadata cache: on a full disk this is often where it fails.
+  fail.check(f.close(), "closing (flushing) the file");
+  return fail.error();
 }
 
 template <class T>
@@ -214,14 +248,13 @@ void write_checkpoint(MPI_Comm comm, const std::string& path, const CheckpointDa
     d.dt = local.dt;
     d.step = local.step;
     d.next_id = local.next_id;
+    d.streams = local.streams;
     for (int r = 0; r < size; ++r) unpack(all.data() + displs[r], counts[r], d);
     const std::string part = path + ".part";
-    H5E_auto2_t old_func;
-    void* old_data;
-    H5Eget_auto2(H5E_DEFAULT, &old_func, &old_data);
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-    error = write_file(part, d);
-    H5Eset_auto2(H5E_DEFAULT, old_func, old_data);
+    {
+      const QuietHdf5Errors quiet;
+      error = write_file(part, d);
+    }
     std::error_code ec;
     if (error.empty()) std::filesystem::rename(part, path, ec);
     if (error.empty() && ec) error = "cannot rename " + part + ": " + ec.message();
@@ -233,7 +266,7 @@ void write_checkpoint(MPI_Comm comm, const std::string& path, const CheckpointDa
   MPI_Bcast(error.data(), length, MPI_CHAR, 0, comm);
   if (!error.empty())
     throw OutputError("cannot write checkpoint '" + path + "': " + error +
-                      "; the previous checkpoint, if any, is untouched");
+                      "; its partial file was deleted and no earlier checkpoint was touched");
 }
 
 CheckpointData read_checkpoint(const std::string& path) {
@@ -282,6 +315,13 @@ CheckpointData read_checkpoint(const std::string& path) {
     const auto t = read_array<double>(s, "tangential", H5T_NATIVE_DOUBLE, 3, m, error);
     const auto ro = read_array<double>(s, "rolling", H5T_NATIVE_DOUBLE, 3, m, error);
     if (s >= 0) H5Gclose(s);
+    if (error.empty() && H5Lexists(f, "streams", H5P_DEFAULT) > 0) {
+      const hid_t st = H5Gopen2(f, "streams", H5P_DEFAULT);
+      std::size_t length = static_cast<std::size_t>(-1);
+      const auto text = read_array<unsigned char>(st, "state", H5T_NATIVE_UCHAR, 1, length, error);
+      if (st >= 0) H5Gclose(st);
+      if (error.empty()) d.streams = std::string(text.begin(), text.end());
+    }
     H5Fclose(f);
     if (error.empty()) {
       for (std::size_t i = 0; i < n; ++i) {
@@ -299,6 +339,7 @@ CheckpointData read_checkpoint(const std::string& path) {
   }
   H5Eset_auto2(H5E_DEFAULT, old_func, old_data);
   if (!error.empty()) throw OutputError("cannot read checkpoint '" + path + "': " + error);
+  d.file = path;
   return d;
 }
 

@@ -7,13 +7,17 @@
 // leaves a truncated checkpoint under the final name. read_checkpoint lets every
 // rank read the whole file; the engine then keeps what each rank owns.
 //
-// Layout: attributes format ("grainflow-checkpoint-1"), time, dt, step, next_id;
+// Layout: attributes format ("grainflow-checkpoint-2"), time, dt, step, next_id;
 // /particles/{id, position, velocity, angular_velocity, force, torque, radius, mass,
 // inertia, material} — force and torque are those of the step's end, which the next
 // velocity-Verlet half kick uses (recomputing them would advance the springs twice); /springs/{particle, partner, tangential, rolling}, where a wall spring
-// has partner = -1 - wall index. A pair's spring may be listed once per partner.
+// has partner = -1 - wall index. A pair's spring may be listed once per partner;
+// /streams/state (uint8 text, StreamInsertion::save_state(): the stream insertions'
+// delivered totals, radii drawn but not placed and generator states). Format 1 files
+// (before stream state was saved) have no /streams group.
 #include <mpi.h>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,6 +40,10 @@ struct CheckpointData {
   GlobalId next_id = 1;
   Particles particles;
   std::vector<CheckpointSpring> springs;
+  // The stream insertions' progress (taken from rank 0 when writing); absent in a format 1
+  // file, which cannot continue a scene with streams.
+  std::optional<std::string> streams;
+  std::string file;  // set by read_checkpoint: where it came from, for messages
 };
 
 // Collective. `local` holds this rank's particles and springs; time, dt, step and

@@ -10,53 +10,12 @@
 #include <string_view>
 #include <utility>
 
+#include "dem/io/hdf5_errors.hpp"
 #include "grainflow_version.hpp"
 
 namespace grainflow {
 
 namespace {
-
-// HDF5 prints its whole error stack to stderr by default; we turn errors into OutputError
-// instead. The previous handler is restored afterwards so other HDF5 users are unaffected.
-class QuietHdf5Errors {
- public:
-  QuietHdf5Errors() {
-    H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  }
-  ~QuietHdf5Errors() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
-  QuietHdf5Errors(const QuietHdf5Errors&) = delete;
-  QuietHdf5Errors& operator=(const QuietHdf5Errors&) = delete;
-
- private:
-  H5E_auto2_t func_ = nullptr;
-  void* data_ = nullptr;
-};
-
-struct ErrorRecord {
-  std::string function;
-  std::string description;
-};
-
-herr_t collect_error(unsigned /*n*/, const H5E_error2_t* err, void* out) {
-  static_cast<std::vector<ErrorRecord>*>(out)->push_back(
-      {err->func_name ? err->func_name : "?", err->desc ? err->desc : ""});
-  return 0;
-}
-
-// The HDF5 error stack in one line: the most specific cause (deepest entry, e.g. the MPI-IO or
-// OS error) and the API call it surfaced in; the stack is cleared.
-std::string hdf5_reason() {
-  std::vector<ErrorRecord> stack;
-  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, collect_error, &stack);
-  H5Eclear2(H5E_DEFAULT);
-  if (stack.empty()) return "HDF5 reported no reason";
-  const ErrorRecord& cause = stack.front();
-  const ErrorRecord& api = stack.back();
-  std::string out = cause.description;
-  if (stack.size() > 1) out += " (in " + api.function + ": " + api.description + ")";
-  return out;
-}
 
 // Owns one HDF5 identifier and closes it on scope exit.
 class Hid {
