@@ -65,14 +65,7 @@ CheckpointSeries::CheckpointSeries(MPI_Comm comm, std::string directory, int kee
 
 std::string CheckpointSeries::write(Simulation& sim) {
   const std::string path = (fs::path(directory_) / file_name(sim.counters().steps)).string();
-  try {
-    sim.write_checkpoint(path);  // <path>.part, then renamed: complete before anything is deleted
-  } catch (const OutputError& e) {
-    throw OutputError(std::string(e.what()) +
-                      (newest_.empty() ? std::string("; this run has no earlier checkpoint")
-                                       : "; the newest complete checkpoint is '" + newest_ +
-                                             "': free space and continue from it with --restart"));
-  }
+  sim.write_checkpoint(path);  // <path>.part, then renamed: complete before anything is deleted
   newest_ = path;
   warning_.clear();
   if (rank_ == 0) {
@@ -87,6 +80,12 @@ std::string CheckpointSeries::write(Simulation& sim) {
     }
   }
   return path;
+}
+
+std::string CheckpointSeries::resume_hint(const std::string& run_command) const {
+  if (newest_.empty()) return "No complete checkpoint of this run exists yet.";
+  return "The newest complete checkpoint is '" + newest_ + "' (untouched); free space and " +
+         "continue with: " + run_command + " --restart " + newest_;
 }
 
 }  // namespace grainflow

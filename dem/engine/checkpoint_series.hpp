@@ -32,6 +32,9 @@ class CheckpointSeries {
   const std::vector<std::string>& removed_partial() const { return removed_partial_; }
   // The newest complete checkpoint of the series ("" when none), on every rank.
   const std::string& newest() const { return newest_; }
+  // For a failed output write: how to continue ("The newest complete checkpoint is ...; ...
+  // continue with: <run_command> --restart <it>").
+  std::string resume_hint(const std::string& run_command) const;
 
  private:
   MPI_Comm comm_;

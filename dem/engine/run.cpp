@@ -176,11 +176,24 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
   long removed_reported = 0;
+  // A failed output write (full disk, lost mount) stops the run on every rank; the message
+  // names the checkpoint to continue from.
+  const std::string rerun = "grain run " + scene.file +
+                            (options.output_directory ? " --output " + dir : std::string());
+  auto resumable = [&](const OutputError& e) {
+    std::string message = e.what();
+    if (!message.ends_with('.')) message += '.';
+    return OutputError(message + " " + checkpoints.resume_hint(rerun));
+  };
   auto write_log = [&] {
     const GlobalState g = sim.global_state();
-    log.write({sim.time(), sim.counters().steps, g.particles, g.kinetic_translational,
-               g.kinetic_rotational, g.max_overlap_ratio, g.contacts, sim.counters().rebuilds,
-               g.removed, wall()});
+    try {
+      log.write({sim.time(), sim.counters().steps, g.particles, g.kinetic_translational,
+                 g.kinetic_rotational, g.max_overlap_ratio, g.contacts, sim.counters().rebuilds,
+                 g.removed, wall()});
+    } catch (const OutputError& e) {
+      throw resumable(e);
+    }
     // Removals are reported once per log interval, not per particle.
     if (g.removed > removed_reported) {
       say << "warning: t = " << sim.time() << " s: " << g.removed - removed_reported
@@ -191,9 +204,20 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     return g;
   };
   auto write_checkpoint = [&] {
-    const std::string path = checkpoints.write(sim);
-    if (!checkpoints.warning().empty()) say << checkpoints.warning() << "\n";
-    return path;
+    try {
+      const std::string path = checkpoints.write(sim);
+      if (!checkpoints.warning().empty()) say << checkpoints.warning() << "\n";
+      return path;
+    } catch (const OutputError& e) {
+      throw resumable(e);
+    }
+  };
+  auto write_snapshot = [&](double t, long k) {
+    try {
+      snapshots.write(sim.particles(), t, k);
+    } catch (const OutputError& e) {
+      throw resumable(e);
+    }
   };
 
   RunSummary sum;
@@ -207,7 +231,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   long check_index = written(check_every);
   long snap_step = first_step, log_step = first_step;  // last step written
   if (!options.restart) {
-    snapshots.write(sim.particles(), sim.time(), 0);
+    write_snapshot(sim.time(), 0);
     sum.particles_start = write_log().particles;
   } else {
     sum.particles_start = sim.global_state().particles;
@@ -232,7 +256,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     if (t >= (snap_index + 1) * snap_every - 0.5 * dt || (last && snap_step != k)) {
       snap_step = k;
       snap_index = static_cast<long>(std::floor(t / snap_every + 0.5));
-      snapshots.write(sim.particles(), t, k);
+      write_snapshot(t, k);
     }
     if (check_every > 0 && !last && t >= (check_index + 1) * check_every - 0.5 * dt) {
       check_index = static_cast<long>(std::floor(t / check_every + 0.5));

@@ -80,41 +80,51 @@ class File {
   hid_t id_;
 };
 
-bool write_array(hid_t loc, const char* name, hid_t type, std::size_t rows, std::size_t cols,
-                 const void* data) {
-  const hsize_t dims[2] = {rows, cols};
-  const hid_t space = H5Screate_simple(cols > 1 ? 2 : 1, dims, nullptr);
-  const hid_t set = H5Dcreate2(loc, name, type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-  bool ok = set >= 0 && (rows == 0 || H5Dwrite(set, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) >= 0);
-  if (set >= 0) H5Dclose(set);
-  H5Sclose(space);
-  return ok;
-}
-
-template <class T>
-bool write_attribute(hid_t loc, const char* name, hid_t type, const T& value) {
-  const hid_t space = H5Screate(H5S_SCALAR);
-  const hid_t attr = H5Acreate2(loc, name, type, space, H5P_DEFAULT, H5P_DEFAULT);
-  const bool ok = attr >= 0 && H5Awrite(attr, type, &value) >= 0;
-  if (attr >= 0) H5Aclose(attr);
-  H5Sclose(space);
-  return ok;
-}
-
-// Records the first failure with HDF5's reason, read at once: every later HDF5 call (closing the
-// file included) starts a new error stack.
+// The first failure of a file write, with HDF5's reason. That reason must be read right after
+// the failing call: every later HDF5 call (closing a dataset included) starts a new error stack.
 class FirstFailure {
  public:
+  // Right after a failed HDF5 call, before any other.
+  void capture() {
+    if (reason_.empty()) reason_ = hdf5_reason();
+  }
   bool check(bool ok, const std::string& what) {
-    if (!ok && error_.empty()) error_ = what + " failed: " + hdf5_reason();
+    if (!ok && error_.empty()) {
+      capture();
+      error_ = what + " failed: " + reason_;
+    }
     return ok;
   }
   bool ok() const { return error_.empty(); }
   const std::string& error() const { return error_; }
 
  private:
+  std::string reason_;
   std::string error_;
 };
+
+bool write_array(FirstFailure& fail, hid_t loc, const char* name, hid_t type, std::size_t rows,
+                 std::size_t cols, const void* data) {
+  const hsize_t dims[2] = {rows, cols};
+  const hid_t space = H5Screate_simple(cols > 1 ? 2 : 1, dims, nullptr);
+  const hid_t set = H5Dcreate2(loc, name, type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  bool ok = set >= 0 && (rows == 0 || H5Dwrite(set, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) >= 0);
+  if (!ok) fail.capture();
+  if (set >= 0) H5Dclose(set);
+  H5Sclose(space);
+  return ok;
+}
+
+template <class T>
+bool write_attribute(FirstFailure& fail, hid_t loc, const char* name, hid_t type, const T& value) {
+  const hid_t space = H5Screate(H5S_SCALAR);
+  const hid_t attr = H5Acreate2(loc, name, type, space, H5P_DEFAULT, H5P_DEFAULT);
+  const bool ok = attr >= 0 && H5Awrite(attr, type, &value) >= 0;
+  if (!ok) fail.capture();
+  if (attr >= 0) H5Aclose(attr);
+  H5Sclose(space);
+  return ok;
+}
 
 std::string write_file(const std::string& path, const CheckpointData& d) {
   const Particles& p = d.particles;
@@ -127,16 +137,18 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
   {
     const hid_t space = H5Screate(H5S_SCALAR);
     const hid_t attr = H5Acreate2(f.id(), "format", str, space, H5P_DEFAULT, H5P_DEFAULT);
-    fail.check(attr >= 0 && H5Awrite(attr, str, kFormat) >= 0, "writing the attribute 'format'");
+    const bool written = attr >= 0 && H5Awrite(attr, str, kFormat) >= 0;
+    if (!written) fail.capture();
     if (attr >= 0) H5Aclose(attr);
+    fail.check(written, "writing the attribute 'format'");
     H5Sclose(space);
   }
   H5Tclose(str);
   const long long step = d.step, next = d.next_id;
-  fail.check(fail.ok() && write_attribute(f.id(), "time", H5T_NATIVE_DOUBLE, d.time) &&
-                 write_attribute(f.id(), "dt", H5T_NATIVE_DOUBLE, d.dt) &&
-                 write_attribute(f.id(), "step", H5T_NATIVE_LLONG, step) &&
-                 write_attribute(f.id(), "next_id", H5T_NATIVE_LLONG, next),
+  fail.check(fail.ok() && write_attribute(fail, f.id(), "time", H5T_NATIVE_DOUBLE, d.time) &&
+                 write_attribute(fail, f.id(), "dt", H5T_NATIVE_DOUBLE, d.dt) &&
+                 write_attribute(fail, f.id(), "step", H5T_NATIVE_LLONG, step) &&
+                 write_attribute(fail, f.id(), "next_id", H5T_NATIVE_LLONG, next),
              "writing the attributes time, dt, step, next_id");
   std::vector<long long> ids(p.id.begin(), p.id.end());
   std::vector<int> mats(p.material.begin(), p.material.end());
@@ -148,17 +160,17 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
   };
   if (fail.ok()) {
     const hid_t g = H5Gcreate2(f.id(), "particles", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    fail.check(g >= 0 && write_array(g, "id", H5T_NATIVE_LLONG, n, 1, ids.data()) &&
-                   write_array(g, "position", H5T_NATIVE_DOUBLE, n, 3, flat(p.x).data()) &&
-                   write_array(g, "velocity", H5T_NATIVE_DOUBLE, n, 3, flat(p.v).data()) &&
-                   write_array(g, "angular_velocity", H5T_NATIVE_DOUBLE, n, 3,
+    fail.check(g >= 0 && write_array(fail, g, "id", H5T_NATIVE_LLONG, n, 1, ids.data()) &&
+                   write_array(fail, g, "position", H5T_NATIVE_DOUBLE, n, 3, flat(p.x).data()) &&
+                   write_array(fail, g, "velocity", H5T_NATIVE_DOUBLE, n, 3, flat(p.v).data()) &&
+                   write_array(fail, g, "angular_velocity", H5T_NATIVE_DOUBLE, n, 3,
                                flat(p.omega).data()) &&
-                   write_array(g, "force", H5T_NATIVE_DOUBLE, n, 3, flat(p.force).data()) &&
-                   write_array(g, "torque", H5T_NATIVE_DOUBLE, n, 3, flat(p.torque).data()) &&
-                   write_array(g, "radius", H5T_NATIVE_DOUBLE, n, 1, p.radius.data()) &&
-                   write_array(g, "mass", H5T_NATIVE_DOUBLE, n, 1, p.mass.data()) &&
-                   write_array(g, "inertia", H5T_NATIVE_DOUBLE, n, 1, p.inertia.data()) &&
-                   write_array(g, "material", H5T_NATIVE_INT, n, 1, mats.data()),
+                   write_array(fail, g, "force", H5T_NATIVE_DOUBLE, n, 3, flat(p.force).data()) &&
+                   write_array(fail, g, "torque", H5T_NATIVE_DOUBLE, n, 3, flat(p.torque).data()) &&
+                   write_array(fail, g, "radius", H5T_NATIVE_DOUBLE, n, 1, p.radius.data()) &&
+                   write_array(fail, g, "mass", H5T_NATIVE_DOUBLE, n, 1, p.mass.data()) &&
+                   write_array(fail, g, "inertia", H5T_NATIVE_DOUBLE, n, 1, p.inertia.data()) &&
+                   write_array(fail, g, "material", H5T_NATIVE_INT, n, 1, mats.data()),
                "writing the group 'particles'");
     if (g >= 0) H5Gclose(g);
   }
@@ -172,16 +184,16 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
   }
   if (fail.ok()) {
     const hid_t s = H5Gcreate2(f.id(), "springs", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    fail.check(s >= 0 && write_array(s, "particle", H5T_NATIVE_LLONG, m, 1, a.data()) &&
-                   write_array(s, "partner", H5T_NATIVE_LLONG, m, 1, b.data()) &&
-                   write_array(s, "tangential", H5T_NATIVE_DOUBLE, m, 3, flat(t).data()) &&
-                   write_array(s, "rolling", H5T_NATIVE_DOUBLE, m, 3, flat(r).data()),
+    fail.check(s >= 0 && write_array(fail, s, "particle", H5T_NATIVE_LLONG, m, 1, a.data()) &&
+                   write_array(fail, s, "partner", H5T_NATIVE_LLONG, m, 1, b.data()) &&
+                   write_array(fail, s, "tangential", H5T_NATIVE_DOUBLE, m, 3, flat(t).data()) &&
+                   write_array(fail, s, "rolling", H5T_NATIVE_DOUBLE, m, 3, flat(r).data()),
                "writing the group 'springs'");
     if (s >= 0) H5Gclose(s);
   }
   if (fail.ok() && d.streams) {
     const hid_t s = H5Gcreate2(f.id(), "streams", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    fail.check(s >= 0 && write_array(s, "state", H5T_NATIVE_UCHAR, d.streams->size(), 1,
+    fail.check(s >= 0 && write_array(fail, s, "state", H5T_NATIVE_UCHAR, d.streams->size(), 1,
                                      d.streams->data()),
                "writing the group 'streams'");
     if (s >= 0) H5Gclose(s);

@@ -34,9 +34,11 @@ std::string hdf5_reason() {
   const ErrorRecord& cause = stack.front();
   const ErrorRecord& api = stack.back();
   std::string out = cause.description;
+  // The POSIX driver's description is long (time, file descriptor, buffer address, sizes):
+  // its error number says it all.
   for (const ErrorRecord& e : stack)
     if (const int err = errno_in(e.description); err != 0) {
-      out = std::string(std::strerror(err)) + " (" + cause.description + ")";
+      out = std::strerror(err);
       break;
     }
   if (stack.size() > 1) out += " (in " + api.function + ": " + api.description + ")";

@@ -26,8 +26,8 @@ class QuietHdf5Errors {
 
 // The current HDF5 error stack in one line, then clears it: the most specific cause (deepest
 // entry, e.g. the OS or MPI-IO error) and the API call it surfaced in. When the cause carries
-// an operating-system error number (HDF5's POSIX driver writes "errno = 28, ..."), the line
-// starts with that error's text, e.g. "No space left on device".
+// an operating-system error number (HDF5's POSIX driver writes "errno = 28, ..."), that
+// error's text replaces it, e.g. "No space left on device".
 std::string hdf5_reason();
 
 }  // namespace grainflow
