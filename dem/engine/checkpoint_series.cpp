@@ -23,7 +23,8 @@ namespace {
 // The step of `name` if it is `checkpoint_<9 digits>.h5` followed by `suffix`, else -1.
 long step_of(const std::string& name, const std::string& suffix) {
   const std::string plain = CheckpointSeries::file_name(0);
-  if (name.size() != plain.size() + suffix.size() || name.compare(plain.size(), suffix.size(), suffix) != 0)
+  if (name.size() != plain.size() + suffix.size() ||
+      name.compare(plain.size(), suffix.size(), suffix) != 0)
     return -1;
   long step = -1;
   int used = 0;

@@ -178,8 +178,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   long removed_reported = 0;
   // A failed output write (full disk, lost mount) stops the run on every rank; the message
   // names the checkpoint to continue from.
-  const std::string rerun = "grain run " + scene.file +
-                            (options.output_directory ? " --output " + dir : std::string());
+  const std::string rerun =
+      "grain run " + scene.file + (options.output_directory ? " --output " + dir : std::string());
   auto resumable = [&](const OutputError& e) {
     std::string message = e.what();
     if (!message.ends_with('.')) message += '.';
@@ -299,8 +299,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   const StreamInsertion& streams = sim.streams();
   for (std::size_t k = 0; k < streams.size(); ++k) {
     sum.streams.push_back({streams.count_inserted(k), streams.mass_inserted(k), streams.lag(k)});
-    say << "stream " << streams.source(k) << ": " << streams.count_inserted(k)
-        << " particles, " << streams.mass_inserted(k) << " kg delivered since t = 0"
+    say << "stream " << streams.source(k) << ": " << streams.count_inserted(k) << " particles, "
+        << streams.mass_inserted(k) << " kg delivered since t = 0"
         << (streams.lag(k) > 0 ? ", " + std::to_string(streams.lag(k)) + " behind (face blocked)"
                                : std::string())
         << "\n";

@@ -253,8 +253,8 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step) {
   // Data plus a few kB of HDF5 metadata (measured: 4000 particles take 436 096 bytes).
   std::uintmax_t bytes_per_particle = 0;
   for (const SnapshotField& f : snapshot_fields)
-    bytes_per_particle += static_cast<std::uintmax_t>(f.components) *
-                          (f.type == SnapshotField::Type::Int32 ? 4 : 8);
+    bytes_per_particle +=
+        static_cast<std::uintmax_t>(f.components) * (f.type == SnapshotField::Type::Int32 ? 4 : 8);
   Agreement agreement(comm_, rank_, size_, path,
                       bytes_per_particle * static_cast<std::uintmax_t>(total) + 4096);
   try {

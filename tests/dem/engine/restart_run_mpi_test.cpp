@@ -158,8 +158,8 @@ long expect_same_end(const TwoRuns& r) {
   std::printf(
       "restart vs uninterrupted after %ld steps (checkpoint at %ld): %zu particles, |dx| %.3g m "
       "(%.3g rel), |dv| %.3g m/s (%.3g rel), |dw| %.3g rad/s (%.3g rel), |dr| %.3g m\n",
-      r.whole_run.steps, r.checkpoint_step, sa.particles.size(), dx, dx / 0.015, dv, dv / vmax,
-      dw, dw / wmax, dr);
+      r.whole_run.steps, r.checkpoint_step, sa.particles.size(), dx, dx / 0.015, dv, dv / vmax, dw,
+      dw / wmax, dr);
   EXPECT_EQ(dx, 0.0);
   EXPECT_EQ(dv, 0.0);
   EXPECT_EQ(dw, 0.0);
@@ -178,7 +178,8 @@ TEST(RestartRun, ContinuesLikeTheUninterruptedRun) {
   scene.output.checkpoint_keep = 1;
   const TwoRuns r = run_and_restart(scene, kWork / "bed");
   if (rank() != 0 || r.checkpoint.empty()) return;
-  EXPECT_GT(expect_same_end(r), 100) << "too few contacts after the checkpoint: the test shows little";
+  EXPECT_GT(expect_same_end(r), 100)
+      << "too few contacts after the checkpoint: the test shows little";
 }
 
 // stream_bed.yaml: 0.025 kg/s of beads (radius 0.4-0.6 mm) from t = 0.002 s to 0.03 s onto a
@@ -199,10 +200,10 @@ TEST(RestartRun, StreamInsertionContinuesLikeTheUninterruptedRun) {
   ASSERT_EQ(r.restarted_run.streams.size(), 1u);
   const RunSummary::StreamTotal a = r.whole_run.streams[0], b = r.restarted_run.streams[0];
   if (rank() == 0)
-    std::printf("stream: %ld particles at the checkpoint (t = %.4g s), %ld at the end; "
-                "delivered %ld / %ld particles, %.9g / %.9g kg (uninterrupted / restarted)\n",
-                at_checkpoint, c.time, r.whole_run.particles_end, a.count, b.count, a.mass,
-                b.mass);
+    std::printf(
+        "stream: %ld particles at the checkpoint (t = %.4g s), %ld at the end; "
+        "delivered %ld / %ld particles, %.9g / %.9g kg (uninterrupted / restarted)\n",
+        at_checkpoint, c.time, r.whole_run.particles_end, a.count, b.count, a.mass, b.mass);
   EXPECT_GT(at_checkpoint, 100);
   EXPECT_GT(r.whole_run.particles_end, at_checkpoint + 100);
   EXPECT_EQ(b.count, a.count);
@@ -216,9 +217,10 @@ TEST(RestartRun, StreamInsertionContinuesLikeTheUninterruptedRun) {
   const double r_max = stream.radius.max;
   const double half_bead = 0.5 * 2500 * 4.0 / 3.0 * std::numbers::pi * r_max * r_max * r_max;
   if (rank() == 0)
-    std::printf("stream: delivered %.9g kg, rate x time = %.9g kg, difference %.3g kg (half the "
-                "heaviest bead: %.3g kg)\n",
-                b.mass, target, b.mass - target, half_bead);
+    std::printf(
+        "stream: delivered %.9g kg, rate x time = %.9g kg, difference %.3g kg (half the "
+        "heaviest bead: %.3g kg)\n",
+        b.mass, target, b.mass - target, half_bead);
   EXPECT_LE(std::abs(b.mass - target), half_bead);
 
   if (rank() == 0) {
