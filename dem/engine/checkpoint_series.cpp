@@ -18,29 +18,56 @@ std::string CheckpointSeries::file_name(long step) {
   return buf;
 }
 
+namespace {
+
+// The step of `name` if it is `checkpoint_<9 digits>.h5` followed by `suffix`, else -1.
+long step_of(const std::string& name, const std::string& suffix) {
+  const std::string plain = CheckpointSeries::file_name(0);
+  if (name.size() != plain.size() + suffix.size() ||
+      name.compare(plain.size(), suffix.size(), suffix) != 0)
+    return -1;
+  long step = -1;
+  int used = 0;
+  const std::string stem = name.substr(0, plain.size());
+  if (std::sscanf(stem.c_str(), "checkpoint_%9ld.h5%n", &step, &used) != 1 ||
+      used != static_cast<int>(stem.size()))
+    return -1;
+  return step;
+}
+
+}  // namespace
+
 CheckpointSeries::CheckpointSeries(MPI_Comm comm, std::string directory, int keep,
                                    long adopt_up_to_step)
     : comm_(comm), directory_(std::move(directory)), keep_(std::max(1, keep)) {
   MPI_Comm_rank(comm_, &rank_);
-  if (rank_ != 0 || adopt_up_to_step < 0) return;
   std::vector<std::string> found;
   std::error_code ec;
   for (const fs::directory_entry& e : fs::directory_iterator(directory_, ec)) {
     const std::string name = e.path().filename().string();
-    long step = -1;
-    int used = 0;
-    if (name.size() == file_name(0).size() &&
-        std::sscanf(name.c_str(), "checkpoint_%9ld.h5%n", &step, &used) == 1 &&
-        used == static_cast<int>(name.size()) && step <= adopt_up_to_step)
+    const long step = step_of(name, "");
+    if (adopt_up_to_step >= 0 && step >= 0 && step <= adopt_up_to_step)
       found.push_back(e.path().string());
+    // A killed run's partial file: a later write of the same step would replace it, but
+    // it must never be mistaken for a checkpoint nor pile up.
+    if (rank_ == 0 && step_of(name, ".part") >= 0) {
+      std::error_code rm;
+      fs::remove(e.path(), rm);
+      removed_partial_.push_back(e.path().string());
+      if (rm)
+        warning_ = "warning: could not delete the partial checkpoint '" + e.path().string() +
+                   "' of an earlier run: " + rm.message();
+    }
   }
   std::sort(found.begin(), found.end());  // 9-digit steps: name order is step order
-  files_.assign(found.begin(), found.end());
+  if (!found.empty()) newest_ = found.back();
+  if (rank_ == 0) files_.assign(found.begin(), found.end());
 }
 
 std::string CheckpointSeries::write(Simulation& sim) {
   const std::string path = (fs::path(directory_) / file_name(sim.counters().steps)).string();
   sim.write_checkpoint(path);  // <path>.part, then renamed: complete before anything is deleted
+  newest_ = path;
   warning_.clear();
   if (rank_ == 0) {
     if (files_.empty() || files_.back() != path) files_.push_back(path);
@@ -54,6 +81,12 @@ std::string CheckpointSeries::write(Simulation& sim) {
     }
   }
   return path;
+}
+
+std::string CheckpointSeries::resume_hint(const std::string& run_command) const {
+  if (newest_.empty()) return "No complete checkpoint of this run exists yet.";
+  return "The newest complete checkpoint is '" + newest_ + "' (untouched); free space and " +
+         "continue with: " + run_command + " --restart " + newest_;
 }
 
 }  // namespace grainflow

@@ -6,6 +6,7 @@
 
 #include <deque>
 #include <string>
+#include <vector>
 
 namespace grainflow {
 
@@ -15,6 +16,8 @@ class CheckpointSeries {
  public:
   // `adopt_up_to_step` >= 0 (a restarted run): the checkpoints already in `directory` with
   // step <= it count as the series' oldest members. Files of other runs are left alone.
+  // Partial checkpoints (checkpoint_<step>.h5.part) that a killed run left behind are
+  // deleted: they are never complete checkpoints (see removed_partial()).
   CheckpointSeries(MPI_Comm comm, std::string directory, int keep, long adopt_up_to_step = -1);
 
   // Collective: writes the checkpoint of the simulation's current step (which also rebuilds
@@ -25,6 +28,13 @@ class CheckpointSeries {
 
   static std::string file_name(long step);  // checkpoint_000001234.h5
   const std::string& warning() const { return warning_; }
+  // Rank 0: the partial checkpoints the constructor deleted (or could not delete: warning()).
+  const std::vector<std::string>& removed_partial() const { return removed_partial_; }
+  // The newest complete checkpoint of the series ("" when none), on every rank.
+  const std::string& newest() const { return newest_; }
+  // For a failed output write: how to continue ("The newest complete checkpoint is ...; ...
+  // continue with: <run_command> --restart <it>").
+  std::string resume_hint(const std::string& run_command) const;
 
  private:
   MPI_Comm comm_;
@@ -32,7 +42,9 @@ class CheckpointSeries {
   std::string directory_;
   int keep_;
   std::deque<std::string> files_;  // oldest first (rank 0 only)
+  std::string newest_;
   std::string warning_;
+  std::vector<std::string> removed_partial_;
 };
 
 }  // namespace grainflow

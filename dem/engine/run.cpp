@@ -126,6 +126,11 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   std::ostream& say = speaker(comm, out);
 
   // A restart takes its particles from the checkpoint instead of inserting them.
+  if (options.restart && options.restart->ends_with(".part"))
+    throw OutputError("cannot restart from '" + *options.restart +
+                      "': a .part file is a checkpoint that was being written when its run "
+                      "was killed, possibly incomplete; restart from a complete "
+                      "checkpoint_<step>.h5");
   Simulation sim(scene, !options.restart, comm);
   if (options.restart) sim.restore(read_checkpoint(*options.restart));
   const long first_step = sim.counters().steps;  // 0, or the checkpoint's step
@@ -156,6 +161,10 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   ProgressLine progress(comm, scene.time.end, options.progress && scene.output.progress, out);
   CheckpointSeries checkpoints(comm, dir, scene.output.checkpoint_keep,
                                options.restart ? first_step : -1);
+  for (const std::string& partial : checkpoints.removed_partial())
+    say << "note: deleted the partial checkpoint " << partial
+        << " (left by a run killed while writing it; never a complete checkpoint)\n";
+  if (!checkpoints.warning().empty()) say << checkpoints.warning() << "\n";
   const StopSignals signals(options.handle_stop_signals);
 
   const double dt = sim.dt();
@@ -167,11 +176,24 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
   long removed_reported = 0;
+  // A failed output write (full disk, lost mount) stops the run on every rank; the message
+  // names the checkpoint to continue from.
+  const std::string rerun =
+      "grain run " + scene.file + (options.output_directory ? " --output " + dir : std::string());
+  auto resumable = [&](const OutputError& e) {
+    std::string message = e.what();
+    if (!message.ends_with('.')) message += '.';
+    return OutputError(message + " " + checkpoints.resume_hint(rerun));
+  };
   auto write_log = [&] {
     const GlobalState g = sim.global_state();
-    log.write({sim.time(), sim.counters().steps, g.particles, g.kinetic_translational,
-               g.kinetic_rotational, g.max_overlap_ratio, g.contacts, sim.counters().rebuilds,
-               g.removed, wall()});
+    try {
+      log.write({sim.time(), sim.counters().steps, g.particles, g.kinetic_translational,
+                 g.kinetic_rotational, g.max_overlap_ratio, g.contacts, sim.counters().rebuilds,
+                 g.removed, wall()});
+    } catch (const OutputError& e) {
+      throw resumable(e);
+    }
     // Removals are reported once per log interval, not per particle.
     if (g.removed > removed_reported) {
       say << "warning: t = " << sim.time() << " s: " << g.removed - removed_reported
@@ -182,9 +204,20 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     return g;
   };
   auto write_checkpoint = [&] {
-    const std::string path = checkpoints.write(sim);
-    if (!checkpoints.warning().empty()) say << checkpoints.warning() << "\n";
-    return path;
+    try {
+      const std::string path = checkpoints.write(sim);
+      if (!checkpoints.warning().empty()) say << checkpoints.warning() << "\n";
+      return path;
+    } catch (const OutputError& e) {
+      throw resumable(e);
+    }
+  };
+  auto write_snapshot = [&](double t, long k) {
+    try {
+      snapshots.write(sim.particles(), t, k);
+    } catch (const OutputError& e) {
+      throw resumable(e);
+    }
   };
 
   RunSummary sum;
@@ -198,7 +231,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   long check_index = written(check_every);
   long snap_step = first_step, log_step = first_step;  // last step written
   if (!options.restart) {
-    snapshots.write(sim.particles(), sim.time(), 0);
+    write_snapshot(sim.time(), 0);
     sum.particles_start = write_log().particles;
   } else {
     sum.particles_start = sim.global_state().particles;
@@ -223,7 +256,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     if (t >= (snap_index + 1) * snap_every - 0.5 * dt || (last && snap_step != k)) {
       snap_step = k;
       snap_index = static_cast<long>(std::floor(t / snap_every + 0.5));
-      snapshots.write(sim.particles(), t, k);
+      write_snapshot(t, k);
     }
     if (check_every > 0 && !last && t >= (check_index + 1) * check_every - 0.5 * dt) {
       check_index = static_cast<long>(std::floor(t / check_every + 0.5));
@@ -263,6 +296,15 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
       << " neighbour rebuilds, " << sum.wall_seconds << " s wall, " << sum.particle_steps_per_second
       << " particle-steps/s\n"
       << "output: " << dir << "/particles.xdmf (open in ParaView), " << dir << "/log.csv\n";
+  const StreamInsertion& streams = sim.streams();
+  for (std::size_t k = 0; k < streams.size(); ++k) {
+    sum.streams.push_back({streams.count_inserted(k), streams.mass_inserted(k), streams.lag(k)});
+    say << "stream " << streams.source(k) << ": " << streams.count_inserted(k) << " particles, "
+        << streams.mass_inserted(k) << " kg delivered since t = 0"
+        << (streams.lag(k) > 0 ? ", " + std::to_string(streams.lag(k)) + " behind (face blocked)"
+                               : std::string())
+        << "\n";
+  }
   for (const std::string& line : sim.force_term_reports())
     if (!line.empty()) say << line << "\n";
   return sum;

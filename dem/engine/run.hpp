@@ -4,6 +4,7 @@
 #include <iosfwd>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <mpi.h>
 
@@ -27,6 +28,12 @@ struct RunSummary {
   double wall_seconds = 0;
   double particle_steps_per_second = 0;
   std::string stop_checkpoint;  // set when a SIGTERM/SIGINT stopped the run early
+  struct StreamTotal {
+    long count = 0;   // particles delivered since t = 0 (a restart continues the count)
+    double mass = 0;  // kg
+    long lag = 0;     // particles behind the target at the end
+  };
+  std::vector<StreamTotal> streams;  // one per stream insertion, in scene order
 };
 
 // Prints the time-step report (`grain check`); returns the process exit code:

@@ -282,6 +282,25 @@ void Simulation::restore(const CheckpointData& checkpoint) {
   next_id_ = checkpoint.next_id;
   restored_springs_ = checkpoint.springs;
   restored_ = true;
+  // Stream insertions continue where they were: delivered totals, radii drawn but not yet
+  // placed and the generators, so the restart inserts what the uninterrupted run would.
+  const std::string where = "checkpoint '" + checkpoint.file + "'";
+  if (!checkpoint.streams) {
+    if (!streams_.empty())
+      throw SetupError(scene_.file + ": error: the scene has " + std::to_string(streams_.size()) +
+                       " stream insertion(s), but " + where +
+                       " holds no stream state (group 'streams'; it was written by a grain "
+                       "before format grainflow-checkpoint-2), so the streams' delivered "
+                       "totals and random sequences cannot be continued. Run the scene from "
+                       "the start, or restart from a checkpoint written by this version");
+    return;
+  }
+  try {
+    streams_.restore_state(*checkpoint.streams);
+  } catch (const std::invalid_argument& e) {
+    throw SetupError(scene_.file + ": error: " + where + ": " + e.what() +
+                     "; restart with the scene the checkpoint was written with");
+  }
 }
 
 void Simulation::write_checkpoint(const std::string& path) {
@@ -295,6 +314,7 @@ void Simulation::write_checkpoint(const std::string& path) {
     d.drag_coefficient = drag_.coefficient;
     d.drag_fluid_velocity = drag_.fluid_velocity;
   }
+  d.streams = streams_.save_state();
   const CarriedState c = save_histories();
   for (std::size_t i = 0; i < p_.size(); ++i)
     for (const PartnerHistory& ph : c.pairs[i])

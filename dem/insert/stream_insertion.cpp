@@ -9,6 +9,9 @@
 #include "dem/insert/insertion.hpp"
 
 namespace grainflow {
+namespace {
+constexpr long kMaxPerStep = 100000;  // particles one stream inserts in one step, at most
+}  // namespace
 
 StreamInsertion::StreamInsertion(const Scene& scene) {
   for (const Insertion& ins : scene.insertions) {
@@ -37,7 +40,6 @@ long StreamInsertion::due(Stream& s, double t) {
   if (t < e.start) return 0;
   const double elapsed = std::min(t, *e.stop) - e.start;
   long n = 0;
-  constexpr long kMaxPerStep = 100000;
   if (e.mass_rate) {
     double mass = s.mass;
     const double target = *e.mass_rate * elapsed;
@@ -163,6 +165,9 @@ void StreamInsertion::restore_state(const std::string& state) {
   for (Stream& s : streams_) {
     std::size_t pending = 0;
     in >> s.mass >> s.count >> pending;
+    // due() draws at most one radius beyond a step's worth ahead.
+    if (!in || pending > static_cast<std::size_t>(kMaxPerStep) + 1)
+      throw std::invalid_argument("stream insertion state is malformed");
     s.pending.assign(pending, 0.0);
     for (double& r : s.pending) in >> r;
     in >> s.radius_rng >> s.place_rng;

@@ -48,6 +48,7 @@ class StreamInsertion {
   // How far stream k is behind its target at the last insert(), in particles.
   long lag(std::size_t k) const { return streams_[k].lag; }
   std::size_t size() const { return streams_.size(); }
+  const std::string& source(std::size_t k) const { return streams_[k].entry.source; }
 
   // The streams' progress (delivered totals, radii drawn but not placed, generator
   // states) as text, for checkpoints: a run restored with restore_state() inserts

@@ -6,10 +6,13 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "dem/io/hdf5_errors.hpp"
+
 namespace grainflow {
 namespace {
 
-constexpr const char* kFormat = "grainflow-checkpoint-1";
+// Format 2 added the group 'streams'; format 1 files are read (without it).
+constexpr const char* kFormat = "grainflow-checkpoint-2";
 
 // Packs per-particle and per-spring records into doubles (ids bit-exact).
 std::vector<double> pack(const CheckpointData& d) {
@@ -88,22 +91,47 @@ class File {
   hid_t id_;
 };
 
-bool write_array(hid_t loc, const char* name, hid_t type, std::size_t rows, std::size_t cols,
-                 const void* data) {
+// The first failure of a file write, with HDF5's reason. That reason must be read right after
+// the failing call: every later HDF5 call (closing a dataset included) starts a new error stack.
+class FirstFailure {
+ public:
+  // Right after a failed HDF5 call, before any other.
+  void capture() {
+    if (reason_.empty()) reason_ = hdf5_reason();
+  }
+  bool check(bool ok, const std::string& what) {
+    if (!ok && error_.empty()) {
+      capture();
+      error_ = what + " failed: " + reason_;
+    }
+    return ok;
+  }
+  bool ok() const { return error_.empty(); }
+  const std::string& error() const { return error_; }
+
+ private:
+  std::string reason_;
+  std::string error_;
+};
+
+bool write_array(FirstFailure& fail, hid_t loc, const char* name, hid_t type, std::size_t rows,
+                 std::size_t cols, const void* data) {
   const hsize_t dims[2] = {rows, cols};
   const hid_t space = H5Screate_simple(cols > 1 ? 2 : 1, dims, nullptr);
   const hid_t set = H5Dcreate2(loc, name, type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
   bool ok = set >= 0 && (rows == 0 || H5Dwrite(set, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) >= 0);
+  if (!ok) fail.capture();
   if (set >= 0) H5Dclose(set);
   H5Sclose(space);
   return ok;
 }
 
 template <class T>
-bool write_attribute(hid_t loc, const char* name, hid_t type, const T& value) {
+bool write_attribute(FirstFailure& fail, hid_t loc, const char* name, hid_t type, const T& value) {
   const hid_t space = H5Screate(H5S_SCALAR);
   const hid_t attr = H5Acreate2(loc, name, type, space, H5P_DEFAULT, H5P_DEFAULT);
   const bool ok = attr >= 0 && H5Awrite(attr, type, &value) >= 0;
+  if (!ok) fail.capture();
   if (attr >= 0) H5Aclose(attr);
   H5Sclose(space);
   return ok;
@@ -112,29 +140,32 @@ bool write_attribute(hid_t loc, const char* name, hid_t type, const T& value) {
 std::string write_file(const std::string& path, const CheckpointData& d) {
   const Particles& p = d.particles;
   const std::size_t n = p.size(), m = d.springs.size();
+  FirstFailure fail;
   if (!d.drag_coefficient.empty() &&
       (d.drag_coefficient.size() != n || d.drag_fluid_velocity.size() != n))
     return "the ranks disagree on whether particles have an implicit drag (" +
            std::to_string(d.drag_coefficient.size()) + " drag entries for " + std::to_string(n) +
            " particles)";
   File f(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT));
-  if (f.id() < 0) return "cannot create the file";
+  if (!fail.check(f.id() >= 0, "creating '" + path + "'")) return fail.error();
   const hid_t str = H5Tcopy(H5T_C_S1);
   H5Tset_size(str, std::char_traits<char>::length(kFormat));
-  bool ok = true;
   {
     const hid_t space = H5Screate(H5S_SCALAR);
     const hid_t attr = H5Acreate2(f.id(), "format", str, space, H5P_DEFAULT, H5P_DEFAULT);
-    ok = ok && attr >= 0 && H5Awrite(attr, str, kFormat) >= 0;
+    const bool written = attr >= 0 && H5Awrite(attr, str, kFormat) >= 0;
+    if (!written) fail.capture();
     if (attr >= 0) H5Aclose(attr);
+    fail.check(written, "writing the attribute 'format'");
     H5Sclose(space);
   }
   H5Tclose(str);
   const long long step = d.step, next = d.next_id;
-  ok = ok && write_attribute(f.id(), "time", H5T_NATIVE_DOUBLE, d.time) &&
-       write_attribute(f.id(), "dt", H5T_NATIVE_DOUBLE, d.dt) &&
-       write_attribute(f.id(), "step", H5T_NATIVE_LLONG, step) &&
-       write_attribute(f.id(), "next_id", H5T_NATIVE_LLONG, next);
+  fail.check(fail.ok() && write_attribute(fail, f.id(), "time", H5T_NATIVE_DOUBLE, d.time) &&
+                 write_attribute(fail, f.id(), "dt", H5T_NATIVE_DOUBLE, d.dt) &&
+                 write_attribute(fail, f.id(), "step", H5T_NATIVE_LLONG, step) &&
+                 write_attribute(fail, f.id(), "next_id", H5T_NATIVE_LLONG, next),
+             "writing the attributes time, dt, step, next_id");
   std::vector<long long> ids(p.id.begin(), p.id.end());
   std::vector<int> mats(p.material.begin(), p.material.end());
   auto flat = [](const std::vector<Vec3>& v) {
@@ -143,23 +174,29 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
     for (const Vec3& x : v) out.insert(out.end(), {x[0], x[1], x[2]});
     return out;
   };
-  const hid_t g = H5Gcreate2(f.id(), "particles", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-  ok = ok && g >= 0 && write_array(g, "id", H5T_NATIVE_LLONG, n, 1, ids.data()) &&
-       write_array(g, "position", H5T_NATIVE_DOUBLE, n, 3, flat(p.x).data()) &&
-       write_array(g, "velocity", H5T_NATIVE_DOUBLE, n, 3, flat(p.v).data()) &&
-       write_array(g, "angular_velocity", H5T_NATIVE_DOUBLE, n, 3, flat(p.omega).data()) &&
-       write_array(g, "force", H5T_NATIVE_DOUBLE, n, 3, flat(p.force).data()) &&
-       write_array(g, "torque", H5T_NATIVE_DOUBLE, n, 3, flat(p.torque).data()) &&
-       write_array(g, "radius", H5T_NATIVE_DOUBLE, n, 1, p.radius.data()) &&
-       write_array(g, "mass", H5T_NATIVE_DOUBLE, n, 1, p.mass.data()) &&
-       write_array(g, "inertia", H5T_NATIVE_DOUBLE, n, 1, p.inertia.data()) &&
-       write_array(g, "material", H5T_NATIVE_INT, n, 1, mats.data());
-  if (!d.drag_coefficient.empty())
-    ok = ok && write_array(g, "drag_coefficient", H5T_NATIVE_DOUBLE, n, 1,
-                           d.drag_coefficient.data()) &&
-         write_array(g, "drag_fluid_velocity", H5T_NATIVE_DOUBLE, n, 3,
-                     flat(d.drag_fluid_velocity).data());
-  if (g >= 0) H5Gclose(g);
+  if (fail.ok()) {
+    const hid_t g = H5Gcreate2(f.id(), "particles", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    fail.check(g >= 0 && write_array(fail, g, "id", H5T_NATIVE_LLONG, n, 1, ids.data()) &&
+                   write_array(fail, g, "position", H5T_NATIVE_DOUBLE, n, 3, flat(p.x).data()) &&
+                   write_array(fail, g, "velocity", H5T_NATIVE_DOUBLE, n, 3, flat(p.v).data()) &&
+                   write_array(fail, g, "angular_velocity", H5T_NATIVE_DOUBLE, n, 3,
+                               flat(p.omega).data()) &&
+                   write_array(fail, g, "force", H5T_NATIVE_DOUBLE, n, 3, flat(p.force).data()) &&
+                   write_array(fail, g, "torque", H5T_NATIVE_DOUBLE, n, 3, flat(p.torque).data()) &&
+                   write_array(fail, g, "radius", H5T_NATIVE_DOUBLE, n, 1, p.radius.data()) &&
+                   write_array(fail, g, "mass", H5T_NATIVE_DOUBLE, n, 1, p.mass.data()) &&
+                   write_array(fail, g, "inertia", H5T_NATIVE_DOUBLE, n, 1, p.inertia.data()) &&
+                   write_array(fail, g, "material", H5T_NATIVE_INT, n, 1, mats.data()),
+               "writing the group 'particles'");
+    if (!d.drag_coefficient.empty())
+      fail.check(g >= 0 &&
+                     write_array(fail, g, "drag_coefficient", H5T_NATIVE_DOUBLE, n, 1,
+                                 d.drag_coefficient.data()) &&
+                     write_array(fail, g, "drag_fluid_velocity", H5T_NATIVE_DOUBLE, n, 3,
+                                 flat(d.drag_fluid_velocity).data()),
+                 "writing the implicit drag in group 'particles'");
+    if (g >= 0) H5Gclose(g);
+  }
   std::vector<long long> a(m), b(m);
   std::vector<Vec3> t(m), r(m);
   for (std::size_t k = 0; k < m; ++k) {
@@ -168,14 +205,25 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
     t[k] = d.springs[k].tangential;
     r[k] = d.springs[k].rolling;
   }
-  const hid_t s = H5Gcreate2(f.id(), "springs", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-  ok = ok && s >= 0 && write_array(s, "particle", H5T_NATIVE_LLONG, m, 1, a.data()) &&
-       write_array(s, "partner", H5T_NATIVE_LLONG, m, 1, b.data()) &&
-       write_array(s, "tangential", H5T_NATIVE_DOUBLE, m, 3, flat(t).data()) &&
-       write_array(s, "rolling", H5T_NATIVE_DOUBLE, m, 3, flat(r).data());
-  if (s >= 0) H5Gclose(s);
-  ok = f.close() && ok;
-  return ok ? "" : "an HDF5 write failed (disk full or quota?)";
+  if (fail.ok()) {
+    const hid_t s = H5Gcreate2(f.id(), "springs", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    fail.check(s >= 0 && write_array(fail, s, "particle", H5T_NATIVE_LLONG, m, 1, a.data()) &&
+                   write_array(fail, s, "partner", H5T_NATIVE_LLONG, m, 1, b.data()) &&
+                   write_array(fail, s, "tangential", H5T_NATIVE_DOUBLE, m, 3, flat(t).data()) &&
+                   write_array(fail, s, "rolling", H5T_NATIVE_DOUBLE, m, 3, flat(r).data()),
+               "writing the group 'springs'");
+    if (s >= 0) H5Gclose(s);
+  }
+  if (fail.ok() && d.streams) {
+    const hid_t s = H5Gcreate2(f.id(), "streams", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    fail.check(s >= 0 && write_array(fail, s, "state", H5T_NATIVE_UCHAR, d.streams->size(), 1,
+                                     d.streams->data()),
+               "writing the group 'streams'");
+    if (s >= 0) H5Gclose(s);
+  }
+  // Closing flushes HDF5's metadata cache: on a full disk this is often where it fails.
+  fail.check(f.close(), "closing (flushing) the file");
+  return fail.error();
 }
 
 template <class T>
@@ -235,14 +283,13 @@ void write_checkpoint(MPI_Comm comm, const std::string& path, const CheckpointDa
     d.dt = local.dt;
     d.step = local.step;
     d.next_id = local.next_id;
+    d.streams = local.streams;
     for (int r = 0; r < size; ++r) unpack(all.data() + displs[r], counts[r], d);
     const std::string part = path + ".part";
-    H5E_auto2_t old_func;
-    void* old_data;
-    H5Eget_auto2(H5E_DEFAULT, &old_func, &old_data);
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-    error = write_file(part, d);
-    H5Eset_auto2(H5E_DEFAULT, old_func, old_data);
+    {
+      const QuietHdf5Errors quiet;
+      error = write_file(part, d);
+    }
     std::error_code ec;
     if (error.empty()) std::filesystem::rename(part, path, ec);
     if (error.empty() && ec) error = "cannot rename " + part + ": " + ec.message();
@@ -254,7 +301,7 @@ void write_checkpoint(MPI_Comm comm, const std::string& path, const CheckpointDa
   MPI_Bcast(error.data(), length, MPI_CHAR, 0, comm);
   if (!error.empty())
     throw OutputError("cannot write checkpoint '" + path + "': " + error +
-                      "; the previous checkpoint, if any, is untouched");
+                      "; its partial file was deleted and no earlier checkpoint was touched");
 }
 
 CheckpointData read_checkpoint(const std::string& path) {
@@ -310,6 +357,13 @@ CheckpointData read_checkpoint(const std::string& path) {
     const auto t = read_array<double>(s, "tangential", H5T_NATIVE_DOUBLE, 3, m, error);
     const auto ro = read_array<double>(s, "rolling", H5T_NATIVE_DOUBLE, 3, m, error);
     if (s >= 0) H5Gclose(s);
+    if (error.empty() && H5Lexists(f, "streams", H5P_DEFAULT) > 0) {
+      const hid_t st = H5Gopen2(f, "streams", H5P_DEFAULT);
+      std::size_t length = static_cast<std::size_t>(-1);
+      const auto text = read_array<unsigned char>(st, "state", H5T_NATIVE_UCHAR, 1, length, error);
+      if (st >= 0) H5Gclose(st);
+      if (error.empty()) d.streams = std::string(text.begin(), text.end());
+    }
     H5Fclose(f);
     if (error.empty()) {
       for (std::size_t i = 0; i < n; ++i) {
@@ -331,6 +385,7 @@ CheckpointData read_checkpoint(const std::string& path) {
   }
   H5Eset_auto2(H5E_DEFAULT, old_func, old_data);
   if (!error.empty()) throw OutputError("cannot read checkpoint '" + path + "': " + error);
+  d.file = path;
   return d;
 }
 

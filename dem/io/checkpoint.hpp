@@ -7,7 +7,7 @@
 // leaves a truncated checkpoint under the final name. read_checkpoint lets every
 // rank read the whole file; the engine then keeps what each rank owns.
 //
-// Layout: attributes format ("grainflow-checkpoint-1"), time, dt, step, next_id;
+// Layout: attributes format ("grainflow-checkpoint-2"), time, dt, step, next_id;
 // /particles/{id, position, velocity, angular_velocity, force, torque, radius, mass,
 // inertia, material} — force and torque are those of the step's end, which the next
 // velocity-Verlet half kick uses (recomputing them would advance the springs twice);
@@ -15,9 +15,13 @@
 // implicit drag K and u of the step's end, which that half kick uses too (a coupled
 // run cannot recompute them: they come from the fluid of the step before);
 // /springs/{particle, partner, tangential, rolling}, where a wall spring
-// has partner = -1 - wall index. A pair's spring may be listed once per partner.
+// has partner = -1 - wall index. A pair's spring may be listed once per partner;
+// /streams/state (uint8 text, StreamInsertion::save_state(): the stream insertions'
+// delivered totals, radii drawn but not placed and generator states). Format 1 files
+// (before stream state was saved) have no /streams group.
 #include <mpi.h>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,6 +48,10 @@ struct CheckpointData {
   std::vector<double> drag_coefficient;
   std::vector<Vec3> drag_fluid_velocity;
   std::vector<CheckpointSpring> springs;
+  // The stream insertions' progress (taken from rank 0 when writing); absent in a format 1
+  // file, which cannot continue a scene with streams.
+  std::optional<std::string> streams;
+  std::string file;  // set by read_checkpoint: where it came from, for messages
 };
 
 // Collective. `local` holds this rank's particles and springs; time, dt, step and

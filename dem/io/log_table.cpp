@@ -40,8 +40,11 @@ LogTable::LogTable(MPI_Comm comm, const std::string& path, long continue_after_s
     if (in && std::getline(in, line) && line == header) {
       kept = line + "\n";
       while (std::getline(in, line)) {
+        // A row without its newline was cut short (by a kill, or a full disk's short write);
+        // even its step may be cut. It and anything after it are dropped.
+        if (in.eof()) break;
         const auto comma = line.find(',');
-        if (comma == std::string::npos) break;  // a row cut short by a kill
+        if (comma == std::string::npos) break;
         const long step = std::strtol(line.c_str() + comma + 1, nullptr, 10);
         if (step > continue_after_step) break;
         kept += line + "\n";

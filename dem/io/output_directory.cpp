@@ -55,4 +55,13 @@ void prepare_output_directory(const std::string& dir) {
     fail(dir, "cannot remove the probe file '" + probe + "'", std::strerror(unlink_errno));
 }
 
+std::string no_space_note(const std::string& dir, std::uintmax_t bytes) {
+  std::error_code ec;
+  const std::filesystem::space_info space = std::filesystem::space(dir, ec);
+  if (ec || space.available >= bytes) return "";
+  return "No space left on device: " + std::to_string(space.available) +
+         " bytes are free on the file system of '" + dir + "', the file needs about " +
+         std::to_string(bytes);
+}
+
 }  // namespace grainflow

@@ -10,53 +10,12 @@
 #include <string_view>
 #include <utility>
 
+#include "dem/io/hdf5_errors.hpp"
 #include "grainflow_version.hpp"
 
 namespace grainflow {
 
 namespace {
-
-// HDF5 prints its whole error stack to stderr by default; we turn errors into OutputError
-// instead. The previous handler is restored afterwards so other HDF5 users are unaffected.
-class QuietHdf5Errors {
- public:
-  QuietHdf5Errors() {
-    H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  }
-  ~QuietHdf5Errors() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
-  QuietHdf5Errors(const QuietHdf5Errors&) = delete;
-  QuietHdf5Errors& operator=(const QuietHdf5Errors&) = delete;
-
- private:
-  H5E_auto2_t func_ = nullptr;
-  void* data_ = nullptr;
-};
-
-struct ErrorRecord {
-  std::string function;
-  std::string description;
-};
-
-herr_t collect_error(unsigned /*n*/, const H5E_error2_t* err, void* out) {
-  static_cast<std::vector<ErrorRecord>*>(out)->push_back(
-      {err->func_name ? err->func_name : "?", err->desc ? err->desc : ""});
-  return 0;
-}
-
-// The HDF5 error stack in one line: the most specific cause (deepest entry, e.g. the MPI-IO or
-// OS error) and the API call it surfaced in; the stack is cleared.
-std::string hdf5_reason() {
-  std::vector<ErrorRecord> stack;
-  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, collect_error, &stack);
-  H5Eclear2(H5E_DEFAULT);
-  if (stack.empty()) return "HDF5 reported no reason";
-  const ErrorRecord& cause = stack.front();
-  const ErrorRecord& api = stack.back();
-  std::string out = cause.description;
-  if (stack.size() > 1) out += " (in " + api.function + ": " + api.description + ")";
-  return out;
-}
 
 // Owns one HDF5 identifier and closes it on scope exit.
 class Hid {
@@ -86,8 +45,9 @@ class Hid {
 // gave up alone would leave the others waiting forever inside the next collective call.
 class Agreement {
  public:
-  Agreement(MPI_Comm comm, int rank, int size, std::string path)
-      : comm_(comm), rank_(rank), size_(size), path_(std::move(path)) {}
+  // `bytes`: the file's expected size, to recognise a full disk (no_space_note).
+  Agreement(MPI_Comm comm, int rank, int size, std::string path, std::uintmax_t bytes = 0)
+      : comm_(comm), rank_(rank), size_(size), path_(std::move(path)), bytes_(bytes) {}
 
   // For HDF5 calls: the reason is read from the HDF5 error stack.
   void check(bool ok, const std::string& what) {
@@ -113,7 +73,10 @@ class Agreement {
  private:
   std::string message(const std::string& what, const std::string& reason) const {
     std::string where = size_ > 1 ? " on rank " + std::to_string(rank_) : "";
+    const std::string full =
+        no_space_note(std::filesystem::path(path_).parent_path().string(), bytes_);
     return "cannot write snapshot '" + path_ + "': " + what + " failed" + where + ": " + reason +
+           (full.empty() ? "" : "; " + full) +
            ". Check free space, quota and permissions of the output directory.";
   }
 
@@ -121,6 +84,7 @@ class Agreement {
   int rank_;
   int size_;
   std::string path_;
+  std::uintmax_t bytes_;
 };
 
 struct HdfTypes {
@@ -286,7 +250,13 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step) {
                     static_cast<hsize_t>(total)};
 
   QuietHdf5Errors quiet;
-  Agreement agreement(comm_, rank_, size_, path);
+  // Data plus a few kB of HDF5 metadata (measured: 4000 particles take 436 096 bytes).
+  std::uintmax_t bytes_per_particle = 0;
+  for (const SnapshotField& f : snapshot_fields)
+    bytes_per_particle +=
+        static_cast<std::uintmax_t>(f.components) * (f.type == SnapshotField::Type::Int32 ? 4 : 8);
+  Agreement agreement(comm_, rank_, size_, path,
+                      bytes_per_particle * static_cast<std::uintmax_t>(total) + 4096);
   try {
     Hid fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
     Hid dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);

@@ -96,6 +96,20 @@ else()
                    ${_scenes}/checkpointed_bed.yaml ${_work}/nan_guard ${GRAINFLOW_PYTHON3})
   set_tests_properties(grain.nan_guard_stops_run
                        PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}" TIMEOUT 60)
+  # 20 SIGKILLs, most while a 3 MB checkpoint is being written (about 17 s).
+  add_test(NAME grain.kill_during_checkpoint
+           COMMAND ${GRAINFLOW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/kill_during_checkpoint.py
+                   ${_grain} ${_scenes}/kill_during_checkpoint.yaml ${_work}/kill_during_checkpoint 20)
+  set_tests_properties(grain.kill_during_checkpoint
+                       PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}" TIMEOUT 120)
+  # A disk that fills mid-run (snapshot, then checkpoint) and an unwritable output directory,
+  # on small tmpfs mounts (about 20 s, 2 ranks); skipped when mounting is not permitted.
+  add_test(NAME grain.disk_full
+           COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/disk_full.sh ${_grain}
+                   ${_scenes}/disk_full.yaml ${_work}/disk_full ${GRAINFLOW_PYTHON3}
+                   ${MPIEXEC_EXECUTABLE})
+  set_tests_properties(grain.disk_full PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}"
+                       TIMEOUT 300 PROCESSORS 2 SKIP_RETURN_CODE 77)
 endif()
 grain_cli_test(restart_missing_checkpoint 1 "no_such_checkpoint.h5"
                CMD ${_grain} run ${_scenes}/periodic_bed.yaml --output out --no-progress

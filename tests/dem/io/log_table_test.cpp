@@ -161,5 +161,20 @@ TEST(LogTable, PlotScriptWritesPng) {
   EXPECT_NE(lines.back().find("valid columns: time_s,"), std::string::npos) << lines.back();
 }
 
+// A restarted run continues the table after the checkpoint's step. A last row without its
+// newline was cut short (kill -9, or a short write on a full disk): even its step may be cut
+// ("12" of step 1234), so it is dropped although 12 <= the checkpoint's step.
+TEST(LogTable, ContinuingDropsARowCutShort) {
+  const fs::path path = fresh_directory("cut_row") / "log.csv";
+  {
+    std::ofstream out(path);
+    out << LogTable::header << "\n0.1,10,5,0,0,0,0,1,0,0.5\n0.2,20,5,0,0,0,0,2,0,1.0\n0.3,12";
+  }
+  { LogTable log(MPI_COMM_WORLD, path.string(), 100); }
+  const std::vector<std::string> lines = read_lines(path);
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_EQ(lines[2], "0.2,20,5,0,0,0,0,2,0,1.0");
+}
+
 }  // namespace
 }  // namespace grainflow
