@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <filesystem>
 #include <limits>
 #include <optional>
@@ -13,6 +12,7 @@
 #include "dem/engine/checkpoint_series.hpp"
 #include "dem/engine/finite_guard.hpp"
 #include "dem/engine/simulation.hpp"
+#include "dem/engine/stop_signals.hpp"
 #include "dem/fluid/fluid_forces.hpp"
 #include "dem/io/log_table.hpp"
 #include "dem/io/output_directory.hpp"
@@ -21,40 +21,6 @@
 
 namespace grainflow {
 namespace {
-
-// The signal that asked the run to stop (0: none). A signal handler can reach nothing but a
-// global, and may only store to a volatile sig_atomic_t (C++20 [support.signal]).
-volatile std::sig_atomic_t stop_signal = 0;
-
-extern "C" void on_stop_signal(int signal) { stop_signal = signal; }
-
-// SIGTERM and SIGINT set stop_signal while a run is in progress; the previous handlers come
-// back afterwards. SA_RESETHAND: a second signal of the same kind kills the run as usual.
-class StopSignals {
- public:
-  explicit StopSignals(bool install) : installed_(install) {
-    stop_signal = 0;
-    if (!installed_) return;
-    struct sigaction action = {};
-    action.sa_handler = on_stop_signal;
-    sigemptyset(&action.sa_mask);
-    action.sa_flags = SA_RESETHAND;
-    sigaction(SIGTERM, &action, &old_term_);
-    sigaction(SIGINT, &action, &old_int_);
-  }
-  ~StopSignals() {
-    if (!installed_) return;
-    sigaction(SIGTERM, &old_term_, nullptr);
-    sigaction(SIGINT, &old_int_, nullptr);
-  }
-  StopSignals(const StopSignals&) = delete;
-  StopSignals& operator=(const StopSignals&) = delete;
-
- private:
-  bool installed_;
-  struct sigaction old_term_ = {};
-  struct sigaction old_int_ = {};
-};
 
 // Stops the run on every rank at the first non-finite particle state, after writing every
 // particle into <dir>/diagnostic_000000.h5.
@@ -266,12 +232,11 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     // Stop signals are agreed on every 100 steps: one small reduction, so all ranks stop at
     // the same step.
     if (k % 100 == 0 && !last) {
-      int signal = stop_signal;
-      MPI_Allreduce(MPI_IN_PLACE, &signal, 1, MPI_INT, MPI_MAX, comm);
+      const int signal = StopSignals::agreed(comm);
       if (signal != 0) {
         if (log_step != k) write_log();
         sum.stop_checkpoint = write_checkpoint();
-        stop_message << "grain: received " << (signal == SIGINT ? "SIGINT" : "SIGTERM")
+        stop_message << "grain: received " << StopSignals::name(signal)
                      << "; stopped after step " << k << " (t = " << t
                      << " s) and wrote the checkpoint " << sum.stop_checkpoint
                      << "; continue with: grain run " << scene.file << " --restart "

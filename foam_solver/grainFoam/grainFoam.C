@@ -23,6 +23,7 @@
 #include <chrono>
 
 #include "coupling/foam/particleCoupling.H"
+#include "dem/engine/stop_signals.hpp"
 #include "fixedFluxPressureFvPatchScalarField.H"
 #include "fvCFD.H"
 #include "pimpleControl.H"
@@ -61,6 +62,11 @@ void solve(const Foam::argList& args) {
   surfaceScalarField phi(IOobject("phi", runTime.timeName(), mesh, IOobject::READ_IF_PRESENT,
                                   IOobject::AUTO_WRITE),
                          fvc::interpolate(eps) * fvc::flux(U));
+
+  // SIGTERM / SIGINT (a batch system's time limit, Ctrl-C): finish the step, write the
+  // fields and the DEM checkpoint, and exit 0; a restart (startFrom latestTime) continues
+  // bit-identically.
+  const grainflow::StopSignals stopSignals(true);
 
   Info << "\nStarting time loop\n" << endl;
   while (runTime.run()) {
@@ -145,6 +151,21 @@ void solve(const Foam::argList& args) {
     runTime.write();
     if (runTime.writeTime()) particles.write();
     runTime.printExecutionTime(Info);
+
+    const int signal = grainflow::StopSignals::agreed(MPI_COMM_WORLD);
+    if (signal != 0) {
+      if (!runTime.writeTime()) {
+        runTime.writeNow();
+        particles.write();
+      }
+      Info << "grainFoam: received " << grainflow::StopSignals::name(signal)
+           << "; stopped after time " << runTime.timeName() << " (time index "
+           << runTime.timeIndex()
+           << ") and wrote it with the DEM checkpoint; continue with startFrom latestTime in "
+              "system/controlDict\n"
+           << endl;
+      return;
+    }
   }
   Info << "End\n" << endl;
 }

@@ -24,7 +24,10 @@ tests/support/grainfoam_driver.py.
 import math
 import os
 import re
+import signal
+import subprocess
 import sys
+import time
 
 import numpy as np
 
@@ -342,8 +345,112 @@ def restart(runner, checks):
                   "a missing DEM checkpoint: refused; the message names the time and the file")
 
 
+# --- coupling.stop_signal ---------------------------------------------------------------
+
+
+def run_until_signalled(runner, case, ranks, after_time):
+    """Starts grainFoam, sends SIGTERM to one process (serial: grainFoam; parallel: rank 1
+    only, so the others learn it through the agreement) once the log reaches `after_time`,
+    and returns (exit code, log)."""
+    cmd = [runner.foam_env]
+    if ranks > 1:
+        cmd += [runner.mpiexec, "-np", str(ranks), "--oversubscribe"]
+    cmd += [runner.solver, "-case", case] + (["-parallel"] if ranks > 1 else [])
+    log_path = os.path.join(case, "log.grainFoam.signalled")
+    with open(log_path, "w") as log:
+        proc = subprocess.Popen(cmd, cwd=case, env=runner.env, stdout=log,
+                                stderr=subprocess.STDOUT)
+        deadline = time.monotonic() + 120
+        target = None
+        while time.monotonic() < deadline and proc.poll() is None:
+            with open(log_path) as f:
+                reached = f"Time = {after_time}\n" in f.read()
+            if reached:
+                if ranks == 1:
+                    target = proc.pid
+                else:
+                    children = subprocess.run(["pgrep", "-P", str(proc.pid)], text=True,
+                                              stdout=subprocess.PIPE).stdout.split()
+                    target = int(sorted(children, key=int)[-1]) if children else None
+                if target is not None:
+                    os.kill(target, signal.SIGTERM)
+                break
+            time.sleep(0.05)
+        code = proc.wait(timeout=120)
+    with open(log_path) as f:
+        return code, f.read(), target
+
+
+def stop_signal(runner, checks):
+    """SIGTERM in the middle of a coupled run (the case of coupling.restart): the solver
+    finishes the fluid step, writes the fields and the DEM checkpoint at that time, says so
+    and exits 0; a restart from that time (startFrom latestTime) continues to the end.
+    Reference: the same case run to exactly that time (endTime), then restarted; the two
+    must end bit-identical, particles and fields. (Writing a checkpoint rebuilds the DEM's
+    lists, which changes summation orders, so a run that wrote no checkpoint at that time
+    would differ in the last bits; coupling.restart shows that a restart equals the run that
+    wrote the checkpoint.) On 2 ranks only one rank is signalled: the ranks agree on it after
+    every fluid step and all stop at the same one."""
+    end_time = "0.04"
+    edits = [("0/U", "internalField   uniform (0 0 0);", "internalField   uniform (0.05 0.02 0);"),
+             ("particles.yaml", "gravity: [0, 0, -9.81]", "gravity: [0, 0, -98.1]"),
+             ("system/controlDict", "endTime         2e-4;", "endTime         4e-2;"),
+             ("system/controlDict", "writeInterval   1;", "writeInterval   200;"),
+             ("system/controlDict", "writeFormat     ascii;", "writeFormat     binary;")]
+
+    def restart_to_end(case, ranks):
+        path = os.path.join(case, "system", "controlDict")
+        with open(path) as f:
+            text = re.sub(r"endTime\s+\S+;", "endTime         4e-2;", f.read())
+            text = re.sub(r"writeInterval\s+\S+;", "writeInterval   200;", text)
+        with open(path, "w") as f:
+            f.write(text.replace("startFrom       startTime;", "startFrom       latestTime;"))
+        log = runner.run(case, "grainFoam.restart", runner.solver, ranks=ranks)
+        if ranks > 1:
+            runner.run(case, "reconstructPar.all", "reconstructPar", "-latestTime")
+        return log
+
+    for ranks in (1, 2):
+        case = runner.fresh_case("periodic_box", f"signalled_np{ranks}", edits)
+        runner.run(case, "blockMesh", "blockMesh")
+        if ranks > 1:
+            runner.run(case, "decomposePar", "decomposePar")
+        code, log, target = run_until_signalled(runner, case, ranks, "0.013")
+        checks.expect(target is not None, f"np {ranks}: SIGTERM sent to process {target}")
+        stopped = re.search(r"grainFoam: received SIGTERM; stopped after time (\S+) \(time index "
+                            r"(\d+)\) and wrote it with the DEM checkpoint", log)
+        checks.expect(code == 0 and stopped is not None,
+                      f"np {ranks}: exit code {code} (0) and the stop message")
+        if stopped is None:
+            continue
+        at = stopped.group(1)
+        checks.expect(0.013 <= float(at) < 0.02,
+                      f"np {ranks}: stopped at t = {at} s, after the signal, before the next write")
+        folder = os.path.join(case, at) if ranks == 1 else os.path.join(case, "processor0", at)
+        checks.expect(os.path.exists(os.path.join(folder, "uniform", "grainflowCheckpoint")),
+                      f"np {ranks}: time {at} written with its checkpoint record")
+        log = restart_to_end(case, ranks)
+        checks.expect(f"restart at time {at}" in log, f"np {ranks}: restarted at {at}")
+
+        index = int(stopped.group(2))  # the reference writes there, and only there
+        reference = runner.fresh_case("periodic_box", f"reference_np{ranks}", edits + [
+            ("system/controlDict", "endTime         4e-2;", f"endTime         {at};"),
+            ("system/controlDict", "writeInterval   200;", f"writeInterval   {index};")])
+        runner.solve(reference, ranks)
+        restart_to_end(reference, ranks)
+        a, b = snapshots(reference)[-1], snapshots(case)[-1]
+        for key in ("id", "position", "velocity"):
+            same = a[1][key].shape == b[1][key].shape and np.array_equal(a[1][key], b[1][key])
+            checks.expect(same and a[0] == b[0] and abs(b[0] - 0.04) < 1e-12,
+                          f"np {ranks}: every particle's {key} at t = {b[0]:.4g} s equal to the "
+                          f"reference's to the last bit")
+        for field in ("U", "p", "phi", "voidfraction"):
+            same = (read_foam_binary_or_ascii(reference, end_time, field) ==
+                    read_foam_binary_or_ascii(case, end_time, field))
+            checks.expect(same, f"np {ranks}: {field} at t = {end_time} equal byte for byte")
+
 TESTS = {f.__name__: f for f in (void_fraction_volume, exchange_balance, neutrally_buoyant,
-                                 refuses_bad_setup, restart)}
+                                 refuses_bad_setup, restart, stop_signal)}
 
 
 if __name__ == "__main__":

@@ -21,6 +21,9 @@
 #       U, p, phi, voidfraction bit-identical; a 1-rank checkpoint restarted on 2 ranks
 #       continues the same flow (centre of mass within 2 % of its fall); a missing DEM
 #       checkpoint is refused naming the file. About 45 s.
+#   coupling.stop_signal           the same case, SIGTERM mid-run (on 2 ranks to one rank only):
+#       exit 0 with the message, the time written with its checkpoint; restarted, it ends
+#       bit-identical to a run stopped at that time by endTime and restarted. About 25 s.
 if(NOT TARGET grainFoam)
   return()
 endif()
@@ -61,3 +64,5 @@ grainflow_coupling_test(neutrally_buoyant 1)
 grainflow_coupling_test(refuses_bad_setup 2)
 grainflow_coupling_test(restart 2)
 set_tests_properties(coupling.restart PROPERTIES TIMEOUT 240)  # ~45 s on a quiet machine
+grainflow_coupling_test(stop_signal 2)
+set_tests_properties(coupling.stop_signal PROPERTIES TIMEOUT 240)  # ~25 s on a quiet machine
