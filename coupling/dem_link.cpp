@@ -1,5 +1,7 @@
 #include "coupling/dem_link.hpp"
 
+#include <fenv.h>
+
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -7,6 +9,7 @@
 #include <stdexcept>
 
 #include "dem/engine/checkpoint_series.hpp"
+#include "dem/engine/finite_guard.hpp"
 #include "dem/engine/simulation.hpp"
 #include "dem/fluid/coupled_fluid.hpp"
 #include "dem/fluid/fluid_forces.hpp"
@@ -253,10 +256,38 @@ void DemLink::set_fluid(std::vector<FluidAtParticle> samples,
   });
 }
 
-void DemLink::advance(int steps) {
+namespace {
+
+// OpenFOAM traps floating-point exceptions (FOAM_SIGFPE): a NaN born in the DEM would kill
+// the run with a stack trace before the DEM's own guard could name the particle. The DEM
+// steps run with the traps off, and the guard checks every step instead.
+class FloatingPointTrapsOff {
+ public:
+  FloatingPointTrapsOff() : traps_(fegetexcept()) {
+    if (traps_ != 0) fedisableexcept(traps_);
+  }
+  ~FloatingPointTrapsOff() {
+    if (traps_ == 0) return;
+    feclearexcept(FE_ALL_EXCEPT);  // flags raised (and checked) in the DEM
+    feenableexcept(traps_);
+  }
+  FloatingPointTrapsOff(const FloatingPointTrapsOff&) = delete;
+  FloatingPointTrapsOff& operator=(const FloatingPointTrapsOff&) = delete;
+
+ private:
+  int traps_;
+};
+
+}  // namespace
+
+void DemLink::advance(int steps, const std::string& diagnostic_directory) {
   Simulation& sim = impl_->simulation();
+  const FloatingPointTrapsOff traps_off;
   try {
-    for (int k = 0; k < steps; ++k) sim.step();
+    for (int k = 0; k < steps; ++k) {
+      sim.step();
+      guard_finite(sim, diagnostic_directory, impl_->dem_comm);
+    }
   } catch (const std::exception& e) {
     throw std::runtime_error(e.what());
   }

@@ -102,8 +102,11 @@ class DemLink {
   // `late` samples a particle that reaches this rank during the next advance().
   void set_fluid(std::vector<FluidAtParticle> samples,
                  std::function<FluidAtParticle(const std::array<double, 3>&)> late);
-  // `steps` DEM steps (collective). Throws std::runtime_error with the DEM's message.
-  void advance(int steps);
+  // `steps` DEM steps (collective). After each, the NaN / Inf guard: the first non-finite
+  // particle state stops the run with the particle, its forces and a diagnostic snapshot
+  // of every particle in `diagnostic_directory`. Throws std::runtime_error with the DEM's
+  // message.
+  void advance(int steps, const std::string& diagnostic_directory);
 
   DemSummary summary() const;  // collective
   // Writes a particle snapshot (HDF5 + XDMF index) into `directory` (created if missing).

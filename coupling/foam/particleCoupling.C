@@ -574,7 +574,7 @@ void ParticleCoupling::evolve() {
   couplingSeconds_ += seconds_since(t0);
   t0 = Clock::now();
   try {
-    dem_->advance(subSteps_);
+    dem_->advance(subSteps_, snapshotDir_);
   } catch (const std::exception& e) {
     FatalErrorInFunction << "\n" << e.what() << Foam::exit(Foam::FatalError);
   }

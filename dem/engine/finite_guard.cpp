@@ -4,6 +4,10 @@
 #include <cstddef>
 #include <sstream>
 
+#include "dem/engine/simulation.hpp"
+#include "dem/io/snapshot_writer.hpp"
+#include "dem/parallel/exchange.hpp"
+
 namespace grainflow {
 namespace {
 
@@ -49,6 +53,24 @@ std::string describe_first_non_finite(const Particles& p, long step, double time
        "stiffness (see `grain check`), particles inserted deeply overlapping, or a NaN in an "
        "input file";
   return s.str();
+}
+
+void guard_finite(const Simulation& sim, const std::string& directory, MPI_Comm comm) {
+  if (!non_finite_anywhere(sim.particles(), comm)) return;
+  std::string where;
+  try {
+    prepare_output_directory(directory);  // a coupled run may not have written any yet
+    SnapshotWriter diagnostic(comm, directory, "diagnostic");
+    where = "; every particle of this step is in " +
+            diagnostic.write(sim.particles(), sim.time(), sim.counters().steps);
+  } catch (const OutputError& e) {
+    where = std::string("; the diagnostic snapshot could not be written: ") + e.what();
+  }
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  const std::string mine =
+      describe_first_non_finite(sim.particles(), sim.counters().steps, sim.time(), rank);
+  agree_on_error(comm, mine.empty() ? mine : mine + where);
 }
 
 }  // namespace grainflow

@@ -18,4 +18,11 @@ bool non_finite_anywhere(const Particles& p, MPI_Comm comm);
 // velocity, angular velocity, force and torque), or "" when this rank has none. Local.
 std::string describe_first_non_finite(const Particles& p, long step, double time, int rank);
 
+class Simulation;
+
+// The guard of a run (`grain run`, the coupled DEM): when any rank holds a non-finite
+// particle, writes every particle of this step to <directory>/diagnostic_<n>.h5 and throws
+// the same ParallelError on every rank, describing the first bad particle. Collective.
+void guard_finite(const Simulation& sim, const std::string& directory, MPI_Comm comm);
+
 }  // namespace grainflow

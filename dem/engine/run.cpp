@@ -22,25 +22,6 @@
 namespace grainflow {
 namespace {
 
-// Stops the run on every rank at the first non-finite particle state, after writing every
-// particle into <dir>/diagnostic_000000.h5.
-void guard_finite(const Simulation& sim, const std::string& dir, MPI_Comm comm) {
-  if (!non_finite_anywhere(sim.particles(), comm)) return;
-  std::string where;
-  try {
-    SnapshotWriter diagnostic(comm, dir, "diagnostic");
-    where = "; every particle of this step is in " +
-            diagnostic.write(sim.particles(), sim.time(), sim.counters().steps);
-  } catch (const OutputError& e) {
-    where = std::string("; the diagnostic snapshot could not be written: ") + e.what();
-  }
-  int rank = 0;
-  MPI_Comm_rank(comm, &rank);
-  const std::string mine =
-      describe_first_non_finite(sim.particles(), sim.counters().steps, sim.time(), rank);
-  agree_on_error(comm, mine.empty() ? mine : mine + where);
-}
-
 // Rank 0 speaks for the run; the other ranks write into this sink.
 std::ostream& speaker(MPI_Comm comm, std::ostream& out) {
   static std::ostream silent(nullptr);

@@ -29,6 +29,7 @@ import subprocess
 import sys
 import time
 
+import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
@@ -449,8 +450,61 @@ def stop_signal(runner, checks):
                     read_foam_binary_or_ascii(case, end_time, field))
             checks.expect(same, f"np {ranks}: {field} at t = {end_time} equal byte for byte")
 
+# --- coupling.nan_guard -----------------------------------------------------------------
+
+
+def nan_guard(runner, checks):
+    """The NaN / Inf guard in a coupled run: cases/periodic_box runs 10 fluid steps and
+    writes its checkpoint; the velocity of one bead that touches nothing is set to NaN
+    (h5py) and the run is restarted from it. The first DEM step must stop grainFoam with an
+    error naming that particle, its non-finite state and its forces (not OpenFOAM's
+    floating-point trap, which the DEM steps run without), and write every particle of
+    that step to particles/diagnostic_000000.h5 — on 1 rank and on 2."""
+    for ranks in (1, 2):
+        case = runner.fresh_case("periodic_box", f"nan_np{ranks}", [
+            ("system/controlDict", "endTime         2e-4;", "endTime         1e-3;"),
+            ("system/controlDict", "writeInterval   1;", "writeInterval   10;")])
+        runner.solve(case, ranks)
+        checkpoint = os.path.join(case, "particles", "checkpoint_000000100.h5")
+        with h5py.File(checkpoint, "r+") as f:
+            ids, x = f["particles/id"][:], f["particles/position"][:]
+            r = f["particles/radius"][:]
+            # A bead touching nothing (periodic minimum image along x and y): the NaN must
+            # not reach a contact partner within the step, so the guard names this one.
+            d = x[:, None, :] - x[None, :, :]
+            d[:, :, :2] -= BOX * np.round(d[:, :, :2] / BOX)
+            gap = np.linalg.norm(d, axis=2) - (r[:, None] + r[None, :])
+            np.fill_diagonal(gap, np.inf)
+            alone = np.flatnonzero(gap.min(axis=1) > 1e-4)
+            k = int(alone[len(alone) // 2])
+            victim = int(ids[k])
+            v = f["particles/velocity"][:]
+            v[k, 0] = float("nan")
+            f["particles/velocity"][...] = v
+        path = os.path.join(case, "system", "controlDict")
+        with open(path) as f:
+            text = f.read().replace("endTime         1e-3;", "endTime         2e-3;")
+        with open(path, "w") as f:
+            f.write(text.replace("startFrom       startTime;", "startFrom       latestTime;"))
+        log = runner.run(case, "grainFoam.nan", runner.solver, ranks=ranks, expect_failure=True)
+        # The first step's drift carries the NaN from the velocity into the position.
+        named = re.search(rf"step 101 \(t = 0.00101 s\): particle {victim} \(rank \d+\) has a "
+                          r"non-finite (position|velocity); position \(nan, .*\) m, "
+                          r"velocity \(nan, .*force \(", log)
+        checks.expect(named is not None, f"np {ranks}: the error names step 101, particle "
+                                         f"{victim}, its NaN state and its force")
+        diagnostic = os.path.join(case, "particles", "diagnostic_000000.h5")
+        count = 0
+        if os.path.exists(diagnostic):
+            with h5py.File(diagnostic, "r") as f:
+                count = int(f.attrs["count"])
+        checks.expect(count == 307 and "diagnostic_000000.h5" in log,
+                      f"np {ranks}: the log names the diagnostic snapshot, which holds {count} "
+                      f"particles (307)")
+
+
 TESTS = {f.__name__: f for f in (void_fraction_volume, exchange_balance, neutrally_buoyant,
-                                 refuses_bad_setup, restart, stop_signal)}
+                                 refuses_bad_setup, restart, stop_signal, nan_guard)}
 
 
 if __name__ == "__main__":

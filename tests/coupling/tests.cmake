@@ -24,6 +24,8 @@
 #   coupling.stop_signal           the same case, SIGTERM mid-run (on 2 ranks to one rank only):
 #       exit 0 with the message, the time written with its checkpoint; restarted, it ends
 #       bit-identical to a run stopped at that time by endTime and restarted. About 25 s.
+#   coupling.nan_guard             a NaN velocity put into the checkpoint: the restarted run
+#       stops at the first DEM step naming that particle, with a diagnostic snapshot.
 if(NOT TARGET grainFoam)
   return()
 endif()
@@ -65,4 +67,5 @@ grainflow_coupling_test(refuses_bad_setup 2)
 grainflow_coupling_test(restart 2)
 set_tests_properties(coupling.restart PROPERTIES TIMEOUT 240)  # ~45 s on a quiet machine
 grainflow_coupling_test(stop_signal 2)
+grainflow_coupling_test(nan_guard 2)
 set_tests_properties(coupling.stop_signal PROPERTIES TIMEOUT 240)  # ~25 s on a quiet machine
