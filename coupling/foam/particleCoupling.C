@@ -10,6 +10,7 @@
 
 #include "coupling/accuracy_table.hpp"
 #include "coupling/shared_decomposition.hpp"
+#include "dem/io/output_directory.hpp"
 #include "zeroGradientFvPatchFields.H"
 #include "interpolationCellPoint.H"
 
@@ -165,6 +166,13 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
                          << exit(FatalError);
   dem_->use_processor_grid(grid);
   snapshotDir_ = mesh.time().rootPath() / mesh.time().globalCaseName() / "particles";
+  // Snapshots, checkpoints and diagnostics go there: a read-only or full disk fails now,
+  // not at the first write time.
+  try {
+    grainflow::prepare_output_directory(snapshotDir_);
+  } catch (const std::exception& e) {
+    FatalErrorInFunction << "\n" << e.what() << exit(FatalError);
+  }
 
   // --- restart: a time that grainFoam wrote names its DEM checkpoint ------------------
   restartIndex_ = mesh.time().timeIndex();
