@@ -26,7 +26,7 @@ inline bool apart(const Vec3& d, double rs) { return d.squaredNorm() >= rs * rs;
 // Evaluates the touching pair (a, b) with displacement d = x_a - x_b.
 template <class Law>
 ContactResult pair_force(const ContactSweep& s, const Vec3& d, const Body& a, const Body& b,
-                         ContactHistory& h, double& overlap) {
+                         ContactHistory& h, double& overlap, double& approach) {
   const double rs = a.r + b.r;
   const double dist = std::sqrt(d.squaredNorm());
   ContactGeometry g;
@@ -49,6 +49,7 @@ ContactResult pair_force(const ContactSweep& s, const Vec3& d, const Body& a, co
   if constexpr (Law::needs_roll_inertia)
     g.roll_inertia =
         1.0 / (1.0 / (a.inertia + a.m * a.r * a.r) + 1.0 / (b.inertia + b.m * b.r * b.r));
+  approach = -g.v_rel.dot(g.n);  // the spin part of v_rel is normal to n
   return Law::evaluate(g, s.table(a.material, b.material), s.constants, h, s.dt);
 }
 
@@ -65,12 +66,12 @@ void local_pair_sweep(ContactSweep& s) {
         continue;
       }
       const std::size_t a = p.id[i] < p.id[j] ? i : j, b = a == i ? j : i;
-      double overlap;
+      double overlap, approach;
       const ContactResult r = pair_force<Law>(
           s, p.x[a] - p.x[b],
           Body{p.v[a], p.omega[a], p.radius[a], p.mass[a], p.inertia[a], p.material[a]},
           Body{p.v[b], p.omega[b], p.radius[b], p.mass[b], p.inertia[b], p.material[b]}, h,
-          overlap);
+          overlap, approach);
       p.force[a] += r.force;
       p.force[b] -= r.force;
       if constexpr (Law::needs_spin) {
@@ -86,6 +87,11 @@ void local_pair_sweep(ContactSweep& s) {
                          p.radius[a] * p.radius[b] / (p.radius[a] + p.radius[b]),
                          p.mass[a] * p.mass[b] / (p.mass[a] + p.mass[b]),
                          s.table(p.material[a], p.material[b]).y_star);
+      if constexpr (kHertz<Law>)
+        s.unresolved.consider(approach, p.radius[a] * p.radius[b] / (p.radius[a] + p.radius[b]),
+                              p.mass[a] * p.mass[b] / (p.mass[a] + p.mass[b]),
+                              s.table(p.material[a], p.material[b]).y_star,
+                              overlap / std::min(p.radius[a], p.radius[b]), p.id[a], p.id[b], s.dt);
     }
   }
 }
@@ -107,12 +113,12 @@ void ghost_pair_sweep(ContactSweep& s) {
       const Body local{p.v[i], p.omega[i], p.radius[i], p.mass[i], p.inertia[i], p.material[i]};
       const Body ghost{g.v[q], g.omega[q], g.radius[q], g.mass[q], g.inertia[q], g.material[q]};
       const bool local_first = p.id[i] < g.id[q];
-      double overlap;
+      double overlap, approach;
       const ContactResult r = local_first
                                   ? pair_force<Law>(s, (p.x[i] - g.x[q]) + (zero - g.shift[q]),
-                                                    local, ghost, h, overlap)
+                                                    local, ghost, h, overlap, approach)
                                   : pair_force<Law>(s, (g.x[q] - p.x[i]) + (g.shift[q] - zero),
-                                                    ghost, local, h, overlap);
+                                                    ghost, local, h, overlap, approach);
       p.force[i] += local_first ? r.force : Vec3(-r.force);
       if constexpr (Law::needs_spin) p.torque[i] += local_first ? r.torque_i : r.torque_j;
       // Both owners see this contact; the owner of the lower id counts it.
@@ -123,6 +129,12 @@ void ghost_pair_sweep(ContactSweep& s) {
                          local.r * ghost.r / (local.r + ghost.r),
                          local.m * ghost.m / (local.m + ghost.m),
                          s.table(local.material, ghost.material).y_star);
+      if constexpr (kHertz<Law>)
+        s.unresolved.consider(approach, local.r * ghost.r / (local.r + ghost.r),
+                              local.m * ghost.m / (local.m + ghost.m),
+                              s.table(local.material, ghost.material).y_star,
+                              overlap / std::min(local.r, ghost.r),
+                              p.id[i], g.id[q], s.dt);
     }
   }
 }

@@ -9,10 +9,13 @@
 // whose partners live on two ranks is evaluated on both, from bit-identical inputs,
 // so both ranks apply exactly opposite forces (Newton's third law holds exactly
 // across rank boundaries, at the price of computing those pairs twice).
+#include <cmath>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "dem/contact/contact_geometry.hpp"
+#include "dem/contact/normal_hertz.hpp"
 #include "dem/contact/pair_coefficients.hpp"
 #include "dem/core/particles.hpp"
 #include "dem/neighbour/verlet_list.hpp"
@@ -42,6 +45,31 @@ struct WorstContact {
   }
 };
 
+// The under-resolved Hertz contact with the fewest steps per contact, for the
+// steps-per-contact guard. A Hertz impact at approach speed v lasts
+//   t_c(v) = 2.868 (m*^2 / (R* Y*^2 v))^{1/5}       (elastic; damping lengthens it)
+// and t_c(v)/dt < N_min  <=>  m*^2 < k R* Y*^2 v  with  k = (N_min dt / 2.868)^5.
+// That test is a few multiplications per contact; the details (one pow) are worked out
+// only for a contact that fails it.
+struct UnresolvedContact {
+  double k = 0;           // (N_min dt / 2.868)^5; 0 turns the test off
+  double fewest = 0;      // t_c(v)/dt of the recorded contact (0: none recorded)
+  double overlap_ratio = 0;
+  WorstContact contact;   // ids, approach speed and pair properties
+  void set(double n_min, double dt) { k = std::pow(n_min * dt / 2.868, 5); }
+  // A touching contact: normal approach speed vn (> 0 approaching), pair properties.
+  void consider(double vn, double rs, double ms, double ys, double overlap_ratio_now, GlobalId ia,
+                GlobalId ib, double dt) {
+    if (!(ms * ms < k * rs * ys * ys * vn)) return;  // resolved, or separating (vn <= 0)
+    const double steps = 2.868 * std::pow(ms * ms / (rs * ys * ys * vn), 0.2) / dt;
+    if (fewest > 0 && steps >= fewest) return;
+    fewest = steps;
+    overlap_ratio = overlap_ratio_now;
+    double unused = 0;
+    contact.consider(1, unused, ia, ib, vn, rs, ms, ys);
+  }
+};
+
 struct ContactSweep {
   Particles& p;
   const Ghosts& ghosts;
@@ -59,7 +87,12 @@ struct ContactSweep {
   long contacts = 0;             // each contact once over all ranks
   double max_overlap_ratio = 0;  // overlap / smaller radius
   WorstContact worst;            // the contact with that overlap
+  UnresolvedContact unresolved;  // set its k before the sweep (Hertz only)
 };
+
+// Whether a contact law's normal slot is Hertz (the steps-per-contact guard applies).
+template <class Law>
+inline constexpr bool kHertz = std::is_same_v<typename Law::normal, HertzNormal>;
 
 using SweepFunction = void (*)(ContactSweep&);
 

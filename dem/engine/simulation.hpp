@@ -136,8 +136,10 @@ class Simulation {
   void compute_forces();     // gravity, contacts, then the force terms
   void apply_force_terms();  // non-contact terms only
   // Stops the run (ParallelError on every rank) when a contact overlaps beyond
-  // time.max_overlap, naming the contact and a time step that would resolve it.
-  void check_overlap(const WorstContact& worst) const;
+  // time.max_overlap, or when a Hertz contact gets fewer than time.min_steps_per_contact
+  // steps at its own approach speed; the message names the contact and a time step that
+  // would resolve it.
+  void check_contacts(const ContactSweep& sweep) const;
   bool needs_rebuild() const;  // collective
   void mark_leaving();         // particles beyond a bounded side of the domain
   void half_kick();            // v += dt/2 F/m (implicit in v where drag is set), same for spin
