@@ -70,8 +70,8 @@ void local_pair_sweep(ContactSweep& s) {
       const ContactResult r = pair_force<Law>(
           s, p.x[a] - p.x[b],
           Body{p.v[a], p.omega[a], p.radius[a], p.mass[a], p.inertia[a], p.material[a]},
-          Body{p.v[b], p.omega[b], p.radius[b], p.mass[b], p.inertia[b], p.material[b]}, h,
-          overlap, approach);
+          Body{p.v[b], p.omega[b], p.radius[b], p.mass[b], p.inertia[b], p.material[b]}, h, overlap,
+          approach);
       p.force[a] += r.force;
       p.force[b] -= r.force;
       if constexpr (Law::needs_spin) {
@@ -133,8 +133,7 @@ void ghost_pair_sweep(ContactSweep& s) {
         s.unresolved.consider(approach, local.r * ghost.r / (local.r + ghost.r),
                               local.m * ghost.m / (local.m + ghost.m),
                               s.table(local.material, ghost.material).y_star,
-                              overlap / std::min(local.r, ghost.r),
-                              p.id[i], g.id[q], s.dt);
+                              overlap / std::min(local.r, ghost.r), p.id[i], g.id[q], s.dt);
     }
   }
 }

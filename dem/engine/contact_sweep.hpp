@@ -52,10 +52,10 @@ struct WorstContact {
 // That test is a few multiplications per contact; the details (one pow) are worked out
 // only for a contact that fails it.
 struct UnresolvedContact {
-  double k = 0;           // (N_min dt / 2.868)^5; 0 turns the test off
-  double fewest = 0;      // t_c(v)/dt of the recorded contact (0: none recorded)
+  double k = 0;       // (N_min dt / 2.868)^5; 0 turns the test off
+  double fewest = 0;  // t_c(v)/dt of the recorded contact (0: none recorded)
   double overlap_ratio = 0;
-  WorstContact contact;   // ids, approach speed and pair properties
+  WorstContact contact;  // ids, approach speed and pair properties
   void set(double n_min, double dt) { k = std::pow(n_min * dt / 2.868, 5); }
   // A touching contact: normal approach speed vn (> 0 approaching), pair properties.
   void consider(double vn, double rs, double ms, double ys, double overlap_ratio_now, GlobalId ia,

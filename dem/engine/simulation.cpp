@@ -377,9 +377,8 @@ void Simulation::check_contacts(const ContactSweep& s) const {
       "about it";
   if (!overlap) {
     o << " approach at " << w.speed << " m/s, overlapping by " << 100 * s.unresolved.overlap_ratio
-      << " % of the smaller radius. At that speed a Hertz contact lasts " << tc
-      << " s: only " << s.unresolved.fewest << " steps of dt = " << dt_
-      << " s (fewer than " << n_min
+      << " % of the smaller radius. At that speed a Hertz contact lasts " << tc << " s: only "
+      << s.unresolved.fewest << " steps of dt = " << dt_ << " s (fewer than " << n_min
       << ", key time.min_steps_per_contact). So coarse a step cannot resolve the contact and "
          "can give it back more energy than it took. A step of at most "
       << tc / 20 << remedy;

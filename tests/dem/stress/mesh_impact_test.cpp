@@ -53,15 +53,20 @@ struct MeshImpact {
   double dt = 0;  // fixed step [s]; 0: 0.2 t_R
 };
 
-void PrintTo(const MeshImpact& c, std::ostream* os) { *os << c.name << " at " << c.speed << " m/s"; }
+void PrintTo(const MeshImpact& c, std::ostream* os) {
+  *os << c.name << " at " << c.speed << " m/s";
+}
 
 // Rotation about x by the tilt: (x, y, 0) -> (x, y cos a, y sin a); the plane's normal is
 // (0, -sin a, cos a).
 Vec3 tilted(const Vec3& x, double a) {
-  return Vec3(x[0], std::cos(a) * x[1] - std::sin(a) * x[2], std::sin(a) * x[1] + std::cos(a) * x[2]);
+  return Vec3(x[0], std::cos(a) * x[1] - std::sin(a) * x[2],
+              std::sin(a) * x[1] + std::cos(a) * x[2]);
 }
 
-double y_star(double youngs) { return youngs / (2 * (1 - kNu * kNu)); }  // wall of the same material
+double y_star(double youngs) {
+  return youngs / (2 * (1 - kNu * kNu));
+}  // wall of the same material
 
 double predicted_overlap_ratio(double youngs, double vn) {
   const double m = kRho * sphere_volume(kR);
@@ -92,7 +97,8 @@ ImpactRun impact(const MeshImpact& c, double dt) {
   test::MeshData mesh = test::flat_grid(4, kLeg, -2 * kLeg, -2 * kLeg, 0);
   for (Vec3& v : mesh.v) v = tilted(v, c.tilt);
   s.walls.push_back(test::mesh_wall(test::write_mesh(mesh, std::string(c.name) + ".stl")));
-  const Vec3 normal = tilted(Vec3::UnitZ(), c.tilt), target = tilted(Vec3(c.along_x, c.along_y, 0), c.tilt);
+  const Vec3 normal = tilted(Vec3::UnitZ(), c.tilt),
+             target = tilted(Vec3(c.along_x, c.along_y, 0), c.tilt);
   // Falling vertically, 1 um (measured along the normal) before touching at the target.
   const Vec3 velocity(0, 0, -c.speed);
   const Vec3 start = target + kR * normal + (1e-6 / std::cos(c.tilt)) * Vec3::UnitZ();
@@ -141,8 +147,8 @@ TEST_P(MeshImpactTest, NeverTunnelsThroughTheMesh) {
 
   if (travel > 1) {
     // Faster than one radius per step: the guard must stop it at its first step past the mesh.
-    ASSERT_FALSE(r.stop.empty()) << "expected the overlap guard to stop a sphere moving "
-                                 << travel << " r per step";
+    ASSERT_FALSE(r.stop.empty()) << "expected the overlap guard to stop a sphere moving " << travel
+                                 << " r per step";
     EXPECT_NE(r.stop.find("particle 1 and a wall overlap by"), std::string::npos) << r.stop;
     EXPECT_NE(r.stop.find("tunnelled"), std::string::npos) << r.stop;
     EXPECT_NE(r.stop.find("key time.max_overlap"), std::string::npos) << r.stop;
@@ -160,10 +166,11 @@ TEST_P(MeshImpactTest, NeverTunnelsThroughTheMesh) {
     EXPECT_GT(fine.lowest, 0.0);
     const double e = fine.v_out.dot(normal) / vn;
     EXPECT_NEAR(e / kE, 1.0, 0.03);
-    std::printf("%s at %4.0f m/s: dt = %.2e s (%.2f r per step) stopped by the overlap guard "
-                "at its first step, %.2f %% overlap with the centre past the mesh; suggested dt "
-                "%.3e s resolves it: e = %.4f, deepest %.2f %% r\n",
-                c.name, c.speed, r.dt, travel, landed, suggested, e, 100 * (1 - fine.lowest));
+    std::printf(
+        "%s at %4.0f m/s: dt = %.2e s (%.2f r per step) stopped by the overlap guard "
+        "at its first step, %.2f %% overlap with the centre past the mesh; suggested dt "
+        "%.3e s resolves it: e = %.4f, deepest %.2f %% r\n",
+        c.name, c.speed, r.dt, travel, landed, suggested, e, 100 * (1 - fine.lowest));
     return;
   }
 
@@ -185,11 +192,11 @@ TEST_P(MeshImpactTest, NeverTunnelsThroughTheMesh) {
     EXPECT_NEAR(e / kE, 1.0, 0.03);
     EXPECT_NEAR(deepest / expected, 1.0, 0.1);
     EXPECT_LT(slip, 1e-9);
-    std::printf("%s at %4.0f m/s: resolved, dt = %.3e s (%.1f steps per contact at v_n = %.1f "
-                "m/s), deepest %.2f %% r (closed form %.2f %%), e = %.4f (asked %.2f), "
-                "tangential change %.1e\n",
-                c.name, c.speed, r.dt, steps_per_contact, vn, 100 * deepest, 100 * expected, e,
-                kE, slip);
+    std::printf(
+        "%s at %4.0f m/s: resolved, dt = %.3e s (%.1f steps per contact at v_n = %.1f "
+        "m/s), deepest %.2f %% r (closed form %.2f %%), e = %.4f (asked %.2f), "
+        "tangential change %.1e\n",
+        c.name, c.speed, r.dt, steps_per_contact, vn, 100 * deepest, 100 * expected, e, kE, slip);
   } else {
     ASSERT_FALSE(r.stop.empty()) << "expected the overlap guard to stop an impact predicted to "
                                     "overlap by "
@@ -200,9 +207,10 @@ TEST_P(MeshImpactTest, NeverTunnelsThroughTheMesh) {
     EXPECT_GT(suggested, 0.0) << r.stop;
     EXPECT_LT(suggested, r.dt) << r.stop;
     EXPECT_LT(r.max_overlap_ratio, limit + vn * r.dt / kR);
-    std::printf("%s at %4.0f m/s: stopped by the overlap guard at %.1f %% r (closed form %.0f "
-                "%%), dt = %.3e s, suggested dt %.3e s\n",
-                c.name, c.speed, 100 * r.max_overlap_ratio, 100 * expected, r.dt, suggested);
+    std::printf(
+        "%s at %4.0f m/s: stopped by the overlap guard at %.1f %% r (closed form %.0f "
+        "%%), dt = %.3e s, suggested dt %.3e s\n",
+        c.name, c.speed, 100 * r.max_overlap_ratio, 100 * expected, r.dt, suggested);
   }
 }
 
@@ -231,7 +239,8 @@ INSTANTIATE_TEST_SUITE_P(
         // 1.5 r per step.
         MeshImpact{"glass_vertex_one_and_a_half_radii_per_step", 60e9, 50, 0, 0, 0, 3e-5}),
     [](const testing::TestParamInfo<MeshImpact>& i) {
-      return std::string(i.param.name) + "_" + std::to_string(static_cast<int>(i.param.speed)) + "ms";
+      return std::string(i.param.name) + "_" + std::to_string(static_cast<int>(i.param.speed)) +
+             "ms";
     });
 
 }  // namespace

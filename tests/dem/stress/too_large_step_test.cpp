@@ -134,9 +134,10 @@ TEST_P(TooLargeStep, StopsWithAWorkingStepBeforeGainingEnergy) {
     // leaves the floor faster than it arrived although it was asked for e = 0.5.
     ASSERT_TRUE(m.empty()) << m;
     EXPECT_GT(big.rebound, big.impact);
-    std::printf("%s: dt = %.1e s ran to t = %.2e s unstopped: in at %.2f m/s, out at %.2f m/s "
-                "(asked e = %.1f: %.2f m/s)\n",
-                c.name, kDt, big.time, big.impact, big.rebound, kE, kE * big.impact);
+    std::printf(
+        "%s: dt = %.1e s ran to t = %.2e s unstopped: in at %.2f m/s, out at %.2f m/s "
+        "(asked e = %.1f: %.2f m/s)\n",
+        c.name, kDt, big.time, big.impact, big.rebound, kE, kE * big.impact);
     return;
   }
 
@@ -185,24 +186,23 @@ TEST_P(TooLargeStep, StopsWithAWorkingStepBeforeGainingEnergy) {
     EXPECT_NEAR(fine.rebound / fine.impact, kE, 0.03 * kE);
   }
   char rebound[64] = "";
-  if (!c.layer) std::snprintf(rebound, sizeof rebound, ", restitution %.4f", fine.rebound / fine.impact);
+  if (!c.layer)
+    std::snprintf(rebound, sizeof rebound, ", restitution %.4f", fine.rebound / fine.impact);
   std::printf(
       "%s: dt = %.1e s stopped at t = %.2e s (%.0f steps), suggested dt %.3e s, which ran %.1e "
       "s clean%s; fastest sphere %.2f m/s before the stop\n  message: %s\n",
-      c.name, kDt, big.time, big.time / kDt, suggested, fine.time, rebound, big.fastest,
-      m.c_str());
+      c.name, kDt, big.time, big.time / kDt, suggested, fine.time, rebound, big.fastest, m.c_str());
 }
 
 INSTANTIATE_TEST_SUITE_P(
     Scenes, TooLargeStep,
-    testing::Values(StepCase{"rain on a layer", true, 0, true, Stop::steps_per_contact},
-                    StepCase{"one sphere from 1.3 r", false, 1.3, true, Stop::steps_per_contact},
-                    StepCase{"one sphere from 1.4 r", false, 1.4, true, Stop::steps_per_contact},
-                    StepCase{"rain on a layer, steps guard off", true, 0, false, Stop::overlap},
-                    StepCase{"one sphere from 1.3 r, steps guard off", false, 1.3, false,
-                             Stop::overlap},
-                    StepCase{"one sphere from 1.4 r, steps guard off", false, 1.4, false,
-                             Stop::none}),
+    testing::Values(
+        StepCase{"rain on a layer", true, 0, true, Stop::steps_per_contact},
+        StepCase{"one sphere from 1.3 r", false, 1.3, true, Stop::steps_per_contact},
+        StepCase{"one sphere from 1.4 r", false, 1.4, true, Stop::steps_per_contact},
+        StepCase{"rain on a layer, steps guard off", true, 0, false, Stop::overlap},
+        StepCase{"one sphere from 1.3 r, steps guard off", false, 1.3, false, Stop::overlap},
+        StepCase{"one sphere from 1.4 r, steps guard off", false, 1.4, false, Stop::none}),
     [](const testing::TestParamInfo<StepCase>& i) {
       std::string name;
       for (const char* s = i.param.name; *s; ++s)
