@@ -11,11 +11,9 @@
 // across rank boundaries, at the price of computing those pairs twice).
 #include <cmath>
 #include <string>
-#include <type_traits>
 #include <vector>
 
 #include "dem/contact/contact_geometry.hpp"
-#include "dem/contact/normal_hertz.hpp"
 #include "dem/contact/pair_coefficients.hpp"
 #include "dem/core/particles.hpp"
 #include "dem/neighbour/verlet_list.hpp"
@@ -57,17 +55,16 @@ struct UnresolvedContact {
   double overlap_ratio = 0;
   WorstContact contact;  // ids, approach speed and pair properties
   void set(double n_min, double dt) { k = std::pow(n_min * dt / 2.868, 5); }
-  // A touching contact: normal approach speed vn (> 0 approaching), pair properties.
+  // One touching contact: vn its normal approach speed (> 0 approaching; a separating
+  // contact never fails), rs, ms, ys its R*, m*, Y*.
   void consider(double vn, double rs, double ms, double ys, double overlap_ratio_now, GlobalId ia,
                 GlobalId ib, double dt) {
-    if (!(ms * ms < k * rs * ys * ys * vn)) return;  // resolved, or separating (vn <= 0)
-    const double steps = 2.868 * std::pow(ms * ms / (rs * ys * ys * vn), 0.2) / dt;
-    if (fewest > 0 && steps >= fewest) return;
-    fewest = steps;
-    overlap_ratio = overlap_ratio_now;
-    double unused = 0;
-    contact.consider(1, unused, ia, ib, vn, rs, ms, ys);
+    if (ms * ms < k * rs * ys * ys * vn) [[unlikely]]
+      record(vn, rs, ms, ys, overlap_ratio_now, ia, ib, dt);
   }
+  // Keeps a failing contact if it has the fewest steps so far (rare; out of line).
+  void record(double vn, double rs, double ms, double ys, double overlap_ratio_now, GlobalId ia,
+              GlobalId ib, double dt);
 };
 
 struct ContactSweep {
@@ -87,12 +84,8 @@ struct ContactSweep {
   long contacts = 0;             // each contact once over all ranks
   double max_overlap_ratio = 0;  // overlap / smaller radius
   WorstContact worst;            // the contact with that overlap
-  UnresolvedContact unresolved;  // set its k before the sweep (Hertz only)
+  UnresolvedContact unresolved;  // filled by steps_per_contact_sweep
 };
-
-// Whether a contact law's normal slot is Hertz (the steps-per-contact guard applies).
-template <class Law>
-inline constexpr bool kHertz = std::is_same_v<typename Law::normal, HertzNormal>;
 
 using SweepFunction = void (*)(ContactSweep&);
 
@@ -104,5 +97,11 @@ struct SweepChoice {
 };
 
 SweepChoice select_sweep(const ContactSettings& settings);
+
+// The steps-per-contact test (UnresolvedContact) over every touching contact of the
+// sweep's lists and walls, as the force sweep finds them, into s.unresolved. A pass of its
+// own, so that the force loop holds no trace of it: the engine runs it (Hertz only) in
+// the steps where some contact could fail (Simulation::contact_may_be_unresolved).
+void steps_per_contact_sweep(ContactSweep& s);
 
 }  // namespace grainflow

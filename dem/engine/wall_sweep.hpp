@@ -46,10 +46,6 @@ void apply_wall_contact(ContactSweep& s, std::size_t i, const WallTouch& t, int 
   if (const double ratio = g.overlap / p.radius[i]; ratio > s.max_overlap_ratio)
     s.worst.consider(ratio, s.max_overlap_ratio, p.id[i], -1, -g.v_rel.dot(g.n), g.r_star,
                      g.m_star, s.table(p.material[i], material).y_star);
-  if constexpr (kHertz<Law>)
-    s.unresolved.consider(-g.v_rel.dot(g.n), g.r_star, g.m_star,
-                          s.table(p.material[i], material).y_star, g.overlap / p.radius[i], p.id[i],
-                          -1, s.dt);
 }
 
 // A plane or a cylinder, against the particles of its neighbour list (all of them when
