@@ -321,15 +321,24 @@ void Simulation::rebuild() {
   exchange_->borders(p_, cutoff_, ghosts_);
   grid_->build(p_, ghosts_, skin_, local_list_, ghost_list_);
   restore_histories(carried);
+  // Bounds for contact_may_be_unresolved, over the particles that can touch anything here:
+  // the least m^2/r, and the largest Y* of a pair with one of their materials.
   lightest_q_ = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < p_.size(); ++i)
+  std::vector<char> present(table_.size(), 0);
+  for (std::size_t i = 0; i < p_.size(); ++i) {
     lightest_q_ = std::min(lightest_q_, p_.mass[i] * p_.mass[i] / p_.radius[i]);
-  for (std::size_t k = 0; k < ghosts_.size(); ++k)
+    present[p_.material[i]] = 1;
+  }
+  for (std::size_t k = 0; k < ghosts_.size(); ++k) {
     lightest_q_ = std::min(lightest_q_, ghosts_.mass[k] * ghosts_.mass[k] / ghosts_.radius[k]);
+    present[ghosts_.material[k]] = 1;
+  }
   largest_y_star_ = 0;
-  for (int a = 0; a < table_.size(); ++a)
+  for (int a = 0; a < table_.size(); ++a) {
+    if (!present[a]) continue;
     for (int b = 0; b < table_.size(); ++b)
       largest_y_star_ = std::max(largest_y_star_, table_(a, b).y_star);
+  }
   wall_neighbours_.build(p_, walls_, skin_);
   wall_neighbours_.end_unlisted_springs(walls_, wall_history_);
   x_at_build_ = p_.x;

@@ -161,8 +161,8 @@ class Simulation {
   ContactConstants constants_;
   SweepChoice sweep_;
   double dt_ = 0, time_ = 0, skin_ = 0, cutoff_ = 0;
-  // For contact_may_be_unresolved: min m^2/r over local and ghost particles (set at each
-  // rebuild), and the largest Y* of the pair table.
+  // For contact_may_be_unresolved, set at each rebuild: min m^2/r over local and ghost
+  // particles, and the largest Y* of a pair involving one of their materials.
   double lightest_q_ = 0, largest_y_star_ = 0;
   std::unique_ptr<BinGrid> grid_;
   NeighbourList local_list_, ghost_list_;
