@@ -351,9 +351,9 @@ def emptied_and_refilled_cells(runner, checks):
 
 
 def fast_crossing_ranks(runner, checks):
-    """The convected slab of emptied_and_refilled_cells for 12 ms (3 laps) on 1, 2 and 4
+    """The convected slab of emptied_and_refilled_cells for 8 ms (2 laps) on 1, 2 and 4
     ranks (simple (2 1 1) and (4 1 1), --oversubscribe): the beads cross the processor
-    planes and the periodic face (also a processor boundary) at 5 m/s, 3 times each, and
+    planes and the periodic face (also a processor boundary) at 5 m/s, twice each, and
     whole ranks are empty at times (all 60 beads beyond a plane). Checked: the common
     invariants on every run (count conserved, none removed, volume and exchange balance to
     1e-12, eps bounds); every rank held no bead at >= 2 writes.
@@ -369,7 +369,7 @@ def fast_crossing_ranks(runner, checks):
     arrivals per bead: |dv| <= n 2 |dv/dt|max dt_f and |dx| <= that times the run time.
     Positions (modulo the period) and velocities after reconstructPar must stay within
     those bounds; the measured differences are printed."""
-    end_time, dt_f = 0.012, 1e-4
+    end_time, dt_f = 0.008, 1e-4
     eps, snaps, late, first_late = {}, {}, {}, {}
     for ranks in (1, 2, 4):
         label = f"slab np {ranks}"
@@ -397,7 +397,8 @@ def fast_crossing_ranks(runner, checks):
                                            f"rank held no bead: {empty} (>= 2 each)")
             changes = np.sum(np.diff(np.array(owner), axis=0) != 0, axis=0)
             laps = slab_laps(snaps[ranks])
-            checks.expect(laps.min() >= 2 and changes.min() >= 2 * ranks,
+            # Two laps make 2 x ranks changes of rank; the first may come before the first write.
+            checks.expect(laps.min() >= 2 and changes.min() >= 2 * ranks - 1,
                           f"{label}: per bead, {laps.min()}..{laps.max()} laps and "
                           f"{changes.min()}..{changes.max()} changes of rank between writes; "
                           f"{late[ranks]} samples on arrival in all")

@@ -25,7 +25,7 @@
 #   coupling_stress.emptied_and_refilled_cells  cases/convected: a slab of 60 beads launched
 #       at 5 m/s round a periodic box of 8 x 2 x 2 cells, 5 laps: every cell is exactly 1 at
 #       some writes and < 1 at others, >= 4 empty -> filled transitions per cell.
-#   coupling_stress.fast_crossing_ranks  the same slab for 3 laps on 1, 2 and 4 ranks: every
+#   coupling_stress.fast_crossing_ranks  the same slab for 2 laps on 1, 2 and 4 ranks: every
 #       rank empty at >= 2 writes; agreement with 1 rank to round-off until the first bead
 #       changes rank, then within the bound set by samples taken on arrival.
 # Run time on 2 cores: each under 60 s (measured figures in docs/stability.md).
@@ -66,3 +66,6 @@ grainflow_coupling_stress_test(on_faces_and_corners_2ranks 2)
 grainflow_coupling_stress_test(crowded_cell_2ranks 2)
 grainflow_coupling_stress_test(emptied_and_refilled_cells 1)
 grainflow_coupling_stress_test(fast_crossing_ranks 2)
+# Five grainFoam runs, two of them on 4 ranks oversubscribed on 2 cores: 15-20 s alone, but
+# slow when the machine is shared.
+set_tests_properties(coupling_stress.fast_crossing_ranks PROPERTIES TIMEOUT 180)
