@@ -255,6 +255,7 @@ class ImpactRig {
     s.domain.lo = Vec3(-0.01, -0.01, -0.01);
     s.domain.hi = Vec3(0.03, 0.01, 0.01);
     s.time.max_overlap = 1;
+    s.time.min_steps_per_contact = 0;  // the sweep measures impacts down to 3 steps
     Wall wall;
     wall.name = "wall";
     wall.plane.point = Vec3::Zero();

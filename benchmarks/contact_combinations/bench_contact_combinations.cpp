@@ -7,6 +7,8 @@
 // and reports the median time per step and its ratio to the cheapest law.
 //
 // usage: bench_contact_combinations [--particles N] [--steps S] [--rounds R] [--markdown FILE]
+#include <mpi.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
@@ -73,6 +75,7 @@ double seconds_per_step(Scene scene, const Particles& start, double dt, long ste
 }  // namespace
 
 int main(int argc, char** argv) {
+  MPI_Init(&argc, &argv);  // the engine runs on a communicator, even on one rank
   long particles = 8000, steps = 400;
   int rounds = 3;
   std::string markdown;
@@ -85,6 +88,7 @@ int main(int argc, char** argv) {
     else {
       std::cerr << "usage: bench_contact_combinations [--particles N] [--steps S] [--rounds R] "
                    "[--markdown FILE]\n";
+      MPI_Finalize();
       return 2;
     }
   }
@@ -152,5 +156,6 @@ int main(int argc, char** argv) {
         << " interleaved rounds of " << steps << " steps each.\n\n"
         << table.str();
   }
+  MPI_Finalize();
   return 0;
 }

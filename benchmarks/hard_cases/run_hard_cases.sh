@@ -11,7 +11,8 @@ scale=${2:-10}
 export GRAINFLOW_STRESS_SCALE=$scale
 export OMPI_ALLOW_RUN_AS_ROOT=${OMPI_ALLOW_RUN_AS_ROOT:-1}
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=${OMPI_ALLOW_RUN_AS_ROOT_CONFIRM:-1}
-serial=(stiff_contacts_test high_speed_impact_test wide_size_distribution_test too_large_step_test)
+serial=(stiff_contacts_test high_speed_impact_test mesh_impact_test wide_size_distribution_test
+        too_large_step_test)
 parallel=(fast_crossing_mpi4_test boundary_resting_mpi4_test periodic_side_many_ranks_mpi4_test)
 ninja -C "$build" -j2 "${serial[@]}" "${parallel[@]}" || exit 1
 mkdir -p "$build/hard_cases"

@@ -6,6 +6,17 @@
 #include "dem/engine/wall_sweep.hpp"
 
 namespace grainflow {
+
+void UnresolvedContact::record(double vn, double rs, double ms, double ys, double overlap_ratio_now,
+                               GlobalId ia, GlobalId ib, double dt) {
+  const double steps = 2.868 * std::pow(ms * ms / (rs * ys * ys * vn), 0.2) / dt;
+  if (fewest > 0 && steps >= fewest) return;
+  fewest = steps;
+  overlap_ratio = overlap_ratio_now;
+  double unused = 0;
+  contact.consider(1, unused, ia, ib, vn, rs, ms, ys);
+}
+
 namespace {
 
 // The state of one body of a pair, as the pair kernel reads it.
@@ -167,6 +178,80 @@ SweepChoice pick_tangential(const ContactSettings& c) {
 SweepChoice select_sweep(const ContactSettings& settings) {
   if (settings.normal == NormalModel::hooke) return pick_tangential<HookeNormal>(settings);
   return pick_tangential<HertzNormal>(settings);
+}
+
+void steps_per_contact_sweep(ContactSweep& s) {
+  const Particles& p = s.p;
+  const Ghosts& g = s.ghosts;
+  UnresolvedContact& u = s.unresolved;
+  const Vec3 zero = Vec3::Zero();
+  // Pairs: the same lists, touching test and canonical ids as the force sweep.
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    for (int k = s.local_list.offsets[i]; k < s.local_list.offsets[i + 1]; ++k) {
+      const std::size_t j = s.local_list.j[k];
+      const Vec3 d = p.x[i] - p.x[j];
+      const double rs = p.radius[i] + p.radius[j];
+      if (apart(d, rs)) continue;
+      const double dist = std::sqrt(d.squaredNorm());
+      u.consider((d / dist).dot(p.v[j] - p.v[i]), p.radius[i] * p.radius[j] / rs,
+                 p.mass[i] * p.mass[j] / (p.mass[i] + p.mass[j]),
+                 s.table(p.material[i], p.material[j]).y_star,
+                 (rs - dist) / std::min(p.radius[i], p.radius[j]), std::min(p.id[i], p.id[j]),
+                 std::max(p.id[i], p.id[j]), s.dt);
+    }
+    for (int k = s.ghost_list.offsets[i]; k < s.ghost_list.offsets[i + 1]; ++k) {
+      const std::size_t q = s.ghost_list.j[k];
+      const Vec3 d = (p.x[i] - g.x[q]) + (zero - g.shift[q]);
+      const double rs = p.radius[i] + g.radius[q];
+      if (apart(d, rs)) continue;
+      const double dist = std::sqrt(d.squaredNorm());
+      u.consider((d / dist).dot(g.v[q] - p.v[i]), p.radius[i] * g.radius[q] / rs,
+                 p.mass[i] * g.mass[q] / (p.mass[i] + g.mass[q]),
+                 s.table(p.material[i], g.material[q]).y_star,
+                 (rs - dist) / std::min(p.radius[i], g.radius[q]), std::min(p.id[i], g.id[q]),
+                 std::max(p.id[i], g.id[q]), s.dt);
+    }
+  }
+  // Walls: the approach speed relative to the wall's surface at the contact point.
+  auto wall_contact = [&](std::size_t i, const WallTouch& t, int material) {
+    u.consider(-(p.v[i] - t.surface_velocity).dot(t.n), p.radius[i], p.mass[i],
+               s.table(p.material[i], material).y_star, t.overlap / p.radius[i], p.id[i], -1, s.dt);
+  };
+  for (std::size_t w = 0; w < s.walls.walls().size(); ++w) {
+    const WallSet::Entry& wall = s.walls.walls()[w];
+    if (wall.kind == Wall::Kind::mesh) {
+      const TriangleMesh& mesh = s.walls.mesh(wall);
+      const bool moving = wall.pose.moving();
+      const Vec3 belt = wall.pose.direction_to_world(wall.surface_velocity);
+      MeshTouch touch[TriangleMesh::kMaxTouches];
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        const double r = p.radius[i];
+        const int n = mesh.touches(moving ? wall.pose.to_body(p.x[i]) : p.x[i], r, touch);
+        for (int k = 0; k < n; ++k) {
+          WallTouch t;
+          t.n = moving ? wall.pose.direction_to_world(touch[k].n) : touch[k].n;
+          t.overlap = touch[k].overlap;
+          t.surface_velocity = belt - belt.dot(t.n) * t.n;
+          if (moving) t.surface_velocity += wall.pose.velocity_at(p.x[i] - (r - t.overlap) * t.n);
+          wall_contact(i, t, wall.material);
+        }
+      }
+      continue;
+    }
+    const WallNeighbours::List& list = s.wall_neighbours.lists[w];
+    const std::size_t n = list.all ? p.size() : list.i.size();
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::size_t i = list.all ? k : static_cast<std::size_t>(list.i[k]);
+      WallTouch t;
+      const bool touching = wall.kind == Wall::Kind::plane
+                                ? touch_plane(wall.plane, p.x[i], p.radius[i], t)
+                                : touch_cylinder(wall.cylinder, p.x[i], p.radius[i], t);
+      if (!touching) continue;
+      if (wall.pose.moving())
+        t.surface_velocity += wall.pose.velocity_at(p.x[i] - (p.radius[i] - t.overlap) * t.n);
+      wall_contact(i, t, wall.material);
+    }
+  }
 }
 
 }  // namespace grainflow

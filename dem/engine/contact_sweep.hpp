@@ -9,6 +9,7 @@
 // whose partners live on two ranks is evaluated on both, from bit-identical inputs,
 // so both ranks apply exactly opposite forces (Newton's third law holds exactly
 // across rank boundaries, at the price of computing those pairs twice).
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,30 @@ struct WorstContact {
   }
 };
 
+// The under-resolved Hertz contact with the fewest steps per contact, for the
+// steps-per-contact guard. A Hertz impact at approach speed v lasts
+//   t_c(v) = 2.868 (m*^2 / (R* Y*^2 v))^{1/5}       (elastic; damping lengthens it)
+// and t_c(v)/dt < N_min  <=>  m*^2 < k R* Y*^2 v  with  k = (N_min dt / 2.868)^5.
+// That test is a few multiplications per contact; the details (one pow) are worked out
+// only for a contact that fails it.
+struct UnresolvedContact {
+  double k = 0;       // (N_min dt / 2.868)^5; 0 turns the test off
+  double fewest = 0;  // t_c(v)/dt of the recorded contact (0: none recorded)
+  double overlap_ratio = 0;
+  WorstContact contact;  // ids, approach speed and pair properties
+  void set(double n_min, double dt) { k = std::pow(n_min * dt / 2.868, 5); }
+  // One touching contact: vn its normal approach speed (> 0 approaching; a separating
+  // contact never fails), rs, ms, ys its R*, m*, Y*.
+  void consider(double vn, double rs, double ms, double ys, double overlap_ratio_now, GlobalId ia,
+                GlobalId ib, double dt) {
+    if (ms * ms < k * rs * ys * ys * vn) [[unlikely]]
+      record(vn, rs, ms, ys, overlap_ratio_now, ia, ib, dt);
+  }
+  // Keeps a failing contact if it has the fewest steps so far (rare; out of line).
+  void record(double vn, double rs, double ms, double ys, double overlap_ratio_now, GlobalId ia,
+              GlobalId ib, double dt);
+};
+
 struct ContactSweep {
   Particles& p;
   const Ghosts& ghosts;
@@ -59,6 +84,7 @@ struct ContactSweep {
   long contacts = 0;             // each contact once over all ranks
   double max_overlap_ratio = 0;  // overlap / smaller radius
   WorstContact worst;            // the contact with that overlap
+  UnresolvedContact unresolved;  // filled by steps_per_contact_sweep
 };
 
 using SweepFunction = void (*)(ContactSweep&);
@@ -71,5 +97,11 @@ struct SweepChoice {
 };
 
 SweepChoice select_sweep(const ContactSettings& settings);
+
+// The steps-per-contact test (UnresolvedContact) over every touching contact of the
+// sweep's lists and walls, as the force sweep finds them, into s.unresolved. A pass of its
+// own, so that the force loop holds no trace of it: the engine runs it (Hertz only) in
+// the steps where some contact could fail (Simulation::contact_may_be_unresolved).
+void steps_per_contact_sweep(ContactSweep& s);
 
 }  // namespace grainflow

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <unordered_map>
 
@@ -366,6 +367,24 @@ void Simulation::rebuild(bool keep_drag) {
       drag_.fluid_velocity[i] = Vec3(k[1], k[2], k[3]);
     }
   }
+  // Bounds for contact_may_be_unresolved, over the particles that can touch anything here:
+  // the least m^2/r, and the largest Y* of a pair with one of their materials.
+  lightest_q_ = std::numeric_limits<double>::infinity();
+  std::vector<char> present(table_.size(), 0);
+  for (std::size_t i = 0; i < p_.size(); ++i) {
+    lightest_q_ = std::min(lightest_q_, p_.mass[i] * p_.mass[i] / p_.radius[i]);
+    present[p_.material[i]] = 1;
+  }
+  for (std::size_t k = 0; k < ghosts_.size(); ++k) {
+    lightest_q_ = std::min(lightest_q_, ghosts_.mass[k] * ghosts_.mass[k] / ghosts_.radius[k]);
+    present[ghosts_.material[k]] = 1;
+  }
+  largest_y_star_ = 0;
+  for (int a = 0; a < table_.size(); ++a) {
+    if (!present[a]) continue;
+    for (int b = 0; b < table_.size(); ++b)
+      largest_y_star_ = std::max(largest_y_star_, table_(a, b).y_star);
+  }
   wall_neighbours_.build(p_, walls_, skin_);
   wall_neighbours_.end_unlisted_springs(walls_, wall_history_);
   x_at_build_ = p_.x;
@@ -381,47 +400,90 @@ void Simulation::compute_forces() {
   ContactSweep s{
       p_,     ghosts_,       local_list_,      ghost_list_, local_history_, ghost_history_,
       walls_, wall_history_, wall_neighbours_, table_,      constants_,     dt_,
-      0,      0.0,           WorstContact{}};
+      0,      0.0,           WorstContact{},   UnresolvedContact{}};
   sweep_.run(s);
+  if (scene_.contact.normal == NormalModel::hertz && scene_.time.min_steps_per_contact > 0 &&
+      contact_may_be_unresolved()) {
+    s.unresolved.set(scene_.time.min_steps_per_contact, dt_);
+    steps_per_contact_sweep(s);
+  }
   counters_.contacts = s.contacts;
   counters_.max_overlap_ratio = s.max_overlap_ratio;
-  check_overlap(s.worst);
+  check_contacts(s);
   apply_force_terms();
 }
 
-void Simulation::check_overlap(const WorstContact& w) const {
-  // Collective only when some rank is beyond the limit, which every rank learns
-  // through the same reduction: keep the common path free of communication.
+bool Simulation::contact_may_be_unresolved() const {
+  // A Hertz contact fails when m*^2 < k R* Y*^2 v (contact_sweep.hpp). Its approach speed
+  // v is at most |v_a| + |v_b| (a fixed wall: |v_a|); m*^2/R* >= q/4 with q = m_s^2/r_s of
+  // the lighter partner s (m* >= m_s/2, R* <= min(r_a, r_b)); and Y* <= the table's
+  // largest. So while 2 v_max stays below q_min / (4 k Y*max^2), no contact can fail and
+  // the sweep need not ask: one pass over the velocities instead of a test per contact.
+  for (const WallSet::Entry& w : walls_.walls())
+    if (w.pose.moving() || w.surface_velocity.squaredNorm() > 0) return true;
+  double v2 = 0;
+  for (const Vec3& v : p_.v) v2 = std::max(v2, v.squaredNorm());
+  for (const Vec3& v : ghosts_.v) v2 = std::max(v2, v.squaredNorm());
+  const double k = std::pow(scene_.time.min_steps_per_contact * dt_ / 2.868, 5);
+  const double floor = lightest_q_ / (4 * k * largest_y_star_ * largest_y_star_);
+  return 4 * v2 >= floor * floor;
+}
+
+void Simulation::check_contacts(const ContactSweep& s) const {
+  // One reduction serves both guards, and they speak only when some rank is beyond a
+  // limit, which every rank learns through it: keep the common path to that one call.
   const double limit = scene_.time.max_overlap;
-  double worst = counters_.max_overlap_ratio;
-  if (decomp_->size() > 1) MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPI_DOUBLE, MPI_MAX, comm_);
-  if (worst <= limit) return;
-  std::string message;
-  if (counters_.max_overlap_ratio == worst) {
-    const double v = std::max(w.speed, 1e-12);
-    const double tc = hertz_contact_time(w.y_star, w.r_star, w.m_star, v);
-    std::ostringstream o;
-    o.precision(4);
-    o << scene_.file << ": error: t = " << time_ << " s (step " << counters_.steps + 1 << "): ";
-    if (w.b >= 0)
-      o << "particles " << w.a << " and " << w.b;
-    else
-      o << "particle " << w.a << " and a wall";
-    o << " overlap by " << 100 * worst << " % of the smaller radius (limit "
-      << 100 * limit << " %, key time.max_overlap)";
+  const double n_min = scene_.time.min_steps_per_contact;
+  // Largest overlap ratio; fewest steps per contact as N_min / N (> 1 when under-resolved).
+  const double mine[2] = {counters_.max_overlap_ratio,
+                          s.unresolved.fewest > 0 ? n_min / s.unresolved.fewest : 0.0};
+  double worst[2] = {mine[0], mine[1]};
+  if (decomp_->size() > 1) MPI_Allreduce(MPI_IN_PLACE, worst, 2, MPI_DOUBLE, MPI_MAX, comm_);
+  if (worst[0] <= limit && worst[1] <= 1) return;
+  std::ostringstream o;
+  o.precision(4);
+  o << scene_.file << ": error: t = " << time_ << " s (step " << counters_.steps + 1 << "): ";
+  const bool overlap = worst[0] > limit;  // the overlap guard speaks first
+  const WorstContact& w = overlap ? s.worst : s.unresolved.contact;
+  if (overlap ? mine[0] != worst[0] : mine[1] != worst[1]) {
+    agree_on_error(comm_, "");  // another rank holds the contact and speaks
+    return;
+  }
+  if (w.b >= 0)
+    o << "particles " << w.a << " and " << w.b;
+  else
+    o << "particle " << w.a << " and a wall";
+  const double tc =
+      hertz_contact_time(w.y_star, w.r_star, w.m_star, std::max(std::abs(w.speed), 1e-12));
+  const char* remedy =
+      " s would (1/20 of the Hertz contact time at that speed); lower time.step or "
+      "time.rayleigh_fraction, or raise time.expected_max_speed so that grain check warns "
+      "about it";
+  if (!overlap) {
+    o << " approach at " << w.speed << " m/s, overlapping by " << 100 * s.unresolved.overlap_ratio
+      << " % of the smaller radius. At that speed a Hertz contact lasts " << tc << " s: only "
+      << s.unresolved.fewest << " steps of dt = " << dt_ << " s (fewer than " << n_min
+      << ", key time.min_steps_per_contact). So coarse a step cannot resolve the contact and "
+         "can give it back more energy than it took. A step of at most "
+      << tc / 20 << remedy;
+  } else {
+    o << " overlap by " << 100 * worst[0] << " % of the smaller radius (limit " << 100 * limit
+      << " %, key time.max_overlap)";
     if (w.speed > 1e-9)
       o << ", approaching at " << w.speed << " m/s: the time step dt = " << dt_
-        << " s is too large to resolve this impact. A step of at most " << tc / 20
-        << " s would (1/20 of the Hertz contact time at that speed); lower time.step or "
-        << "time.rayleigh_fraction, or raise time.expected_max_speed so that grain check "
-        << "warns about it";
+        << " s is too large to resolve this impact. A step of at most " << tc / 20 << remedy;
+    else if (w.speed < -1e-9)
+      // Deep and already separating at its first sight: the centre jumped past the other
+      // body's surface (a two-sided mesh, another particle's centre) within one step.
+      o << ", moving apart at " << -w.speed << " m/s: the centre has most likely crossed the "
+        << "other surface within one step of dt = " << dt_ << " s (tunnelled; or the two were "
+        << "placed overlapping). A step of at most " << tc / 20 << remedy;
     else
       o << " without approaching each other: the overlap was there at the start, or the load "
         << "compresses a too-soft material; check the initial positions (insertion, CSV) or "
         << "raise the Young's modulus";
-    message = o.str();
   }
-  agree_on_error(comm_, message);  // the rank holding the worst contact speaks
+  agree_on_error(comm_, o.str());  // the rank holding the worst contact speaks
 }
 
 void Simulation::restore_implicit_drag() {

@@ -138,8 +138,13 @@ class Simulation {
   void apply_force_terms();  // non-contact terms only
   void restore_implicit_drag();  // initialise() after restore()
   // Stops the run (ParallelError on every rank) when a contact overlaps beyond
-  // time.max_overlap, naming the contact and a time step that would resolve it.
-  void check_overlap(const WorstContact& worst) const;
+  // time.max_overlap, or when a Hertz contact gets fewer than time.min_steps_per_contact
+  // steps at its own approach speed; the message names the contact and a time step that
+  // would resolve it.
+  void check_contacts(const ContactSweep& sweep) const;
+  // Whether any contact of this step could fail the steps-per-contact test (else the
+  // sweep skips it): a bound from the fastest local or ghost particle.
+  bool contact_may_be_unresolved() const;
   bool needs_rebuild() const;  // collective
   void mark_leaving();         // particles beyond a bounded side of the domain
   void half_kick();            // v += dt/2 F/m (implicit in v where drag is set), same for spin
@@ -158,6 +163,9 @@ class Simulation {
   ContactConstants constants_;
   SweepChoice sweep_;
   double dt_ = 0, time_ = 0, skin_ = 0, cutoff_ = 0;
+  // For contact_may_be_unresolved, set at each rebuild: min m^2/r over local and ghost
+  // particles, and the largest Y* of a pair involving one of their materials.
+  double lightest_q_ = 0, largest_y_star_ = 0;
   std::unique_ptr<BinGrid> grid_;
   NeighbourList local_list_, ghost_list_;
   std::vector<ContactHistory> local_history_, ghost_history_;

@@ -60,6 +60,9 @@ struct TimeSettings {
   double end = 0;                                 // simulated end time [s] > 0
   double expected_max_speed = 1.0;                // for the Hertz contact-time check [m/s]
   double max_overlap = 0.25;  // overlap / smaller radius that stops the run, (0, 1]
+  // Hertz contacts: t_c(v)/dt at a contact's own approach speed v below this stops the
+  // run (the start-up refusal threshold of grain check); 0 turns the check off.
+  double min_steps_per_contact = 5;
 };
 
 struct PlaneWall {

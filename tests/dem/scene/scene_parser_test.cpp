@@ -88,6 +88,8 @@ TEST(SceneParser, BaseSceneIsValidAndTakesDefaults) {
   EXPECT_FALSE(s.time.rayleigh_fraction.has_value());
   EXPECT_DOUBLE_EQ(s.time.end, 0.5);
   EXPECT_DOUBLE_EQ(s.time.expected_max_speed, 1.0);
+  EXPECT_DOUBLE_EQ(s.time.max_overlap, 0.25);
+  EXPECT_DOUBLE_EQ(s.time.min_steps_per_contact, 5.0);  // grain check's refusal threshold
   ASSERT_EQ(s.pairs.size(), 1u);
   EXPECT_DOUBLE_EQ(s.pairs[0].restitution, 0.9);
   EXPECT_DOUBLE_EQ(s.pairs[0].friction, 0.5);
@@ -405,6 +407,15 @@ TEST(SceneErrors, ValueOutOfRangeStatesRangeAndValue) {
                 22, 45);
   EXPECT_THAT(radius,
               HasSubstr("insert[0].radius.value: value -1e-3 is out of range; it must be > 0"));
+
+  const std::string steps = expect_at(
+      error_of(with("end: 0.5", "end: 0.5\n  min_steps_per_contact: -1")), 7, 26);
+  EXPECT_THAT(steps, HasSubstr("time.min_steps_per_contact: value -1 is out of range; it must "
+                               "be >= 0"));
+  EXPECT_DOUBLE_EQ(
+      parse_scene(with("end: 0.5", "end: 0.5\n  min_steps_per_contact: 0"), kLabel)
+          .time.min_steps_per_contact,
+      0.0);  // 0 turns the steps-per-contact guard off
 
   const std::string end = expect_at(error_of(with("end: 0.5", "end: 0")), 6, 8);
   EXPECT_THAT(end, HasSubstr("time.end: value 0 is out of range; it must be > 0"));
