@@ -25,6 +25,7 @@
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -87,10 +88,20 @@ TimeSettings parse_time(const Field& f) {
   return t;
 }
 
+// Materials in one scene. Each pair has its own entry in Scene::pairs, so the table
+// holds kMaxMaterials^2 / 2 = 500 500 entries at most.
+constexpr std::size_t kMaxMaterials = 1000;
+
 std::vector<Material> parse_materials(const Field& f) {
   std::vector<Material> out;
   std::map<std::string, int> first_line;
-  for (const Field& item : f.non_empty_items("define at least one material")) {
+  const std::vector<Field> items = f.non_empty_items("define at least one material");
+  // The pair table grows as n^2 / 2 (parse_pairs): bound it before building it.
+  if (items.size() > kMaxMaterials)
+    f.fail_at_key(std::to_string(items.size()) + " materials are listed; at most " +
+                  std::to_string(kMaxMaterials) +
+                  " are allowed (every pair of materials gets its own contact properties)");
+  for (const Field& item : items) {
     const Map m = item.map({"name", "youngs_modulus", "poisson_ratio", "density"});
     const Field name = m.get("name", "add `name: <material name>`");
     Material mat;
@@ -274,8 +285,8 @@ WallMotion parse_wall_motion(const Field& f) {
   return w;
 }
 
-// `earlier` are the walls already read, to keep names unique.
-Wall parse_wall(const Field& item, const std::vector<Wall>& earlier,
+// `names` are the names of the walls already read, to keep them unique.
+Wall parse_wall(const Field& item, const std::unordered_set<std::string>& names,
                 const std::vector<Material>& materials) {
   const Map m = item.map();
   Wall w;
@@ -315,18 +326,20 @@ Wall parse_wall(const Field& item, const std::vector<Wall>& earlier,
     c.angular_velocity = m.number_or("angular_velocity", 0.0, kAny);
   }
   const std::optional<Field> name = m.find("name");
-  w.name = name ? name->text() : "wall" + std::to_string(earlier.size());
-  for (const Wall& other : earlier)
-    if (other.name == w.name)
-      (name ? *name : item)
-          .fail("duplicate wall name '" + w.name + "'; give each wall a unique name");
+  w.name = name ? name->text() : "wall" + std::to_string(names.size());
+  if (names.count(w.name) > 0)
+    (name ? *name : item).fail("duplicate wall name '" + w.name + "'; give each wall a unique name");
   w.material = material_ref(m, "material", materials);
   return w;
 }
 
 std::vector<Wall> parse_walls(const Field& f, const std::vector<Material>& materials) {
   std::vector<Wall> walls;
-  for (const Field& item : f.items()) walls.push_back(parse_wall(item, walls, materials));
+  std::unordered_set<std::string> names;  // a set: many walls cost linear, not quadratic, time
+  for (const Field& item : f.items()) {
+    walls.push_back(parse_wall(item, names, materials));
+    names.insert(walls.back().name);
+  }
   return walls;
 }
 
@@ -446,6 +459,22 @@ SizeDistribution parse_size_distribution(const Field& f) {
   return s;
 }
 
+double smallest_radius(const SizeDistribution& s) {
+  using K = SizeDistribution::Kind;
+  switch (s.kind) {
+    case K::constant: return s.value;
+    case K::uniform:
+    case K::normal: return s.min;
+    case K::discrete: return *std::min_element(s.values.begin(), s.values.end());
+  }
+  return s.value;
+}
+
+double region_volume(const Region& r) {
+  if (r.kind == Region::Kind::box) return (r.hi - r.lo).prod();
+  return std::acos(-1.0) * r.radius * r.radius * r.height;
+}
+
 void parse_fill(const Map& m, const Scene& scene, Insertion& ins) {
   m.allow_only(
       {"type", "region", "count", "volume_fraction", "material", "radius", "velocity", "seed"},
@@ -460,6 +489,19 @@ void parse_fill(const Map& m, const Scene& scene, Insertion& ins) {
   ins.material = material_ref(m, "material", scene.materials);
   ins.radius = parse_size_distribution(
       m.get("radius", "add `radius: {distribution: constant, value: <m>}`"));
+  if (ins.count) {
+    // Even the smallest spheres the distribution can draw must fit by volume alone;
+    // this also bounds what insertion will try to allocate.
+    const double r = smallest_radius(ins.radius);
+    const double solid = static_cast<double>(*ins.count) * 4.0 / 3.0 * std::acos(-1.0) * r * r * r;
+    if (solid > region_volume(ins.region))
+      m.get("count").fail(std::to_string(*ins.count) + " spheres of radius at least " +
+                          format_number(r) + " m have a volume of " + format_number(solid) +
+                          " m^3, more than the region's " +
+                          format_number(region_volume(ins.region)) +
+                          " m^3; lower the count or enlarge the region (random filling "
+                          "reaches a solid fraction near 0.35)");
+  }
   ins.velocity = m.vec3_or("velocity", Vec3::Zero());
   if (const auto s = m.find("seed"))
     ins.seed = static_cast<unsigned>(s->integer(Range{0, double(UINT_MAX), true, true}));

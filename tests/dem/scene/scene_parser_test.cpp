@@ -595,6 +595,53 @@ TEST(SceneErrors, MissingFileHasNoPosition) {
   }
 }
 
+TEST(SceneErrors, DuplicateWallName) {
+  const std::string walls =
+      "walls:\n"                                                                           // 17
+      "  - {type: plane, name: floor, point: [0, 0, 0], normal: [0, 0, 1], material: glass}\n"  // 18
+      "  - {type: plane, point: [0, 0, 1], normal: [0, 0, -1], material: glass}\n"            // 19
+      "  - {type: plane, name: floor, point: [0, 0, 0], normal: [1, 0, 0], material: glass}\n";  // 20
+  const std::string msg = expect_at(error_of(kBase + walls), 20, 25);
+  EXPECT_THAT(msg, HasSubstr("walls[2].name: duplicate wall name 'floor'"));
+  // The unnamed wall is 'wall1'; naming a later one so collides too.
+  const std::string msg2 = expect_at(error_of(kBase + with("name: floor, point: [0, 0, 0], normal: [1",
+                                                           "name: wall1, point: [0, 0, 0], normal: [1",
+                                                           walls)),
+                                     20, 25);
+  EXPECT_THAT(msg2, HasSubstr("duplicate wall name 'wall1'"));
+}
+
+// Hostile sizes (docs/reliability.md, "Hostile input"): what the parser would build
+// from them is bounded before it is built.
+TEST(SceneErrors, MaterialCountIsBounded) {
+  std::string many = "materials:\n";
+  for (int i = 0; i < 1001; ++i)
+    many += "  - {name: m" + std::to_string(i) +
+            ", youngs_modulus: 5e6, poisson_ratio: 0.3, density: 2500}\n";
+  const std::string text =
+      with("interactions:\n  - materials: [glass, glass]\n    restitution: 0.9\n",
+           "interaction_defaults: {restitution: 0.9}\n",
+           with("materials:\n  - name: glass\n    youngs_modulus: 5e6\n    poisson_ratio: 0.3\n"
+                "    density: 2500\n",
+                many));
+  const std::string msg = expect_at(error_of(text), 7, 1);
+  EXPECT_THAT(msg, HasSubstr("materials: 1001 materials are listed; at most 1000 are allowed"));
+}
+
+TEST(SceneErrors, FillCountMustFitTheRegionByVolume) {
+  const std::string fill =
+      "insert:\n"                                              // 17
+      "  - type: fill\n"                                       // 18
+      "    region: {box: {min: [0, 0, 0], max: [1, 1, 0.5]}}\n"  // 19
+      "    count: 1e9\n"                                       // 20
+      "    material: glass\n"                                  // 21
+      "    radius: {distribution: uniform, min: 1e-3, max: 2e-3}\n";  // 22
+  // 1e9 spheres of r >= 1 mm: 1e9 (4/3) pi 1e-9 = 4.18879 m^3 > 0.5 m^3.
+  const std::string msg = expect_at(error_of(kBase + fill), 20, 12);
+  EXPECT_THAT(msg, HasSubstr("insert[0].count: 1000000000 spheres of radius at least 0.001 m have "
+                             "a volume of 4.18879020479 m^3, more than the region's 0.5 m^3"));
+}
+
 // Periodic checkpoints (docs/reliability.md): off unless an interval is given; keep 2.
 TEST(SceneParser, CheckpointSettings) {
   const Scene none = parse_scene(kBase, kLabel);
