@@ -9,6 +9,7 @@
 // The first mistake found throws a SceneError; nothing is collected or deferred.
 #include "dem/scene/scene_parser.hpp"
 
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -65,11 +66,15 @@ Domain parse_domain(const Field& f) {
   d.lo = m.vec3("min");
   const Field max = m.get("max", "add `max: [x, y, z]`");
   d.hi = max.vec3();
-  for (int i = 0; i < 3; ++i)
+  for (int i = 0; i < 3; ++i) {
     if (!(d.hi[i] > d.lo[i]))
       max.items()[i].fail("value " + max.items()[i].node().Scalar() +
                           " is not greater than domain.min[" + std::to_string(i) + "] = " +
                           format_number(d.lo[i]) + "; each max coordinate must exceed min");
+    if (!std::isfinite(d.hi[i] - d.lo[i]))
+      max.items()[i].fail("the domain's extent max - min overflows the range of numbers along " +
+                          std::string(1, "xyz"[i]) + "; give a domain of a physical size");
+  }
   if (const auto p = m.find("periodic")) d.periodic = p->bool3();
   return d;
 }
@@ -398,6 +403,9 @@ void parse_normal_distribution(const Map& m, SizeDistribution& s) {
   // mean/10 so no vanishingly small particle wrecks the time step.
   s.min = m.number_or("min", std::max(s.mean - 3 * s.stddev, 0.1 * s.mean), kPositive);
   s.max = m.number_or("max", s.mean + 3 * s.stddev, kPositive);
+  if (!std::isfinite(s.max))
+    m.get("stddev").fail("mean + 3 stddev overflows the range of numbers; give a smaller stddev "
+                         "or an explicit max");
   if (!(s.min <= s.mean))
     m.find("min").value_or(m.self()).fail("the lower bound " + format_number(s.min) +
                                           " is above the mean " + format_number(s.mean) +
@@ -419,8 +427,10 @@ void parse_discrete_distribution(const Map& m, SizeDistribution& s) {
   if (s.weights.size() != s.values.size())
     w->fail(std::to_string(s.weights.size()) + " weights are given for " +
             std::to_string(s.values.size()) + " values; give one weight per radius");
+  // Scaled by the largest first, so that weights near the double limit cannot sum to inf.
+  const double largest = *std::max_element(s.weights.begin(), s.weights.end());
   double sum = 0;
-  for (double x : s.weights) sum += x;
+  for (double& x : s.weights) sum += (x /= largest);
   for (double& x : s.weights) x /= sum;
 }
 
@@ -662,6 +672,12 @@ void raise_if_tab_indented(const std::string& text, int error_line, const Source
 YAML::Node load_yaml(const std::string& text, const Source& src) {
   try {
     return YAML::Load(text);
+  } catch (const YAML::DeepRecursion& e) {
+    // yaml-cpp stops at a fixed depth (500 in 0.7) instead of overflowing the stack,
+    // with only "bad file" as its message.
+    raise(src, e.mark,
+          "YAML syntax error: brackets or indentation nest " + std::to_string(e.depth()) +
+              " levels deep; a scene needs at most a few levels (check for unclosed '[' or '{')");
   } catch (const YAML::ParserException& e) {
     raise_if_tab_indented(text, e.mark.line, src);
     raise(src, e.mark,

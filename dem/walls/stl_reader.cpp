@@ -187,7 +187,10 @@ TriangleMesh parse_stl(const std::string& bytes, const std::string& label,
                         (expected > bytes.size()
                              ? "the file is truncated or not an STL file"
                              : "bytes are left over after the declared triangles (a wrong count, "
-                               "or not an STL file)"));
+                               "or not an STL file)") +
+                        (starts_solid ? " (it starts with 'solid' but holds NUL or control "
+                                        "bytes, so it is not an ASCII STL either)"
+                                      : ""));
   } else {
     fail(label, "", "not an STL file: it neither starts with 'solid' (ASCII) nor holds the " +
                         std::string("84-byte header of a binary STL"));

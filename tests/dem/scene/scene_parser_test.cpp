@@ -611,6 +611,40 @@ TEST(SceneErrors, DuplicateWallName) {
   EXPECT_THAT(msg2, HasSubstr("duplicate wall name 'wall1'"));
 }
 
+// yaml-cpp refuses deep nesting (500 levels in 0.7) instead of overflowing the stack;
+// the error says what that means.
+TEST(SceneErrors, DeepNestingIsASyntaxErrorNotACrash) {
+  const std::string deep = "domain: " + std::string(5000, '[') + std::string(5000, ']') + "\n";
+  const SceneError e = error_of(deep);
+  EXPECT_EQ(e.line(), 1);
+  EXPECT_THAT(e.what(), AllOf(HasSubstr("YAML syntax error: brackets or indentation nest "),
+                              HasSubstr(" levels deep; a scene needs at most a few levels")));
+}
+
+TEST(SceneErrors, NumbersNearTheDoubleLimit) {
+  const std::string extent = expect_at(error_of(with("min: [0, 0, 0]", "min: [-1e308, 0, 0]",
+                                                     with("max: [1, 1, 1]", "max: [1e308, 1, 1]"))),
+                                       3, 9);
+  EXPECT_THAT(extent, HasSubstr("domain.max[0]: the domain's extent max - min overflows"));
+  const std::string fill =
+      "insert:\n"
+      "  - type: fill\n"
+      "    region: {box: {min: [0, 0, 0], max: [1, 1, 1]}}\n"
+      "    count: 10\n"
+      "    material: glass\n";
+  const std::string stddev = expect_at(
+      error_of(kBase + fill + "    radius: {distribution: normal, mean: 1e-3, stddev: 1e308}\n"),
+      22, 56);
+  EXPECT_THAT(stddev, HasSubstr("insert[0].radius.stddev: mean + 3 stddev overflows"));
+  // Weights near the limit would sum to inf and normalise to 0: scaled first.
+  const Scene s = parse_scene(
+      kBase + fill +
+          "    radius: {distribution: discrete, values: [1e-3, 2e-3], weights: [1e308, 1.5e308]}\n",
+      kLabel);
+  EXPECT_DOUBLE_EQ(s.insertions[0].radius.weights[0], 0.4);
+  EXPECT_DOUBLE_EQ(s.insertions[0].radius.weights[1], 0.6);
+}
+
 // Hostile sizes (docs/reliability.md, "Hostile input"): what the parser would build
 // from them is bounded before it is built.
 TEST(SceneErrors, MaterialCountIsBounded) {

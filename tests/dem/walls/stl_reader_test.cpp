@@ -178,7 +178,9 @@ TEST(StlReader, BinaryCountBelowTheFileSizeIsAnError) {
 TEST(StlReader, SolidHeaderWithWrongCountIsReportedAsBinary) {
   const std::string b = with_count(binary_stl(kSquare, "solid exported"), 3);
   EXPECT_THAT(error_of(b), HasSubstr("binary STL header declares 3 triangles (234 bytes) but the "
-                                     "file has 184 bytes"));
+                                     "file has 184 bytes; the file is truncated or not an STL file "
+                                     "(it starts with 'solid' but holds NUL or control bytes, so "
+                                     "it is not an ASCII STL either)"));
 }
 
 TEST(StlReader, EmptyShortAndTruncatedFilesAreErrors) {
@@ -243,6 +245,33 @@ walls: [{type: mesh, name: floor, file: d.stl, material: glass}]
   ASSERT_EQ(walls.notes().size(), 1u);
   EXPECT_THAT(walls.notes()[0], HasSubstr("wall 'floor': 2 triangles, 4 vertices from binary STL"));
   EXPECT_THAT(walls.notes()[0], HasSubstr("(1 degenerate triangles removed)"));
+}
+
+// A mesh whose triangles each span the whole bounding box (100 slanted triangles across
+// a unit cube): with the 2^22-cell grid a small cell asks for, every triangle would be
+// listed in all 4 million cells (4e8 entries, 3 GB). The number of (cell, triangle)
+// entries is bounded by max(2 max_cells, 8 triangles) = 8 388 608, which here needs
+// 100 (floor(1/h) + 1)^3 <= 8 388 608, floor(1/h) <= 42: cells h > 1/43; the step
+// before (h / 1.25) did not fit, so h <= 1.25/43.
+TEST(StlReader, SearchGridOfLargeSlantedTrianglesIsBounded) {
+  std::vector<Vec3> v;
+  std::vector<std::array<int, 3>> t;
+  for (int k = 0; k < 100; ++k) {
+    const int b = static_cast<int>(v.size());
+    v.insert(v.end(), {Vec3(0, 0, 0), Vec3(1, 1, 0.5 + 0.001 * k), Vec3(0.5, 1, 1)});
+    t.push_back({b, b + 1, b + 2});
+  }
+  TriangleMesh m(v, t);
+  m.build_grid(1e-3);
+  EXPECT_GT(m.cell_size(), 1.0 / 43);
+  EXPECT_LE(m.cell_size(), 1.25 / 43);  // enlarged in steps of 1.25 only as far as needed
+  // The search is still exact: the same contacts as the brute-force reference.
+  MeshTouch a[TriangleMesh::kMaxTouches], b[TriangleMesh::kMaxTouches];
+  for (const Vec3& c : {Vec3(0.5, 0.6, 0.5), Vec3(0.2, 0.3, 0.1), Vec3(0.9, 0.95, 0.8)}) {
+    const int n = m.touches(c, 0.05, a);
+    ASSERT_EQ(n, m.touches_brute_force(c, 0.05, b));
+    for (int i = 0; i < n; ++i) EXPECT_EQ(a[i].triangle, b[i].triangle);
+  }
 }
 
 TEST(StlReader, AsciiVertexWithExtraNumbersAndBinaryGarbageAreClearErrors) {
