@@ -41,9 +41,14 @@ done
 GENERATOR=()
 command -v ninja >/dev/null && GENERATOR=(-G Ninja)
 log "building in $BUILD"
-cmake -S "$ROOT/tests/fuzz" -B "$BUILD" "${GENERATOR[@]}" -DCMAKE_BUILD_TYPE=None \
-      -DCMAKE_CXX_COMPILER="${CXX:-clang++}" >/dev/null
-cmake --build "$BUILD" --target "${TARGETS[@]/%/_fuzz}" -- -j2 >/dev/null
+mkdir -p "$BUILD"
+if ! { cmake -S "$ROOT/tests/fuzz" -B "$BUILD" "${GENERATOR[@]}" -DCMAKE_BUILD_TYPE=None \
+         -DCMAKE_CXX_COMPILER="${CXX:-clang++}" &&
+       cmake --build "$BUILD" --target "${TARGETS[@]/%/_fuzz}" -- -j2; } >"$BUILD/build.log" 2>&1; then
+  cat "$BUILD/build.log" >&2
+  log "build failed (log: $BUILD/build.log)"
+  exit 1
+fi
 [ "$SECONDS_PER_TARGET" != 0 ] || { log "built ${TARGETS[*]/%/_fuzz}"; exit 0; }
 
 rc=0
