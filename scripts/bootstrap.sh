@@ -20,6 +20,7 @@ PACKAGES=(
   libhdf5-openmpi-dev hdf5-tools
   googletest libgtest-dev libgmock-dev
   libyaml-cpp-dev
+  clang libclang-rt-14-dev
   python3 python3-numpy python3-matplotlib python3-h5py python3-yaml
 )
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iomanip>
 #include <numbers>
 #include <sstream>
 #include <unordered_map>
@@ -56,21 +57,34 @@ class OverlapGrid {
     rs_.push_back(r);
     r_max_ = std::max(r_max_, r);
   }
-  bool overlaps(const Vec3& x, double r) const {
+  // The index of a stored sphere that overlaps the sphere (x, r), or -1.
+  int overlapping(const Vec3& x, double r) const {
+    auto overlap = [&](int k) {
+      const double s = r + rs_[k];
+      return (x - xs_[k]).squaredNorm() < s * s;
+    };
+    // A sphere much larger than the cells (a hostile CSV radius) would visit more
+    // cells than there are spheres: then checking every sphere is cheaper.
+    const double reach_cells = std::ceil((r + r_max_) / edge_);
+    if (!(std::pow(2 * reach_cells + 1, 3) < static_cast<double>(xs_.size()))) {
+      for (int k = 0; k < static_cast<int>(xs_.size()); ++k)
+        if (overlap(k)) return k;
+      return -1;
+    }
     const auto c = cell(x);
-    const long reach = static_cast<long>(std::ceil((r + r_max_) / edge_));
+    const long reach = static_cast<long>(reach_cells);
     for (long dz = -reach; dz <= reach; ++dz)
       for (long dy = -reach; dy <= reach; ++dy)
         for (long dx = -reach; dx <= reach; ++dx) {
           auto it = cells_.find(key({c[0] + dx, c[1] + dy, c[2] + dz}));
           if (it == cells_.end()) continue;
-          for (int k : it->second) {
-            const double s = r + rs_[k];
-            if ((x - xs_[k]).squaredNorm() < s * s) return true;
-          }
+          for (int k : it->second)
+            if (overlap(k)) return k;
         }
-    return false;
+    return -1;
   }
+  const Vec3& position(int k) const { return xs_[k]; }
+  double radius(int k) const { return rs_[k]; }
 
  private:
   std::array<long, 3> cell(const Vec3& x) const {
@@ -129,8 +143,9 @@ bool inside_domain(const Domain& d, const Vec3& x, double r, double tolerance = 
   return true;
 }
 
-// Overlap test that also sees periodic images of earlier particles.
-bool overlaps_with_images(const OverlapGrid& grid, const Domain& d, const Vec3& x, double r) {
+// Overlap test that also sees periodic images of earlier particles: the index of an
+// earlier particle (x, r) overlaps, or -1.
+int overlapping_with_images(const OverlapGrid& grid, const Domain& d, const Vec3& x, double r) {
   const Vec3 length = d.hi - d.lo;
   for (int sz = -1; sz <= 1; ++sz)
     for (int sy = -1; sy <= 1; ++sy)
@@ -142,9 +157,14 @@ bool overlaps_with_images(const OverlapGrid& grid, const Domain& d, const Vec3& 
           if (s[a] != 0 && !d.periodic[a]) valid = false;
           shifted[a] += s[a] * length[a];
         }
-        if (valid && grid.overlaps(shifted, r)) return true;
+        if (!valid) continue;
+        if (const int k = grid.overlapping(shifted, r); k >= 0) return k;
       }
-  return false;
+  return -1;
+}
+
+bool overlaps_with_images(const OverlapGrid& grid, const Domain& d, const Vec3& x, double r) {
+  return overlapping_with_images(grid, d, x, r) >= 0;
 }
 
 bool touches_a_wall(const Scene& s, const WallSet* walls, const Vec3& x, double r) {
@@ -167,7 +187,9 @@ void fill_region(const Scene& scene, const WallSet* walls, const Insertion& ins,
   auto done = [&] { return ins.count ? placed >= target_count : volume >= target_volume; };
   // Random sequential addition saturates near 38 % solids for equal spheres; the
   // attempt budget turns an impossible request into a clear error, not a hang.
-  const long budget = 2000 * std::max<long>(1000, target_count) + 2'000'000;
+  // (In double: a count near the parser's limit of 9e15 would overflow a long here.)
+  const long budget = static_cast<long>(
+      std::min(2000.0 * std::max(1000.0, static_cast<double>(target_count)) + 2e6, 9e18));
   while (!done()) {
     if (++attempts > budget) {
       std::ostringstream msg;
@@ -202,30 +224,88 @@ std::vector<std::string> split_csv(const std::string& line) {
   return out;
 }
 
+std::string format_number(double x) {
+  std::ostringstream s;
+  s << std::setprecision(9) << x;
+  return s.str();
+}
+
+std::string format_vec(const Vec3& x) {
+  std::ostringstream s;
+  s << std::setprecision(9) << '(' << x[0] << ", " << x[1] << ", " << x[2] << ')';
+  return s.str();
+}
+
+// Why a particle (x, r) is not inside the domain (inside_domain() is false), for messages.
+std::string outside_domain_reason(const Domain& d, const Vec3& x, double r) {
+  const char* axis = "xyz";
+  std::ostringstream s;
+  s << std::setprecision(9);
+  for (int a = 0; a < 3; ++a) {
+    if (d.periodic[a]) {
+      if (x[a] < d.lo[a] || x[a] >= d.hi[a]) {
+        s << "its centre " << axis[a] << " = " << x[a] << " is outside the periodic range ["
+          << d.lo[a] << ", " << d.hi[a] << ")";
+        return s.str();
+      }
+    } else if (x[a] - r < d.lo[a] || x[a] + r > d.hi[a]) {
+      s << "it spans " << axis[a] << " from " << x[a] - r << " to " << x[a] + r
+        << ", beyond the domain's " << d.lo[a] << " to " << d.hi[a]
+        << " (a sphere must lie wholly inside a bounded side)";
+      return s.str();
+    }
+  }
+  return "it lies outside the domain";
+}
+
+// The columns a particle file may have; x, y, z and radius are required, vx, vy, vz
+// come together.
+const std::vector<std::string> kCsvColumns = {"x", "y", "z", "radius", "vx", "vy", "vz", "material"};
+
 void read_csv(const Scene& scene, const Insertion& ins, Particles& p, GlobalId& next_id,
               OverlapGrid& grid) {
   std::ifstream in(ins.csv_file);
   if (!in)
     throw InsertionError(ins.source + ": error: cannot open particle file '" + ins.csv_file + "'");
   auto fail = [&](long line, const std::string& what) {
-    throw InsertionError(ins.csv_file + ":" + std::to_string(line) + ": error: " + what +
-                         " (particle file of the insertion at " + ins.source + ")");
+    std::string where = ins.csv_file;
+    if (line > 0) {
+      where += ':';  // (not ":" + to_string: GCC 12 false -Wrestrict)
+      where += std::to_string(line);
+    }
+    throw InsertionError(where + ": error: " + what + " (particle file of the insertion at " +
+                         ins.source + ")");
   };
+  const std::string allowed = "columns: x,y,z,radius (required), vx,vy,vz, material (optional)";
   std::string line;
-  long lineno = 0;
+  long lineno = 0, header_line = 0;
   std::vector<std::string> header;
   while (header.empty() && std::getline(in, line)) {
     ++lineno;
     if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
     header = split_csv(line);
+    header_line = lineno;
   }
+  if (header.empty())
+    fail(0, "the file is empty (no header line); its first line must name the " + allowed);
   std::unordered_map<std::string, int> col;
-  for (std::size_t k = 0; k < header.size(); ++k) col[header[k]] = static_cast<int>(k);
+  for (std::size_t k = 0; k < header.size(); ++k) {
+    const std::string& name = header[k];
+    if (std::find(kCsvColumns.begin(), kCsvColumns.end(), name) == kCsvColumns.end())
+      fail(header_line, "unknown column '" + name + "' in the header; allowed " + allowed);
+    if (!col.emplace(name, static_cast<int>(k)).second)
+      fail(header_line, "column '" + name + "' appears twice in the header");
+  }
   for (const char* need : {"x", "y", "z", "radius"})
     if (!col.count(need))
-      fail(lineno, std::string("header lacks column '") + need +
-                       "'; required columns: x,y,z,radius; optional: vx,vy,vz,material");
-  const bool has_v = col.count("vx") && col.count("vy") && col.count("vz");
+      fail(header_line, std::string("header lacks column '") + need + "'; " + allowed);
+  const int velocity_columns =
+      static_cast<int>(col.count("vx") + col.count("vy") + col.count("vz"));
+  if (velocity_columns != 0 && velocity_columns != 3)
+    fail(header_line, "the header has only " + std::to_string(velocity_columns) +
+                          " of the velocity columns vx,vy,vz; give all three or none");
+  const bool has_v = velocity_columns == 3;
+  long particles = 0;
   while (std::getline(in, line)) {
     ++lineno;
     if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
@@ -238,24 +318,39 @@ void read_csv(const Scene& scene, const Insertion& ins, Particles& p, GlobalId& 
       char* end = nullptr;
       const double v = std::strtod(s.c_str(), &end);
       if (s.empty() || *end != '\0' || !std::isfinite(v))
-        fail(lineno, std::string("column '") + name + "' is not a finite number: '" + s + "'");
+        fail(lineno, std::string("column '") + name + "' is not a finite number: '" +
+                         s.substr(0, 40) + (s.size() > 40 ? "..." : "") + "'");
       return v;
     };
     const Vec3 x(number("x"), number("y"), number("z"));
     const double r = number("radius");
-    if (r <= 0) fail(lineno, "radius must be > 0, got " + std::to_string(r));
+    if (r <= 0) fail(lineno, "radius must be > 0, got " + cells[col["radius"]]);
     const Vec3 v = has_v ? Vec3(number("vx"), number("vy"), number("vz")) : ins.velocity;
     int mat = ins.material;
     if (col.count("material")) {
-      mat = scene.material_index(cells[col["material"]]);
-      if (mat < 0) fail(lineno, "unknown material '" + cells[col["material"]] + "'");
+      const std::string& name = cells[col["material"]];
+      mat = scene.material_index(name);
+      if (mat < 0) {
+        std::string known;
+        for (const Material& m : scene.materials) known += (known.empty() ? "" : ", ") + m.name;
+        fail(lineno, "unknown material '" + name + "'; known materials: " + known);
+      }
     }
     if (!inside_domain(scene.domain, x, r))
-      fail(lineno, "particle lies outside the domain (or crosses a bounded side)");
-    if (overlaps_with_images(grid, scene.domain, x, r)) fail(lineno, "particle overlaps an earlier particle");
+      fail(lineno, "the particle at " + format_vec(x) + " with radius " + format_number(r) +
+                       " is outside the domain: " + outside_domain_reason(scene.domain, x, r));
+    if (const int k = overlapping_with_images(grid, scene.domain, x, r); k >= 0)
+      fail(lineno, "the particle at " + format_vec(x) + " with radius " + format_number(r) +
+                       " overlaps an earlier particle at " + format_vec(grid.position(k)) +
+                       " with radius " + format_number(grid.radius(k)) +
+                       "; particles must not overlap at insertion (move one or shrink it)");
     grid.add(x, r);
     p.add(next_id++, x, v, Vec3::Zero(), r, mat, scene.materials[mat].density);
+    ++particles;
   }
+  if (particles == 0)
+    fail(header_line, "the file has a header but no particle rows; add one line per particle "
+                      "or remove the insertion");
 }
 
 void read_snapshot_entry(const Scene& scene, const Insertion& ins, Particles& p,

@@ -9,6 +9,7 @@
 // The first mistake found throws a SceneError; nothing is collected or deferred.
 #include "dem/scene/scene_parser.hpp"
 
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -25,6 +26,7 @@
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -64,11 +66,15 @@ Domain parse_domain(const Field& f) {
   d.lo = m.vec3("min");
   const Field max = m.get("max", "add `max: [x, y, z]`");
   d.hi = max.vec3();
-  for (int i = 0; i < 3; ++i)
+  for (int i = 0; i < 3; ++i) {
     if (!(d.hi[i] > d.lo[i]))
       max.items()[i].fail("value " + max.items()[i].node().Scalar() +
                           " is not greater than domain.min[" + std::to_string(i) + "] = " +
                           format_number(d.lo[i]) + "; each max coordinate must exceed min");
+    if (!std::isfinite(d.hi[i] - d.lo[i]))
+      max.items()[i].fail("the domain's extent max - min overflows the range of numbers along " +
+                          std::string(1, "xyz"[i]) + "; give a domain of a physical size");
+  }
   if (const auto p = m.find("periodic")) d.periodic = p->bool3();
   return d;
 }
@@ -89,10 +95,20 @@ TimeSettings parse_time(const Field& f) {
   return t;
 }
 
+// Materials in one scene. Each pair has its own entry in Scene::pairs, so the table
+// holds kMaxMaterials^2 / 2 = 500 500 entries at most.
+constexpr std::size_t kMaxMaterials = 1000;
+
 std::vector<Material> parse_materials(const Field& f) {
   std::vector<Material> out;
   std::map<std::string, int> first_line;
-  for (const Field& item : f.non_empty_items("define at least one material")) {
+  const std::vector<Field> items = f.non_empty_items("define at least one material");
+  // The pair table grows as n^2 / 2 (parse_pairs): bound it before building it.
+  if (items.size() > kMaxMaterials)
+    f.fail_at_key(std::to_string(items.size()) + " materials are listed; at most " +
+                  std::to_string(kMaxMaterials) +
+                  " are allowed (every pair of materials gets its own contact properties)");
+  for (const Field& item : items) {
     const Map m = item.map({"name", "youngs_modulus", "poisson_ratio", "density"});
     const Field name = m.get("name", "add `name: <material name>`");
     Material mat;
@@ -276,8 +292,8 @@ WallMotion parse_wall_motion(const Field& f) {
   return w;
 }
 
-// `earlier` are the walls already read, to keep names unique.
-Wall parse_wall(const Field& item, const std::vector<Wall>& earlier,
+// `names` are the names of the walls already read, to keep them unique.
+Wall parse_wall(const Field& item, const std::unordered_set<std::string>& names,
                 const std::vector<Material>& materials) {
   const Map m = item.map();
   Wall w;
@@ -317,18 +333,20 @@ Wall parse_wall(const Field& item, const std::vector<Wall>& earlier,
     c.angular_velocity = m.number_or("angular_velocity", 0.0, kAny);
   }
   const std::optional<Field> name = m.find("name");
-  w.name = name ? name->text() : "wall" + std::to_string(earlier.size());
-  for (const Wall& other : earlier)
-    if (other.name == w.name)
-      (name ? *name : item)
-          .fail("duplicate wall name '" + w.name + "'; give each wall a unique name");
+  w.name = name ? name->text() : "wall" + std::to_string(names.size());
+  if (names.count(w.name) > 0)
+    (name ? *name : item).fail("duplicate wall name '" + w.name + "'; give each wall a unique name");
   w.material = material_ref(m, "material", materials);
   return w;
 }
 
 std::vector<Wall> parse_walls(const Field& f, const std::vector<Material>& materials) {
   std::vector<Wall> walls;
-  for (const Field& item : f.items()) walls.push_back(parse_wall(item, walls, materials));
+  std::unordered_set<std::string> names;  // a set: many walls cost linear, not quadratic, time
+  for (const Field& item : f.items()) {
+    walls.push_back(parse_wall(item, names, materials));
+    names.insert(walls.back().name);
+  }
   return walls;
 }
 
@@ -387,6 +405,9 @@ void parse_normal_distribution(const Map& m, SizeDistribution& s) {
   // mean/10 so no vanishingly small particle wrecks the time step.
   s.min = m.number_or("min", std::max(s.mean - 3 * s.stddev, 0.1 * s.mean), kPositive);
   s.max = m.number_or("max", s.mean + 3 * s.stddev, kPositive);
+  if (!std::isfinite(s.max))
+    m.get("stddev").fail("mean + 3 stddev overflows the range of numbers; give a smaller stddev "
+                         "or an explicit max");
   if (!(s.min <= s.mean))
     m.find("min").value_or(m.self()).fail("the lower bound " + format_number(s.min) +
                                           " is above the mean " + format_number(s.mean) +
@@ -408,8 +429,10 @@ void parse_discrete_distribution(const Map& m, SizeDistribution& s) {
   if (s.weights.size() != s.values.size())
     w->fail(std::to_string(s.weights.size()) + " weights are given for " +
             std::to_string(s.values.size()) + " values; give one weight per radius");
+  // Scaled by the largest first, so that weights near the double limit cannot sum to inf.
+  const double largest = *std::max_element(s.weights.begin(), s.weights.end());
   double sum = 0;
-  for (double x : s.weights) sum += x;
+  for (double& x : s.weights) sum += (x /= largest);
   for (double& x : s.weights) x /= sum;
 }
 
@@ -448,6 +471,22 @@ SizeDistribution parse_size_distribution(const Field& f) {
   return s;
 }
 
+double smallest_radius(const SizeDistribution& s) {
+  using K = SizeDistribution::Kind;
+  switch (s.kind) {
+    case K::constant: return s.value;
+    case K::uniform:
+    case K::normal: return s.min;
+    case K::discrete: return *std::min_element(s.values.begin(), s.values.end());
+  }
+  return s.value;
+}
+
+double region_volume(const Region& r) {
+  if (r.kind == Region::Kind::box) return (r.hi - r.lo).prod();
+  return std::acos(-1.0) * r.radius * r.radius * r.height;
+}
+
 void parse_fill(const Map& m, const Scene& scene, Insertion& ins) {
   m.allow_only(
       {"type", "region", "count", "volume_fraction", "material", "radius", "velocity", "seed"},
@@ -462,6 +501,19 @@ void parse_fill(const Map& m, const Scene& scene, Insertion& ins) {
   ins.material = material_ref(m, "material", scene.materials);
   ins.radius = parse_size_distribution(
       m.get("radius", "add `radius: {distribution: constant, value: <m>}`"));
+  if (ins.count) {
+    // Even the smallest spheres the distribution can draw must fit by volume alone;
+    // this also bounds what insertion will try to allocate.
+    const double r = smallest_radius(ins.radius);
+    const double solid = static_cast<double>(*ins.count) * 4.0 / 3.0 * std::acos(-1.0) * r * r * r;
+    if (solid > region_volume(ins.region))
+      m.get("count").fail(std::to_string(*ins.count) + " spheres of radius at least " +
+                          format_number(r) + " m have a volume of " + format_number(solid) +
+                          " m^3, more than the region's " +
+                          format_number(region_volume(ins.region)) +
+                          " m^3; lower the count or enlarge the region (random filling "
+                          "reaches a solid fraction near 0.35)");
+  }
   ins.velocity = m.vec3_or("velocity", Vec3::Zero());
   if (const auto s = m.find("seed"))
     ins.seed = static_cast<unsigned>(s->integer(Range{0, double(UINT_MAX), true, true}));
@@ -622,6 +674,12 @@ void raise_if_tab_indented(const std::string& text, int error_line, const Source
 YAML::Node load_yaml(const std::string& text, const Source& src) {
   try {
     return YAML::Load(text);
+  } catch (const YAML::DeepRecursion& e) {
+    // yaml-cpp stops at a fixed depth (500 in 0.7) instead of overflowing the stack,
+    // with only "bad file" as its message.
+    raise(src, e.mark,
+          "YAML syntax error: brackets or indentation nest " + std::to_string(e.depth()) +
+              " levels deep; a scene needs at most a few levels (check for unclosed '[' or '{')");
   } catch (const YAML::ParserException& e) {
     raise_if_tab_indented(text, e.mark.line, src);
     raise(src, e.mark,

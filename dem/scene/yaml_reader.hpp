@@ -17,6 +17,7 @@
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -424,15 +425,17 @@ inline Map Field::map() const {
          "; write it as `key: value` lines "
          "or as {key: value, ...}");
   std::vector<Map::Entry> entries;
+  // Key -> its entry: a hostile map of many keys costs linear, not quadratic, time.
+  std::unordered_map<std::string, std::size_t> seen;
   for (const auto& key_value : node_) {
     const YAML::Node key = key_value.first;  // copies: the iterator yields temporaries
     if (!key.IsScalar()) raise(*src_, key.Mark(), "a key in " + path_ + " is not a plain name");
-    for (const Map::Entry& seen : entries)
-      if (seen.key == key.Scalar())
-        raise(*src_, key.Mark(),
-              "key '" + key.Scalar() + "' is given twice in " +
-                  (path_.empty() ? std::string("the top level") : path_) + " (first at line " +
-                  std::to_string(seen.key_mark.line + 1) + "); keep only one");
+    if (const auto it = seen.find(key.Scalar()); it != seen.end())
+      raise(*src_, key.Mark(),
+            "key '" + key.Scalar() + "' is given twice in " +
+                (path_.empty() ? std::string("the top level") : path_) + " (first at line " +
+                std::to_string(entries[it->second].key_mark.line + 1) + "); keep only one");
+    seen.emplace(key.Scalar(), entries.size());
     entries.push_back({key.Scalar(), key.Mark(), key_value.second});
   }
   return Map(*this, std::move(entries));

@@ -1,6 +1,8 @@
 #include "dem/walls/stl_reader.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <climits>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -10,6 +12,9 @@
 
 namespace grainflow {
 namespace {
+
+// Vertex and triangle indices are ints: at most three vertices per triangle must fit.
+constexpr std::size_t kMaxTriangles = INT_MAX / 3;
 
 struct RawTriangle {
   std::array<Vec3, 3> v;
@@ -21,6 +26,26 @@ struct RawTriangle {
   throw GeometryError(label + where + ": error: " + what);
 }
 
+// A word of the file for a message: at most 40 characters, bytes that are not
+// printable shown as '?', so a binary file read as text cannot flood the terminal.
+std::string as_shown(const std::string& word) {
+  std::string out = "'";
+  for (std::size_t i = 0; i < std::min<std::size_t>(word.size(), 40); ++i) {
+    const unsigned char c = static_cast<unsigned char>(word[i]);
+    out += c >= 32 && c < 127 ? static_cast<char>(c) : '?';
+  }
+  return out + (word.size() > 40 ? "...'" : "'");
+}
+
+// An ASCII STL is plain text; a binary STL's float data almost always holds bytes that
+// no text has (NUL, control characters), even when its header starts with "solid".
+bool is_text(const std::string& b) {
+  return std::none_of(b.begin(), b.end(), [](char ch) {
+    const unsigned char c = static_cast<unsigned char>(ch);
+    return c < 32 && c != '\t' && c != '\n' && c != '\r' && c != '\f' && c != '\v';
+  });
+}
+
 bool looks_binary(const std::string& b, std::uint32_t& count) {
   if (b.size() < 84) return false;
   std::memcpy(&count, b.data() + 80, 4);  // little-endian on every supported platform
@@ -29,6 +54,9 @@ bool looks_binary(const std::string& b, std::uint32_t& count) {
 
 std::vector<RawTriangle> read_binary(const std::string& b, std::uint32_t count,
                                      const std::string& label) {
+  if (count > kMaxTriangles)
+    fail(label, "", "binary STL declares " + std::to_string(count) + " triangles; at most " +
+                        std::to_string(kMaxTriangles) + " are supported");
   std::vector<RawTriangle> out(count);
   for (std::uint32_t t = 0; t < count; ++t) {
     const char* rec = b.data() + 84 + 50 * static_cast<std::size_t>(t);
@@ -87,12 +115,15 @@ std::vector<RawTriangle> read_ascii(const std::string& b, const std::string& lab
         if (!(words >> s)) fail(label, at(lineno), "a vertex needs three coordinates");
         x[a] = std::strtod(s.c_str(), &end);
         if (end == s.c_str() || *end != '\0')
-          fail(label, at(lineno), "coordinate '" + s + "' is not a number");
+          fail(label, at(lineno), "coordinate " + as_shown(s) + " is not a number");
         if (!std::isfinite(x[a]))
-          fail(label, at(lineno), "vertex coordinate '" + s +
-                                      "' is not finite (NaN or inf); repair the mesh in its CAD "
+          fail(label, at(lineno), "vertex coordinate " + as_shown(s) +
+                                      " is not finite (NaN or inf); repair the mesh in its CAD "
                                       "tool");
       }
+      if (std::string extra; words >> extra)
+        fail(label, at(lineno), "a vertex has three coordinates, but " + as_shown(extra) +
+                                    " follows the third");
       if (nv < 3) cur.v[nv] = x;
       ++nv;
     } else if (key == "endloop") {
@@ -106,11 +137,14 @@ std::vector<RawTriangle> read_ascii(const std::string& b, const std::string& lab
       if (!in_facet || in_loop || nv != 3)
         fail(label, at(lineno), "'endfacet' without a complete 'outer loop' of three vertices");
       cur.where = facet_line;
+      if (out.size() == kMaxTriangles)
+        fail(label, at(lineno), "more than " + std::to_string(kMaxTriangles) +
+                                    " triangles; at most that many are supported");
       out.push_back(cur);
       in_facet = false;
     } else {
-      fail(label, at(lineno), "unexpected '" + key +
-                                  "' in an ASCII STL file (expected solid, facet, outer loop, "
+      fail(label, at(lineno), "unexpected " + as_shown(key) +
+                                  " in an ASCII STL file (expected solid, facet, outer loop, "
                                   "vertex, endloop, endfacet, endsolid)");
     }
   }
@@ -138,16 +172,25 @@ TriangleMesh parse_stl(const std::string& bytes, const std::string& label,
   const std::size_t first = bytes.find_first_not_of(" \t\r\n");
   std::vector<RawTriangle> raw;
   StlReport rep;
+  const bool starts_solid = first != std::string::npos && bytes.compare(first, 5, "solid") == 0;
   if (looks_binary(bytes, count)) {
     rep.binary = true;
     raw = read_binary(bytes, count, label);
-  } else if (first != std::string::npos && bytes.compare(first, 5, "solid") == 0) {
+  } else if (starts_solid && (bytes.size() < 84 || is_text(bytes))) {
     raw = read_ascii(bytes, label);
   } else if (bytes.size() >= 84) {
+    // The count is only compared with the file's size: nothing is allocated for it.
+    const std::uint64_t expected = 84 + 50 * static_cast<std::uint64_t>(count);
     fail(label, "", "binary STL header declares " + std::to_string(count) + " triangles (" +
-                        std::to_string(84 + 50 * static_cast<std::uint64_t>(count)) +
-                        " bytes) but the file has " + std::to_string(bytes.size()) +
-                        " bytes; the file is truncated or not an STL file");
+                        std::to_string(expected) + " bytes) but the file has " +
+                        std::to_string(bytes.size()) + " bytes; " +
+                        (expected > bytes.size()
+                             ? "the file is truncated or not an STL file"
+                             : "bytes are left over after the declared triangles (a wrong count, "
+                               "or not an STL file)") +
+                        (starts_solid ? " (it starts with 'solid' but holds NUL or control "
+                                        "bytes, so it is not an ASCII STL either)"
+                                      : ""));
   } else {
     fail(label, "", "not an STL file: it neither starts with 'solid' (ASCII) nor holds the " +
                         std::string("84-byte header of a binary STL"));
@@ -183,7 +226,15 @@ TriangleMesh parse_stl(const std::string& bytes, const std::string& label,
     fail(label, "", raw.empty() ? "the STL file holds no triangles"
                                 : "all " + std::to_string(raw.size()) +
                                       " triangles of the STL file are degenerate (zero area)");
-  for (Vec3& x : verts) x = transform.apply(x);
+  for (Vec3& x : verts) {
+    x = transform.apply(x);
+    if (!x.allFinite()) {
+      std::ostringstream scale;
+      scale << transform.scale;
+      fail(label, "", "the placement (scale " + scale.str() +
+                          ") moves a vertex to a non-finite position; use a smaller scale");
+    }
+  }
   rep.vertices = static_cast<long>(verts.size());
   if (report) *report = rep;
   return TriangleMesh(std::move(verts), std::move(tris));

@@ -6,12 +6,15 @@
 //
 // Which format: a file whose size is exactly 84 + 50 n, n being its uint32 at byte
 // 80, is binary even if its header starts with "solid" (many exporters write that);
-// otherwise a file starting with "solid" is ASCII. Anything else is an error.
+// otherwise a file starting with "solid" and holding only text (no NUL or control
+// bytes) is ASCII. Anything else is an error. The binary count is only compared with
+// the file size, never trusted for an allocation.
 //
 // What is an error (GeometryError naming the file and the line or triangle): a
 // binary size that does not match its count, an ASCII facet without exactly three
-// vertices, a number that does not parse, a non-finite (NaN, inf) coordinate, a
-// file that ends inside a facet, a mesh with no usable triangle. What is repaired
+// vertices or a vertex without exactly three numbers, a number that does not parse,
+// a non-finite (NaN, inf) coordinate before or after the placement, a file that ends
+// inside a facet, a mesh with no usable triangle. What is repaired
 // and counted in StlReport: degenerate triangles (two vertices equal, or all three
 // collinear to round-off) are dropped. Facet normals in the file are ignored: a
 // mesh wall is two-sided and normals are recomputed from the vertices.

@@ -66,7 +66,27 @@ void TriangleMesh::build_grid(double cell, std::size_t max_cells) {
     for (int a = 0; a < 3; ++a) n *= std::floor(extent[a] / h) + 1;
     return n;
   };
-  while (count(cell) > static_cast<double>(max_cells)) cell *= 1.25;
+  // (cell, triangle) entries: a triangle is listed in every cell its bounding box
+  // overlaps, so a few large or slanted triangles could fill the whole grid each.
+  // Bounded too, so a hostile mesh cannot make the grid use unbounded memory.
+  auto entries = [&](double h) {
+    double n = 0;
+    for (const auto& t : tris_) {
+      Vec3 a = verts_[t[0]], b = a;
+      for (int k = 1; k < 3; ++k) {
+        a = a.cwiseMin(verts_[t[k]]);
+        b = b.cwiseMax(verts_[t[k]]);
+      }
+      double cells = 1;
+      for (int d = 0; d < 3; ++d)
+        cells *= std::floor((b[d] - lo_[d]) / h) - std::floor((a[d] - lo_[d]) / h) + 1;
+      n += cells;
+    }
+    return n;
+  };
+  const double max_entries =
+      std::max(2.0 * static_cast<double>(max_cells), 8.0 * static_cast<double>(tris_.size()));
+  while (count(cell) > static_cast<double>(max_cells) || entries(cell) > max_entries) cell *= 1.25;
   cell_ = cell;
   inv_cell_ = 1 / cell;
   for (int a = 0; a < 3; ++a) dims_[a] = static_cast<int>(std::floor(extent[a] * inv_cell_)) + 1;

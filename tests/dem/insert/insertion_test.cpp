@@ -3,6 +3,7 @@
 // containment and pairwise non-overlap checked by brute force, and the moments of
 // the size distributions (sample mean within 4 standard errors of the exact mean:
 // a false failure rate below 1e-4).
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -185,6 +186,102 @@ TEST(CsvInsertion, ReadsColumnsAndReportsBadRows) {
   } catch (const InsertionError& e) {
     EXPECT_NE(std::string(e.what()).find("lacks column 'z'"), std::string::npos) << e.what();
   }
+}
+
+// Broken particle files (docs/reliability.md, "Hostile input"): each is an error naming
+// the file, the line and what is wrong; nothing is skipped or clamped silently.
+class BrokenCsv : public ::testing::Test {
+ protected:
+  // The error inserting a CSV file with `text` gives (or "no error"), in the scene of
+  // one_material_scene: domain [-1, 1]^3, one material 'm'.
+  std::string error_of(const std::string& text, bool periodic = false) {
+    const auto dir = std::filesystem::temp_directory_path() / "grainflow_broken_csv";
+    std::filesystem::create_directories(dir);
+    file_ = (dir / "p.csv").string();
+    std::ofstream(file_) << text;
+    Scene s = test::one_material_scene(1e7, 0.3, 2500, 0.5);
+    if (periodic) s.domain.periodic = {true, true, true};
+    Insertion ins;
+    ins.kind = Insertion::Kind::csv;
+    ins.csv_file = file_;
+    ins.source = "scene.yaml:7";
+    s.insertions.push_back(ins);
+    Particles p;
+    GlobalId next = 1;
+    try {
+      insert_particles(s, p, next);
+    } catch (const InsertionError& e) {
+      EXPECT_THAT(e.what(), ::testing::HasSubstr("(particle file of the insertion at scene.yaml:7)"));
+      return e.what();
+    }
+    return "no error";
+  }
+  std::string at(int line) const { return file_ + ":" + std::to_string(line) + ": error: "; }
+  std::string file_;
+};
+
+using ::testing::HasSubstr;
+
+TEST_F(BrokenCsv, EmptyOrHeaderOnly) {
+  EXPECT_THAT(error_of(""), HasSubstr("p.csv: error: the file is empty (no header line); its first "
+                                      "line must name the columns: x,y,z,radius (required)"));
+  EXPECT_THAT(error_of("# only a comment\n\n"), HasSubstr("the file is empty (no header line)"));
+  EXPECT_THAT(error_of("x,y,z,radius\n"),
+              HasSubstr(at(1) + "the file has a header but no particle rows"));
+}
+
+TEST_F(BrokenCsv, MissingUnknownRepeatedAndPartialColumns) {
+  EXPECT_THAT(error_of("x,y,radius\n0,0,0.1\n"),
+              HasSubstr(at(1) + "header lacks column 'z'; columns: x,y,z,radius (required), "
+                                "vx,vy,vz, material (optional)"));
+  // A misspelt column would otherwise be ignored with its values.
+  EXPECT_THAT(error_of("x,y,z,radius,vX,vy,vz\n0,0,0,0.1,1,0,0\n"),
+              HasSubstr(at(1) + "unknown column 'vX' in the header; allowed columns: x,y,z,radius"));
+  EXPECT_THAT(error_of("x,y,z,radius,x\n0,0,0,0.1,0.5\n"),
+              HasSubstr(at(1) + "column 'x' appears twice in the header"));
+  EXPECT_THAT(error_of("x,y,z,radius,vz\n0,0,0,0.1,-1\n"),
+              HasSubstr(at(1) + "the header has only 1 of the velocity columns vx,vy,vz; give all "
+                                "three or none"));
+  EXPECT_THAT(error_of("x,y,z,radius\n0,0,0,0.1\n0.5,0.5\n"),
+              HasSubstr(at(3) + "expected 4 columns, found 2"));
+  EXPECT_THAT(error_of("x,y,z,radius\n0,0,0,0.1,7\n"), HasSubstr(at(2) + "expected 4 columns, found 5"));
+}
+
+TEST_F(BrokenCsv, NonNumericAndNonFiniteValues) {
+  EXPECT_THAT(error_of("x,y,z,radius\n0,abc,0,0.1\n"),
+              HasSubstr(at(2) + "column 'y' is not a finite number: 'abc'"));
+  EXPECT_THAT(error_of("x,y,z,radius\n0,0,0.5m,0.1\n"),
+              HasSubstr(at(2) + "column 'z' is not a finite number: '0.5m'"));
+  EXPECT_THAT(error_of("x,y,z,radius\n0,0,,0.1\n"),
+              HasSubstr(at(2) + "column 'z' is not a finite number: ''"));
+  EXPECT_THAT(error_of("x,y,z,radius\nnan,0,0,0.1\n"),
+              HasSubstr(at(2) + "column 'x' is not a finite number: 'nan'"));
+  EXPECT_THAT(error_of("x,y,z,radius\n0,0,0,1e999\n"),  // overflows to inf
+              HasSubstr(at(2) + "column 'radius' is not a finite number: '1e999'"));
+  EXPECT_THAT(error_of("x,y,z,radius\n0,0,0,-0.1\n"), HasSubstr(at(2) + "radius must be > 0, got -0.1"));
+  EXPECT_THAT(error_of("x,y,z,radius,material\n0,0,0,0.1,glas\n"),
+              HasSubstr(at(2) + "unknown material 'glas'; known materials: m"));
+}
+
+TEST_F(BrokenCsv, OutsideTheDomainAndOverlapping) {
+  EXPECT_THAT(error_of("x,y,z,radius\n0,0,0,0.1\n0,0.95,0,0.1\n"),
+              HasSubstr(at(3) + "the particle at (0, 0.95, 0) with radius 0.1 is outside the "
+                                "domain: it spans y from 0.85 to 1.05, beyond the domain's -1 to 1"));
+  EXPECT_THAT(error_of("x,y,z,radius\n0,0,5,0.1\n", true),
+              HasSubstr(at(2) + "the particle at (0, 0, 5) with radius 0.1 is outside the domain: "
+                                "its centre z = 5 is outside the periodic range [-1, 1)"));
+  EXPECT_THAT(error_of("x,y,z,radius\n0,0,0,0.1\n0.15,0,0,0.1\n"),
+              HasSubstr(at(3) + "the particle at (0.15, 0, 0) with radius 0.1 overlaps an earlier "
+                                "particle at (0, 0, 0) with radius 0.1"));
+  // Across a periodic boundary: x = 0.95 and x = -0.95 are 0.1 apart.
+  EXPECT_THAT(error_of("x,y,z,radius\n0.95,0,0,0.1\n-0.95,0,0,0.1\n", true),
+              HasSubstr(at(3) + "the particle at (-0.95, 0, 0) with radius 0.1 overlaps an earlier "
+                                "particle at (0.95, 0, 0)"));
+  // A radius far beyond the search grid's cells (the grid edge is 2/50 here): checked
+  // against every earlier particle instead of visiting ~(2e6)^3 cells.
+  EXPECT_THAT(error_of("x,y,z,radius\n0,0,0,0.01\n0.5,0.5,0.5,4e4\n", true),
+              HasSubstr(at(3) + "the particle at (0.5, 0.5, 0.5) with radius 40000 overlaps an "
+                                "earlier particle at (0, 0, 0) with radius 0.01"));
 }
 
 }  // namespace

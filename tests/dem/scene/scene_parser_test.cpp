@@ -606,6 +606,87 @@ TEST(SceneErrors, MissingFileHasNoPosition) {
   }
 }
 
+TEST(SceneErrors, DuplicateWallName) {
+  const std::string walls =
+      "walls:\n"                                                                           // 17
+      "  - {type: plane, name: floor, point: [0, 0, 0], normal: [0, 0, 1], material: glass}\n"  // 18
+      "  - {type: plane, point: [0, 0, 1], normal: [0, 0, -1], material: glass}\n"            // 19
+      "  - {type: plane, name: floor, point: [0, 0, 0], normal: [1, 0, 0], material: glass}\n";  // 20
+  const std::string msg = expect_at(error_of(kBase + walls), 20, 25);
+  EXPECT_THAT(msg, HasSubstr("walls[2].name: duplicate wall name 'floor'"));
+  // The unnamed wall is 'wall1'; naming a later one so collides too.
+  const std::string msg2 = expect_at(error_of(kBase + with("name: floor, point: [0, 0, 0], normal: [1",
+                                                           "name: wall1, point: [0, 0, 0], normal: [1",
+                                                           walls)),
+                                     20, 25);
+  EXPECT_THAT(msg2, HasSubstr("duplicate wall name 'wall1'"));
+}
+
+// yaml-cpp refuses deep nesting (500 levels in 0.7) instead of overflowing the stack;
+// the error says what that means.
+TEST(SceneErrors, DeepNestingIsASyntaxErrorNotACrash) {
+  const std::string deep = "domain: " + std::string(5000, '[') + std::string(5000, ']') + "\n";
+  const SceneError e = error_of(deep);
+  EXPECT_EQ(e.line(), 1);
+  EXPECT_THAT(e.what(), AllOf(HasSubstr("YAML syntax error: brackets or indentation nest "),
+                              HasSubstr(" levels deep; a scene needs at most a few levels")));
+}
+
+TEST(SceneErrors, NumbersNearTheDoubleLimit) {
+  const std::string extent = expect_at(error_of(with("min: [0, 0, 0]", "min: [-1e308, 0, 0]",
+                                                     with("max: [1, 1, 1]", "max: [1e308, 1, 1]"))),
+                                       3, 9);
+  EXPECT_THAT(extent, HasSubstr("domain.max[0]: the domain's extent max - min overflows"));
+  const std::string fill =
+      "insert:\n"
+      "  - type: fill\n"
+      "    region: {box: {min: [0, 0, 0], max: [1, 1, 1]}}\n"
+      "    count: 10\n"
+      "    material: glass\n";
+  const std::string stddev = expect_at(
+      error_of(kBase + fill + "    radius: {distribution: normal, mean: 1e-3, stddev: 1e308}\n"),
+      22, 56);
+  EXPECT_THAT(stddev, HasSubstr("insert[0].radius.stddev: mean + 3 stddev overflows"));
+  // Weights near the limit would sum to inf and normalise to 0: scaled first.
+  const Scene s = parse_scene(
+      kBase + fill +
+          "    radius: {distribution: discrete, values: [1e-3, 2e-3], weights: [1e308, 1.5e308]}\n",
+      kLabel);
+  EXPECT_DOUBLE_EQ(s.insertions[0].radius.weights[0], 0.4);
+  EXPECT_DOUBLE_EQ(s.insertions[0].radius.weights[1], 0.6);
+}
+
+// Hostile sizes (docs/reliability.md, "Hostile input"): what the parser would build
+// from them is bounded before it is built.
+TEST(SceneErrors, MaterialCountIsBounded) {
+  std::string many = "materials:\n";
+  for (int i = 0; i < 1001; ++i)
+    many += "  - {name: m" + std::to_string(i) +
+            ", youngs_modulus: 5e6, poisson_ratio: 0.3, density: 2500}\n";
+  const std::string text =
+      with("interactions:\n  - materials: [glass, glass]\n    restitution: 0.9\n",
+           "interaction_defaults: {restitution: 0.9}\n",
+           with("materials:\n  - name: glass\n    youngs_modulus: 5e6\n    poisson_ratio: 0.3\n"
+                "    density: 2500\n",
+                many));
+  const std::string msg = expect_at(error_of(text), 7, 1);
+  EXPECT_THAT(msg, HasSubstr("materials: 1001 materials are listed; at most 1000 are allowed"));
+}
+
+TEST(SceneErrors, FillCountMustFitTheRegionByVolume) {
+  const std::string fill =
+      "insert:\n"                                              // 17
+      "  - type: fill\n"                                       // 18
+      "    region: {box: {min: [0, 0, 0], max: [1, 1, 0.5]}}\n"  // 19
+      "    count: 1e9\n"                                       // 20
+      "    material: glass\n"                                  // 21
+      "    radius: {distribution: uniform, min: 1e-3, max: 2e-3}\n";  // 22
+  // 1e9 spheres of r >= 1 mm: 1e9 (4/3) pi 1e-9 = 4.18879 m^3 > 0.5 m^3.
+  const std::string msg = expect_at(error_of(kBase + fill), 20, 12);
+  EXPECT_THAT(msg, HasSubstr("insert[0].count: 1000000000 spheres of radius at least 0.001 m have "
+                             "a volume of 4.18879020479 m^3, more than the region's 0.5 m^3"));
+}
+
 // Periodic checkpoints (docs/reliability.md): off unless an interval is given; keep 2.
 TEST(SceneParser, CheckpointSettings) {
   const Scene none = parse_scene(kBase, kLabel);

@@ -6,9 +6,14 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
+#include <filesystem>
+#include <fstream>
 #include <numbers>
 
+#include "dem/scene/scene_parser.hpp"
 #include "dem/walls/stl_reader.hpp"
+#include "dem/walls/wall_set.hpp"
 
 namespace grainflow {
 namespace {
@@ -141,6 +146,144 @@ TEST(StlReader, BrokenAsciiFacetsAreErrorsWithLines) {
   EXPECT_THAT(error_of(truncated), HasSubstr("ends inside the facet begun at line 9"));
   EXPECT_THAT(error_of("hello"), HasSubstr("not an STL file"));
   EXPECT_THAT(error_of("solid empty\nendsolid empty\n"), HasSubstr("holds no triangles"));
+}
+
+// --- Hostile and broken files (docs/reliability.md, "Hostile input") ---
+
+std::string with_count(std::string b, std::uint32_t n) {
+  std::memcpy(b.data() + 80, &n, 4);
+  return b;
+}
+
+const std::vector<std::array<float, 9>> kSquare = {{0, 0, 0, 1, 0, 0, 1, 1, 0},
+                                                   {0, 0, 0, 1, 1, 0, 0, 1, 0}};
+
+// A header claiming 4e9 triangles (200 GB) in a 184-byte file: the count is only
+// compared with the size, never used to allocate.
+TEST(StlReader, HugeBinaryCountIsAnErrorWithoutAllocating) {
+  const std::string b = with_count(binary_stl(kSquare, "x"), 4'000'000'000u);
+  EXPECT_THAT(error_of(b), HasSubstr("mesh.stl: error: binary STL header declares 4000000000 "
+                                     "triangles (200000000084 bytes) but the file has 184 bytes; "
+                                     "the file is truncated"));
+}
+
+TEST(StlReader, BinaryCountBelowTheFileSizeIsAnError) {
+  const std::string b = with_count(binary_stl(kSquare, "x"), 1);
+  EXPECT_THAT(error_of(b), HasSubstr("declares 1 triangles (134 bytes) but the file has 184 bytes; "
+                                     "bytes are left over after the declared triangles"));
+}
+
+// A binary file whose header starts with "solid" and whose count is wrong is reported
+// as a binary file with a wrong count, not as ASCII text full of unreadable words.
+TEST(StlReader, SolidHeaderWithWrongCountIsReportedAsBinary) {
+  const std::string b = with_count(binary_stl(kSquare, "solid exported"), 3);
+  EXPECT_THAT(error_of(b), HasSubstr("binary STL header declares 3 triangles (234 bytes) but the "
+                                     "file has 184 bytes; the file is truncated or not an STL file "
+                                     "(it starts with 'solid' but holds NUL or control bytes, so "
+                                     "it is not an ASCII STL either)"));
+}
+
+TEST(StlReader, EmptyShortAndTruncatedFilesAreErrors) {
+  EXPECT_THAT(error_of(""), HasSubstr("mesh.stl: error: not an STL file"));
+  EXPECT_THAT(error_of(std::string(40, '\0')), HasSubstr("not an STL file"));
+  // A binary file cut inside its header, and one cut inside its last triangle.
+  const std::string b = binary_stl(kSquare, "x");
+  EXPECT_THAT(error_of(b.substr(0, 83)), HasSubstr("not an STL file"));
+  EXPECT_THAT(error_of(b.substr(0, 180)), HasSubstr("declares 2 triangles (184 bytes) but the file "
+                                                    "has 180 bytes; the file is truncated"));
+  EXPECT_THAT(error_of("solid only\n"), HasSubstr("the STL file holds no triangles"));
+}
+
+TEST(StlReader, InfiniteVerticesAreErrors) {
+  const float inf = std::numeric_limits<float>::infinity();
+  EXPECT_THAT(error_of(binary_stl({{0, 0, 0, 1, 0, 0, 1, 1, -inf}}, "x")),
+              HasSubstr("binary triangle 1 of 1: vertex 3 has a non-finite coordinate"));
+  std::string a = kTwoTriangles;
+  a.replace(a.find("vertex 1 0 0"), 12, "vertex 1 inf 0");
+  EXPECT_THAT(error_of(a), HasSubstr("mesh.stl:5: error: vertex coordinate 'inf' is not finite"));
+  // A finite vertex that the placement's scale pushes beyond the double range.
+  MeshTransform huge;
+  huge.scale = 1e300;
+  try {
+    parse_stl(binary_stl({{0, 0, 0, 3e38f, 0, 0, 0, 3e38f, 0}}, "x"), "big.stl", huge);
+    ADD_FAILURE() << "expected GeometryError";
+  } catch (const GeometryError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("big.stl: error: the placement (scale 1e+300)"));
+    EXPECT_THAT(e.what(), HasSubstr("moves a vertex to a non-finite position"));
+  }
+}
+
+TEST(StlReader, DegenerateBinaryTrianglesAreCountedAndAllDegenerateIsAnError) {
+  StlReport rep;
+  const TriangleMesh m =
+      parse_stl(binary_stl({kSquare[0], {0, 0, 0, 0, 0, 0, 1, 1, 0}, {0, 0, 0, 2, 0, 0, 4, 0, 0}},
+                           "x"),
+                "d.stl", {}, &rep);
+  EXPECT_TRUE(rep.binary);
+  EXPECT_EQ(rep.facets_read, 3);
+  EXPECT_EQ(rep.degenerate_removed, 2);
+  EXPECT_EQ(m.triangle_count(), 1u);
+  EXPECT_THAT(error_of(binary_stl({{0, 0, 0, 0, 0, 0, 1, 1, 0}, {0, 0, 0, 1, 1, 1, 2, 2, 2}}, "x")),
+              HasSubstr("all 2 triangles of the STL file are degenerate (zero area)"));
+}
+
+// The repair is reported where a user sees it: the run's report line for the wall.
+TEST(StlReader, DegenerateRemovalIsReportedForTheWall) {
+  const auto dir = std::filesystem::temp_directory_path() / "grainflow_stl_report";
+  std::filesystem::create_directories(dir);
+  std::ofstream((dir / "d.stl").string(), std::ios::binary)
+      << binary_stl({kSquare[0], kSquare[1], {0, 0, 0, 0, 0, 0, 1, 1, 0}}, "x");
+  const Scene scene = parse_scene(R"(domain: {min: [-1, -1, -1], max: [2, 2, 2]}
+time: {step: 1.0e-5, end: 0.01}
+materials: [{name: glass, youngs_modulus: 1.0e7, poisson_ratio: 0.3, density: 2500}]
+interaction_defaults: {restitution: 0.5}
+contact: {normal: hertz}
+walls: [{type: mesh, name: floor, file: d.stl, material: glass}]
+)",
+                                  (dir / "scene.yaml").string());
+  const WallSet walls(scene);
+  ASSERT_EQ(walls.notes().size(), 1u);
+  EXPECT_THAT(walls.notes()[0], HasSubstr("wall 'floor': 2 triangles, 4 vertices from binary STL"));
+  EXPECT_THAT(walls.notes()[0], HasSubstr("(1 degenerate triangles removed)"));
+}
+
+// A mesh whose triangles each span the whole bounding box (100 slanted triangles across
+// a unit cube): with the 2^22-cell grid a small cell asks for, every triangle would be
+// listed in all 4 million cells (4e8 entries, 3 GB). The number of (cell, triangle)
+// entries is bounded by max(2 max_cells, 8 triangles) = 8 388 608, which here needs
+// 100 (floor(1/h) + 1)^3 <= 8 388 608, floor(1/h) <= 42: cells h > 1/43; the step
+// before (h / 1.25) did not fit, so h <= 1.25/43.
+TEST(StlReader, SearchGridOfLargeSlantedTrianglesIsBounded) {
+  std::vector<Vec3> v;
+  std::vector<std::array<int, 3>> t;
+  for (int k = 0; k < 100; ++k) {
+    const int b = static_cast<int>(v.size());
+    v.insert(v.end(), {Vec3(0, 0, 0), Vec3(1, 1, 0.5 + 0.001 * k), Vec3(0.5, 1, 1)});
+    t.push_back({b, b + 1, b + 2});
+  }
+  TriangleMesh m(v, t);
+  m.build_grid(1e-3);
+  EXPECT_GT(m.cell_size(), 1.0 / 43);
+  EXPECT_LE(m.cell_size(), 1.25 / 43);  // enlarged in steps of 1.25 only as far as needed
+  // The search is still exact: the same contacts as the brute-force reference.
+  MeshTouch a[TriangleMesh::kMaxTouches], b[TriangleMesh::kMaxTouches];
+  for (const Vec3& c : {Vec3(0.5, 0.6, 0.5), Vec3(0.2, 0.3, 0.1), Vec3(0.9, 0.95, 0.8)}) {
+    const int n = m.touches(c, 0.05, a);
+    ASSERT_EQ(n, m.touches_brute_force(c, 0.05, b));
+    for (int i = 0; i < n; ++i) EXPECT_EQ(a[i].triangle, b[i].triangle);
+  }
+}
+
+TEST(StlReader, AsciiVertexWithExtraNumbersAndBinaryGarbageAreClearErrors) {
+  std::string four = kTwoTriangles;
+  four.replace(four.find("vertex 1 0 0"), 12, "vertex 1 0 0 7");
+  EXPECT_THAT(error_of(four), HasSubstr("mesh.stl:5: error: a vertex has three coordinates, but "
+                                        "'7' follows the third"));
+  // A long unreadable word is shown cut to 40 characters, control bytes as '?'.
+  const std::string garbage = "solid x\n" + std::string(100, 'A') + "\n";
+  EXPECT_THAT(error_of(garbage), HasSubstr("mesh.stl:2: error: unexpected '" +
+                                           std::string(40, 'A') + "...' in an ASCII STL file"));
+  EXPECT_THAT(error_of("solid x\nfa\x01" "cet\n"), HasSubstr("unexpected 'fa?cet'"));
 }
 
 }  // namespace
