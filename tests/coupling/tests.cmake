@@ -65,7 +65,7 @@ grainflow_coupling_test(exchange_balance 2)
 grainflow_coupling_test(neutrally_buoyant 1)
 grainflow_coupling_test(refuses_bad_setup 2)
 grainflow_coupling_test(restart 2)
-set_tests_properties(coupling.restart PROPERTIES TIMEOUT 240)  # ~45 s on a quiet machine
+set_tests_properties(coupling.restart PROPERTIES TIMEOUT 600)  # ~45 s on a quiet machine
 grainflow_coupling_test(stop_signal 2)
 grainflow_coupling_test(nan_guard 2)
-set_tests_properties(coupling.stop_signal PROPERTIES TIMEOUT 240)  # ~25 s on a quiet machine
+set_tests_properties(coupling.stop_signal PROPERTIES TIMEOUT 600)  # ~25 s on a quiet machine

@@ -80,7 +80,7 @@ class Runner:
             cmd.append("-parallel")
         t0 = time.monotonic()
         r = subprocess.run(cmd, cwd=case, env=self.env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                           text=True, timeout=120)
+                           text=True, timeout=300)
         with open(os.path.join(case, "log." + log), "w") as f:
             f.write(r.stdout)
         print(f"  ran   {log} ({time.monotonic() - t0:.1f} s, exit {r.returncode})")
