@@ -44,6 +44,19 @@ from grainfoam_driver import (ROUND_OFF, NAN_WORD, balance_lines, main, particle
                               read_scalar_field, snapshots, time_folders, void_lines)
 
 
+# benchmarks/hard_cases/coupled/run.sh: GRAINFLOW_STRESS_SCALE=N runs the cases that evolve
+# in time (dense bed, convected slab) N times longer, with the same checks at every write.
+SCALE = float(os.environ.get("GRAINFLOW_STRESS_SCALE", "1"))
+
+
+def longer(end_time):
+    """The controlDict edit that runs a case SCALE times longer (none at scale 1)."""
+    if SCALE == 1:
+        return []
+    return [("system/controlDict", f"endTime         {end_time};",
+             f"endTime         {end_time * SCALE:g};")]
+
+
 def check_run(checks, label, case, log, count, min_eps, cell_volume=None):
     """The invariants every run must keep. Returns ({folder: eps}, snapshots, void lines).
     cell_volume: when given (uniform mesh), sum (1 - eps) V + clamped is recomputed from
@@ -122,7 +135,7 @@ def dense_bed_10x_umf(runner, checks):
     distributor by no more than max_overlap r (z - r > -0.25 r) and below the lid alike,
     and the bed really moved (its centre of mass rose by > 1 mm after the switch-on: the
     gas is on and strong)."""
-    case = runner.fresh_case("dense_bed", "dense_bed")
+    case = runner.fresh_case("dense_bed", "dense_bed", longer(0.04))
     t0 = time.monotonic()
     log = runner.solve(case, 1)
     print(f"  grainFoam wall time {time.monotonic() - t0:.1f} s")
@@ -326,7 +339,7 @@ def emptied_and_refilled_cells(runner, checks):
     once per lap. Checked: the common invariants with the volume recomputed from every
     written field; every cell is exactly 1 at some writes and below 1 at others, and goes
     from empty to filled at least 4 times; every bead lapped the box at least 4 times."""
-    case = runner.fresh_case("convected", "emptied_refilled")
+    case = runner.fresh_case("convected", "emptied_refilled", longer(0.02))
     t0 = time.monotonic()
     log = runner.solve(case, 1)
     print(f"  grainFoam wall time {time.monotonic() - t0:.1f} s")
@@ -369,12 +382,12 @@ def fast_crossing_ranks(runner, checks):
     arrivals per bead: |dv| <= n 2 |dv/dt|max dt_f and |dx| <= that times the run time.
     Positions (modulo the period) and velocities after reconstructPar must stay within
     those bounds; the measured differences are printed."""
-    end_time, dt_f = 0.008, 1e-4
+    end_time, dt_f = 0.008 * SCALE, 1e-4
     eps, snaps, late, first_late = {}, {}, {}, {}
     for ranks in (1, 2, 4):
         label = f"slab np {ranks}"
         print(f"{label}:")
-        edits = [("system/controlDict", "endTime         0.02;", f"endTime         {end_time};")]
+        edits = [("system/controlDict", "endTime         0.02;", f"endTime         {end_time:g};")]
         if ranks != 2:
             edits += [("system/decomposeParDict", "numberOfSubdomains 2;",
                        f"numberOfSubdomains {ranks};"),
