@@ -174,21 +174,22 @@ CarriedState Simulation::save_histories() const {
   if (!sweep_.has_history) return c;
   for (std::size_t i = 0; i + 1 < local_list_.offsets.size(); ++i) {
     for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k)
-      if (is_set(local_history_[k])) {
+      if (const ContactHistory h = local_springs_[k]; is_set(h)) {
         const std::size_t j = local_list_.j[k];
-        c.pairs[i].push_back({p_.id[j], local_history_[k]});
-        c.pairs[j].push_back({p_.id[i], local_history_[k]});
+        c.pairs[i].push_back({p_.id[j], h});
+        c.pairs[j].push_back({p_.id[i], h});
       }
     for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k)
-      if (is_set(ghost_history_[k])) c.pairs[i].push_back({ghosts_.id[ghost_list_.j[k]], ghost_history_[k]});
+      if (const ContactHistory h = ghost_springs_[k]; is_set(h))
+        c.pairs[i].push_back({ghosts_.id[ghost_list_.j[k]], h});
   }
   return c;
 }
 
 void Simulation::restore_histories(const CarriedState& carried) {
   wall_history_ = carried.wall;
-  local_history_.assign(local_list_.pairs(), ContactHistory{});
-  ghost_history_.assign(ghost_list_.pairs(), ContactHistory{});
+  local_springs_.reset(local_list_.pairs(), sweep_.keeps_tangential, sweep_.keeps_rolling);
+  ghost_springs_.reset(ghost_list_.pairs(), sweep_.keeps_tangential, sweep_.keeps_rolling);
   if (!sweep_.has_history) return;
   std::unordered_map<PairKey, ContactHistory, PairKeyHash> saved;
   for (std::size_t i = 0; i < carried.pairs.size(); ++i)
@@ -198,11 +199,11 @@ void Simulation::restore_histories(const CarriedState& carried) {
   for (std::size_t i = 0; i < p_.size(); ++i) {
     for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k) {
       auto it = saved.find(PairKey(p_.id[i], p_.id[local_list_.j[k]]));
-      if (it != saved.end()) local_history_[k] = it->second;
+      if (it != saved.end()) local_springs_.set(k, it->second);
     }
     for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k) {
       auto it = saved.find(PairKey(p_.id[i], ghosts_.id[ghost_list_.j[k]]));
-      if (it != saved.end()) ghost_history_[k] = it->second;
+      if (it != saved.end()) ghost_springs_.set(k, it->second);
     }
   }
 }
@@ -379,7 +380,7 @@ void Simulation::compute_forces() {
     p_.torque[i].setZero();
   }
   ContactSweep s{
-      p_,     ghosts_,       local_list_,      ghost_list_, local_history_, ghost_history_,
+      p_,     ghosts_,       local_list_,      ghost_list_, local_springs_, ghost_springs_,
       walls_, wall_history_, wall_neighbours_, table_,      constants_,     dt_,
       0,      0.0,           WorstContact{}};
   sweep_.run(s);

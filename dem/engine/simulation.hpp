@@ -160,7 +160,7 @@ class Simulation {
   double dt_ = 0, time_ = 0, skin_ = 0, cutoff_ = 0;
   std::unique_ptr<BinGrid> grid_;
   NeighbourList local_list_, ghost_list_;
-  std::vector<ContactHistory> local_history_, ghost_history_;
+  ListSprings local_springs_, ghost_springs_;              // parallel to the lists' entries
   std::vector<std::vector<ContactHistory>> wall_history_;  // [WallSet column][particle]
   WallNeighbours wall_neighbours_;                         // rebuilt with the Verlet lists
   WallSet walls_;
