@@ -168,8 +168,21 @@ bool Simulation::needs_rebuild() const {
 }
 
 CarriedState Simulation::save_histories() const {
-  CarriedState c;
+  CarriedState c = pair_histories();
   c.wall = wall_history_;
+  return c;
+}
+
+CarriedState Simulation::take_histories() {
+  CarriedState c = pair_histories();
+  c.wall = std::move(wall_history_);
+  local_springs_.reset(0, false, false);  // released before the new lists are built
+  ghost_springs_.reset(0, false, false);
+  return c;
+}
+
+CarriedState Simulation::pair_histories() const {
+  CarriedState c;
   c.pairs.resize(p_.size());
   if (!sweep_.has_history) return c;
   for (std::size_t i = 0; i + 1 < local_list_.offsets.size(); ++i) {
@@ -186,25 +199,25 @@ CarriedState Simulation::save_histories() const {
   return c;
 }
 
-void Simulation::restore_histories(const CarriedState& carried) {
-  wall_history_ = carried.wall;
+void Simulation::restore_histories(CarriedState& carried) {
+  wall_history_ = std::move(carried.wall);
   local_springs_.reset(local_list_.pairs(), sweep_.keeps_tangential, sweep_.keeps_rolling);
   ghost_springs_.reset(ghost_list_.pairs(), sweep_.keeps_tangential, sweep_.keeps_rolling);
   if (!sweep_.has_history) return;
-  std::unordered_map<PairKey, ContactHistory, PairKeyHash> saved;
-  for (std::size_t i = 0; i < carried.pairs.size(); ++i)
+  // Each particle carries all its springs (both partners of a local pair carry the same
+  // one), so an entry's spring is found in the few its own particle carries.
+  const auto find = [&](std::size_t i, GlobalId partner) -> const ContactHistory* {
     for (const PartnerHistory& ph : carried.pairs[i])
-      saved.emplace(PairKey(p_.id[i], ph.partner), ph.history);
-  if (saved.empty()) return;
+      if (ph.partner == partner) return &ph.history;
+    return nullptr;
+  };
   for (std::size_t i = 0; i < p_.size(); ++i) {
-    for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k) {
-      auto it = saved.find(PairKey(p_.id[i], p_.id[local_list_.j[k]]));
-      if (it != saved.end()) local_springs_.set(k, it->second);
-    }
-    for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k) {
-      auto it = saved.find(PairKey(p_.id[i], ghosts_.id[ghost_list_.j[k]]));
-      if (it != saved.end()) ghost_springs_.set(k, it->second);
-    }
+    if (carried.pairs[i].empty()) continue;
+    for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k)
+      if (const ContactHistory* h = find(i, p_.id[local_list_.j[k]])) local_springs_.set(k, *h);
+    for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k)
+      if (const ContactHistory* h = find(i, ghosts_.id[ghost_list_.j[k]]))
+        ghost_springs_.set(k, *h);
   }
 }
 
@@ -332,7 +345,7 @@ void Simulation::write_checkpoint(const std::string& path) {
 
 void Simulation::rebuild(bool keep_drag) {
   // Springs by global ids (indices change below); after a restore, those of the checkpoint.
-  CarriedState carried = pending_carried_ ? std::move(*pending_carried_) : save_histories();
+  CarriedState carried = pending_carried_ ? std::move(*pending_carried_) : take_histories();
   pending_carried_.reset();
   carried.carries_drag = keep_drag && !terms_.empty();
   if (carried.carries_drag)

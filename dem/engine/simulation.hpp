@@ -143,8 +143,12 @@ class Simulation {
   bool needs_rebuild() const;  // collective
   void mark_leaving();         // particles beyond a bounded side of the domain
   void half_kick();            // v += dt/2 F/m (implicit in v where drag is set), same for spin
-  CarriedState save_histories() const;
-  void restore_histories(const CarriedState& carried);
+  CarriedState save_histories() const;  // a copy of every spring, by global ids
+  // The same, moving the wall springs out and releasing the lists' springs (at a rebuild,
+  // which makes them anew: the old and new copies do not coexist at the memory peak).
+  CarriedState take_histories();
+  CarriedState pair_histories() const;  // the particle pairs' part
+  void restore_histories(CarriedState& carried);  // takes carried.wall
   void apply_order(const std::vector<std::size_t>& perm, CarriedState& carried);
 
   Scene scene_;
