@@ -27,10 +27,16 @@ std::string text(const Vec3& a) {
 
 }  // namespace
 
-bool non_finite_anywhere(const Particles& p, MPI_Comm comm) {
-  int bad = first_bad(p) < p.size() ? 1 : 0;
+bool has_non_finite(const Particles& p) { return first_bad(p) < p.size(); }
+
+bool non_finite_anywhere(bool local_bad, MPI_Comm comm) {
+  int bad = local_bad ? 1 : 0;
   MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPI_INT, MPI_MAX, comm);
   return bad != 0;
+}
+
+bool non_finite_anywhere(const Particles& p, MPI_Comm comm) {
+  return non_finite_anywhere(has_non_finite(p), comm);
 }
 
 std::string describe_first_non_finite(const Particles& p, long step, double time, int rank) {

@@ -13,6 +13,10 @@ namespace grainflow {
 // Collective: true on every rank when any rank holds a particle whose position, velocity or
 // angular velocity is not finite. One MPI_Allreduce of an int.
 bool non_finite_anywhere(const Particles& p, MPI_Comm comm);
+// The same from each rank's own answer (`local_bad`: this rank holds a non-finite state).
+bool non_finite_anywhere(bool local_bad, MPI_Comm comm);
+// Whether p holds a non-finite position, velocity or angular velocity (no communication).
+bool has_non_finite(const Particles& p);
 
 // This rank's first such particle described for the user (id, rank, step, time, position,
 // velocity, angular velocity, force and torque), or "" when this rank has none. Local.

@@ -23,9 +23,10 @@ namespace grainflow {
 namespace {
 
 // Stops the run on every rank at the first non-finite particle state, after writing every
-// particle into <dir>/diagnostic_000000.h5.
-void guard_finite(const Simulation& sim, const std::string& dir, MPI_Comm comm) {
-  if (!non_finite_anywhere(sim.particles(), comm)) return;
+// particle into <dir>/diagnostic_000000.h5. `local_bad`: this rank holds a non-finite state
+// (after a step, Simulation::state_finite() knows it without another pass).
+void guard_finite(const Simulation& sim, bool local_bad, const std::string& dir, MPI_Comm comm) {
+  if (!non_finite_anywhere(local_bad, comm)) return;
   std::string where;
   try {
     SnapshotWriter diagnostic(comm, dir, "diagnostic");
@@ -109,7 +110,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     throw SetupError(scene.file + ": error: refusing to run with this time step (see above); "
                                   "lower time.step / time.rayleigh_fraction, or pass "
                                   "--allow-large-dt to run anyway");
-  guard_finite(sim, dir, comm);
+  guard_finite(sim, has_non_finite(sim.particles()), dir, comm);
 
   SnapshotWriter snapshots(comm, dir);
   const std::string log_path = (std::filesystem::path(dir) / "log.csv").string();
@@ -210,7 +211,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   std::ostringstream stop_message;
   for (long k = first_step + 1; k <= total_steps; ++k) {
     sim.step();
-    guard_finite(sim, dir, comm);
+    guard_finite(sim, !sim.state_finite(), dir, comm);
     particle_steps += static_cast<double>(sim.particles().size());
     const double t = sim.time();
     const bool last = k == total_steps;

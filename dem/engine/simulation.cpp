@@ -10,18 +10,6 @@
 
 namespace grainflow {
 namespace {
-// Contact springs are saved across rebuilds under the pair's global ids.
-struct PairKey {
-  GlobalId lo, hi;
-  PairKey(GlobalId a, GlobalId b) : lo(std::min(a, b)), hi(std::max(a, b)) {}
-  bool operator==(const PairKey&) const = default;
-};
-struct PairKeyHash {
-  std::size_t operator()(const PairKey& k) const {
-    return std::hash<GlobalId>()(k.lo) * 0x9E3779B97F4A7C15ull ^ std::hash<GlobalId>()(k.hi);
-  }
-};
-
 bool is_set(const ContactHistory& h) { return !h.tangential.isZero(0) || !h.rolling.isZero(0); }
 
 template <class T>
@@ -156,11 +144,28 @@ void Simulation::mark_leaving() {
       }
 }
 
-bool Simulation::needs_rebuild() const {
-  int local = !leaving_.empty();
+void Simulation::drift() {
+  // One pass: x += dt v, then the tests of mark_leaving() and of the skin, on the new x.
+  const Domain& d = scene_.domain;
   const double limit2 = 0.25 * skin_ * skin_;
-  for (std::size_t i = 0; i < p_.size() && !local; ++i)
-    local = (p_.x[i] - x_at_build_[i]).squaredNorm() > limit2;
+  const std::size_t n = p_.size();
+  bool moved_far = false;
+  leaving_.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    Vec3& x = p_.x[i];
+    x += dt_ * p_.v[i];
+    moved_far |= (x - x_at_build_[i]).squaredNorm() > limit2;
+    for (int a = 0; a < 3; ++a)
+      if (!d.periodic[a] && (x[a] < d.lo[a] || x[a] > d.hi[a])) {
+        leaving_.resize(n, 0);
+        leaving_[i] = 1;
+      }
+  }
+  moved_beyond_half_skin_ = moved_far;
+}
+
+bool Simulation::needs_rebuild() const {
+  int local = !leaving_.empty() || moved_beyond_half_skin_;
   if (decomp_->size() == 1) return local;
   int any = 0;
   MPI_Allreduce(&local, &any, 1, MPI_INT, MPI_LOR, comm_);
@@ -469,32 +474,42 @@ void Simulation::apply_force_terms() {
   }
 }
 
-void Simulation::half_kick() {
+namespace {
+bool finite(const Vec3& a) {
+  return std::isfinite(a.x()) && std::isfinite(a.y()) && std::isfinite(a.z());
+}
+}  // namespace
+
+template <bool Guard>
+bool Simulation::half_kick() {
   const double h = 0.5 * dt_;
   const std::size_t n = p_.size();
-  if (drag_.coefficient.empty()) {
-    for (std::size_t i = 0; i < n; ++i) p_.v[i] += (h / p_.mass[i]) * p_.force[i];
-  } else {
-    // v' = v + h/m (F + K (u - v'))  =>  v' = (v + h/m (F + K u)) / (1 + h K / m)
-    for (std::size_t i = 0; i < n; ++i) {
+  const bool drag = !drag_.coefficient.empty(), spin = sweep_.needs_spin;
+  bool all_finite = true;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!drag) {
+      p_.v[i] += (h / p_.mass[i]) * p_.force[i];
+    } else {
+      // v' = v + h/m (F + K (u - v'))  =>  v' = (v + h/m (F + K u)) / (1 + h K / m)
       const double a = h / p_.mass[i], k = drag_.coefficient[i];
       p_.v[i] = (p_.v[i] + a * (p_.force[i] + k * drag_.fluid_velocity[i])) / (1 + a * k);
     }
+    if (spin) p_.omega[i] += (h / p_.inertia[i]) * p_.torque[i];
+    if constexpr (Guard) all_finite &= finite(p_.x[i]) && finite(p_.v[i]) && finite(p_.omega[i]);
   }
-  if (sweep_.needs_spin)
-    for (std::size_t i = 0; i < n; ++i) p_.omega[i] += (h / p_.inertia[i]) * p_.torque[i];
+  return all_finite;
 }
 
 void Simulation::step() {
   if (!initialised_) initialise();
   // Velocity Verlet: half kick, drift, new forces, half kick.
-  half_kick();
-  for (std::size_t i = 0; i < p_.size(); ++i) p_.x[i] += dt_ * p_.v[i];
+  half_kick<false>();
+  drift();
   // Stream insertion (dem/insert/stream_insertion.hpp); new particles force a rebuild.
   const bool inserted = !streams_.empty() && streams_.insert(time_ + dt_, p_, ghosts_, walls_,
                                                              *decomp_, next_id_, comm_) > 0;
   for (auto& column : wall_history_) column.resize(p_.size());
-  mark_leaving();
+  if (inserted) mark_leaving();  // the new particles too
   if (inserted || needs_rebuild())
     rebuild();
   else
@@ -502,7 +517,7 @@ void Simulation::step() {
   time_ += dt_;
   walls_.move_to(time_);
   compute_forces();
-  half_kick();
+  state_finite_ = half_kick<true>();
   ++counters_.steps;
 }
 

@@ -95,6 +95,9 @@ class Simulation {
 
   Particles& particles() { return p_; }  // this rank's particles
   const Particles& particles() const { return p_; }
+  // Whether every position, velocity and spin of this rank's particles was finite at the
+  // end of the last step() (checked in its last pass over the particles).
+  bool state_finite() const { return state_finite_; }
   const Ghosts& ghosts() const { return ghosts_; }
   const Scene& scene() const { return scene_; }
   const WallSet& walls() const { return walls_; }               // current wall positions
@@ -142,7 +145,12 @@ class Simulation {
   void check_overlap(const WorstContact& worst) const;
   bool needs_rebuild() const;  // collective
   void mark_leaving();         // particles beyond a bounded side of the domain
-  void half_kick();            // v += dt/2 F/m (implicit in v where drag is set), same for spin
+  // x += dt v, with mark_leaving()'s test and the skin test in the same pass.
+  void drift();
+  // v += dt/2 F/m (implicit in v where drag is set), same for spin. With Guard: returns
+  // whether every position, velocity and spin is finite after it (false otherwise).
+  template <bool Guard>
+  bool half_kick();
   CarriedState save_histories() const;  // a copy of every spring, by global ids
   // The same, moving the wall springs out and releasing the lists' springs (at a rebuild,
   // which makes them anew: the old and new copies do not coexist at the memory peak).
@@ -179,6 +187,8 @@ class Simulation {
   // The checkpoint's implicit drag by global id (K, u), until initialise().
   std::unordered_map<GlobalId, std::pair<double, Vec3>> restored_drag_;
   std::optional<CarriedState> pending_carried_;     // springs for the first rebuild
+  bool moved_beyond_half_skin_ = false;             // by the last drift(), since the last rebuild
+  bool state_finite_ = true;                        // after the last step(), this rank's particles
   bool restored_ = false;                           // initialise() keeps the forces read
   bool initialised_ = false;
 };
