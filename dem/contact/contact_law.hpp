@@ -31,7 +31,7 @@ struct ContactLaw {
   // no lower clamp: the contact ends when the overlap returns to zero, which is
   // the end-of-contact definition the restitution mappings assume. `tangential` and
   // `rolling` are the contact's springs (each touched only by a law that has it).
-  static ContactResult evaluate(const ContactGeometry& g, const PairCoefficients& pc,
+  [[gnu::always_inline]] static ContactResult evaluate(const ContactGeometry& g, const PairCoefficients& pc,
                                 const ContactConstants& cc, Vec3& tangential, Vec3& rolling,
                                 double dt) {
     const SpringDashpot s = Normal::coefficients(pc, cc, g.r_star, g.m_star, g.overlap);
