@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <unordered_map>
 
@@ -146,7 +147,14 @@ void Simulation::mark_leaving() {
 
 void Simulation::drift() {
   // One pass: x += dt v, then the tests of mark_leaving() and of the skin, on the new x.
+  // A periodic side has infinite bounds here: nothing leaves through it.
   const Domain& d = scene_.domain;
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  Vec3 lo, hi;
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = d.periodic[a] ? -inf : d.lo[a];
+    hi[a] = d.periodic[a] ? inf : d.hi[a];
+  }
   const double limit2 = 0.25 * skin_ * skin_;
   const std::size_t n = p_.size();
   bool moved_far = false;
@@ -155,11 +163,11 @@ void Simulation::drift() {
     Vec3& x = p_.x[i];
     x += dt_ * p_.v[i];
     moved_far |= (x - x_at_build_[i]).squaredNorm() > limit2;
-    for (int a = 0; a < 3; ++a)
-      if (!d.periodic[a] && (x[a] < d.lo[a] || x[a] > d.hi[a])) {
-        leaving_.resize(n, 0);
-        leaving_[i] = 1;
-      }
+    if (x[0] < lo[0] || x[0] > hi[0] || x[1] < lo[1] || x[1] > hi[1] || x[2] < lo[2] ||
+        x[2] > hi[2]) {
+      leaving_.resize(n, 0);
+      leaving_[i] = 1;
+    }
   }
   moved_beyond_half_skin_ = moved_far;
 }
@@ -474,18 +482,14 @@ void Simulation::apply_force_terms() {
   }
 }
 
-namespace {
-bool finite(const Vec3& a) {
-  return std::isfinite(a.x()) && std::isfinite(a.y()) && std::isfinite(a.z());
-}
-}  // namespace
-
 template <bool Guard>
 bool Simulation::half_kick() {
   const double h = 0.5 * dt_;
   const std::size_t n = p_.size();
   const bool drag = !drag_.coefficient.empty(), spin = sweep_.needs_spin;
-  bool all_finite = true;
+  // x - x is 0 for a finite x and NaN for an infinite or NaN one, and NaN stays in a sum:
+  // `nan_if_any` ends 0 exactly when every component was finite.
+  double nan_if_any = 0;
   for (std::size_t i = 0; i < n; ++i) {
     if (!drag) {
       p_.v[i] += (h / p_.mass[i]) * p_.force[i];
@@ -495,9 +499,10 @@ bool Simulation::half_kick() {
       p_.v[i] = (p_.v[i] + a * (p_.force[i] + k * drag_.fluid_velocity[i])) / (1 + a * k);
     }
     if (spin) p_.omega[i] += (h / p_.inertia[i]) * p_.torque[i];
-    if constexpr (Guard) all_finite &= finite(p_.x[i]) && finite(p_.v[i]) && finite(p_.omega[i]);
+    if constexpr (Guard)
+      nan_if_any += ((p_.x[i] - p_.x[i]) + (p_.v[i] - p_.v[i]) + (p_.omega[i] - p_.omega[i])).sum();
   }
-  return all_finite;
+  return nan_if_any == 0;
 }
 
 void Simulation::step() {
