@@ -198,7 +198,22 @@ CarriedState Simulation::pair_histories() const {
   CarriedState c;
   c.pairs.resize(p_.size());
   if (!sweep_.has_history) return c;
-  for (std::size_t i = 0; i + 1 < local_list_.offsets.size(); ++i) {
+  // Counted first, so that each particle's springs take one allocation of the exact size
+  // (grown one push_back at a time they took several, and left the freed ones behind).
+  const std::size_t lists = local_list_.offsets.size();
+  std::vector<int> count(p_.size(), 0);
+  for (std::size_t i = 0; i + 1 < lists; ++i) {
+    for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k)
+      if (is_set(local_springs_[k])) {
+        ++count[i];
+        ++count[local_list_.j[k]];
+      }
+    for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k)
+      if (is_set(ghost_springs_[k])) ++count[i];
+  }
+  for (std::size_t i = 0; i < p_.size(); ++i)
+    if (count[i] > 0) c.pairs[i].reserve(count[i]);
+  for (std::size_t i = 0; i + 1 < lists; ++i) {
     for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k)
       if (const ContactHistory h = local_springs_[k]; is_set(h)) {
         const std::size_t j = local_list_.j[k];
