@@ -1,6 +1,8 @@
 #pragma once
 // What one contact law evaluation sees, and what it returns.
 #include <cmath>
+#include <cstddef>
+#include <vector>
 
 #include "dem/core/types.hpp"
 
@@ -10,6 +12,31 @@ namespace grainflow {
 struct ContactHistory {
   Vec3 tangential = Vec3::Zero();  // accumulated tangential spring displacement [m]
   Vec3 rolling = Vec3::Zero();     // EPSD rolling spring torque [N m]
+};
+
+// The springs of a neighbour list, parallel to its entries. Only the springs the contact law
+// has are stored: with a tangential spring and no EPSD rolling spring (the common choice)
+// an entry holds 24 bytes, not the 48 of a ContactHistory.
+struct ListSprings {
+  std::vector<Vec3> tangential;  // empty unless the law has a tangential spring
+  std::vector<Vec3> rolling;     // empty unless the law has a rolling spring (EPSD)
+
+  // `entries` zero springs of the kinds asked for; the memory of the others is released.
+  void reset(std::size_t entries, bool with_tangential, bool with_rolling) {
+    tangential.assign(with_tangential ? entries : 0, Vec3::Zero());
+    rolling.assign(with_rolling ? entries : 0, Vec3::Zero());
+    if (!with_tangential) tangential.shrink_to_fit();
+    if (!with_rolling) rolling.shrink_to_fit();
+  }
+  // Both springs of entry k (zero where not stored).
+  ContactHistory operator[](std::size_t k) const {
+    return {tangential.empty() ? Vec3::Zero() : tangential[k],
+            rolling.empty() ? Vec3::Zero() : rolling[k]};
+  }
+  void set(std::size_t k, const ContactHistory& h) {
+    if (!tangential.empty()) tangential[k] = h.tangential;
+    if (!rolling.empty()) rolling[k] = h.rolling;
+  }
 };
 
 struct ContactGeometry {

@@ -21,15 +21,19 @@ struct ContactLaw {
   using tangential = Tangential;
   using rolling = Rolling;
   using cohesion = Cohesion;
-  static constexpr bool has_history = Tangential::enabled || std::is_same_v<Rolling, EpsdRolling>;
+  static constexpr bool keeps_tangential = Tangential::enabled;  // a tangential spring
+  static constexpr bool keeps_rolling = std::is_same_v<Rolling, EpsdRolling>;  // a rolling one
+  static constexpr bool has_history = keeps_tangential || keeps_rolling;
   static constexpr bool needs_spin = Tangential::enabled || Rolling::enabled;
   static constexpr bool needs_roll_inertia = Rolling::needs_inertia;
 
   // Force on i (and torques on both) for one touching pair. The normal force has
   // no lower clamp: the contact ends when the overlap returns to zero, which is
-  // the end-of-contact definition the restitution mappings assume.
-  static ContactResult evaluate(const ContactGeometry& g, const PairCoefficients& pc,
-                                const ContactConstants& cc, ContactHistory& h, double dt) {
+  // the end-of-contact definition the restitution mappings assume. `tangential` and
+  // `rolling` are the contact's springs (each touched only by a law that has it).
+  [[gnu::always_inline]] static ContactResult evaluate(const ContactGeometry& g, const PairCoefficients& pc,
+                                const ContactConstants& cc, Vec3& tangential, Vec3& rolling,
+                                double dt) {
     const SpringDashpot s = Normal::coefficients(pc, cc, g.r_star, g.m_star, g.overlap);
     const double vn = g.v_rel.dot(g.n);
     const double fn = s.kn * g.overlap - s.gn * vn;
@@ -40,8 +44,7 @@ struct ContactLaw {
     ContactResult r{fn_total * g.n, Vec3::Zero(), Vec3::Zero()};
     if constexpr (Tangential::enabled) {
       const Vec3 vt = g.v_rel - vn * g.n;
-      const Vec3 ft =
-          Tangential::force(vt, s.kt, s.gt, pc.friction * fn_pos, g.n, h.tangential, dt);
+      const Vec3 ft = Tangential::force(vt, s.kt, s.gt, pc.friction * fn_pos, g.n, tangential, dt);
       r.force += ft;
       const Vec3 n_x_ft = g.n.cross(ft);
       r.torque_i = -g.arm_i * n_x_ft;
@@ -49,7 +52,7 @@ struct ContactLaw {
     }
     if constexpr (Rolling::enabled) {
       const double m_max = pc.rolling_friction * g.r_star * fn_pos;
-      const Vec3 m = Rolling::torque(g, m_max, s.kn, pc.rolling_friction, cc, h.rolling, dt);
+      const Vec3 m = Rolling::torque(g, m_max, s.kn, pc.rolling_friction, cc, rolling, dt);
       r.torque_i += m;
       r.torque_j -= m;
     }

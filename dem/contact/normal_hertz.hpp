@@ -12,7 +12,7 @@ namespace grainflow {
 
 struct HertzNormal {
   static constexpr const char* name = "hertz";
-  static SpringDashpot coefficients(const PairCoefficients& pc, const ContactConstants&,
+  [[gnu::always_inline]] static SpringDashpot coefficients(const PairCoefficients& pc, const ContactConstants&,
                                     double r_star, double m_star, double overlap) {
     constexpr double two_sqrt_5_6 = 1.8257418583505538;  // 2 sqrt(5/6)
     const double a = std::sqrt(r_star * overlap);

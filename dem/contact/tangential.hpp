@@ -16,7 +16,7 @@ struct NoTangential {
 struct HistoryTangential {
   static constexpr bool enabled = true;
   static constexpr const char* name = "history";
-  static Vec3 force(const Vec3& vt, double kt, double gt, double coulomb_limit, const Vec3& n,
+  [[gnu::always_inline]] static Vec3 force(const Vec3& vt, double kt, double gt, double coulomb_limit, const Vec3& n,
                     Vec3& xi, double dt) {
     rotate_into_tangent_plane(xi, n);
     xi += vt * dt;

@@ -34,10 +34,12 @@ struct Body {
 // squares; + is commutative), so it is asked before the pair is put in canonical order.
 inline bool apart(const Vec3& d, double rs) { return d.squaredNorm() >= rs * rs; }
 
-// Evaluates the touching pair (a, b) with displacement d = x_a - x_b.
+// Evaluates the touching pair (a, b) with displacement d = x_a - x_b. Inlined into the
+// sweeps, like the law's evaluation: the geometry and the result then stay in registers
+// instead of going through memory.
 template <class Law>
-ContactResult pair_force(const ContactSweep& s, const Vec3& d, const Body& a, const Body& b,
-                         ContactHistory& h, double& overlap) {
+[[gnu::always_inline]] inline ContactResult pair_force(const ContactSweep& s, const Vec3& d, const Body& a, const Body& b,
+                         Vec3& tangential, Vec3& rolling, double& overlap) {
   const double rs = a.r + b.r;
   const double dist = std::sqrt(d.squaredNorm());
   ContactGeometry g;
@@ -52,7 +54,9 @@ ContactResult pair_force(const ContactSweep& s, const Vec3& d, const Body& a, co
   g.m_star = a.m * b.m / (a.m + b.m);
   g.wall = false;
   if constexpr (Law::needs_spin) {
-    g.v_rel = a.v - b.v - (g.arm_i * a.w + g.arm_j * b.w).cross(g.n);
+    // Evaluated first: GCC does not inline Eigen's cross product of an expression.
+    const Vec3 arm_w = g.arm_i * a.w + g.arm_j * b.w;
+    g.v_rel = a.v - b.v - arm_w.cross(g.n);
     g.w_rel = a.w - b.w;
   } else {
     g.v_rel = a.v - b.v;
@@ -60,19 +64,21 @@ ContactResult pair_force(const ContactSweep& s, const Vec3& d, const Body& a, co
   if constexpr (Law::needs_roll_inertia)
     g.roll_inertia =
         1.0 / (1.0 / (a.inertia + a.m * a.r * a.r) + 1.0 / (b.inertia + b.m * b.r * b.r));
-  return Law::evaluate(g, s.table(a.material, b.material), s.constants, h, s.dt);
+  return Law::evaluate(g, s.table(a.material, b.material), s.constants, tangential, rolling, s.dt);
 }
 
 template <class Law>
 void local_pair_sweep(ContactSweep& s) {
   Particles& p = s.p;
-  ContactHistory unused;
+  Vec3 unused;
   for (std::size_t i = 0; i < p.size(); ++i) {
     for (int k = s.local_list.offsets[i]; k < s.local_list.offsets[i + 1]; ++k) {
       const std::size_t j = s.local_list.j[k];
-      ContactHistory& h = Law::has_history ? s.local_history[k] : unused;
+      Vec3& ht = Law::keeps_tangential ? s.local_springs.tangential[k] : unused;
+      Vec3& hr = Law::keeps_rolling ? s.local_springs.rolling[k] : unused;
       if (apart(p.x[i] - p.x[j], p.radius[i] + p.radius[j])) {
-        if constexpr (Law::has_history) h = ContactHistory{};
+        if constexpr (Law::keeps_tangential) ht.setZero();
+        if constexpr (Law::keeps_rolling) hr.setZero();
         continue;
       }
       const std::size_t a = p.id[i] < p.id[j] ? i : j, b = a == i ? j : i;
@@ -80,7 +86,7 @@ void local_pair_sweep(ContactSweep& s) {
       const ContactResult r = pair_force<Law>(
           s, p.x[a] - p.x[b],
           Body{p.v[a], p.omega[a], p.radius[a], p.mass[a], p.inertia[a], p.material[a]},
-          Body{p.v[b], p.omega[b], p.radius[b], p.mass[b], p.inertia[b], p.material[b]}, h,
+          Body{p.v[b], p.omega[b], p.radius[b], p.mass[b], p.inertia[b], p.material[b]}, ht, hr,
           overlap);
       p.force[a] += r.force;
       p.force[b] -= r.force;
@@ -105,14 +111,16 @@ template <class Law>
 void ghost_pair_sweep(ContactSweep& s) {
   Particles& p = s.p;
   const Ghosts& g = s.ghosts;
-  ContactHistory unused;
+  Vec3 unused;
   const Vec3 zero = Vec3::Zero();
   for (std::size_t i = 0; i < p.size(); ++i) {
     for (int k = s.ghost_list.offsets[i]; k < s.ghost_list.offsets[i + 1]; ++k) {
       const std::size_t q = s.ghost_list.j[k];
-      ContactHistory& h = Law::has_history ? s.ghost_history[k] : unused;
+      Vec3& ht = Law::keeps_tangential ? s.ghost_springs.tangential[k] : unused;
+      Vec3& hr = Law::keeps_rolling ? s.ghost_springs.rolling[k] : unused;
       if (apart((p.x[i] - g.x[q]) + (zero - g.shift[q]), p.radius[i] + g.radius[q])) {
-        if constexpr (Law::has_history) h = ContactHistory{};
+        if constexpr (Law::keeps_tangential) ht.setZero();
+        if constexpr (Law::keeps_rolling) hr.setZero();
         continue;
       }
       const Body local{p.v[i], p.omega[i], p.radius[i], p.mass[i], p.inertia[i], p.material[i]};
@@ -121,9 +129,9 @@ void ghost_pair_sweep(ContactSweep& s) {
       double overlap;
       const ContactResult r = local_first
                                   ? pair_force<Law>(s, (p.x[i] - g.x[q]) + (zero - g.shift[q]),
-                                                    local, ghost, h, overlap)
+                                                    local, ghost, ht, hr, overlap)
                                   : pair_force<Law>(s, (g.x[q] - p.x[i]) + (g.shift[q] - zero),
-                                                    ghost, local, h, overlap);
+                                                    ghost, local, ht, hr, overlap);
       p.force[i] += local_first ? r.force : Vec3(-r.force);
       if constexpr (Law::needs_spin) p.torque[i] += local_first ? r.torque_i : r.torque_j;
       // Both owners see this contact; the owner of the lower id counts it.
@@ -147,7 +155,11 @@ void sweep(ContactSweep& s) {
 
 template <class Law>
 SweepChoice choice() {
-  return {&sweep<Law>, Law::has_history, Law::needs_spin,
+  return {&sweep<Law>,
+          Law::has_history,
+          Law::keeps_tangential,
+          Law::keeps_rolling,
+          Law::needs_spin,
           std::string(Law::normal::name) + " + " + Law::tangential::name + " + " +
               Law::rolling::name + " + " + Law::cohesion::name};
 }

@@ -30,8 +30,8 @@ struct WorstContact {
   double speed = 0;         // normal approach speed [m/s]
   double r_star = 0, m_star = 0, y_star = 0;
   // Records the contact if it beats the current maximum of `ratio`.
-  void consider(double overlap_ratio, double& ratio, GlobalId ia, GlobalId ib, double vn,
-                double rs, double ms, double ys) {
+  void consider(double overlap_ratio, double& ratio, GlobalId ia, GlobalId ib, double vn, double rs,
+                double ms, double ys) {
     if (overlap_ratio <= ratio) return;
     ratio = overlap_ratio;
     a = ia;
@@ -72,9 +72,9 @@ struct ContactSweep {
   const Ghosts& ghosts;
   const NeighbourList& local_list;
   const NeighbourList& ghost_list;
-  std::vector<ContactHistory>& local_history;              // parallel to local_list.j
-  std::vector<ContactHistory>& ghost_history;              // parallel to ghost_list.j
-  const WallSet& walls;  // current wall positions (dem/walls/wall_set.hpp)
+  ListSprings& local_springs;  // parallel to local_list.j
+  ListSprings& ghost_springs;  // parallel to ghost_list.j
+  const WallSet& walls;        // current wall positions (dem/walls/wall_set.hpp)
   std::vector<std::vector<ContactHistory>>& wall_history;  // [wall][particle]
   const WallNeighbours& wall_neighbours;                   // the particles each wall may touch
   const PairTable& table;
@@ -91,9 +91,11 @@ using SweepFunction = void (*)(ContactSweep&);
 
 struct SweepChoice {
   SweepFunction run;
-  bool has_history;  // pair/wall histories must be kept
-  bool needs_spin;   // torques are produced
-  std::string name;  // e.g. "hertz + history + none + none"
+  bool has_history;       // pair/wall histories must be kept
+  bool keeps_tangential;  // of which tangential springs
+  bool keeps_rolling;     // and rolling springs (EPSD)
+  bool needs_spin;        // torques are produced
+  std::string name;       // e.g. "hertz + history + none + none"
 };
 
 SweepChoice select_sweep(const ContactSettings& settings);

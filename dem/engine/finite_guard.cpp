@@ -31,10 +31,16 @@ std::string text(const Vec3& a) {
 
 }  // namespace
 
-bool non_finite_anywhere(const Particles& p, MPI_Comm comm) {
-  int bad = first_bad(p) < p.size() ? 1 : 0;
+bool has_non_finite(const Particles& p) { return first_bad(p) < p.size(); }
+
+bool non_finite_anywhere(bool local_bad, MPI_Comm comm) {
+  int bad = local_bad ? 1 : 0;
   MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPI_INT, MPI_MAX, comm);
   return bad != 0;
+}
+
+bool non_finite_anywhere(const Particles& p, MPI_Comm comm) {
+  return non_finite_anywhere(has_non_finite(p), comm);
 }
 
 std::string describe_first_non_finite(const Particles& p, long step, double time, int rank) {
@@ -55,8 +61,9 @@ std::string describe_first_non_finite(const Particles& p, long step, double time
   return s.str();
 }
 
-void guard_finite(const Simulation& sim, const std::string& directory, MPI_Comm comm) {
-  if (!non_finite_anywhere(sim.particles(), comm)) return;
+void guard_finite(const Simulation& sim, bool local_bad, const std::string& directory,
+                  MPI_Comm comm) {
+  if (!non_finite_anywhere(local_bad, comm)) return;
   std::string where;
   try {
     prepare_output_directory(directory);  // a coupled run may not have written any yet

@@ -13,6 +13,10 @@ namespace grainflow {
 // Collective: true on every rank when any rank holds a particle whose position, velocity or
 // angular velocity is not finite. One MPI_Allreduce of an int.
 bool non_finite_anywhere(const Particles& p, MPI_Comm comm);
+// The same from each rank's own answer (`local_bad`: this rank holds a non-finite state).
+bool non_finite_anywhere(bool local_bad, MPI_Comm comm);
+// Whether p holds a non-finite position, velocity or angular velocity (no communication).
+bool has_non_finite(const Particles& p);
 
 // This rank's first such particle described for the user (id, rank, step, time, position,
 // velocity, angular velocity, force and torque), or "" when this rank has none. Local.
@@ -22,7 +26,10 @@ class Simulation;
 
 // The guard of a run (`grain run`, the coupled DEM): when any rank holds a non-finite
 // particle, writes every particle of this step to <directory>/diagnostic_<n>.h5 and throws
-// the same ParallelError on every rank, describing the first bad particle. Collective.
-void guard_finite(const Simulation& sim, const std::string& directory, MPI_Comm comm);
+// the same ParallelError on every rank, describing the first bad particle. `local_bad`:
+// this rank holds a non-finite state (after a step, Simulation::state_finite() knows it
+// without another pass). Collective.
+void guard_finite(const Simulation& sim, bool local_bad, const std::string& directory,
+                  MPI_Comm comm);
 
 }  // namespace grainflow

@@ -90,7 +90,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     throw SetupError(scene.file + ": error: refusing to run with this time step (see above); "
                                   "lower time.step / time.rayleigh_fraction, or pass "
                                   "--allow-large-dt to run anyway");
-  guard_finite(sim, dir, comm);
+  guard_finite(sim, has_non_finite(sim.particles()), dir, comm);
 
   SnapshotWriter snapshots(comm, dir);
   const std::string log_path = (std::filesystem::path(dir) / "log.csv").string();
@@ -191,7 +191,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   std::ostringstream stop_message;
   for (long k = first_step + 1; k <= total_steps; ++k) {
     sim.step();
-    guard_finite(sim, dir, comm);
+    guard_finite(sim, !sim.state_finite(), dir, comm);
     particle_steps += static_cast<double>(sim.particles().size());
     const double t = sim.time();
     const bool last = k == total_steps;

@@ -11,18 +11,6 @@
 
 namespace grainflow {
 namespace {
-// Contact springs are saved across rebuilds under the pair's global ids.
-struct PairKey {
-  GlobalId lo, hi;
-  PairKey(GlobalId a, GlobalId b) : lo(std::min(a, b)), hi(std::max(a, b)) {}
-  bool operator==(const PairKey&) const = default;
-};
-struct PairKeyHash {
-  std::size_t operator()(const PairKey& k) const {
-    return std::hash<GlobalId>()(k.lo) * 0x9E3779B97F4A7C15ull ^ std::hash<GlobalId>()(k.hi);
-  }
-};
-
 bool is_set(const ContactHistory& h) { return !h.tangential.isZero(0) || !h.rolling.isZero(0); }
 
 template <class T>
@@ -157,11 +145,35 @@ void Simulation::mark_leaving() {
       }
 }
 
-bool Simulation::needs_rebuild() const {
-  int local = !leaving_.empty();
+void Simulation::drift() {
+  // One pass: x += dt v, then the tests of mark_leaving() and of the skin, on the new x.
+  // A periodic side has infinite bounds here: nothing leaves through it.
+  const Domain& d = scene_.domain;
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  Vec3 lo, hi;
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = d.periodic[a] ? -inf : d.lo[a];
+    hi[a] = d.periodic[a] ? inf : d.hi[a];
+  }
   const double limit2 = 0.25 * skin_ * skin_;
-  for (std::size_t i = 0; i < p_.size() && !local; ++i)
-    local = (p_.x[i] - x_at_build_[i]).squaredNorm() > limit2;
+  const std::size_t n = p_.size();
+  bool moved_far = false;
+  leaving_.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    Vec3& x = p_.x[i];
+    x += dt_ * p_.v[i];
+    moved_far |= (x - x_at_build_[i]).squaredNorm() > limit2;
+    if (x[0] < lo[0] || x[0] > hi[0] || x[1] < lo[1] || x[1] > hi[1] || x[2] < lo[2] ||
+        x[2] > hi[2]) {
+      leaving_.resize(n, 0);
+      leaving_[i] = 1;
+    }
+  }
+  moved_beyond_half_skin_ = moved_far;
+}
+
+bool Simulation::needs_rebuild() const {
+  int local = !leaving_.empty() || moved_beyond_half_skin_;
   if (decomp_->size() == 1) return local;
   int any = 0;
   MPI_Allreduce(&local, &any, 1, MPI_INT, MPI_LOR, comm_);
@@ -169,42 +181,71 @@ bool Simulation::needs_rebuild() const {
 }
 
 CarriedState Simulation::save_histories() const {
-  CarriedState c;
+  CarriedState c = pair_histories();
   c.wall = wall_history_;
+  return c;
+}
+
+CarriedState Simulation::take_histories() {
+  CarriedState c = pair_histories();
+  c.wall = std::move(wall_history_);
+  local_springs_.reset(0, false, false);  // released before the new lists are built
+  ghost_springs_.reset(0, false, false);
+  return c;
+}
+
+CarriedState Simulation::pair_histories() const {
+  CarriedState c;
   c.pairs.resize(p_.size());
   if (!sweep_.has_history) return c;
-  for (std::size_t i = 0; i + 1 < local_list_.offsets.size(); ++i) {
+  // Counted first, so that each particle's springs take one allocation of the exact size
+  // (grown one push_back at a time they took several, and left the freed ones behind).
+  const std::size_t lists = local_list_.offsets.size();
+  std::vector<int> count(p_.size(), 0);
+  for (std::size_t i = 0; i + 1 < lists; ++i) {
     for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k)
-      if (is_set(local_history_[k])) {
-        const std::size_t j = local_list_.j[k];
-        c.pairs[i].push_back({p_.id[j], local_history_[k]});
-        c.pairs[j].push_back({p_.id[i], local_history_[k]});
+      if (is_set(local_springs_[k])) {
+        ++count[i];
+        ++count[local_list_.j[k]];
       }
     for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k)
-      if (is_set(ghost_history_[k])) c.pairs[i].push_back({ghosts_.id[ghost_list_.j[k]], ghost_history_[k]});
+      if (is_set(ghost_springs_[k])) ++count[i];
+  }
+  for (std::size_t i = 0; i < p_.size(); ++i)
+    if (count[i] > 0) c.pairs[i].reserve(count[i]);
+  for (std::size_t i = 0; i + 1 < lists; ++i) {
+    for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k)
+      if (const ContactHistory h = local_springs_[k]; is_set(h)) {
+        const std::size_t j = local_list_.j[k];
+        c.pairs[i].push_back({p_.id[j], h});
+        c.pairs[j].push_back({p_.id[i], h});
+      }
+    for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k)
+      if (const ContactHistory h = ghost_springs_[k]; is_set(h))
+        c.pairs[i].push_back({ghosts_.id[ghost_list_.j[k]], h});
   }
   return c;
 }
 
-void Simulation::restore_histories(const CarriedState& carried) {
-  wall_history_ = carried.wall;
-  local_history_.assign(local_list_.pairs(), ContactHistory{});
-  ghost_history_.assign(ghost_list_.pairs(), ContactHistory{});
+void Simulation::restore_histories(CarriedState& carried) {
+  wall_history_ = std::move(carried.wall);
+  local_springs_.reset(local_list_.pairs(), sweep_.keeps_tangential, sweep_.keeps_rolling);
+  ghost_springs_.reset(ghost_list_.pairs(), sweep_.keeps_tangential, sweep_.keeps_rolling);
   if (!sweep_.has_history) return;
-  std::unordered_map<PairKey, ContactHistory, PairKeyHash> saved;
-  for (std::size_t i = 0; i < carried.pairs.size(); ++i)
+  // Each particle carries all its springs (both partners of a local pair carry the same
+  // one), so an entry's spring is found in the few its own particle carries.
+  const auto find = [&](std::size_t i, GlobalId partner) -> const ContactHistory* {
     for (const PartnerHistory& ph : carried.pairs[i])
-      saved.emplace(PairKey(p_.id[i], ph.partner), ph.history);
-  if (saved.empty()) return;
+      if (ph.partner == partner) return &ph.history;
+    return nullptr;
+  };
   for (std::size_t i = 0; i < p_.size(); ++i) {
-    for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k) {
-      auto it = saved.find(PairKey(p_.id[i], p_.id[local_list_.j[k]]));
-      if (it != saved.end()) local_history_[k] = it->second;
-    }
-    for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k) {
-      auto it = saved.find(PairKey(p_.id[i], ghosts_.id[ghost_list_.j[k]]));
-      if (it != saved.end()) ghost_history_[k] = it->second;
-    }
+    if (carried.pairs[i].empty()) continue;
+    for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k)
+      if (const ContactHistory* h = find(i, p_.id[local_list_.j[k]])) local_springs_.set(k, *h);
+    for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k)
+      if (const ContactHistory* h = find(i, ghosts_.id[ghost_list_.j[k]]))
+        ghost_springs_.set(k, *h);
   }
 }
 
@@ -332,7 +373,7 @@ void Simulation::write_checkpoint(const std::string& path) {
 
 void Simulation::rebuild(bool keep_drag) {
   // Springs by global ids (indices change below); after a restore, those of the checkpoint.
-  CarriedState carried = pending_carried_ ? std::move(*pending_carried_) : save_histories();
+  CarriedState carried = pending_carried_ ? std::move(*pending_carried_) : take_histories();
   pending_carried_.reset();
   carried.carries_drag = keep_drag && !terms_.empty();
   if (carried.carries_drag)
@@ -398,7 +439,7 @@ void Simulation::compute_forces() {
     p_.torque[i].setZero();
   }
   ContactSweep s{
-      p_,     ghosts_,       local_list_,      ghost_list_, local_history_, ghost_history_,
+      p_,     ghosts_,       local_list_,      ghost_list_, local_springs_, ghost_springs_,
       walls_, wall_history_, wall_neighbours_, table_,      constants_,     dt_,
       0,      0.0,           WorstContact{},   UnresolvedContact{}};
   sweep_.run(s);
@@ -517,32 +558,39 @@ void Simulation::apply_force_terms() {
   }
 }
 
-void Simulation::half_kick() {
+template <bool Guard>
+bool Simulation::half_kick() {
   const double h = 0.5 * dt_;
   const std::size_t n = p_.size();
-  if (drag_.coefficient.empty()) {
-    for (std::size_t i = 0; i < n; ++i) p_.v[i] += (h / p_.mass[i]) * p_.force[i];
-  } else {
-    // v' = v + h/m (F + K (u - v'))  =>  v' = (v + h/m (F + K u)) / (1 + h K / m)
-    for (std::size_t i = 0; i < n; ++i) {
+  const bool drag = !drag_.coefficient.empty(), spin = sweep_.needs_spin;
+  // x - x is 0 for a finite x and NaN for an infinite or NaN one, and NaN stays in a sum:
+  // `nan_if_any` ends 0 exactly when every component was finite.
+  double nan_if_any = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!drag) {
+      p_.v[i] += (h / p_.mass[i]) * p_.force[i];
+    } else {
+      // v' = v + h/m (F + K (u - v'))  =>  v' = (v + h/m (F + K u)) / (1 + h K / m)
       const double a = h / p_.mass[i], k = drag_.coefficient[i];
       p_.v[i] = (p_.v[i] + a * (p_.force[i] + k * drag_.fluid_velocity[i])) / (1 + a * k);
     }
+    if (spin) p_.omega[i] += (h / p_.inertia[i]) * p_.torque[i];
+    if constexpr (Guard)
+      nan_if_any += ((p_.x[i] - p_.x[i]) + (p_.v[i] - p_.v[i]) + (p_.omega[i] - p_.omega[i])).sum();
   }
-  if (sweep_.needs_spin)
-    for (std::size_t i = 0; i < n; ++i) p_.omega[i] += (h / p_.inertia[i]) * p_.torque[i];
+  return nan_if_any == 0;
 }
 
 void Simulation::step() {
   if (!initialised_) initialise();
   // Velocity Verlet: half kick, drift, new forces, half kick.
-  half_kick();
-  for (std::size_t i = 0; i < p_.size(); ++i) p_.x[i] += dt_ * p_.v[i];
+  half_kick<false>();
+  drift();
   // Stream insertion (dem/insert/stream_insertion.hpp); new particles force a rebuild.
   const bool inserted = !streams_.empty() && streams_.insert(time_ + dt_, p_, ghosts_, walls_,
                                                              *decomp_, next_id_, comm_) > 0;
   for (auto& column : wall_history_) column.resize(p_.size());
-  mark_leaving();
+  if (inserted) mark_leaving();  // the new particles too
   if (inserted || needs_rebuild())
     rebuild();
   else
@@ -550,7 +598,7 @@ void Simulation::step() {
   time_ += dt_;
   walls_.move_to(time_);
   compute_forces();
-  half_kick();
+  state_finite_ = half_kick<true>();
   ++counters_.steps;
 }
 

@@ -95,6 +95,9 @@ class Simulation {
 
   Particles& particles() { return p_; }  // this rank's particles
   const Particles& particles() const { return p_; }
+  // Whether every position, velocity and spin of this rank's particles was finite at the
+  // end of the last step() (checked in its last pass over the particles).
+  bool state_finite() const { return state_finite_; }
   const Ghosts& ghosts() const { return ghosts_; }
   const Scene& scene() const { return scene_; }
   const WallSet& walls() const { return walls_; }               // current wall positions
@@ -147,9 +150,18 @@ class Simulation {
   bool contact_may_be_unresolved() const;
   bool needs_rebuild() const;  // collective
   void mark_leaving();         // particles beyond a bounded side of the domain
-  void half_kick();            // v += dt/2 F/m (implicit in v where drag is set), same for spin
-  CarriedState save_histories() const;
-  void restore_histories(const CarriedState& carried);
+  // x += dt v, with mark_leaving()'s test and the skin test in the same pass.
+  void drift();
+  // v += dt/2 F/m (implicit in v where drag is set), same for spin. With Guard: returns
+  // whether every position, velocity and spin is finite after it (false otherwise).
+  template <bool Guard>
+  bool half_kick();
+  CarriedState save_histories() const;  // a copy of every spring, by global ids
+  // The same, moving the wall springs out and releasing the lists' springs (at a rebuild,
+  // which makes them anew: the old and new copies do not coexist at the memory peak).
+  CarriedState take_histories();
+  CarriedState pair_histories() const;  // the particle pairs' part
+  void restore_histories(CarriedState& carried);  // takes carried.wall
   void apply_order(const std::vector<std::size_t>& perm, CarriedState& carried);
 
   Scene scene_;
@@ -168,7 +180,7 @@ class Simulation {
   double lightest_q_ = 0, largest_y_star_ = 0;
   std::unique_ptr<BinGrid> grid_;
   NeighbourList local_list_, ghost_list_;
-  std::vector<ContactHistory> local_history_, ghost_history_;
+  ListSprings local_springs_, ghost_springs_;              // parallel to the lists' entries
   std::vector<std::vector<ContactHistory>> wall_history_;  // [WallSet column][particle]
   WallNeighbours wall_neighbours_;                         // rebuilt with the Verlet lists
   WallSet walls_;
@@ -183,6 +195,8 @@ class Simulation {
   // The checkpoint's implicit drag by global id (K, u), until initialise().
   std::unordered_map<GlobalId, std::pair<double, Vec3>> restored_drag_;
   std::optional<CarriedState> pending_carried_;     // springs for the first rebuild
+  bool moved_beyond_half_skin_ = false;             // by the last drift(), since the last rebuild
+  bool state_finite_ = true;                        // after the last step(), this rank's particles
   bool restored_ = false;                           // initialise() keeps the forces read
   bool initialised_ = false;
 };

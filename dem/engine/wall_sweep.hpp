@@ -39,13 +39,14 @@ void apply_wall_contact(ContactSweep& s, std::size_t i, const WallTouch& t, int 
   }
   if constexpr (Law::needs_roll_inertia)
     g.roll_inertia = p.inertia[i] + p.mass[i] * p.radius[i] * p.radius[i];
-  const ContactResult r = Law::evaluate(g, s.table(p.material[i], material), s.constants, h, s.dt);
+  const ContactResult r = Law::evaluate(g, s.table(p.material[i], material), s.constants,
+                                        h.tangential, h.rolling, s.dt);
   p.force[i] += r.force;
   if constexpr (Law::needs_spin) p.torque[i] += r.torque_i;
   ++s.contacts;
   if (const double ratio = g.overlap / p.radius[i]; ratio > s.max_overlap_ratio)
-    s.worst.consider(ratio, s.max_overlap_ratio, p.id[i], -1, -g.v_rel.dot(g.n), g.r_star,
-                     g.m_star, s.table(p.material[i], material).y_star);
+    s.worst.consider(ratio, s.max_overlap_ratio, p.id[i], -1, -g.v_rel.dot(g.n), g.r_star, g.m_star,
+                     s.table(p.material[i], material).y_star);
 }
 
 // A plane or a cylinder, against the particles of its neighbour list (all of them when
@@ -103,8 +104,7 @@ void mesh_sweep(ContactSweep& s, const WallSet::Entry& wall, const TriangleMesh&
           }
         }
         for (int j = 0; j < kSlots && best < 0; ++j)
-          if (!used[j] && s.wall_history[wall.column + 2 * j + 1][i].tangential.isZero(0))
-            best = j;
+          if (!used[j] && s.wall_history[wall.column + 2 * j + 1][i].tangential.isZero(0)) best = j;
         for (int j = 0; j < kSlots && best < 0; ++j)  // stale key of an older contact
           if (!used[j]) best = j;
         if (best >= 0) {
@@ -144,7 +144,9 @@ void wall_sweep(ContactSweep& s) {
                               return touch_cylinder(wall.cylinder, x, r, t);
                             });
         break;
-      case Wall::Kind::mesh: mesh_sweep<Law>(s, wall, s.walls.mesh(wall)); break;
+      case Wall::Kind::mesh:
+        mesh_sweep<Law>(s, wall, s.walls.mesh(wall));
+        break;
     }
   }
 }

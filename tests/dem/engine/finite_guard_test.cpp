@@ -1,6 +1,7 @@
 // The NaN / Inf guard (dem/engine/finite_guard.hpp): a particle whose velocity becomes NaN is
 // found after the step that carried it, and the message names its id, the step, the bad
-// quantity, its position and its force. Reference: the particle we poisoned ourselves.
+// quantity, its position and its force; the step's own check (Simulation::state_finite(), what
+// `grain run` asks after each step) says the same. Reference: the particle we poisoned ourselves.
 #include "dem/engine/finite_guard.hpp"
 
 #include <gtest/gtest.h>
@@ -27,6 +28,8 @@ TEST(FiniteGuard, NamesTheFirstParticleWithANaNVelocity) {
   for (int k = 0; k < 10; ++k) sim.step();
   EXPECT_FALSE(non_finite_anywhere(sim.particles(), MPI_COMM_WORLD));
   EXPECT_EQ(describe_first_non_finite(sim.particles(), 10, sim.time(), 0), "");
+  // The step's own check (in its last pass, which the run's guard uses) agrees.
+  EXPECT_TRUE(sim.state_finite());
 
   // Poison particle 2's velocity; the next step's drift carries the NaN into its position.
   for (std::size_t i = 0; i < sim.particles().size(); ++i)
@@ -34,6 +37,7 @@ TEST(FiniteGuard, NamesTheFirstParticleWithANaNVelocity) {
       sim.particles().v[i].x() = std::numeric_limits<double>::quiet_NaN();
   sim.step();
   ASSERT_TRUE(non_finite_anywhere(sim.particles(), MPI_COMM_WORLD));
+  EXPECT_FALSE(sim.state_finite());
   const std::string m = describe_first_non_finite(sim.particles(), 11, sim.time(), 0);
   std::printf("%s\n", m.c_str());
   EXPECT_NE(m.find("step 11"), std::string::npos) << m;
