@@ -14,7 +14,7 @@ export DEBIAN_FRONTEND=noninteractive
 
 PACKAGES=(
   build-essential cmake ninja-build pkg-config dpkg-dev
-  openfoam libopenfoam
+  openfoam libopenfoam openfoam-examples   # examples: the DPMFoam peer case (benchmarks/peers/goldschmidt)
   openmpi-bin libopenmpi-dev
   libeigen3-dev
   libhdf5-openmpi-dev hdf5-tools

@@ -307,11 +307,13 @@ laplacianSchemes { default Gauss linear corrected; }
 interpolationSchemes { default linear; }
 snGradSchemes   { default corrected; }
 """)
+    if snapshot:
+        shutil.copy(snapshot, gf / "settled.h5")
     with open(gf / "particles.csv", "w") as f:
-        f.write("# The parcels of constant/kinematicCloudPositions (nParticle 1 each).\n")
+        f.write("# The parcels of DPMFoam's constant/kinematicCloudPositions (nParticle 1 each).\n")
         f.write("x,y,z,radius\n")
         for p in positions:
-            f.write(f"{p[0]:.6g},{p[1]:.6g},{p[2]:.6g},{radius:.6g}\n")
+            f.write(f"{p[0]:.9g},{p[1]:.9g},{p[2]:.9g},{radius:.9g}\n")
     names = ["left", "right", "front", "back", "bottom", "top"]
     walls = []
     for axis in range(3):
@@ -342,7 +344,10 @@ snGradSchemes   { default corrected; }
         ],
         "contact": {"normal": "hertz", "tangential": "history"},
         "walls": walls,
-        "insert": [{"type": "csv", "file": "particles.csv", "material": "glass"}],
+        # From the settled bed: grain's own snapshot (a settled sphere may touch a wall by a
+        # little overlap, which a CSV insertion refuses and a snapshot allows), at rest.
+        "insert": [{"type": "snapshot", "file": "settled.h5", "keep_velocity": False}
+                   if snapshot else {"type": "csv", "file": "particles.csv", "material": "glass"}],
         "fluid": {"density": rho_f, "viscosity": rho_f * nu, "drag": "gidaspow", "model": "A",
                   "pressure": {"hydrostatic": False},
                   "forces": ["drag", "pressure_gradient", "viscous", "buoyancy"]},
@@ -373,7 +378,7 @@ snGradSchemes   { default corrected; }
     settle["interactions"] = [dict(i, restitution=desc["settle_restitution"])
                               for i in scene["interactions"]]
     settle["output"] = {"directory": str(out / "settle/output"),
-                        "snapshot_interval": desc["settle_time"] / 4, "progress": False}
+                        "snapshot_interval": desc["settle_time"] / 3, "progress": False}
     (out / "settle").mkdir()
     # The lattice is simple cubic, each sphere straight above another: left alone it settles
     # into towers of touching spheres. Every coordinate is moved by a uniform random amount of
