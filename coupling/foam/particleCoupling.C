@@ -481,12 +481,15 @@ std::vector<coupling::FluidAtParticle> ParticleCoupling::sample() const {
       const label c = centreCell_[i];
       if (c < 0) continue;
       const point x(particles_.x[i][0], particles_.x[i][1], particles_.x[i][2]);
+      // The tetrahedron holding x and its weights, found once for all the fields
+      // (interpolate(x, c) would search and allocate again for each of them).
+      const cellPointWeight weight(mesh_, x, c);
       coupling::FluidAtParticle& f = out[i];
-      f.velocity = toArray(iU.interpolate(x, c));
-      f.void_fraction = std::max(minVoidFraction_, std::min(1.0, double(iE.interpolate(x, c))));
-      f.pressure_gradient = toArray(iG.interpolate(x, c));
-      f.viscous_stress_divergence = toArray(iT.interpolate(x, c));
-      if (curl) f.vorticity = toArray(iC->interpolate(x, c));
+      f.velocity = toArray(iU.interpolate(weight));
+      f.void_fraction = std::max(minVoidFraction_, std::min(1.0, double(iE.interpolate(weight))));
+      f.pressure_gradient = toArray(iG.interpolate(weight));
+      f.viscous_stress_divergence = toArray(iT.interpolate(weight));
+      if (curl) f.vorticity = toArray(iC->interpolate(weight));
     }
     return out;
   }
