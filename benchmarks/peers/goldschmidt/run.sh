@@ -13,7 +13,7 @@
 set -euo pipefail
 HERE="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 ROOT="$(cd "$HERE/../../.." && pwd)"
-BUILD="${GRAINFLOW_BUILD_DIR:-$ROOT/build}"
+BUILD="$(realpath "${GRAINFLOW_BUILD_DIR:-$ROOT/build}")"  # absolute: the runs cd into their cases
 FOAM="$ROOT/scripts/foam_env.sh"
 rounds=3
 compare_only=0
