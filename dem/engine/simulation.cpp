@@ -411,9 +411,11 @@ void Simulation::rebuild(bool keep_drag) {
   // Bounds for contact_may_be_unresolved, over the particles that can touch anything here:
   // the least m^2/r, and the largest Y* of a pair with one of their materials.
   lightest_q_ = std::numeric_limits<double>::infinity();
+  smallest_radius_ = std::numeric_limits<double>::infinity();
   std::vector<char> present(table_.size(), 0);
   for (std::size_t i = 0; i < p_.size(); ++i) {
     lightest_q_ = std::min(lightest_q_, p_.mass[i] * p_.mass[i] / p_.radius[i]);
+    smallest_radius_ = std::min(smallest_radius_, p_.radius[i]);
     present[p_.material[i]] = 1;
   }
   for (std::size_t k = 0; k < ghosts_.size(); ++k) {
@@ -443,18 +445,38 @@ void Simulation::compute_forces() {
       walls_, wall_history_, wall_neighbours_, table_,      constants_,     dt_,
       0,      0.0,           WorstContact{},   UnresolvedContact{}};
   sweep_.run(s);
+  // The fastest local particle bounds both the steps-per-contact gate and the travel guard.
+  double v2_local = 0;
+  for (const Vec3& v : p_.v) v2_local = std::max(v2_local, v.squaredNorm());
   if (scene_.contact.normal == NormalModel::hertz && scene_.time.min_steps_per_contact > 0 &&
-      contact_may_be_unresolved()) {
+      contact_may_be_unresolved(v2_local)) {
     s.unresolved.set(scene_.time.min_steps_per_contact, dt_);
     steps_per_contact_sweep(s);
   }
   counters_.contacts = s.contacts;
   counters_.max_overlap_ratio = s.max_overlap_ratio;
-  check_contacts(s);
+  check_contacts(s, fastest_particle(v2_local));
   apply_force_terms();
 }
 
-bool Simulation::contact_may_be_unresolved() const {
+Simulation::FastParticle Simulation::fastest_particle(double v2_max) const {
+  // A particle that moves more than its radius r in one step can cross a (two-sided,
+  // thin) mesh wall, or pass through another particle, without the two ever overlapping at
+  // the end of a step, so no contact guard can see it (docs/stability.md). The drift just
+  // made moved each particle by |v| dt with the velocity of the half kick before it. The
+  // gate needs no division: nobody can exceed the limit while v_max dt <= limit r_min.
+  FastParticle fast;
+  const double limit = scene_.time.max_step_travel;
+  if (limit <= 0 || v2_max * dt_ * dt_ <= limit * limit * smallest_radius_ * smallest_radius_)
+    return fast;
+  for (std::size_t i = 0; i < p_.size(); ++i) {
+    const double ratio = std::sqrt(p_.v[i].squaredNorm()) * dt_ / (limit * p_.radius[i]);
+    if (ratio > fast.ratio) fast = {ratio, i};
+  }
+  return fast;
+}
+
+bool Simulation::contact_may_be_unresolved(double v2_local) const {
   // A Hertz contact fails when m*^2 < k R* Y*^2 v (contact_sweep.hpp). Its approach speed
   // v is at most |v_a| + |v_b| (a fixed wall: |v_a|); m*^2/R* >= q/4 with q = m_s^2/r_s of
   // the lighter partner s (m* >= m_s/2, R* <= min(r_a, r_b)); and Y* <= the table's
@@ -462,28 +484,58 @@ bool Simulation::contact_may_be_unresolved() const {
   // the sweep need not ask: one pass over the velocities instead of a test per contact.
   for (const WallSet::Entry& w : walls_.walls())
     if (w.pose.moving() || w.surface_velocity.squaredNorm() > 0) return true;
-  double v2 = 0;
-  for (const Vec3& v : p_.v) v2 = std::max(v2, v.squaredNorm());
+  double v2 = v2_local;
   for (const Vec3& v : ghosts_.v) v2 = std::max(v2, v.squaredNorm());
   const double k = std::pow(scene_.time.min_steps_per_contact * dt_ / 2.868, 5);
   const double floor = lightest_q_ / (4 * k * largest_y_star_ * largest_y_star_);
   return 4 * v2 >= floor * floor;
 }
 
-void Simulation::check_contacts(const ContactSweep& s) const {
-  // One reduction serves both guards, and they speak only when some rank is beyond a
+void Simulation::check_contacts(const ContactSweep& s, const FastParticle& fast) const {
+  // One reduction serves the three guards, and they speak only when some rank is beyond a
   // limit, which every rank learns through it: keep the common path to that one call.
   const double limit = scene_.time.max_overlap;
   const double n_min = scene_.time.min_steps_per_contact;
-  // Largest overlap ratio; fewest steps per contact as N_min / N (> 1 when under-resolved).
-  const double mine[2] = {counters_.max_overlap_ratio,
-                          s.unresolved.fewest > 0 ? n_min / s.unresolved.fewest : 0.0};
-  double worst[2] = {mine[0], mine[1]};
-  if (decomp_->size() > 1) MPI_Allreduce(MPI_IN_PLACE, worst, 2, MPI_DOUBLE, MPI_MAX, comm_);
-  if (worst[0] <= limit && worst[1] <= 1) return;
+  // Largest overlap ratio; fewest steps per contact as N_min / N (> 1 when under-resolved);
+  // the longest travel in the last drift over its limit (> 1 beyond it).
+  const double mine[3] = {counters_.max_overlap_ratio,
+                          s.unresolved.fewest > 0 ? n_min / s.unresolved.fewest : 0.0,
+                          fast.ratio};
+  double worst[3] = {mine[0], mine[1], mine[2]};
+  if (decomp_->size() > 1) MPI_Allreduce(MPI_IN_PLACE, worst, 3, MPI_DOUBLE, MPI_MAX, comm_);
+  if (worst[0] <= limit && worst[1] <= 1 && worst[2] <= 1) return;
   std::ostringstream o;
   o.precision(4);
   o << scene_.file << ": error: t = " << time_ << " s (step " << counters_.steps + 1 << "): ";
+  if (worst[0] <= limit && worst[1] <= 1) {  // the travel guard (a contact's guard comes first)
+    if (mine[2] != worst[2]) {
+      agree_on_error(comm_, "");  // another rank holds the particle and speaks
+      return;
+    }
+    const std::size_t i = fast.index;
+    const double speed = std::sqrt(p_.v[i].squaredNorm()), r = p_.radius[i];
+    const double travel_limit = scene_.time.max_step_travel;
+    const Vec3& x = p_.x[i];
+    o << "particle " << p_.id[i] << " moves " << speed * dt_ / r
+      << " of its radii per step (speed " << speed << " m/s, radius " << r << " m, dt = "
+      << dt_ << " s, at (" << x[0] << ", " << x[1] << ", " << x[2] << ") m); the limit is "
+      << travel_limit
+      << " (key time.max_step_travel). So fast a particle can pass through a mesh wall or "
+         "another particle between two steps without ever overlapping it, which no contact "
+         "guard can see. A step of at most "
+      << travel_limit * r / speed << " s keeps it within the limit";
+    if (scene_.contact.normal == NormalModel::hertz) {
+      // An impact at that speed on a wall of its own material: R* = r, m* = m.
+      const double tc =
+          hertz_contact_time(table_(p_.material[i], p_.material[i]).y_star, r, p_.mass[i], speed);
+      o << "; resolving an impact at that speed needs at most " << tc / 20
+        << " s (1/20 of the Hertz contact time against a wall of its own material)";
+    }
+    o << ". If the speed itself is unphysical, look for what caused it (an initial velocity, a "
+         "fluid force, a contact in the steps before)";
+    agree_on_error(comm_, o.str());
+    return;
+  }
   const bool overlap = worst[0] > limit;  // the overlap guard speaks first
   const WorstContact& w = overlap ? s.worst : s.unresolved.contact;
   if (overlap ? mine[0] != worst[0] : mine[1] != worst[1]) {

@@ -143,11 +143,19 @@ class Simulation {
   // Stops the run (ParallelError on every rank) when a contact overlaps beyond
   // time.max_overlap, or when a Hertz contact gets fewer than time.min_steps_per_contact
   // steps at its own approach speed; the message names the contact and a time step that
-  // would resolve it.
-  void check_contacts(const ContactSweep& sweep) const;
+  // would resolve it; and when a particle moved more than time.max_step_travel of its
+  // radii in the last drift (`fast`).
+  // The particle that moved the most of its own radius in the last drift, when any could
+  // have moved more than time.max_step_travel radii (ratio: travel / (limit r); 0: none).
+  struct FastParticle {
+    double ratio = 0;
+    std::size_t index = 0;
+  };
+  FastParticle fastest_particle(double v2_max) const;  // v2_max: largest local |v|^2
+  void check_contacts(const ContactSweep& sweep, const FastParticle& fast) const;
   // Whether any contact of this step could fail the steps-per-contact test (else the
-  // sweep skips it): a bound from the fastest local or ghost particle.
-  bool contact_may_be_unresolved() const;
+  // sweep skips it): a bound from the fastest local (v2_local: its |v|^2) or ghost particle.
+  bool contact_may_be_unresolved(double v2_local) const;
   bool needs_rebuild() const;  // collective
   void mark_leaving();         // particles beyond a bounded side of the domain
   // x += dt v, with mark_leaving()'s test and the skin test in the same pass.
@@ -178,6 +186,7 @@ class Simulation {
   // For contact_may_be_unresolved, set at each rebuild: min m^2/r over local and ghost
   // particles, and the largest Y* of a pair involving one of their materials.
   double lightest_q_ = 0, largest_y_star_ = 0;
+  double smallest_radius_ = 0;  // of the local particles, set at each rebuild (travel guard)
   std::unique_ptr<BinGrid> grid_;
   NeighbourList local_list_, ghost_list_;
   ListSprings local_springs_, ghost_springs_;              // parallel to the lists' entries

@@ -59,12 +59,18 @@ grain_cli_test(runs_on_two_ranks 0 "MPI ranks: 2 as a;done: [0-9]+ steps, 300 pa
                FILES out/particles.xdmf out/log.csv out/particles_000010.h5)
 set_tests_properties(grain.runs_on_two_ranks PROPERTIES PROCESSORS 2)
 # Forced past the refusal, the run is stopped by the steps-per-contact guard at the first
-# contact it cannot resolve; with that guard off, by the overlap guard (docs/stability.md).
+# contact it cannot resolve; with that guard off, by the travel guard (a bead thrown faster
+# than one radius per step); with both off, by the overlap guard (docs/stability.md).
 grain_cli_test(steps_guard_stops_run 1
                "particles? [0-9]+ and [a-z0-9 ]+ approach at [0-9.e-]+ m/s;only [0-9.e-]+ steps of dt = 0.001 s [(]fewer than 5, key time.min_steps_per_contact[)]"
                CMD ${_grain} run ${_scenes}/bad/huge_time_step.yaml --allow-large-dt --no-progress
                    --output out
                WORKDIR ${_work}/steps_guard)
+grain_cli_test(travel_guard_stops_run 1
+               "particle [0-9]+ moves [0-9.]+ of its radii per step;key time.max_step_travel"
+               CMD ${_grain} run ${_scenes}/bad/huge_time_step_travel_guard.yaml --allow-large-dt
+                   --no-progress --output out
+               WORKDIR ${_work}/travel_guard)
 grain_cli_test(overlap_guard_stops_run 1
                "particle [0-9]+ and a wall overlap by [0-9.]+ % of the smaller radius"
                CMD ${_grain} run ${_scenes}/bad/huge_time_step_no_steps_guard.yaml --allow-large-dt
