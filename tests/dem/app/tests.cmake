@@ -26,6 +26,14 @@ grain_cli_test(missing_scene_file 2 "no_such.yaml: error: cannot open the scene 
                CMD ${_grain} check ${_scenes}/no_such.yaml)
 grain_cli_test(check_minimal 0 "Rayleigh time t_R = ;contact time t_c = ;steps per impact"
                CMD ${_grain} check ${_scenes}/minimal.yaml)
+# The travel guard's speed for the smallest bead: r / dt = 0.4004 mm / (0.07 t_R), with
+# t_R = pi r sqrt(rho / G) / (0.1631 nu + 0.8766) = 4.896e-5 s (DESIGN.md §3): 116.8 m/s.
+grain_cli_test(check_reports_travel_limit 0
+               "travel guard: a particle that moves more than 1 x its radius in one step stops the run [(]key time.max_step_travel[)]: above 116.[78] m/s for the smallest"
+               CMD ${_grain} check ${_scenes}/minimal.yaml FORBID "warning")
+grain_cli_test(check_warns_travel_limit 0
+               "above 116.[78] m/s for the smallest.*; warning: that is below time.expected_max_speed = 150 m/s"
+               CMD ${_grain} check ${_scenes}/fast_impacts.yaml)
 # The time step placed on the measured accuracy curve (docs/accuracy-vs-cost.md):
 # minimal.yaml runs at 0.07 t_R with e = 0.9 between its glass beads. (';' separates the
 # regexes that must all match.)
