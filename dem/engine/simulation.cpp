@@ -98,19 +98,19 @@ void Simulation::initialise() {
   for (std::size_t i = 0; i < p_.size(); ++i) foreign[i] = !decomp_->owns(p_.x[i]);
   p_.remove_if(foreign);
   if (!restored_springs_.empty()) {
+    // Each rank keeps the springs of the particles it owns (the file lists a pair's
+    // spring under each partner).
     CarriedState c;
-    c.wall.assign(walls_.history_columns(), std::vector<ContactHistory>(p_.size()));
-    c.pairs.resize(p_.size());
-    std::unordered_map<GlobalId, std::size_t> index;
-    for (std::size_t i = 0; i < p_.size(); ++i) index[p_.id[i]] = i;
+    c.springs = CarriedSprings(sweep_.keeps_tangential, sweep_.keeps_rolling);
+    std::vector<GlobalId> owned = p_.id;
+    std::sort(owned.begin(), owned.end());
     for (const CheckpointSpring& sp : restored_springs_) {
-      const auto it = index.find(sp.particle);
-      if (it == index.end()) continue;
-      const ContactHistory h{sp.tangential, sp.rolling};
+      if (!std::binary_search(owned.begin(), owned.end(), sp.particle)) continue;
       if (sp.partner >= 0)
-        c.pairs[it->second].push_back({sp.partner, h});
-      else if (static_cast<std::size_t>(-1 - sp.partner) < c.wall.size())
-        c.wall[-1 - sp.partner][it->second] = h;
+        c.springs.add_pair(sp.particle, sp.partner, sp.tangential, sp.rolling);
+      else if (static_cast<std::size_t>(-1 - sp.partner) < walls_.history_columns())
+        c.springs.add_wall(sp.particle, static_cast<int>(-1 - sp.partner),
+                           {sp.tangential, sp.rolling});
     }
     pending_carried_ = std::move(c);
     restored_springs_.clear();
@@ -118,7 +118,6 @@ void Simulation::initialise() {
 
   grid_ = std::make_unique<BinGrid>(decomp_->lo() - Vec3::Constant(cutoff_),
                                     decomp_->hi() + Vec3::Constant(cutoff_), cutoff_);
-  wall_history_.assign(walls_.history_columns(), std::vector<ContactHistory>(p_.size()));
   walls_.move_to(time_);
   walls_.fit_grids(r_max);  // mesh search cells of one particle diameter
   const bool restoring = restored_;
@@ -180,79 +179,95 @@ bool Simulation::needs_rebuild() const {
   return any;
 }
 
-CarriedState Simulation::save_histories() const {
-  CarriedState c = pair_histories();
-  c.wall = wall_history_;
-  return c;
-}
-
 CarriedState Simulation::take_histories() {
-  CarriedState c = pair_histories();
-  c.wall = std::move(wall_history_);
-  local_springs_.reset(0, false, false);  // released before the new lists are built
-  ghost_springs_.reset(0, false, false);
-  return c;
-}
-
-CarriedState Simulation::pair_histories() const {
   CarriedState c;
-  c.pairs.resize(p_.size());
-  if (!sweep_.has_history) return c;
-  // Counted first, so that each particle's springs take one allocation of the exact size
-  // (grown one push_back at a time they took several, and left the freed ones behind).
-  const std::size_t lists = local_list_.offsets.size();
-  std::vector<int> count(p_.size(), 0);
-  for (std::size_t i = 0; i + 1 < lists; ++i) {
-    for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k)
-      if (is_set(local_springs_[k])) {
-        ++count[i];
-        ++count[local_list_.j[k]];
-      }
-    for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k)
-      if (is_set(ghost_springs_[k])) ++count[i];
+  c.springs = CarriedSprings(sweep_.keeps_tangential, sweep_.keeps_rolling);
+  if (sweep_.has_history) {
+    // Counted first, so that the records take one allocation of the exact size.
+    const std::size_t lists = local_list_.offsets.size();
+    std::size_t pairs = 0, walls = 0;
+    for (std::size_t i = 0; i + 1 < lists; ++i) {
+      for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k)
+        pairs += is_set(local_springs_[k]);
+      for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k)
+        pairs += is_set(ghost_springs_[k]);
+    }
+    for (const auto& column : wall_history_)
+      for (const ContactHistory& h : column) walls += is_set(h);
+    c.springs.reserve(pairs, walls);
+    for (std::size_t i = 0; i + 1 < lists; ++i) {
+      for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k)
+        if (const ContactHistory h = local_springs_[k]; is_set(h))
+          c.springs.add_pair(p_.id[i], p_.id[local_list_.j[k]], h.tangential, h.rolling);
+      for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k)
+        if (const ContactHistory h = ghost_springs_[k]; is_set(h))
+          c.springs.add_pair(p_.id[i], ghosts_.id[ghost_list_.j[k]], h.tangential, h.rolling);
+    }
+    for (std::size_t col = 0; col < wall_history_.size(); ++col)
+      for (std::size_t i = 0; i < wall_history_[col].size(); ++i)
+        if (is_set(wall_history_[col][i]))
+          c.springs.add_wall(p_.id[i], static_cast<int>(col), wall_history_[col][i]);
   }
-  for (std::size_t i = 0; i < p_.size(); ++i)
-    if (count[i] > 0) c.pairs[i].reserve(count[i]);
-  for (std::size_t i = 0; i + 1 < lists; ++i) {
-    for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k)
-      if (const ContactHistory h = local_springs_[k]; is_set(h)) {
-        const std::size_t j = local_list_.j[k];
-        c.pairs[i].push_back({p_.id[j], h});
-        c.pairs[j].push_back({p_.id[i], h});
-      }
-    for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k)
-      if (const ContactHistory h = ghost_springs_[k]; is_set(h))
-        c.pairs[i].push_back({ghosts_.id[ghost_list_.j[k]], h});
-  }
+  // Released before the new lists are built: the old and new copies do not coexist.
+  local_springs_.reset(0, false, false);
+  ghost_springs_.reset(0, false, false);
+  std::vector<std::vector<ContactHistory>>().swap(wall_history_);
   return c;
 }
 
 void Simulation::restore_histories(CarriedState& carried) {
-  wall_history_ = std::move(carried.wall);
+  CarriedSprings& cs = carried.springs;
+  cs.index();
   local_springs_.reset(local_list_.pairs(), sweep_.keeps_tangential, sweep_.keeps_rolling);
   ghost_springs_.reset(ghost_list_.pairs(), sweep_.keeps_tangential, sweep_.keeps_rolling);
-  if (!sweep_.has_history) return;
-  // Each particle carries all its springs (both partners of a local pair carry the same
-  // one), so an entry's spring is found in the few its own particle carries.
-  const auto find = [&](std::size_t i, GlobalId partner) -> const ContactHistory* {
-    for (const PartnerHistory& ph : carried.pairs[i])
-      if (ph.partner == partner) return &ph.history;
-    return nullptr;
-  };
-  for (std::size_t i = 0; i < p_.size(); ++i) {
-    if (carried.pairs[i].empty()) continue;
-    for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k)
-      if (const ContactHistory* h = find(i, p_.id[local_list_.j[k]])) local_springs_.set(k, *h);
-    for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k)
-      if (const ContactHistory* h = find(i, ghosts_.id[ghost_list_.j[k]]))
-        ghost_springs_.set(k, *h);
+  wall_history_.assign(walls_.history_columns(), {});
+  if (!sweep_.has_history) {
+    cs.clear();
+    return;
   }
+  for (auto& column : wall_history_) column.assign(p_.size(), ContactHistory{});
+  if (cs.walls() > 0)
+    for (std::size_t i = 0; i < p_.size(); ++i) {
+      const auto [first, last] = cs.walls_of(p_.id[i]);
+      for (std::size_t pos = first; pos < last; ++pos) {
+        const std::size_t r = cs.wall_at(pos);
+        wall_history_[cs.wall_key(r).column][i] = cs.wall(r);
+      }
+    }
+  if (cs.pairs() > 0) {
+    // first[i]: where the records whose lower id is particle i's begin in the index; a
+    // local pair's record is then found among the few of its lower-id partner.
+    std::vector<std::uint32_t> first(p_.size());
+    for (std::size_t i = 0; i < p_.size(); ++i)
+      first[i] = static_cast<std::uint32_t>(cs.pairs_from(p_.id[i]).first);
+    const auto among = [&cs](std::size_t pos, GlobalId lo, GlobalId hi) {
+      for (; pos < cs.pairs(); ++pos) {
+        const std::size_t r = cs.pair_at(pos);
+        if (cs.pair_key(r).lo != lo) break;
+        if (cs.pair_key(r).hi == hi) return r;
+      }
+      return CarriedSprings::npos;
+    };
+    for (std::size_t i = 0; i < p_.size(); ++i) {
+      const GlobalId a = p_.id[i];
+      for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k) {
+        const std::size_t j = local_list_.j[k];
+        const GlobalId b = p_.id[j];
+        const std::size_t r = a < b ? among(first[i], a, b) : among(first[j], b, a);
+        if (r != CarriedSprings::npos) local_springs_.set(k, cs.pair(r));
+      }
+      for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k) {
+        const GlobalId b = ghosts_.id[ghost_list_.j[k]];
+        const std::size_t r = a < b ? among(first[i], a, b) : cs.find_pair(a, b);
+        if (r != CarriedSprings::npos) ghost_springs_.set(k, cs.pair(r));
+      }
+    }
+  }
+  cs.clear();
 }
 
 void Simulation::apply_order(const std::vector<std::size_t>& perm, CarriedState& carried) {
   p_.permute(perm);
-  for (auto& wh : carried.wall) reorder(wh, perm);
-  reorder(carried.pairs, perm);
   if (carried.carries_drag) reorder(carried.drag, perm);
 }
 
@@ -357,15 +372,26 @@ void Simulation::write_checkpoint(const std::string& path) {
     d.drag_fluid_velocity = drag_.fluid_velocity;
   }
   d.streams = streams_.save_state();
-  const CarriedState c = save_histories();
-  for (std::size_t i = 0; i < p_.size(); ++i)
-    for (const PartnerHistory& ph : c.pairs[i])
-      d.springs.push_back({p_.id[i], ph.partner, ph.history.tangential, ph.history.rolling});
-  for (std::size_t w = 0; w < c.wall.size(); ++w)
-    for (std::size_t i = 0; i < p_.size(); ++i)
-      if (is_set(c.wall[w][i]))
-        d.springs.push_back({p_.id[i], -1 - static_cast<GlobalId>(w), c.wall[w][i].tangential,
-                             c.wall[w][i].rolling});
+  // Every spring, listed under each partner that this rank owns.
+  if (sweep_.has_history) {
+    const std::size_t lists = local_list_.offsets.size();
+    for (std::size_t i = 0; i + 1 < lists; ++i) {
+      for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k)
+        if (const ContactHistory h = local_springs_[k]; is_set(h)) {
+          const std::size_t j = local_list_.j[k];
+          d.springs.push_back({p_.id[i], p_.id[j], h.tangential, h.rolling});
+          d.springs.push_back({p_.id[j], p_.id[i], h.tangential, h.rolling});
+        }
+      for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k)
+        if (const ContactHistory h = ghost_springs_[k]; is_set(h))
+          d.springs.push_back({p_.id[i], ghosts_.id[ghost_list_.j[k]], h.tangential, h.rolling});
+    }
+  }
+  for (std::size_t w = 0; w < wall_history_.size(); ++w)
+    for (std::size_t i = 0; i < wall_history_[w].size(); ++i)
+      if (is_set(wall_history_[w][i]))
+        d.springs.push_back({p_.id[i], -1 - static_cast<GlobalId>(w),
+                             wall_history_[w][i].tangential, wall_history_[w][i].rolling});
   grainflow::write_checkpoint(comm_, path, d);
   mark_leaving();
   rebuild(/*keep_drag=*/true);  // the next half kick uses the drag of this step's end
@@ -387,9 +413,7 @@ void Simulation::rebuild(bool keep_drag) {
     balance_cuts();
   if (!leaving_.empty()) {
     const long before = static_cast<long>(p_.size());
-    p_.remove_if(leaving_);
-    for (auto& wh : carried.wall) keep_unflagged(wh, leaving_);
-    keep_unflagged(carried.pairs, leaving_);
+    p_.remove_if(leaving_);  // their springs stay behind in `carried`, never looked up
     if (carried.carries_drag) keep_unflagged(carried.drag, leaving_);
     counters_.removed += before - static_cast<long>(p_.size());
     leaving_.clear();
@@ -589,7 +613,8 @@ void Simulation::step() {
   // Stream insertion (dem/insert/stream_insertion.hpp); new particles force a rebuild.
   const bool inserted = !streams_.empty() && streams_.insert(time_ + dt_, p_, ghosts_, walls_,
                                                              *decomp_, next_id_, comm_) > 0;
-  for (auto& column : wall_history_) column.resize(p_.size());
+  if (sweep_.has_history)
+    for (auto& column : wall_history_) column.resize(p_.size());
   if (inserted) mark_leaving();  // the new particles too
   if (inserted || needs_rebuild())
     rebuild();

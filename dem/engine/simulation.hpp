@@ -156,12 +156,11 @@ class Simulation {
   // whether every position, velocity and spin is finite after it (false otherwise).
   template <bool Guard>
   bool half_kick();
-  CarriedState save_histories() const;  // a copy of every spring, by global ids
-  // The same, moving the wall springs out and releasing the lists' springs (at a rebuild,
-  // which makes them anew: the old and new copies do not coexist at the memory peak).
+  // Every stretched spring by global ids (CarriedSprings); the lists' and walls' springs are
+  // released (a rebuild makes them anew: the old and new copies do not coexist).
   CarriedState take_histories();
-  CarriedState pair_histories() const;  // the particle pairs' part
-  void restore_histories(CarriedState& carried);  // takes carried.wall
+  // The springs of the new lists and walls, from `carried` (whose springs it releases).
+  void restore_histories(CarriedState& carried);
   void apply_order(const std::vector<std::size_t>& perm, CarriedState& carried);
 
   Scene scene_;
