@@ -204,9 +204,10 @@ CarriedState Simulation::take_histories() {
           c.springs.add_pair(p_.id[i], ghosts_.id[ghost_list_.j[k]], h.tangential, h.rolling);
     }
     for (std::size_t col = 0; col < wall_history_.size(); ++col)
-      for (std::size_t i = 0; i < wall_history_[col].size(); ++i)
-        if (is_set(wall_history_[col][i]))
-          c.springs.add_wall(p_.id[i], static_cast<int>(col), wall_history_[col][i]);
+      for (std::size_t k = 0; k < wall_history_[col].size(); ++k)
+        if (is_set(wall_history_[col][k]))
+          c.springs.add_wall(p_.id[wall_neighbours_.particle_of(col, k)], static_cast<int>(col),
+                             wall_history_[col][k]);
   }
   // Released before the new lists are built: the old and new copies do not coexist.
   local_springs_.reset(0, false, false);
@@ -225,44 +226,30 @@ void Simulation::restore_histories(CarriedState& carried) {
     cs.clear();
     return;
   }
-  for (auto& column : wall_history_) column.assign(p_.size(), ContactHistory{});
+  // The wall springs along the new wall lists: a particle now off a wall's list cannot touch
+  // the wall before the next rebuild (and does not now), so its spring there ends.
+  for (std::size_t col = 0; col < wall_history_.size(); ++col)
+    wall_history_[col].assign(wall_neighbours_.column_size(col, p_.size()), ContactHistory{});
   if (cs.walls() > 0)
-    for (std::size_t i = 0; i < p_.size(); ++i) {
-      const auto [first, last] = cs.walls_of(p_.id[i]);
-      for (std::size_t pos = first; pos < last; ++pos) {
-        const std::size_t r = cs.wall_at(pos);
-        wall_history_[cs.wall_key(r).column][i] = cs.wall(r);
+    for (std::size_t col = 0; col < wall_history_.size(); ++col)
+      for (std::size_t k = 0; k < wall_history_[col].size(); ++k) {
+        const GlobalId id = p_.id[wall_neighbours_.particle_of(col, k)];
+        if (const std::size_t r = cs.find_wall(id, static_cast<int>(col));
+            r != CarriedSprings::npos)
+          wall_history_[col][k] = cs.wall(r);
       }
-    }
-  if (cs.pairs() > 0) {
-    // first[i]: where the records whose lower id is particle i's begin in the index; a
-    // local pair's record is then found among the few of its lower-id partner.
-    std::vector<std::uint32_t> first(p_.size());
-    for (std::size_t i = 0; i < p_.size(); ++i)
-      first[i] = static_cast<std::uint32_t>(cs.pairs_from(p_.id[i]).first);
-    const auto among = [&cs](std::size_t pos, GlobalId lo, GlobalId hi) {
-      for (; pos < cs.pairs(); ++pos) {
-        const std::size_t r = cs.pair_at(pos);
-        if (cs.pair_key(r).lo != lo) break;
-        if (cs.pair_key(r).hi == hi) return r;
-      }
-      return CarriedSprings::npos;
-    };
+  if (cs.pairs() > 0)
     for (std::size_t i = 0; i < p_.size(); ++i) {
       const GlobalId a = p_.id[i];
-      for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k) {
-        const std::size_t j = local_list_.j[k];
-        const GlobalId b = p_.id[j];
-        const std::size_t r = a < b ? among(first[i], a, b) : among(first[j], b, a);
-        if (r != CarriedSprings::npos) local_springs_.set(k, cs.pair(r));
-      }
-      for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k) {
-        const GlobalId b = ghosts_.id[ghost_list_.j[k]];
-        const std::size_t r = a < b ? among(first[i], a, b) : cs.find_pair(a, b);
-        if (r != CarriedSprings::npos) ghost_springs_.set(k, cs.pair(r));
-      }
+      for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k)
+        if (const std::size_t r = cs.find_pair(a, p_.id[local_list_.j[k]]);
+            r != CarriedSprings::npos)
+          local_springs_.set(k, cs.pair(r));
+      for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k)
+        if (const std::size_t r = cs.find_pair(a, ghosts_.id[ghost_list_.j[k]]);
+            r != CarriedSprings::npos)
+          ghost_springs_.set(k, cs.pair(r));
     }
-  }
   cs.clear();
 }
 
@@ -388,10 +375,11 @@ void Simulation::write_checkpoint(const std::string& path) {
     }
   }
   for (std::size_t w = 0; w < wall_history_.size(); ++w)
-    for (std::size_t i = 0; i < wall_history_[w].size(); ++i)
-      if (is_set(wall_history_[w][i]))
-        d.springs.push_back({p_.id[i], -1 - static_cast<GlobalId>(w),
-                             wall_history_[w][i].tangential, wall_history_[w][i].rolling});
+    for (std::size_t k = 0; k < wall_history_[w].size(); ++k)
+      if (is_set(wall_history_[w][k]))
+        d.springs.push_back({p_.id[wall_neighbours_.particle_of(w, k)],
+                             -1 - static_cast<GlobalId>(w), wall_history_[w][k].tangential,
+                             wall_history_[w][k].rolling});
   grainflow::write_checkpoint(comm_, path, d);
   mark_leaving();
   rebuild(/*keep_drag=*/true);  // the next half kick uses the drag of this step's end
@@ -422,6 +410,7 @@ void Simulation::rebuild(bool keep_drag) {
   apply_order(grid_->sort_permutation(p_), carried);
   exchange_->borders(p_, cutoff_, ghosts_);
   grid_->build(p_, ghosts_, skin_, local_list_, ghost_list_);
+  wall_neighbours_.build(p_, walls_, skin_);
   restore_histories(carried);
   if (carried.carries_drag) {
     drag_.coefficient.resize(p_.size());
@@ -450,8 +439,6 @@ void Simulation::rebuild(bool keep_drag) {
     for (int b = 0; b < table_.size(); ++b)
       largest_y_star_ = std::max(largest_y_star_, table_(a, b).y_star);
   }
-  wall_neighbours_.build(p_, walls_, skin_);
-  wall_neighbours_.end_unlisted_springs(walls_, wall_history_);
   x_at_build_ = p_.x;
   ++counters_.rebuilds;
 }
@@ -613,8 +600,9 @@ void Simulation::step() {
   // Stream insertion (dem/insert/stream_insertion.hpp); new particles force a rebuild.
   const bool inserted = !streams_.empty() && streams_.insert(time_ + dt_, p_, ghosts_, walls_,
                                                              *decomp_, next_id_, comm_) > 0;
-  if (sweep_.has_history)
-    for (auto& column : wall_history_) column.resize(p_.size());
+  if (sweep_.has_history)  // inserted particles: a spring in the columns of every particle
+    for (std::size_t col = 0; col < wall_history_.size(); ++col)
+      if (wall_neighbours_.list_of_column(col).all) wall_history_[col].resize(p_.size());
   if (inserted) mark_leaving();  // the new particles too
   if (inserted || needs_rebuild())
     rebuild();

@@ -180,8 +180,9 @@ class Simulation {
   std::unique_ptr<BinGrid> grid_;
   NeighbourList local_list_, ghost_list_;
   ListSprings local_springs_, ghost_springs_;              // parallel to the lists' entries
-  std::vector<std::vector<ContactHistory>> wall_history_;  // [WallSet column][particle]
-  WallNeighbours wall_neighbours_;                         // rebuilt with the Verlet lists
+  // [WallSet column][entry of the wall's list, or particle]: the layout of wall_neighbours.hpp
+  std::vector<std::vector<ContactHistory>> wall_history_;
+  WallNeighbours wall_neighbours_;  // rebuilt with the Verlet lists
   WallSet walls_;
   StreamInsertion streams_;
   std::vector<Vec3> x_at_build_;

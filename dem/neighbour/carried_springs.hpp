@@ -13,13 +13,14 @@
 // them (Exchange::migrate). A pair may then be held twice by the same rank (both owners' copies
 // meet when a partner migrates); the copies are equal and either serves.
 //
-// Compared with a list of springs per particle (each spring held by both partners, 56 bytes
-// per copy plus an allocation per particle), a touching pair costs 40 bytes here (16 of ids,
-// 24 of tangential spring) and a 4-byte index at the lookup.
+// For the lookups, index() builds a hash table of 4-byte record numbers (open addressing,
+// linear probing, 1.5 slots per record): one probe sequence per list entry at the rebuild,
+// no sort. Compared with a list of springs per particle (each spring held by both partners,
+// 56 bytes per copy plus an allocation per particle), a touching pair costs 40 bytes here (16
+// of ids, 24 of tangential spring) and 6 bytes of table.
 #include <array>
 #include <cstddef>
 #include <cstdint>
-#include <utility>
 #include <vector>
 
 #include "dem/contact/contact_geometry.hpp"
@@ -64,19 +65,13 @@ class CarriedSprings {
   void drop_pairs(const std::vector<char>& drop);
   void drop_walls(const std::vector<char>& drop);
 
-  // Sorts an index of the records by key, for the lookups below; call after the last add
-  // (adding or dropping records clears it). Costs 4 bytes per record.
+  // Builds the hash tables for the lookups below; call after the last add (adding or
+  // dropping records clears them). Costs 6 bytes per record.
   void index();
-  // Lookups (after index()): a pair record of (a, b) in either order, or npos.
+  // Lookups (after index()): a pair record of (a, b) in either order, a wall record of
+  // (particle, column); npos when there is none.
   std::size_t find_pair(GlobalId a, GlobalId b) const;
-  // The pair records with lower id `lo`, as positions [first, last) in the index, and the
-  // record at an index position.
-  std::pair<std::size_t, std::size_t> pairs_from(GlobalId lo) const;
-  std::size_t pair_at(std::size_t position) const { return pair_order_[position]; }
-  // The wall records of `particle`, as positions [first, last) in the index (ascending
-  // columns), and the record at an index position.
-  std::pair<std::size_t, std::size_t> walls_of(GlobalId particle) const;
-  std::size_t wall_at(std::size_t position) const { return wall_order_[position]; }
+  std::size_t find_wall(GlobalId particle, int column) const;
 
   void clear();  // every record and the index, memory released
 
@@ -86,7 +81,8 @@ class CarriedSprings {
   std::vector<Vec3> tangential_values_, rolling_values_;  // parallel to pair_key_, if kept
   std::vector<WallKey> wall_key_;
   std::vector<ContactHistory> wall_values_;
-  std::vector<std::uint32_t> pair_order_, wall_order_;  // the index (empty until index())
+  // The hash tables: record number + 1 per slot, 0 for an empty slot (empty until index()).
+  std::vector<std::uint32_t> pair_slots_, wall_slots_;
 };
 
 // Per-particle data that moves with its particle between ranks (and is permuted and
