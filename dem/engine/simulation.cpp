@@ -386,6 +386,9 @@ void Simulation::write_checkpoint(const std::string& path) {
 }
 
 void Simulation::rebuild(bool keep_drag) {
+  // The positions of the last build are done with (the skin test asked them); released
+  // now, they do not add to the memory peak of the rebuild.
+  std::vector<Vec3>().swap(x_at_build_);
   // Springs by global ids (indices change below); after a restore, those of the checkpoint.
   CarriedState carried = pending_carried_ ? std::move(*pending_carried_) : take_histories();
   pending_carried_.reset();
