@@ -164,12 +164,11 @@ class Simulation {
   // whether every position, velocity and spin is finite after it (false otherwise).
   template <bool Guard>
   bool half_kick();
-  CarriedState save_histories() const;  // a copy of every spring, by global ids
-  // The same, moving the wall springs out and releasing the lists' springs (at a rebuild,
-  // which makes them anew: the old and new copies do not coexist at the memory peak).
+  // Every stretched spring by global ids (CarriedSprings); the lists' and walls' springs are
+  // released (a rebuild makes them anew: the old and new copies do not coexist).
   CarriedState take_histories();
-  CarriedState pair_histories() const;  // the particle pairs' part
-  void restore_histories(CarriedState& carried);  // takes carried.wall
+  // The springs of the new lists and walls, from `carried` (whose springs it releases).
+  void restore_histories(CarriedState& carried);
   void apply_order(const std::vector<std::size_t>& perm, CarriedState& carried);
 
   Scene scene_;
@@ -190,8 +189,9 @@ class Simulation {
   std::unique_ptr<BinGrid> grid_;
   NeighbourList local_list_, ghost_list_;
   ListSprings local_springs_, ghost_springs_;              // parallel to the lists' entries
-  std::vector<std::vector<ContactHistory>> wall_history_;  // [WallSet column][particle]
-  WallNeighbours wall_neighbours_;                         // rebuilt with the Verlet lists
+  // [WallSet column][entry of the wall's list, or particle]: the layout of wall_neighbours.hpp
+  std::vector<std::vector<ContactHistory>> wall_history_;
+  WallNeighbours wall_neighbours_;  // rebuilt with the Verlet lists
   WallSet walls_;
   StreamInsertion streams_;
   std::vector<Vec3> x_at_build_;
