@@ -12,7 +12,7 @@
 #include "coupling/shared_decomposition.hpp"
 #include "dem/io/output_directory.hpp"
 #include "zeroGradientFvPatchFields.H"
-#include "interpolationCellPoint.H"
+#include "volPointInterpolation.H"
 
 namespace grainflow::foam {
 namespace {
@@ -278,6 +278,8 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
     }
   }
   const label structuredRanks = returnReduce(label(structured_ ? 1 : 0), sumOp<label>());
+  if (sampling_ == Sampling::cellPoint)
+    cellPointWeights_ = std::make_unique<CellPointWeights>(mesh);
 
   Info << "grainFoam coupling: scene " << sceneFile << "\n"
        << "  VANS model " << model_ << ", drag " << dem_->drag_law().c_str()
@@ -473,23 +475,34 @@ std::vector<coupling::FluidAtParticle> ParticleCoupling::sample() const {
   const std::size_t local = particles_.local;
   std::vector<coupling::FluidAtParticle> out(local);
   if (sampling_ == Sampling::cellPoint) {
-    interpolationCellPoint<vector> iU(U_), iG(gradP), iT(divTau);
-    std::unique_ptr<interpolationCellPoint<vector>> iC;
-    if (curl) iC = std::make_unique<interpolationCellPoint<vector>>(tCurlU());
-    interpolationCellPoint<scalar> iE(voidFraction_);
+    // OpenFOAM's cellPoint interpolation (interpolationCellPoint): the point values by
+    // volPointInterpolation, as its constructor computes them (but not copied: it copies the
+    // cached point field), the tetrahedron and its weights by cellPointWeights_, once per
+    // particle for all the fields (cellPointWeights.H: the same weights to the last bit).
+    const volPointInterpolation& toPoints = volPointInterpolation::New(mesh_);
+    const auto points = [&toPoints](const auto& field) {
+      return toPoints.interpolate(field, "volPointInterpolate(" + field.name() + ')', false);
+    };
+    const tmp<pointVectorField> pU(points(U_)), pG(points(gradP)), pT(points(divTau));
+    const tmp<pointScalarField> pE(points(voidFraction_));
+    tmp<pointVectorField> pC;
+    if (curl) pC = points(tCurlU());
+    const CellPointWeights& weights = *cellPointWeights_;
     for (std::size_t i = 0; i < local; ++i) {
       const label c = centreCell_[i];
       if (c < 0) continue;
       const point x(particles_.x[i][0], particles_.x[i][1], particles_.x[i][2]);
-      // The tetrahedron holding x and its weights, found once for all the fields
-      // (interpolate(x, c) would search and allocate again for each of them).
-      const cellPointWeight weight(mesh_, x, c);
+      const CellPointWeight w = weights.at(x, c);
       coupling::FluidAtParticle& f = out[i];
-      f.velocity = toArray(iU.interpolate(weight));
-      f.void_fraction = std::max(minVoidFraction_, std::min(1.0, double(iE.interpolate(weight))));
-      f.pressure_gradient = toArray(iG.interpolate(weight));
-      f.viscous_stress_divergence = toArray(iT.interpolate(weight));
-      if (curl) f.vorticity = toArray(iC->interpolate(weight));
+      f.velocity = toArray(CellPointWeights::interpolate(w, U_.primitiveField(), pU()));
+      f.void_fraction =
+          std::max(minVoidFraction_, std::min(1.0, double(CellPointWeights::interpolate(
+                                                       w, voidFraction_.primitiveField(), pE()))));
+      f.pressure_gradient = toArray(CellPointWeights::interpolate(w, gradP.primitiveField(), pG()));
+      f.viscous_stress_divergence =
+          toArray(CellPointWeights::interpolate(w, divTau.primitiveField(), pT()));
+      if (curl)
+        f.vorticity = toArray(CellPointWeights::interpolate(w, tCurlU().primitiveField(), pC()));
     }
     return out;
   }
@@ -639,13 +652,29 @@ void ParticleCoupling::write() {
          << share(t[1]) << " %), fluid " << t[2] << " s (" << share(t[2]) << " %)";
     return text.str();
   };
+  const std::string cellPoint = cellPointLine();
   Foam::Info << "grainFoam particles: " << s.particles << " particles, " << s.contacts
              << " contacts, max overlap " << s.max_overlap_ratio << " r, removed " << s.removed
              << ", sampled on arrival " << s.late_samples << "; void fraction clamped "
              << Foam::label(counts[0]) << " cell-steps (" << counts[1]
              << " m^3 solid volume removed), volume not deposited " << lostVolume_ << " m^3\n"
+             << cellPoint.c_str()
              << "grainFoam time split since the last write: " << split(interval).c_str() << "\n"
              << "grainFoam time split: " << split(times).c_str() << Foam::endl;
+}
+
+std::string ParticleCoupling::cellPointLine() const {
+  if (!cellPointWeights_) return {};
+  // Collective: every rank has the table when sampling is cellPoint.
+  double counts[3] = {double(cellPointWeights_->calls()),
+                      double(cellPointWeights_->orderedSearches()),
+                      double(cellPointWeights_->outside())};
+  MPI_Allreduce(MPI_IN_PLACE, counts, 3, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  std::ostringstream text;
+  text << "grainFoam cellPoint: " << static_cast<long>(counts[0]) << " particle samples, "
+       << static_cast<long>(counts[1]) << " off the closed form (ordered search), "
+       << static_cast<long>(counts[2]) << " outside their cell's tetrahedra (nearest one)\n";
+  return text.str();
 }
 
 void ParticleCoupling::report(Foam::Ostream&) const {}
