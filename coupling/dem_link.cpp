@@ -40,6 +40,7 @@ struct DemLink::Impl {
   std::optional<CheckpointData> restart;  // until initialise()
   long restored_step = -1;                // the checkpoint's DEM step, after a restart
   std::unique_ptr<CheckpointSeries> checkpoints;
+  std::vector<double> forwarded;  // particles(): the values forwarded to ghosts, reused
 
   ~Impl() {
     sim.reset();
@@ -180,53 +181,63 @@ double DemLink::time() const { return impl_->simulation().time(); }
 long DemLink::steps() const { return impl_->simulation().counters().steps; }
 
 ParticleSet DemLink::particles(bool with_ghosts_and_exchange) const {
+  ParticleSet out;
+  particles(with_ghosts_and_exchange, out);
+  return out;
+}
+
+void DemLink::particles(bool with_ghosts_and_exchange, ParticleSet& out) const {
   const Simulation& sim = impl_->simulation();
   const Particles& p = sim.particles();
-  ParticleSet out;
-  out.local = p.size();
-  const std::size_t n = p.size() + (with_ghosts_and_exchange ? sim.ghosts().size() : 0);
-  out.id.reserve(n);
-  out.x.reserve(n);
-  out.v.reserve(n);
-  out.radius.reserve(n);
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    out.id.push_back(static_cast<long long>(p.id[i]));
-    out.x.push_back(arr(p.x[i]));
-    out.v.push_back(arr(p.v[i]));
-    out.radius.push_back(p.radius[i]);
+  const std::size_t local = p.size();
+  const std::size_t n = local + (with_ghosts_and_exchange ? sim.ghosts().size() : 0);
+  out.local = local;
+  out.id.resize(n);
+  out.x.resize(n);
+  out.v.resize(n);
+  out.radius.resize(n);
+  for (std::size_t i = 0; i < local; ++i) {
+    out.id[i] = static_cast<long long>(p.id[i]);
+    out.x[i] = arr(p.x[i]);
+    out.v[i] = arr(p.v[i]);
+    out.radius[i] = p.radius[i];
   }
-  if (!with_ghosts_and_exchange) return out;
+  if (!with_ghosts_and_exchange) {
+    out.drag_coefficient.clear();
+    out.exchange_force.clear();
+    return;
+  }
   // K, the exchange force and the velocity at the end of the last step, local first, then
   // forwarded to ghosts (the ghosts' own velocities were forwarded mid-step, before the
   // second half kick).
   const ImplicitDrag& drag = sim.implicit_drag();
   const std::vector<Vec3>& carried = impl_->fluid->exchange_force;
   constexpr std::size_t W = 7;
-  std::vector<double> values(W * p.size(), 0.0);
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    values[W * i] = i < drag.coefficient.size() ? drag.coefficient[i] : 0.0;
+  std::vector<double>& values = impl_->forwarded;  // kept: no allocation per fluid step
+  values.resize(W * local);
+  for (std::size_t i = 0; i < local; ++i) {
+    double* v = &values[W * i];
+    v[0] = i < drag.coefficient.size() ? drag.coefficient[i] : 0.0;
     for (int c = 0; c < 3; ++c) {
-      if (i < carried.size()) values[W * i + 1 + c] = carried[i][c];
-      values[W * i + 4 + c] = p.v[i][c];
+      v[1 + c] = i < carried.size() ? carried[i][c] : 0.0;
+      v[4 + c] = p.v[i][c];
     }
   }
   const std::vector<double> ghost_values = sim.ghost_values(values, W);
   const Ghosts& g = sim.ghosts();
   for (std::size_t k = 0; k < g.size(); ++k) {
-    out.id.push_back(static_cast<long long>(g.id[k]));
-    out.x.push_back(arr(g.position(k)));
-    out.v.push_back({0, 0, 0});
-    out.radius.push_back(g.radius[k]);
+    out.id[local + k] = static_cast<long long>(g.id[k]);
+    out.x[local + k] = arr(g.position(k));
+    out.radius[local + k] = g.radius[k];
   }
   out.drag_coefficient.resize(n);
   out.exchange_force.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const double* v = i < p.size() ? &values[W * i] : &ghost_values[W * (i - p.size())];
+    const double* v = i < local ? &values[W * i] : &ghost_values[W * (i - local)];
     out.drag_coefficient[i] = v[0];
     out.exchange_force[i] = {v[1], v[2], v[3]};
     out.v[i] = {v[4], v[5], v[6]};
   }
-  return out;
 }
 
 std::vector<double> DemLink::sum_onto_owners(const std::vector<double>& values,

@@ -92,6 +92,9 @@ class DemLink {
   long steps() const;  // DEM steps since the start of the run (the checkpoint's count)
 
   ParticleSet particles(bool with_ghosts_and_exchange) const;
+  // The same, written into `out` in place: a set kept from one fluid step to the next is
+  // refilled without allocating (its arrays only grow).
+  void particles(bool with_ghosts_and_exchange, ParticleSet& out) const;
 
   // Adds each ghost's `width` values (after the local ones, as in `values` sized
   // set.size()·width for the set of particles(true)) to its owner's entry; returns the

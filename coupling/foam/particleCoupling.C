@@ -18,6 +18,10 @@ namespace grainflow::foam {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+// locate(): a point more than this many cells from the domain's corner is outside (and
+// its cell index would not fit an int).
+constexpr double kFarOutside = 1e9;
+
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
@@ -354,37 +358,43 @@ ParticleCoupling::~ParticleCoupling() = default;
 
 Foam::label ParticleCoupling::locate(const Foam::point& x) const {
   if (structured_) {
-    std::array<int, 3> idx{};
-    for (int a = 0; a < 3; ++a) {
+    std::size_t k = 0;
+    for (int a = 2; a >= 0; --a) {
       // The global cell index, from the domain's corner and one spacing on every rank, so a
       // point on a cell face falls in the same cell whatever the rank layout; then local.
       const double s = (x[a] - domain_.lo[a]) / gridH_[a];
-      idx[a] = static_cast<int>(std::floor(s)) - gridOffset_[a];
+      // Below the domain (or NaN), or far beyond it (and beyond int): outside.
+      if (!(s >= 0) || s >= kFarOutside) return -1;
+      int idx = static_cast<int>(s) - gridOffset_[a];  // s >= 0: truncation is floor
       // A point on the domain's upper face belongs to the last cell.
-      if (idx[a] == gridN_[a] && std::abs(x[a] - domain_.hi[a]) <= 1e-12 * gridH_[a] * gridN_[a])
-        idx[a] = gridN_[a] - 1;
-      if (s < 0 || idx[a] < 0 || idx[a] >= gridN_[a]) return -1;
+      if (idx == gridN_[a] && std::abs(x[a] - domain_.hi[a]) <= 1e-12 * gridH_[a] * gridN_[a])
+        idx = gridN_[a] - 1;
+      if (idx < 0 || idx >= gridN_[a]) return -1;
+      k = k * static_cast<std::size_t>(gridN_[a]) + static_cast<std::size_t>(idx);
     }
-    return gridCell_[(static_cast<std::size_t>(idx[2]) * gridN_[1] + idx[1]) * gridN_[0] +
-                     idx[0]];
+    return gridCell_[k];
   }
   return mesh_.findCell(x);
 }
 
 void ParticleCoupling::buildFootprints() {
-  particles_ = dem_->particles(true);
+  dem_->particles(true, particles_);  // refilled in place: no allocation per step
   const std::size_t n = particles_.size();
-  first_.assign(n + 1, 0);
-  points_.clear();
-  centreCell_.assign(particles_.local, -1);
-  std::vector<coupling::FootprintPoint> pts;
+  first_.resize(n + 1);
+  first_[0] = 0;
+  points_.clear();  // keeps its capacity
+  centreCell_.resize(particles_.local);
+  const std::vector<coupling::FootprintPoint>& unit = footprint_.unit_points();
   for (std::size_t i = 0; i < n; ++i) {
-    footprint_.points(particles_.radius[i], pts);
-    for (const coupling::FootprintPoint& q : pts) {
+    const std::array<double, 3>& centre = particles_.x[i];
+    const double r = particles_.radius[i];
+    const Foam::label centreCell = locate(Foam::point(centre[0], centre[1], centre[2]));
+    for (const coupling::FootprintPoint& q : unit) {
       Foam::point x;
       bool image = false;  // beyond a periodic side: the particle's image deposits it
       for (int a = 0; a < 3; ++a) {
-        double s = particles_.x[i][a] + q.offset[a];
+        // Footprint::points(): the unit offset scaled by the radius.
+        double s = centre[a] + q.offset[a] * r;
         // A bounded side reflects the part of a footprint that pokes through it.
         if (!periodic_[a]) {
           if (s < domain_.lo[a]) s = 2 * domain_.lo[a] - s;
@@ -395,22 +405,32 @@ void ParticleCoupling::buildFootprints() {
         x[a] = s;
       }
       if (image) continue;
-      const Foam::label c = locate(x);
+      // The centre itself (the `centre` footprint, or a centred part): its cell is known.
+      const bool atCentre = x[0] == centre[0] && x[1] == centre[1] && x[2] == centre[2];
+      const Foam::label c = atCentre ? centreCell : locate(x);
       if (c >= 0) points_.push_back({c, q.weight});
     }
     first_[i + 1] = points_.size();
-    if (i < particles_.local) {
-      Foam::point x(particles_.x[i][0], particles_.x[i][1], particles_.x[i][2]);
-      centreCell_[i] = locate(x);
-    }
+    if (i < particles_.local) centreCell_[i] = centreCell;
   }
 }
 
 void ParticleCoupling::deposit() {
   using namespace Foam;
   const scalarField& V = mesh_.V().field();
-  scalarField solid(mesh_.nCells(), 0.0), K(mesh_.nCells(), 0.0);
-  vectorField KU(mesh_.nCells(), Zero), F(mesh_.nCells(), Zero);
+  // Sums per cell, kept from step to step (no allocation per step).
+  scalarField& solid = solid_;
+  scalarField& K = K_;
+  vectorField& KU = KU_;
+  vectorField& F = F_;
+  solid.setSize(mesh_.nCells());
+  K.setSize(mesh_.nCells());
+  KU.setSize(mesh_.nCells());
+  F.setSize(mesh_.nCells());
+  solid = 0.0;
+  K = 0.0;
+  KU = Zero;
+  F = Zero;
   const bool exchange = !particles_.drag_coefficient.empty();
   for (std::size_t i = 0; i < particles_.size(); ++i) {
     const double r = particles_.radius[i];
