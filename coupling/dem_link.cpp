@@ -212,31 +212,36 @@ void DemLink::particles(bool with_ghosts_and_exchange, ParticleSet& out) const {
   // second half kick).
   const ImplicitDrag& drag = sim.implicit_drag();
   const std::vector<Vec3>& carried = impl_->fluid->exchange_force;
+  out.drag_coefficient.resize(n);
+  out.exchange_force.resize(n);
+  for (std::size_t i = 0; i < local; ++i) {
+    out.drag_coefficient[i] = i < drag.coefficient.size() ? drag.coefficient[i] : 0.0;
+    out.exchange_force[i] = i < carried.size() ? arr(carried[i]) : std::array<double, 3>{};
+  }
+  // One rank without ghosts of its own (no periodic images): nothing to forward, and no
+  // other rank waits for this one's values.
+  if (n == local && sim.decomposition().dims() == std::array<int, 3>{1, 1, 1}) return;
   constexpr std::size_t W = 7;
   std::vector<double>& values = impl_->forwarded;  // kept: no allocation per fluid step
   values.resize(W * local);
   for (std::size_t i = 0; i < local; ++i) {
     double* v = &values[W * i];
-    v[0] = i < drag.coefficient.size() ? drag.coefficient[i] : 0.0;
+    v[0] = out.drag_coefficient[i];
     for (int c = 0; c < 3; ++c) {
-      v[1 + c] = i < carried.size() ? carried[i][c] : 0.0;
-      v[4 + c] = p.v[i][c];
+      v[1 + c] = out.exchange_force[i][c];
+      v[4 + c] = out.v[i][c];
     }
   }
   const std::vector<double> ghost_values = sim.ghost_values(values, W);
   const Ghosts& g = sim.ghosts();
   for (std::size_t k = 0; k < g.size(); ++k) {
+    const double* v = &ghost_values[W * k];
     out.id[local + k] = static_cast<long long>(g.id[k]);
     out.x[local + k] = arr(g.position(k));
     out.radius[local + k] = g.radius[k];
-  }
-  out.drag_coefficient.resize(n);
-  out.exchange_force.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const double* v = i < local ? &values[W * i] : &ghost_values[W * (i - local)];
-    out.drag_coefficient[i] = v[0];
-    out.exchange_force[i] = {v[1], v[2], v[3]};
-    out.v[i] = {v[4], v[5], v[6]};
+    out.drag_coefficient[local + k] = v[0];
+    out.exchange_force[local + k] = {v[1], v[2], v[3]};
+    out.v[local + k] = {v[4], v[5], v[6]};
   }
 }
 
@@ -250,7 +255,7 @@ std::vector<double> DemLink::sum_onto_owners(const std::vector<double>& values,
   return local;
 }
 
-void DemLink::set_fluid(std::vector<FluidAtParticle> samples,
+void DemLink::set_fluid(const std::vector<FluidAtParticle>& samples,
                         std::function<FluidAtParticle(const std::array<double, 3>&)> late) {
   Impl& m = *impl_;
   const Particles& p = m.simulation().particles();

@@ -103,7 +103,7 @@ class DemLink {
 
   // The fluid at each local particle, in the order of particles(false) taken right before.
   // `late` samples a particle that reaches this rank during the next advance().
-  void set_fluid(std::vector<FluidAtParticle> samples,
+  void set_fluid(const std::vector<FluidAtParticle>& samples,
                  std::function<FluidAtParticle(const std::array<double, 3>&)> late);
   // `steps` DEM steps (collective). After each, the NaN / Inf guard: the first non-finite
   // particle state stops the run with the particle, its forces and a diagnostic snapshot

@@ -7,181 +7,217 @@
 namespace grainflow::foam {
 namespace {
 
-// Margin of the closed-form search on box grids (see the header): a point whose barycentric
-// coordinates in a tetrahedron all exceed it is that far inside, relative to the
-// tetrahedron's heights (a few mm here), i.e. ~1e-12 m for mm cells: six orders of magnitude
-// above OpenFOAM's acceptance tolerance of 1e-15 and far above the round-off of the
-// coordinates (~1e-16), so no neighbouring tetrahedron can accept the point.
-constexpr double kInsideMargin = 1e-9;
+// A point further than this (in half widths) beyond a box face is outside the box and gets
+// OpenFOAM's nearest-tetrahedron rule. Round-off of xi is ~1e-16; a located point lies in
+// its cell up to that, so the margin is never reached by a point of the cell.
+constexpr double kOutsideMargin = 1e-9;
+
+// Flatness of a box face: its points off the face's plane by at most this, relative to the
+// cell's diagonal (block meshes: round-off, ~1e-16).
+constexpr double kFlat = 1e-12;
 
 }  // namespace
 
 CellPointWeights::CellPointWeights(const Foam::polyMesh& mesh)
     : mesh_(mesh), tol_(Foam::cellPointWeight::tol) {
-  using namespace Foam;
-  const cellList& cells = mesh.cells();
-  const faceList& faces = mesh.faces();
-  const pointField& points = mesh.points();
-  const vectorField& centres = mesh.cellCentres();
-  const scalarField& volumes = mesh.cellVolumes();
+  const Foam::label n = mesh.nCells();
   (void)mesh.tetBasePtIs();  // built once by the mesh, as interpolationCellPoint does
-
-  label count = 0;
-  for (const cell& c : cells)
-    for (const label f : c) count += faces[f].size() - 2;
-  first_.assign(cells.size() + 1, 0);
-  tets_.reserve(static_cast<std::size_t>(count));
-  sideTet_.assign(cells.size(), std::array<label, 6>{-1, -1, -1, -1, -1, -1});
-  halfWidthInverse_.assign(cells.size(), vector::zero);
-
-  forAll(cells, celli) {
-    // polyMeshTetDecomposition::cellTetIndices: the cell's faces in order, triangles 1 ..
-    // n - 2 of each.
-    for (const label facei : cells[celli]) {
-      const face& f = faces[facei];
-      for (label k = 1; k < f.size() - 1; ++k) {
-        const tetIndices ti(celli, facei, k);
-        const triFace tri = ti.faceTriIs(mesh);
-        const vector& a = centres[celli];
-        const vector& b = points[tri[0]];
-        const vector& c = points[tri[1]];
-        const vector& d = points[tri[2]];
-        // tetrahedron::pointToBarycentric: columns a - d, b - d, c - d.
-        const vector e0(a - d), e1(b - d), e2(c - d);
-        const tensor t(e0.x(), e1.x(), e2.x(), e0.y(), e1.y(), e2.y(), e0.z(), e1.z(), e2.z());
-        const scalar detT = det(t);
-        Tet tet;
-        // cellPointWeight::findTetrahedron passes over tetrahedra with |det / V| <= tol: they
-        // never take a point in its first pass.
-        tet.usable = mag(detT / volumes[celli]) > tol_;
-        tet.degenerate = mag(detT) < SMALL;
-        tet.inverse = tet.degenerate ? tensor::zero : inv(t, detT);
-        tet.d = d;
-        tet.point = {tri[0], tri[1], tri[2]};
-        tets_.push_back(tet);
-      }
+  box_.assign(static_cast<std::size_t>(n), -1);
+  boxes_.reserve(static_cast<std::size_t>(n));
+  first_.assign(static_cast<std::size_t>(n) + 1, 0);
+  for (Foam::label c = 0; c < n; ++c) {
+    Box box;
+    if (prepareBox(c, box)) {
+      box_[c] = static_cast<Foam::label>(boxes_.size());
+      boxes_.push_back(box);
+    } else {
+      prepareTets(c);
     }
-    first_[celli + 1] = static_cast<label>(tets_.size());
-    const std::array<label, 6> sides = boxSides(celli);
-    if (sides[0] < 0) continue;
-    const boundBox bb(points, cells[celli].labels(faces), false);
-    const vector span = bb.max() - bb.min();
-    for (int ax = 0; ax < 3; ++ax) halfWidthInverse_[celli][ax] = 2 / span[ax];
-    sideTet_[celli] = sides;
+    first_[c + 1] = static_cast<Foam::label>(tets_.size());
   }
 }
 
-std::array<Foam::label, 6> CellPointWeights::boxSides(Foam::label celli) const {
-  // A box: six quadrilateral faces, each flat and normal to an axis, one on every side; every
-  // one of its tetrahedra usable and not degenerate. Then the cell's tetrahedra partition it
-  // (a convex cell with planar faces, its centroid inside) and the closed form applies.
+bool CellPointWeights::prepareBox(Foam::label celli, Box& box) const {
+  // A box: six quadrilateral faces, each flat and normal to an axis, one on every side. Its
+  // centroid (OpenFOAM's cell centre, the tetrahedra's common vertex) is the box's centre.
   using namespace Foam;
-  const std::array<label, 6> none{-1, -1, -1, -1, -1, -1};
   const cell& c = mesh_.cells()[celli];
-  if (c.size() != 6) return none;
+  if (c.size() != 6) return false;
   const pointField& points = mesh_.points();
-  const boundBox bb(points, c.labels(mesh_.faces()), false);
+  const faceList& faces = mesh_.faces();
+  const boundBox bb(points, c.labels(faces), false);
   const double size = mag(bb.span());
-  std::array<label, 6> sides = none;
-  label offset = 0;
+  box.centre = mesh_.cellCentres()[celli];
+  for (int ax = 0; ax < 3; ++ax) box.halfWidthInverse[ax] = 2 / bb.span()[ax];
+  std::array<bool, 6> seen{};
   for (const label facei : c) {
-    const face& f = mesh_.faces()[facei];
-    if (f.size() != 4) return none;
+    const face& f = faces[facei];
+    if (f.size() != 4) return false;
     vector n = mesh_.faceAreas()[facei];
     if (mesh_.faceOwner()[facei] != celli) n = -n;  // outward
-    int axis = 0;
+    int a = 0;
     for (int ax = 1; ax < 3; ++ax)
-      if (std::abs(n[ax]) > std::abs(n[axis])) axis = ax;
-    const int side = 2 * axis + (n[axis] > 0 ? 1 : 0);
-    const double plane = n[axis] > 0 ? bb.max()[axis] : bb.min()[axis];
-    for (const label p : f)
-      if (std::abs(points[p][axis] - plane) > 1e-12 * size) return none;
-    if (sides[side] != -1) return none;
-    sides[side] = offset;
-    for (label k = offset; k < offset + 2; ++k) {
-      const Tet& t = tets_[first_[celli] + k];
-      if (!t.usable || t.degenerate) return none;
+      if (std::abs(n[ax]) > std::abs(n[a])) a = ax;
+    const int side = 2 * a + (n[a] > 0 ? 1 : 0);
+    if (seen[side]) return false;
+    seen[side] = true;
+    const double plane = n[a] > 0 ? bb.max()[a] : bb.min()[a];
+    const int b = (a + 1) % 3, cc = (a + 2) % 3;
+    std::array<bool, 4> filled{};
+    std::array<int, 4> quadrant{};
+    for (label k = 0; k < 4; ++k) {
+      const point& p = points[f[k]];
+      if (std::abs(p[a] - plane) > kFlat * size) return false;
+      // A corner of the face: at the box's bounds on both in-plane axes.
+      int q = 0;
+      for (const int ax : {b, cc}) {
+        const bool hi = std::abs(p[ax] - bb.max()[ax]) <= kFlat * size;
+        const bool lo = std::abs(p[ax] - bb.min()[ax]) <= kFlat * size;
+        if (hi == lo) return false;
+        if (hi) q += ax == b ? 1 : 2;
+      }
+      if (filled[q]) return false;
+      filled[q] = true;
+      quadrant[k] = q;
+      box.corner[side][q] = f[k];
     }
-    offset += 2;
+    // The face's triangles (base, base + 1, base + 2) and (base, base + 2, base + 3) share
+    // the diagonal from the base point (tetIndices::faceTriIs: base 0 when none is valid).
+    label base = mesh_.tetBasePtIs()[facei];
+    if (base < 0) base = 0;
+    const int qBase = quadrant[base % 4];
+    box.diagonal[side] = (qBase == 0 || qBase == 3) ? 0 : 1;
   }
-  return sides;
+  return true;
 }
 
-Foam::label CellPointWeights::boxCells() const {
-  Foam::label n = 0;
-  for (const auto& sides : sideTet_) n += sides[0] >= 0 ? 1 : 0;
-  return n;
+void CellPointWeights::prepareTets(Foam::label celli) {
+  using namespace Foam;
+  const pointField& points = mesh_.points();
+  const vector& a = mesh_.cellCentres()[celli];
+  const scalar volume = mesh_.cellVolumes()[celli];
+  // polyMeshTetDecomposition::cellTetIndices: the cell's faces in order, triangles 1 ..
+  // n - 2 of each.
+  for (const label facei : mesh_.cells()[celli]) {
+    const face& f = mesh_.faces()[facei];
+    for (label k = 1; k < f.size() - 1; ++k) {
+      const triFace tri = tetIndices(celli, facei, k).faceTriIs(mesh_);
+      const vector& b = points[tri[0]];
+      const vector& c = points[tri[1]];
+      const vector& d = points[tri[2]];
+      // tetrahedron::pointToBarycentric: columns a - d, b - d, c - d.
+      const vector e0(a - d), e1(b - d), e2(c - d);
+      const tensor t(e0.x(), e1.x(), e2.x(), e0.y(), e1.y(), e2.y(), e0.z(), e1.z(), e2.z());
+      const scalar detT = det(t);
+      Tet tet;
+      // cellPointWeight::findTetrahedron passes over tetrahedra with |det / V| <= tol in its
+      // search: they never take a point.
+      tet.usable = mag(detT / volume) > tol_;
+      tet.degenerate = mag(detT) < SMALL;
+      tet.inverse = tet.degenerate ? tensor::zero : inv(t, detT);
+      tet.d = d;
+      tet.point = {tri[0], tri[1], tri[2]};
+      tets_.push_back(tet);
+    }
+  }
 }
 
 std::size_t CellPointWeights::bytes() const {
-  return tets_.capacity() * sizeof(Tet) + first_.capacity() * sizeof(Foam::label) +
-         sideTet_.capacity() * sizeof(sideTet_[0]) +
-         halfWidthInverse_.capacity() * sizeof(Foam::vector);
-}
-
-void CellPointWeights::barycentric(const Tet& t, const Foam::point& x, double w[4]) {
-  if (t.degenerate) {
-    w[0] = w[1] = w[2] = w[3] = 0.25;
-    return;
-  }
-  // vector res = inv(t, detT) & (pt - d); bary = (res, 1 - cmptSum(res)).
-  const Foam::vector res = t.inverse & (x - t.d);
-  w[0] = res.x();
-  w[1] = res.y();
-  w[2] = res.z();
-  w[3] = 1 - Foam::cmptSum(res);
-}
-
-bool CellPointWeights::accepts(const double w[4]) const {
-  // cellPointWeight::findTetrahedron's test, term for term.
-  return w[0] + tol_ > 0 && w[1] + tol_ > 0 && w[2] + tol_ > 0 && w[0] + w[1] + w[2] < 1 + tol_;
+  return box_.capacity() * sizeof(Foam::label) + boxes_.capacity() * sizeof(Box) +
+         first_.capacity() * sizeof(Foam::label) + tets_.capacity() * sizeof(Tet);
 }
 
 CellPointWeight CellPointWeights::at(const Foam::point& x, Foam::label cell) const {
-  ++calls_;
-  if (sideTet_[cell][0] >= 0) {
-    const Foam::vector& centre = mesh_.cellCentres()[cell];
-    const Foam::vector& hInv = halfWidthInverse_[cell];
-    int axis = 0;
-    double best = -1, sign = 0;
-    for (int ax = 0; ax < 3; ++ax) {
-      const double s = (x[ax] - centre[ax]) * hInv[ax];
-      if (std::abs(s) > best) {
-        best = std::abs(s);
-        axis = ax;
-        sign = s;
-      }
+  const Foam::label b = box_[cell];
+  return b >= 0 ? inBox(boxes_[b], x, cell) : orderedSearch(x, cell);
+}
+
+CellPointWeight CellPointWeights::inBox(const Box& box, const Foam::point& x,
+                                        Foam::label cell) const {
+  double xi[3];
+  for (int ax = 0; ax < 3; ++ax) xi[ax] = (x[ax] - box.centre[ax]) * box.halfWidthInverse[ax];
+  int a = 0;
+  for (int ax = 1; ax < 3; ++ax)
+    if (std::abs(xi[ax]) > std::abs(xi[a])) a = ax;
+  const double t = std::abs(xi[a]);
+  if (!(t <= 1 + kOutsideMargin)) return nearest(x, cell);  // also NaN
+  const int side = 2 * a + (xi[a] > 0 ? 1 : 0);
+  const double u = xi[(a + 1) % 3], v = xi[(a + 2) % 3];
+  const std::array<Foam::label, 4>& q = box.corner[side];
+  // In the pyramid (centre, face), scaled to the face [-1, 1]^2 at distance 1, x is
+  // w_centre * 0 + sum_k w_k (corner_k, 1) with w_centre = 1 - t and, for the corners of the
+  // triangle holding (u, v) / t, the w_k solving sum w_k (U_k, V_k, 1) = (u, v, t), corners
+  // (U, V) = q0 (-1, -1), q1 (1, -1), q2 (-1, 1), q3 (1, 1):
+  //   diagonal q0-q3: u >= v: q0 (t - u)/2, q1 (u - v)/2, q3 (t + v)/2
+  //                   u <  v: q0 (t - v)/2, q2 (v - u)/2, q3 (t + u)/2
+  //   diagonal q1-q2: u + v <= 0: q0 -(u + v)/2, q1 (t + u)/2, q2 (t + v)/2
+  //                   u + v >  0: q1 (t - v)/2, q2 (t - u)/2, q3 (u + v)/2
+  // (each row sums to t and reproduces u and v: the barycentric coordinates of OpenFOAM's
+  // tetrahedron (centre, base, ...), which are affine-invariant, in the box's coordinates).
+  // On the diagonal both triangles give the same weights.
+  CellPointWeight s;
+  s.cell = cell;
+  s.w[0] = 1 - t;
+  if (box.diagonal[side] == 0) {
+    if (u >= v) {
+      s.point = {q[0], q[1], q[3]};
+      s.w[1] = 0.5 * (t - u);
+      s.w[2] = 0.5 * (u - v);
+      s.w[3] = 0.5 * (t + v);
+    } else {
+      s.point = {q[0], q[2], q[3]};
+      s.w[1] = 0.5 * (t - v);
+      s.w[2] = 0.5 * (v - u);
+      s.w[3] = 0.5 * (t + u);
     }
-    const Foam::label k0 = first_[cell] + sideTet_[cell][2 * axis + (sign > 0 ? 1 : 0)];
-    for (Foam::label k = k0; k < k0 + 2; ++k) {
-      CellPointWeight s;
-      barycentric(tets_[k], x, s.w.data());
-      if (s.w[0] > kInsideMargin && s.w[1] > kInsideMargin && s.w[2] > kInsideMargin &&
-          s.w[3] > kInsideMargin) {
-        s.cell = cell;
-        s.point = tets_[k].point;
-        return s;
-      }
+  } else {
+    if (u + v <= 0) {
+      s.point = {q[0], q[1], q[2]};
+      s.w[1] = -0.5 * (u + v);
+      s.w[2] = 0.5 * (t + u);
+      s.w[3] = 0.5 * (t + v);
+    } else {
+      s.point = {q[1], q[2], q[3]};
+      s.w[1] = 0.5 * (t - v);
+      s.w[2] = 0.5 * (t - u);
+      s.w[3] = 0.5 * (u + v);
     }
-    ++ordered_;
   }
-  return orderedSearch(x, cell);
+  return s;
 }
 
 CellPointWeight CellPointWeights::orderedSearch(const Foam::point& x, Foam::label cell) const {
   CellPointWeight s;
   s.cell = cell;
   for (Foam::label k = first_[cell]; k < first_[cell + 1]; ++k) {
-    if (!tets_[k].usable) continue;
-    barycentric(tets_[k], x, s.w.data());
-    if (accepts(s.w.data())) {
-      s.point = tets_[k].point;
+    const Tet& tet = tets_[k];
+    if (!tet.usable) continue;
+    double* w = s.w.data();
+    if (tet.degenerate) {
+      w[0] = w[1] = w[2] = w[3] = 0.25;
+    } else {
+      // tetrahedron::pointToBarycentric: res = inv(t, detT) & (pt - d), (res, 1 - sum res).
+      const Foam::vector res = tet.inverse & (x - tet.d);
+      w[0] = res.x();
+      w[1] = res.y();
+      w[2] = res.z();
+      w[3] = 1 - Foam::cmptSum(res);
+    }
+    // cellPointWeight::findTetrahedron's test, term for term.
+    if (w[0] + tol_ > 0 && w[1] + tol_ > 0 && w[2] + tol_ > 0 && w[0] + w[1] + w[2] < 1 + tol_) {
+      s.point = tet.point;
       return s;
     }
   }
-  // Outside every tetrahedron of the cell: OpenFOAM's nearest-tetrahedron rule, by OpenFOAM.
+  return nearest(x, cell);
+}
+
+CellPointWeight CellPointWeights::nearest(const Foam::point& x, Foam::label cell) const {
+  // Outside the cell: OpenFOAM's nearest-tetrahedron rule, by OpenFOAM (rare: not per step).
   ++outside_;
   const Foam::cellPointWeight foam(mesh_, x, cell);
+  CellPointWeight s;
+  s.cell = cell;
   for (int j = 0; j < 4; ++j) s.w[j] = foam.weights()[j];
   for (int j = 0; j < 3; ++j) s.point[j] = foam.faceVertices()[j];
   return s;

@@ -287,8 +287,14 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
     }
   }
   const label structuredRanks = returnReduce(label(structured_ ? 1 : 0), sumOp<label>());
-  if (sampling_ == Sampling::cellPoint)
+  if (sampling_ == Sampling::cellPoint) {
     cellPointWeights_ = std::make_unique<CellPointWeights>(mesh);
+    const label boxCells = returnReduce(cellPointWeights_->boxCells(), sumOp<label>());
+    const double bytes = returnReduce(double(cellPointWeights_->bytes()), sumOp<double>());
+    Info << "grainFoam coupling: cellPoint weights prepared for "
+         << returnReduce(mesh.nCells(), sumOp<label>()) << " cells (" << boxCells
+         << " boxes: closed form; the others: their tetrahedra), " << bytes / 1e6 << " MB" << endl;
+  }
 
   // --- the viscous term div(tau) = rho nu laplacian(U) at the particles ----------------
   // Its non-orthogonal correction (corrected snGrad: correction vectors . interpolated
@@ -461,9 +467,11 @@ void ParticleCoupling::deposit() {
   KU = Zero;
   F = Zero;
   const bool exchange = !particles_.drag_coefficient.empty();
+  double particleVolume = 0;  // of the local particles
   for (std::size_t i = 0; i < particles_.size(); ++i) {
     const double r = particles_.radius[i];
     const double volume = 4.0 / 3.0 * constant::mathematical::pi * r * r * r;
+    if (i < particles_.local) particleVolume += volume;
     const vector v(particles_.v[i][0], particles_.v[i][1], particles_.v[i][2]);
     const double k = exchange ? particles_.drag_coefficient[i] : 0.0;
     const vector f = exchange ? vector(particles_.exchange_force[i][0],
@@ -479,8 +487,14 @@ void ParticleCoupling::deposit() {
       F[c] -= w * f;
     }
   }
+  // One pass over the cells for eps and the exchange fields (the arithmetic of the field
+  // expressions K / V, sum(solid), sum((1 - eps) V), without their temporaries).
   scalarField& eps = voidFraction_.primitiveFieldRef();
+  scalarField& Ksl = Ksl_.primitiveFieldRef();
+  vectorField& KslUs = KslUs_.primitiveFieldRef();
+  vectorField& fExplicit = fExplicit_.primitiveFieldRef();
   stepClampedVolume_ = 0;
+  double depositedVolume = 0, meshSolidVolume = 0;
   forAll(eps, c) {
     const double raw = 1 - solid[c] / V[c];
     if (raw < minVoidFraction_) {
@@ -491,22 +505,19 @@ void ParticleCoupling::deposit() {
     } else {
       eps[c] = raw;
     }
+    Ksl[c] = K[c] / V[c];
+    KslUs[c] = KU[c] / V[c];
+    fExplicit[c] = F[c] / V[c];
+    depositedVolume += solid[c];
+    meshSolidVolume += (1 - eps[c]) * V[c];
   }
   voidFraction_.correctBoundaryConditions();
-  Ksl_.primitiveFieldRef() = K / V;
   Ksl_.correctBoundaryConditions();
-  KslUs_.primitiveFieldRef() = KU / V;
   KslUs_.correctBoundaryConditions();
-  fExplicit_.primitiveFieldRef() = F / V;
   fExplicit_.correctBoundaryConditions();
 
   // Volume not deposited anywhere (footprint points outside every rank's cells).
-  double particleVolume = 0;
-  for (std::size_t i = 0; i < particles_.local; ++i) {
-    const double r = particles_.radius[i];
-    particleVolume += 4.0 / 3.0 * constant::mathematical::pi * r * r * r;
-  }
-  double sums[4] = {particleVolume, sum(solid), sum((1 - eps) * V), stepClampedVolume_};
+  double sums[4] = {particleVolume, depositedVolume, meshSolidVolume, stepClampedVolume_};
   MPI_Allreduce(MPI_IN_PLACE, sums, 4, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
   lostVolume_ = std::max(0.0, sums[0] - sums[1]);
   particleVolume_ = sums[0];
@@ -526,7 +537,7 @@ Foam::tmp<Foam::volVectorField> ParticleCoupling::viscousLaplacian() const {
   return uncorrectedLaplacian_.ref().fvcLaplacian(nuFaces, U_);  // ref(): the tmp owns it
 }
 
-std::vector<coupling::FluidAtParticle> ParticleCoupling::sample() const {
+void ParticleCoupling::sample() {
   using namespace Foam;
   const volVectorField gradP(rho_ * fvc::grad(p_));
   const volVectorField divTau(rho_ * viscousLaplacian());
@@ -534,7 +545,9 @@ std::vector<coupling::FluidAtParticle> ParticleCoupling::sample() const {
   tmp<volVectorField> tCurlU;
   if (curl) tCurlU = fvc::curl(U_);
   const std::size_t local = particles_.local;
-  std::vector<coupling::FluidAtParticle> out(local);
+  // Kept from step to step; every entry is written below.
+  std::vector<coupling::FluidAtParticle>& out = samples_;
+  out.resize(local);
   if (sampling_ == Sampling::cellPoint) {
     // OpenFOAM's cellPoint interpolation (interpolationCellPoint): the point values by
     // volPointInterpolation, as its constructor computes them (but not copied: it copies the
@@ -549,12 +562,16 @@ std::vector<coupling::FluidAtParticle> ParticleCoupling::sample() const {
     tmp<pointVectorField> pC;
     if (curl) pC = points(tCurlU());
     const CellPointWeights& weights = *cellPointWeights_;
+    cellPointSamples_ += static_cast<long>(local);
     for (std::size_t i = 0; i < local; ++i) {
+      coupling::FluidAtParticle& f = out[i];
       const label c = centreCell_[i];
-      if (c < 0) continue;
+      if (c < 0) {
+        f = coupling::FluidAtParticle{};  // outside the mesh: fluid at rest, eps = 1
+        continue;
+      }
       const point x(particles_.x[i][0], particles_.x[i][1], particles_.x[i][2]);
       const CellPointWeight w = weights.at(x, c);
-      coupling::FluidAtParticle& f = out[i];
       f.velocity = toArray(CellPointWeights::interpolate(w, U_.primitiveField(), pU()));
       f.void_fraction =
           std::max(minVoidFraction_, std::min(1.0, double(CellPointWeights::interpolate(
@@ -562,10 +579,11 @@ std::vector<coupling::FluidAtParticle> ParticleCoupling::sample() const {
       f.pressure_gradient = toArray(CellPointWeights::interpolate(w, gradP.primitiveField(), pG()));
       f.viscous_stress_divergence =
           toArray(CellPointWeights::interpolate(w, divTau.primitiveField(), pT()));
-      if (curl)
-        f.vorticity = toArray(CellPointWeights::interpolate(w, tCurlU().primitiveField(), pC()));
+      f.vorticity = curl
+                        ? toArray(CellPointWeights::interpolate(w, tCurlU().primitiveField(), pC()))
+                        : std::array<double, 3>{};
     }
-    return out;
+    return;
   }
   // Footprint-weighted cell values; ghosts' shares go back to their owners.
   constexpr std::size_t W = 14;
@@ -598,7 +616,6 @@ std::vector<coupling::FluidAtParticle> ParticleCoupling::sample() const {
     }
     f.void_fraction = a[13] > 0 ? a[3] * norm : 1.0;
   }
-  return out;
 }
 
 coupling::FluidAtParticle ParticleCoupling::sampleAt(const std::array<double, 3>& x) const {
@@ -654,8 +671,8 @@ void ParticleCoupling::checkBalance() {
 
 void ParticleCoupling::evolve() {
   auto t0 = Clock::now();
-  std::vector<coupling::FluidAtParticle> samples = sample();
-  dem_->set_fluid(std::move(samples), [this](const std::array<double, 3>& x) { return sampleAt(x); });
+  sample();
+  dem_->set_fluid(samples_, [this](const std::array<double, 3>& x) { return sampleAt(x); });
   couplingSeconds_ += seconds_since(t0);
   t0 = Clock::now();
   try {
@@ -727,14 +744,11 @@ void ParticleCoupling::write() {
 std::string ParticleCoupling::cellPointLine() const {
   if (!cellPointWeights_) return {};
   // Collective: every rank has the table when sampling is cellPoint.
-  double counts[3] = {double(cellPointWeights_->calls()),
-                      double(cellPointWeights_->orderedSearches()),
-                      double(cellPointWeights_->outside())};
-  MPI_Allreduce(MPI_IN_PLACE, counts, 3, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  double counts[2] = {double(cellPointSamples_), double(cellPointWeights_->outside())};
+  MPI_Allreduce(MPI_IN_PLACE, counts, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
   std::ostringstream text;
   text << "grainFoam cellPoint: " << static_cast<long>(counts[0]) << " particle samples, "
-       << static_cast<long>(counts[1]) << " off the closed form (ordered search), "
-       << static_cast<long>(counts[2]) << " outside their cell's tetrahedra (nearest one)\n";
+       << static_cast<long>(counts[1]) << " outside their cell (OpenFOAM's nearest tetrahedron)\n";
   return text.str();
 }
 
