@@ -2,6 +2,7 @@
 
 #include <fenv.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -41,6 +42,7 @@ struct DemLink::Impl {
   long restored_step = -1;                // the checkpoint's DEM step, after a restart
   std::unique_ptr<CheckpointSeries> checkpoints;
   std::vector<double> forwarded;  // particles(): the values forwarded to ghosts, reused
+  std::vector<FluidSample> pending;  // begin_fluid() .. end_fluid()
 
   ~Impl() {
     sim.reset();
@@ -196,27 +198,33 @@ void DemLink::particles(bool with_ghosts_and_exchange, ParticleSet& out) const {
   out.x.resize(n);
   out.v.resize(n);
   out.radius.resize(n);
-  for (std::size_t i = 0; i < local; ++i) {
-    out.id[i] = static_cast<long long>(p.id[i]);
-    out.x[i] = arr(p.x[i]);
-    out.v[i] = arr(p.v[i]);
-    out.radius[i] = p.radius[i];
-  }
   if (!with_ghosts_and_exchange) {
+    for (std::size_t i = 0; i < local; ++i) {
+      out.id[i] = static_cast<long long>(p.id[i]);
+      out.x[i] = arr(p.x[i]);
+      out.v[i] = arr(p.v[i]);
+      out.radius[i] = p.radius[i];
+    }
     out.drag_coefficient.clear();
     out.exchange_force.clear();
     return;
   }
   // K, the exchange force and the velocity at the end of the last step, local first, then
   // forwarded to ghosts (the ghosts' own velocities were forwarded mid-step, before the
-  // second half kick).
+  // second half kick). One pass over the local particles.
   const ImplicitDrag& drag = sim.implicit_drag();
   const std::vector<Vec3>& carried = impl_->fluid->exchange_force;
   out.drag_coefficient.resize(n);
   out.exchange_force.resize(n);
+  const std::size_t withDrag = std::min(local, drag.coefficient.size());
+  const std::size_t withForce = std::min(local, carried.size());
   for (std::size_t i = 0; i < local; ++i) {
-    out.drag_coefficient[i] = i < drag.coefficient.size() ? drag.coefficient[i] : 0.0;
-    out.exchange_force[i] = i < carried.size() ? arr(carried[i]) : std::array<double, 3>{};
+    out.id[i] = static_cast<long long>(p.id[i]);
+    out.x[i] = arr(p.x[i]);
+    out.v[i] = arr(p.v[i]);
+    out.radius[i] = p.radius[i];
+    out.drag_coefficient[i] = i < withDrag ? drag.coefficient[i] : 0.0;
+    out.exchange_force[i] = i < withForce ? arr(carried[i]) : std::array<double, 3>{};
   }
   // One rank without ghosts of its own (no periodic images): nothing to forward, and no
   // other rank waits for this one's values.
@@ -257,15 +265,38 @@ std::vector<double> DemLink::sum_onto_owners(const std::vector<double>& values,
 
 void DemLink::set_fluid(const std::vector<FluidAtParticle>& samples,
                         std::function<FluidAtParticle(const std::array<double, 3>&)> late) {
+  begin_fluid();
+  for (const FluidAtParticle& f : samples) add_fluid(f);
+  end_fluid(std::move(late));
+}
+
+void DemLink::begin_fluid() {
+  Impl& m = *impl_;
+  m.pending.clear();
+  m.pending.reserve(m.simulation().particles().size());
+}
+
+void DemLink::add_fluid(const FluidAtParticle& f) {
+  const Impl& m = *impl_;
+  // to_sample(f), built in place.
+  impl_->pending.push_back(
+      FluidSample{.velocity = vec(f.velocity),
+                  .void_fraction = f.void_fraction,
+                  .pressure_gradient = vec(f.pressure_gradient),
+                  .viscous_stress_divergence = vec(f.viscous_stress_divergence),
+                  .density = m.fluid_density,
+                  .viscosity = m.fluid_viscosity,
+                  .vorticity = vec(f.vorticity)});
+}
+
+void DemLink::end_fluid(std::function<FluidAtParticle(const std::array<double, 3>&)> late) {
   Impl& m = *impl_;
   const Particles& p = m.simulation().particles();
-  if (samples.size() != p.size())
-    throw std::logic_error("DemLink::set_fluid: " + std::to_string(samples.size()) +
-                           " samples for " + std::to_string(p.size()) + " particles");
-  std::vector<FluidSample> s;
-  s.reserve(samples.size());
-  for (const FluidAtParticle& f : samples) s.push_back(m.to_sample(f));
-  m.fluid->set(p.id, std::move(s));
+  if (m.pending.size() != p.size())
+    throw std::logic_error("DemLink: " + std::to_string(m.pending.size()) + " fluid samples for " +
+                           std::to_string(p.size()) + " particles");
+  m.fluid->set(p.id, std::move(m.pending));
+  m.pending = {};
   Impl* self = &m;
   m.fluid->set_sampler([self, late = std::move(late)](const Vec3& x) {
     return self->to_sample(late(arr(x)));

@@ -105,6 +105,12 @@ class DemLink {
   // `late` samples a particle that reaches this rank during the next advance().
   void set_fluid(const std::vector<FluidAtParticle>& samples,
                  std::function<FluidAtParticle(const std::array<double, 3>&)> late);
+  // The same without a vector of samples in between (it would be written and read again
+  // every fluid step): begin_fluid(), then add_fluid() once per local particle in that
+  // order, then end_fluid(late).
+  void begin_fluid();
+  void add_fluid(const FluidAtParticle& f);
+  void end_fluid(std::function<FluidAtParticle(const std::array<double, 3>&)> late);
   // `steps` DEM steps (collective). After each, the NaN / Inf guard: the first non-finite
   // particle state stops the run with the particle, its forces and a diagnostic snapshot
   // of every particle in `diagnostic_directory`. Throws std::runtime_error with the DEM's

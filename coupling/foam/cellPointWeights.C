@@ -7,11 +7,6 @@
 namespace grainflow::foam {
 namespace {
 
-// A point further than this (in half widths) beyond a box face is outside the box and gets
-// OpenFOAM's nearest-tetrahedron rule. Round-off of xi is ~1e-16; a located point lies in
-// its cell up to that, so the margin is never reached by a point of the cell.
-constexpr double kOutsideMargin = 1e-9;
-
 // Flatness of a box face: its points off the face's plane by at most this, relative to the
 // cell's diagonal (block meshes: round-off, ~1e-16).
 constexpr double kFlat = 1e-12;
@@ -125,65 +120,6 @@ void CellPointWeights::prepareTets(Foam::label celli) {
 std::size_t CellPointWeights::bytes() const {
   return box_.capacity() * sizeof(Foam::label) + boxes_.capacity() * sizeof(Box) +
          first_.capacity() * sizeof(Foam::label) + tets_.capacity() * sizeof(Tet);
-}
-
-CellPointWeight CellPointWeights::at(const Foam::point& x, Foam::label cell) const {
-  const Foam::label b = box_[cell];
-  return b >= 0 ? inBox(boxes_[b], x, cell) : orderedSearch(x, cell);
-}
-
-CellPointWeight CellPointWeights::inBox(const Box& box, const Foam::point& x,
-                                        Foam::label cell) const {
-  double xi[3];
-  for (int ax = 0; ax < 3; ++ax) xi[ax] = (x[ax] - box.centre[ax]) * box.halfWidthInverse[ax];
-  int a = 0;
-  for (int ax = 1; ax < 3; ++ax)
-    if (std::abs(xi[ax]) > std::abs(xi[a])) a = ax;
-  const double t = std::abs(xi[a]);
-  if (!(t <= 1 + kOutsideMargin)) return nearest(x, cell);  // also NaN
-  const int side = 2 * a + (xi[a] > 0 ? 1 : 0);
-  const double u = xi[(a + 1) % 3], v = xi[(a + 2) % 3];
-  const std::array<Foam::label, 4>& q = box.corner[side];
-  // In the pyramid (centre, face), scaled to the face [-1, 1]^2 at distance 1, x is
-  // w_centre * 0 + sum_k w_k (corner_k, 1) with w_centre = 1 - t and, for the corners of the
-  // triangle holding (u, v) / t, the w_k solving sum w_k (U_k, V_k, 1) = (u, v, t), corners
-  // (U, V) = q0 (-1, -1), q1 (1, -1), q2 (-1, 1), q3 (1, 1):
-  //   diagonal q0-q3: u >= v: q0 (t - u)/2, q1 (u - v)/2, q3 (t + v)/2
-  //                   u <  v: q0 (t - v)/2, q2 (v - u)/2, q3 (t + u)/2
-  //   diagonal q1-q2: u + v <= 0: q0 -(u + v)/2, q1 (t + u)/2, q2 (t + v)/2
-  //                   u + v >  0: q1 (t - v)/2, q2 (t - u)/2, q3 (u + v)/2
-  // (each row sums to t and reproduces u and v: the barycentric coordinates of OpenFOAM's
-  // tetrahedron (centre, base, ...), which are affine-invariant, in the box's coordinates).
-  // On the diagonal both triangles give the same weights.
-  CellPointWeight s;
-  s.cell = cell;
-  s.w[0] = 1 - t;
-  if (box.diagonal[side] == 0) {
-    if (u >= v) {
-      s.point = {q[0], q[1], q[3]};
-      s.w[1] = 0.5 * (t - u);
-      s.w[2] = 0.5 * (u - v);
-      s.w[3] = 0.5 * (t + v);
-    } else {
-      s.point = {q[0], q[2], q[3]};
-      s.w[1] = 0.5 * (t - v);
-      s.w[2] = 0.5 * (v - u);
-      s.w[3] = 0.5 * (t + u);
-    }
-  } else {
-    if (u + v <= 0) {
-      s.point = {q[0], q[1], q[2]};
-      s.w[1] = -0.5 * (u + v);
-      s.w[2] = 0.5 * (t + u);
-      s.w[3] = 0.5 * (t + v);
-    } else {
-      s.point = {q[1], q[2], q[3]};
-      s.w[1] = 0.5 * (t - v);
-      s.w[2] = 0.5 * (t - u);
-      s.w[3] = 0.5 * (u + v);
-    }
-  }
-  return s;
 }
 
 CellPointWeight CellPointWeights::orderedSearch(const Foam::point& x, Foam::label cell) const {

@@ -537,6 +537,37 @@ Foam::tmp<Foam::volVectorField> ParticleCoupling::viscousLaplacian() const {
   return uncorrectedLaplacian_.ref().fvcLaplacian(nuFaces, U_);  // ref(): the tmp owns it
 }
 
+template <int width>
+void ParticleCoupling::sampleCellPoint() {
+  const CellPointWeights& weights = *cellPointWeights_;
+  for (std::size_t i = 0; i < particles_.local; ++i) {
+    coupling::FluidAtParticle f;  // outside the mesh: fluid at rest, eps = 1
+    const Foam::label c = centreCell_[i];
+    if (c < 0) {
+      dem_->add_fluid(f);
+      continue;
+    }
+    const CellPointWeight w =
+        weights.at(Foam::point(particles_.x[i][0], particles_.x[i][1], particles_.x[i][2]), c);
+    // interpolationCellPoint<Type>::interpolate per component, in its order:
+    // cell * w0, then + point_k * w_k for k = 1, 2, 3.
+    const double* r[4] = {&cellRecords_[std::size_t{width} * c],
+                          &pointRecords_[std::size_t{width} * w.point[0]],
+                          &pointRecords_[std::size_t{width} * w.point[1]],
+                          &pointRecords_[std::size_t{width} * w.point[2]]};
+    double v[width];
+    for (int k = 0; k < width; ++k) v[k] = r[0][k] * w.w[0];
+    for (int j = 1; j < 4; ++j)
+      for (int k = 0; k < width; ++k) v[k] += r[j][k] * w.w[j];
+    f.velocity = {v[0], v[1], v[2]};
+    f.pressure_gradient = {v[3], v[4], v[5]};
+    f.viscous_stress_divergence = {v[6], v[7], v[8]};
+    f.void_fraction = std::max(minVoidFraction_, std::min(1.0, v[9]));
+    if constexpr (width == 13) f.vorticity = {v[10], v[11], v[12]};
+    dem_->add_fluid(f);
+  }
+}
+
 void ParticleCoupling::sample() {
   using namespace Foam;
   const volVectorField gradP(rho_ * fvc::grad(p_));
@@ -545,9 +576,7 @@ void ParticleCoupling::sample() {
   tmp<volVectorField> tCurlU;
   if (curl) tCurlU = fvc::curl(U_);
   const std::size_t local = particles_.local;
-  // Kept from step to step; every entry is written below.
-  std::vector<coupling::FluidAtParticle>& out = samples_;
-  out.resize(local);
+  dem_->begin_fluid();
   if (sampling_ == Sampling::cellPoint) {
     // OpenFOAM's cellPoint interpolation (interpolationCellPoint): the point values by
     // volPointInterpolation, as its constructor computes them (but not copied: it copies the
@@ -561,28 +590,32 @@ void ParticleCoupling::sample() {
     const tmp<pointScalarField> pE(points(voidFraction_));
     tmp<pointVectorField> pC;
     if (curl) pC = points(tCurlU());
-    const CellPointWeights& weights = *cellPointWeights_;
-    cellPointSamples_ += static_cast<long>(local);
-    for (std::size_t i = 0; i < local; ++i) {
-      coupling::FluidAtParticle& f = out[i];
-      const label c = centreCell_[i];
-      if (c < 0) {
-        f = coupling::FluidAtParticle{};  // outside the mesh: fluid at rest, eps = 1
-        continue;
+    // The fields side by side, one record per cell and per point (U 0-2, grad p 3-5,
+    // div tau 6-8, eps 9, curl U 10-12), so that a stencil reads four records.
+    const int width = curl ? 13 : 10;
+    const auto pack = [width](std::vector<double>& records, const UList<vector>& U,
+                              const UList<vector>& G, const UList<vector>& T,
+                              const UList<scalar>& E, const UList<vector>* C) {
+      records.resize(static_cast<std::size_t>(width) * U.size());
+      forAll(U, k) {
+        double* r = &records[static_cast<std::size_t>(width) * k];
+        for (int d = 0; d < 3; ++d) {
+          r[d] = U[k][d];
+          r[3 + d] = G[k][d];
+          r[6 + d] = T[k][d];
+          if (C) r[10 + d] = (*C)[k][d];
+        }
+        r[9] = E[k];
       }
-      const point x(particles_.x[i][0], particles_.x[i][1], particles_.x[i][2]);
-      const CellPointWeight w = weights.at(x, c);
-      f.velocity = toArray(CellPointWeights::interpolate(w, U_.primitiveField(), pU()));
-      f.void_fraction =
-          std::max(minVoidFraction_, std::min(1.0, double(CellPointWeights::interpolate(
-                                                       w, voidFraction_.primitiveField(), pE()))));
-      f.pressure_gradient = toArray(CellPointWeights::interpolate(w, gradP.primitiveField(), pG()));
-      f.viscous_stress_divergence =
-          toArray(CellPointWeights::interpolate(w, divTau.primitiveField(), pT()));
-      f.vorticity = curl
-                        ? toArray(CellPointWeights::interpolate(w, tCurlU().primitiveField(), pC()))
-                        : std::array<double, 3>{};
-    }
+    };
+    pack(cellRecords_, U_.primitiveField(), gradP.primitiveField(), divTau.primitiveField(),
+         voidFraction_.primitiveField(), curl ? &tCurlU().primitiveField() : nullptr);
+    pack(pointRecords_, pU(), pG(), pT(), pE(), curl ? &pC().primitiveField() : nullptr);
+    cellPointSamples_ += static_cast<long>(local);
+    if (curl)
+      sampleCellPoint<13>();
+    else
+      sampleCellPoint<10>();
     return;
   }
   // Footprint-weighted cell values; ghosts' shares go back to their owners.
@@ -607,7 +640,7 @@ void ParticleCoupling::sample() {
   for (std::size_t i = 0; i < local; ++i) {
     const double* a = &sums[W * i];
     const double norm = a[13] > 0 ? 1 / a[13] : 0;
-    coupling::FluidAtParticle& f = out[i];
+    coupling::FluidAtParticle f;
     for (int d = 0; d < 3; ++d) {
       f.velocity[d] = a[d] * norm;
       f.pressure_gradient[d] = a[4 + d] * norm;
@@ -615,6 +648,7 @@ void ParticleCoupling::sample() {
       f.vorticity[d] = a[10 + d] * norm;
     }
     f.void_fraction = a[13] > 0 ? a[3] * norm : 1.0;
+    dem_->add_fluid(f);
   }
 }
 
@@ -671,8 +705,8 @@ void ParticleCoupling::checkBalance() {
 
 void ParticleCoupling::evolve() {
   auto t0 = Clock::now();
-  sample();
-  dem_->set_fluid(samples_, [this](const std::array<double, 3>& x) { return sampleAt(x); });
+  sample();  // straight into the DEM (DemLink::add_fluid)
+  dem_->end_fluid([this](const std::array<double, 3>& x) { return sampleAt(x); });
   couplingSeconds_ += seconds_since(t0);
   t0 = Clock::now();
   try {
