@@ -741,6 +741,10 @@ void ParticleCoupling::write() {
   info.add("demStep", label(dem_->steps()));
   info.add("demTime", dem_->time());
   info.regIOobject::write();
+  // The particle output is timed apart: like the fluid's field output (runTime.write()),
+  // it is not part of the DEM / coupling / fluid split.
+  outputSeconds_ += seconds_since(t0);
+  t0 = Clock::now();
   // Writing the checkpoint rebuilt the DEM's lists and reordered its particles: the next
   // fluid samples must follow the new order.
   buildFootprints();
@@ -748,10 +752,10 @@ void ParticleCoupling::write() {
   const coupling::DemSummary s = dem_->summary();
   double counts[3] = {double(clampedCells_), clampedVolume_, 0};
   MPI_Allreduce(MPI_IN_PLACE, counts, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
-  double times[3] = {demSeconds_, couplingSeconds_, fluidSeconds_};
-  MPI_Allreduce(MPI_IN_PLACE, times, 3, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-  double interval[3];
-  for (int k = 0; k < 3; ++k) {
+  double times[4] = {demSeconds_, couplingSeconds_, fluidSeconds_, outputSeconds_};
+  MPI_Allreduce(MPI_IN_PLACE, times, 4, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  double interval[4];
+  for (int k = 0; k < 4; ++k) {
     interval[k] = times[k] - reportedSeconds_[k];
     reportedSeconds_[k] = times[k];
   }
@@ -761,7 +765,8 @@ void ParticleCoupling::write() {
     std::ostringstream text;
     text.precision(3);
     text << "DEM " << t[0] << " s (" << share(t[0]) << " %), coupling " << t[1] << " s ("
-         << share(t[1]) << " %), fluid " << t[2] << " s (" << share(t[2]) << " %)";
+         << share(t[1]) << " %), fluid " << t[2] << " s (" << share(t[2]) << " %); particle output "
+         << t[3] << " s (snapshots, checkpoints; not in the shares)";
     return text.str();
   };
   const std::string cellPoint = cellPointLine();
