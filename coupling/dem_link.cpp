@@ -253,6 +253,57 @@ void DemLink::particles(bool with_ghosts_and_exchange, ParticleSet& out) const {
   }
 }
 
+void DemLink::view(ParticleView& out) const {
+  const Simulation& sim = impl_->simulation();
+  const Particles& p = sim.particles();
+  // Vec3 (Eigen, fixed size 3, not vectorised) is three packed doubles, so an array of them
+  // reads as 3 n doubles (the Eigen::Map view DESIGN.md allows for the SoA arrays).
+  static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 is not three packed doubles");
+  const ImplicitDrag& drag = sim.implicit_drag();
+  const std::vector<Vec3>& carried = impl_->fluid->exchange_force;
+  const std::size_t local = p.size();
+  out.local_ = local;
+  out.x_ = local ? p.x.data()->data() : nullptr;
+  out.v_ = local ? p.v.data()->data() : nullptr;
+  out.radius_ = p.radius.data();
+  out.drag_ = drag.coefficient.data();
+  out.drag_count_ = std::min(local, drag.coefficient.size());
+  out.force_ = carried.empty() ? nullptr : carried.data()->data();
+  out.force_count_ = std::min(local, carried.size());
+  const Ghosts& g = sim.ghosts();
+  out.ghost_x_.resize(g.size());
+  out.ghost_v_.resize(g.size());
+  out.ghost_force_.resize(g.size());
+  out.ghost_radius_.resize(g.size());
+  out.ghost_drag_.resize(g.size());
+  // One rank without ghosts of its own (no periodic images): nothing to forward, and no
+  // other rank waits for this one's values.
+  if (g.size() == 0 && sim.decomposition().dims() == std::array<int, 3>{1, 1, 1}) return;
+  // K, the exchange force and the velocity of the last step, forwarded to the ghosts (as
+  // particles(true) does).
+  constexpr std::size_t W = 7;
+  std::vector<double>& values = impl_->forwarded;
+  values.resize(W * local);
+  for (std::size_t i = 0; i < local; ++i) {
+    double* v = &values[W * i];
+    v[0] = out.drag_coefficient(i);
+    const std::array<double, 3> f = out.exchange_force(i);
+    for (int c = 0; c < 3; ++c) {
+      v[1 + c] = f[c];
+      v[4 + c] = p.v[i][c];
+    }
+  }
+  const std::vector<double> ghost_values = sim.ghost_values(values, W);
+  for (std::size_t k = 0; k < g.size(); ++k) {
+    const double* v = &ghost_values[W * k];
+    out.ghost_x_[k] = arr(g.position(k));
+    out.ghost_radius_[k] = g.radius[k];
+    out.ghost_drag_[k] = v[0];
+    out.ghost_force_[k] = {v[1], v[2], v[3]};
+    out.ghost_v_[k] = {v[4], v[5], v[6]};
+  }
+}
+
 std::vector<double> DemLink::sum_onto_owners(const std::vector<double>& values,
                                              std::size_t width) const {
   const Simulation& sim = impl_->simulation();

@@ -413,16 +413,16 @@ Foam::label ParticleCoupling::locate(const Foam::point& x) const {
 }
 
 void ParticleCoupling::buildFootprints() {
-  dem_->particles(true, particles_);  // refilled in place: no allocation per step
+  dem_->view(particles_);  // the DEM's arrays, no copy
   const std::size_t n = particles_.size();
   first_.resize(n + 1);
   first_[0] = 0;
   points_.clear();  // keeps its capacity
-  centreCell_.resize(particles_.local);
+  centreCell_.resize(particles_.local());
   const std::vector<coupling::FootprintPoint>& unit = footprint_.unit_points();
   for (std::size_t i = 0; i < n; ++i) {
-    const std::array<double, 3>& centre = particles_.x[i];
-    const double r = particles_.radius[i];
+    const double* centre = particles_.x(i);
+    const double r = particles_.radius(i);
     const Foam::label centreCell = locate(Foam::point(centre[0], centre[1], centre[2]));
     for (const coupling::FootprintPoint& q : unit) {
       Foam::point x;
@@ -446,7 +446,7 @@ void ParticleCoupling::buildFootprints() {
       if (c >= 0) points_.push_back({c, q.weight});
     }
     first_[i + 1] = points_.size();
-    if (i < particles_.local) centreCell_[i] = centreCell;
+    if (i < particles_.local()) centreCell_[i] = centreCell;
   }
 }
 
@@ -466,18 +466,16 @@ void ParticleCoupling::deposit() {
   K = 0.0;
   KU = Zero;
   F = Zero;
-  const bool exchange = !particles_.drag_coefficient.empty();
   double particleVolume = 0;  // of the local particles
   for (std::size_t i = 0; i < particles_.size(); ++i) {
-    const double r = particles_.radius[i];
+    const double r = particles_.radius(i);
     const double volume = 4.0 / 3.0 * constant::mathematical::pi * r * r * r;
-    if (i < particles_.local) particleVolume += volume;
-    const vector v(particles_.v[i][0], particles_.v[i][1], particles_.v[i][2]);
-    const double k = exchange ? particles_.drag_coefficient[i] : 0.0;
-    const vector f = exchange ? vector(particles_.exchange_force[i][0],
-                                       particles_.exchange_force[i][1],
-                                       particles_.exchange_force[i][2])
-                              : vector::zero;
+    if (i < particles_.local()) particleVolume += volume;
+    const double* vi = particles_.v(i);
+    const vector v(vi[0], vi[1], vi[2]);
+    const double k = particles_.drag_coefficient(i);
+    const std::array<double, 3> fi = particles_.exchange_force(i);
+    const vector f(fi[0], fi[1], fi[2]);
     for (std::size_t j = first_[i]; j < first_[i + 1]; ++j) {
       const label c = points_[j].cell;
       const double w = points_[j].weight;
@@ -540,7 +538,7 @@ Foam::tmp<Foam::volVectorField> ParticleCoupling::viscousLaplacian() const {
 template <int width>
 void ParticleCoupling::sampleCellPoint() {
   const CellPointWeights& weights = *cellPointWeights_;
-  for (std::size_t i = 0; i < particles_.local; ++i) {
+  for (std::size_t i = 0; i < particles_.local(); ++i) {
     coupling::FluidAtParticle f;  // outside the mesh: fluid at rest, eps = 1
     const Foam::label c = centreCell_[i];
     if (c < 0) {
@@ -548,7 +546,7 @@ void ParticleCoupling::sampleCellPoint() {
       continue;
     }
     const CellPointWeight w =
-        weights.at(Foam::point(particles_.x[i][0], particles_.x[i][1], particles_.x[i][2]), c);
+        weights.at(Foam::point(particles_.x(i)[0], particles_.x(i)[1], particles_.x(i)[2]), c);
     // interpolationCellPoint<Type>::interpolate per component, in its order:
     // cell * w0, then + point_k * w_k for k = 1, 2, 3.
     const double* r[4] = {&cellRecords_[std::size_t{width} * c],
@@ -575,7 +573,7 @@ void ParticleCoupling::sample() {
   const bool curl = dem_->needs_vorticity();
   tmp<volVectorField> tCurlU;
   if (curl) tCurlU = fvc::curl(U_);
-  const std::size_t local = particles_.local;
+  const std::size_t local = particles_.local();
   dem_->begin_fluid();
   if (sampling_ == Sampling::cellPoint) {
     // OpenFOAM's cellPoint interpolation (interpolationCellPoint): the point values by
@@ -676,10 +674,10 @@ void ParticleCoupling::checkBalance() {
     }
   const std::vector<double> u = dem_->sum_onto_owners(acc, W);
   double totals[7] = {0, 0, 0, 0, 0, 0, 0};  // particle force, fluid source, magnitude
-  for (std::size_t i = 0; i < particles_.local; ++i)
+  for (std::size_t i = 0; i < particles_.local(); ++i)
     for (int d = 0; d < 3; ++d) {
-      const double f = particles_.drag_coefficient[i] * (u[W * i + d] - particles_.v[i][d]) +
-                       particles_.exchange_force[i][d];
+      const double f = particles_.drag_coefficient(i) * (u[W * i + d] - particles_.v(i)[d]) +
+                       particles_.exchange_force(i)[d];
       totals[d] += f;
       totals[6] += std::abs(f);
     }
