@@ -568,8 +568,13 @@ void ParticleCoupling::sampleCellPoint() {
 
 void ParticleCoupling::sample() {
   using namespace Foam;
-  const volVectorField gradP(rho_ * fvc::grad(p_));
-  const volVectorField divTau(rho_ * viscousLaplacian());
+  // rho grad p and rho nu laplacian(U), scaled in place (no second field).
+  const dimensionedScalar rho("rho", dimless, rho_);
+  tmp<volVectorField> tGradP(fvc::grad(p_)), tDivTau(viscousLaplacian());
+  tGradP.ref() *= rho;
+  tDivTau.ref() *= rho;
+  const volVectorField& gradP = tGradP();
+  const volVectorField& divTau = tDivTau();
   const bool curl = dem_->needs_vorticity();
   tmp<volVectorField> tCurlU;
   if (curl) tCurlU = fvc::curl(U_);
