@@ -582,9 +582,9 @@ void ParticleCoupling::sample() {
   dem_->begin_fluid();
   if (sampling_ == Sampling::cellPoint) {
     // OpenFOAM's cellPoint interpolation (interpolationCellPoint): the point values by
-    // volPointInterpolation, as its constructor computes them (but not copied: it copies the
-    // cached point field), the tetrahedron and its weights by cellPointWeights_, once per
-    // particle for all the fields (cellPointWeights.H: the same weights to the last bit).
+    // volPointInterpolation, as its constructor computes them (not copied, as it copies
+    // them), the tetrahedron and its weights by cellPointWeights_, once per particle for all
+    // the fields (cellPointWeights.H: OpenFOAM's weights, to round-off in box cells).
     const volPointInterpolation& toPoints = volPointInterpolation::New(mesh_);
     const auto points = [&toPoints](const auto& field) {
       return toPoints.interpolate(field, "volPointInterpolate(" + field.name() + ')', false);
