@@ -41,7 +41,7 @@ struct DemLink::Impl {
   std::optional<CheckpointData> restart;  // until initialise()
   long restored_step = -1;                // the checkpoint's DEM step, after a restart
   std::unique_ptr<CheckpointSeries> checkpoints;
-  std::vector<double> forwarded;  // particles(): the values forwarded to ghosts, reused
+  std::vector<double> forwarded;     // particles(): the values forwarded to ghosts, reused
   std::vector<FluidSample> pending;  // begin_fluid() .. end_fluid()
 
   ~Impl() {
