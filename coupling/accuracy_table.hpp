@@ -1,8 +1,9 @@
 #pragma once
 // Where a coupled run's settings sit on the measured accuracy-versus-cost curves
 // (docs/accuracy-vs-cost-coupled.md), for grainFoam's start-up report. The numbers are copied
-// from benchmarks/accuracy_cost/coupled/coupled_results.csv (measured 2026-11-23; the test
-// tests/coupling/accuracy_table_test.cpp fails if the two disagree). C++17.
+// from benchmarks/accuracy_cost/coupled/coupled_results.csv (measured 2026-12-01, branch
+// h-coupling; the test tests/coupling/accuracy_table_test.cpp fails if the two disagree).
+// C++17.
 #include <optional>
 #include <string>
 
@@ -23,33 +24,33 @@ struct IntervalAccuracy {
 };
 
 inline constexpr FootprintAccuracy kFootprintAccuracy[] = {
-    {"centre", "cell", 2, -0.1408, 0.053},
-    {"centre", "cell", 3, -0.1230, 0.055},
-    {"centre", "cell", 4, -0.1120, 0.046},
-    {"centre", "cellPoint", 2, -0.1713, 0.367},
-    {"centre", "cellPoint", 3, -0.1398, 0.476},
-    {"centre", "cellPoint", 4, -0.1414, 0.453},
-    {"divided", "cell", 2, -0.0726, 0.200},
-    {"divided", "cell", 3, -0.1249, 0.201},
-    {"divided", "cell", 4, -0.1169, 0.177},
-    {"divided", "cellPoint", 2, -0.0888, 0.437},
-    {"divided", "cellPoint", 3, -0.1374, 0.430},
-    {"divided", "cellPoint", 4, -0.1425, 0.402},
-    {"smoothed", "cell", 2, -0.0812, 0.505},
-    {"smoothed", "cell", 3, -0.1264, 0.576},
-    {"smoothed", "cell", 4, -0.1213, 0.678},
-    {"smoothed", "cellPoint", 2, -0.0926, 0.705},
-    {"smoothed", "cellPoint", 3, -0.1375, 0.770},
-    {"smoothed", "cellPoint", 4, -0.1451, 0.759},
+    {"centre", "cell", 2, -0.1253, 0.040},
+    {"centre", "cell", 3, -0.1202, 0.046},
+    {"centre", "cell", 4, -0.1123, 0.038},
+    {"centre", "cellPoint", 2, -0.1540, 0.039},
+    {"centre", "cellPoint", 3, -0.1377, 0.032},
+    {"centre", "cellPoint", 4, -0.1428, 0.028},
+    {"divided", "cell", 2, -0.0726, 0.103},
+    {"divided", "cell", 3, -0.1256, 0.117},
+    {"divided", "cell", 4, -0.1163, 0.116},
+    {"divided", "cellPoint", 2, -0.0882, 0.105},
+    {"divided", "cellPoint", 3, -0.1379, 0.126},
+    {"divided", "cellPoint", 4, -0.1424, 0.110},
+    {"smoothed", "cell", 2, -0.0807, 0.617},
+    {"smoothed", "cell", 3, -0.1262, 0.439},
+    {"smoothed", "cell", 4, -0.1205, 0.439},
+    {"smoothed", "cellPoint", 2, -0.0926, 0.345},
+    {"smoothed", "cellPoint", 3, -0.1378, 0.375},
+    {"smoothed", "cellPoint", 4, -0.1444, 0.381},
 };
 
 inline constexpr IntervalAccuracy kIntervalAccuracy[] = {
-    {2, -0.0553, 344},
-    {5, -0.0617, 183},
-    {10, -0.0670, 126},
-    {20, -0.0726, 100},
-    {50, -0.0799, 82},
-    {100, -0.0847, 72},
+    {2, -0.0555, 301},
+    {5, -0.0617, 153},
+    {10, -0.0671, 106},
+    {20, -0.0726, 81},
+    {50, -0.0797, 65},
+    {100, -0.0845, 61},
 };
 
 // One or two lines: the measured packed-bed error and cost share of this footprint and

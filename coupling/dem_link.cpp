@@ -2,6 +2,7 @@
 
 #include <fenv.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -40,6 +41,8 @@ struct DemLink::Impl {
   std::optional<CheckpointData> restart;  // until initialise()
   long restored_step = -1;                // the checkpoint's DEM step, after a restart
   std::unique_ptr<CheckpointSeries> checkpoints;
+  std::vector<double> forwarded;     // particles(): the values forwarded to ghosts, reused
+  std::vector<FluidSample> pending;  // begin_fluid() .. end_fluid()
 
   ~Impl() {
     sim.reset();
@@ -180,53 +183,125 @@ double DemLink::time() const { return impl_->simulation().time(); }
 long DemLink::steps() const { return impl_->simulation().counters().steps; }
 
 ParticleSet DemLink::particles(bool with_ghosts_and_exchange) const {
+  ParticleSet out;
+  particles(with_ghosts_and_exchange, out);
+  return out;
+}
+
+void DemLink::particles(bool with_ghosts_and_exchange, ParticleSet& out) const {
   const Simulation& sim = impl_->simulation();
   const Particles& p = sim.particles();
-  ParticleSet out;
-  out.local = p.size();
-  const std::size_t n = p.size() + (with_ghosts_and_exchange ? sim.ghosts().size() : 0);
-  out.id.reserve(n);
-  out.x.reserve(n);
-  out.v.reserve(n);
-  out.radius.reserve(n);
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    out.id.push_back(static_cast<long long>(p.id[i]));
-    out.x.push_back(arr(p.x[i]));
-    out.v.push_back(arr(p.v[i]));
-    out.radius.push_back(p.radius[i]);
+  const std::size_t local = p.size();
+  const std::size_t n = local + (with_ghosts_and_exchange ? sim.ghosts().size() : 0);
+  out.local = local;
+  out.id.resize(n);
+  out.x.resize(n);
+  out.v.resize(n);
+  out.radius.resize(n);
+  if (!with_ghosts_and_exchange) {
+    for (std::size_t i = 0; i < local; ++i) {
+      out.id[i] = static_cast<long long>(p.id[i]);
+      out.x[i] = arr(p.x[i]);
+      out.v[i] = arr(p.v[i]);
+      out.radius[i] = p.radius[i];
+    }
+    out.drag_coefficient.clear();
+    out.exchange_force.clear();
+    return;
   }
-  if (!with_ghosts_and_exchange) return out;
   // K, the exchange force and the velocity at the end of the last step, local first, then
   // forwarded to ghosts (the ghosts' own velocities were forwarded mid-step, before the
-  // second half kick).
+  // second half kick). One pass over the local particles.
   const ImplicitDrag& drag = sim.implicit_drag();
   const std::vector<Vec3>& carried = impl_->fluid->exchange_force;
+  out.drag_coefficient.resize(n);
+  out.exchange_force.resize(n);
+  const std::size_t withDrag = std::min(local, drag.coefficient.size());
+  const std::size_t withForce = std::min(local, carried.size());
+  for (std::size_t i = 0; i < local; ++i) {
+    out.id[i] = static_cast<long long>(p.id[i]);
+    out.x[i] = arr(p.x[i]);
+    out.v[i] = arr(p.v[i]);
+    out.radius[i] = p.radius[i];
+    out.drag_coefficient[i] = i < withDrag ? drag.coefficient[i] : 0.0;
+    out.exchange_force[i] = i < withForce ? arr(carried[i]) : std::array<double, 3>{};
+  }
+  // One rank without ghosts of its own (no periodic images): nothing to forward, and no
+  // other rank waits for this one's values.
+  if (n == local && sim.decomposition().dims() == std::array<int, 3>{1, 1, 1}) return;
   constexpr std::size_t W = 7;
-  std::vector<double> values(W * p.size(), 0.0);
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    values[W * i] = i < drag.coefficient.size() ? drag.coefficient[i] : 0.0;
+  std::vector<double>& values = impl_->forwarded;  // kept: no allocation per fluid step
+  values.resize(W * local);
+  for (std::size_t i = 0; i < local; ++i) {
+    double* v = &values[W * i];
+    v[0] = out.drag_coefficient[i];
     for (int c = 0; c < 3; ++c) {
-      if (i < carried.size()) values[W * i + 1 + c] = carried[i][c];
-      values[W * i + 4 + c] = p.v[i][c];
+      v[1 + c] = out.exchange_force[i][c];
+      v[4 + c] = out.v[i][c];
     }
   }
   const std::vector<double> ghost_values = sim.ghost_values(values, W);
   const Ghosts& g = sim.ghosts();
   for (std::size_t k = 0; k < g.size(); ++k) {
-    out.id.push_back(static_cast<long long>(g.id[k]));
-    out.x.push_back(arr(g.position(k)));
-    out.v.push_back({0, 0, 0});
-    out.radius.push_back(g.radius[k]);
+    const double* v = &ghost_values[W * k];
+    out.id[local + k] = static_cast<long long>(g.id[k]);
+    out.x[local + k] = arr(g.position(k));
+    out.radius[local + k] = g.radius[k];
+    out.drag_coefficient[local + k] = v[0];
+    out.exchange_force[local + k] = {v[1], v[2], v[3]};
+    out.v[local + k] = {v[4], v[5], v[6]};
   }
-  out.drag_coefficient.resize(n);
-  out.exchange_force.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const double* v = i < p.size() ? &values[W * i] : &ghost_values[W * (i - p.size())];
-    out.drag_coefficient[i] = v[0];
-    out.exchange_force[i] = {v[1], v[2], v[3]};
-    out.v[i] = {v[4], v[5], v[6]};
+}
+
+void DemLink::view(ParticleView& out) const {
+  const Simulation& sim = impl_->simulation();
+  const Particles& p = sim.particles();
+  // Vec3 (Eigen, fixed size 3, not vectorised) is three packed doubles, so an array of them
+  // reads as 3 n doubles (the Eigen::Map view DESIGN.md allows for the SoA arrays).
+  static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 is not three packed doubles");
+  const ImplicitDrag& drag = sim.implicit_drag();
+  const std::vector<Vec3>& carried = impl_->fluid->exchange_force;
+  const std::size_t local = p.size();
+  out.local_ = local;
+  out.x_ = local ? p.x.data()->data() : nullptr;
+  out.v_ = local ? p.v.data()->data() : nullptr;
+  out.radius_ = p.radius.data();
+  out.drag_ = drag.coefficient.data();
+  out.drag_count_ = std::min(local, drag.coefficient.size());
+  out.force_ = carried.empty() ? nullptr : carried.data()->data();
+  out.force_count_ = std::min(local, carried.size());
+  const Ghosts& g = sim.ghosts();
+  out.ghost_x_.resize(g.size());
+  out.ghost_v_.resize(g.size());
+  out.ghost_force_.resize(g.size());
+  out.ghost_radius_.resize(g.size());
+  out.ghost_drag_.resize(g.size());
+  // One rank without ghosts of its own (no periodic images): nothing to forward, and no
+  // other rank waits for this one's values.
+  if (g.size() == 0 && sim.decomposition().dims() == std::array<int, 3>{1, 1, 1}) return;
+  // K, the exchange force and the velocity of the last step, forwarded to the ghosts (as
+  // particles(true) does).
+  constexpr std::size_t W = 7;
+  std::vector<double>& values = impl_->forwarded;
+  values.resize(W * local);
+  for (std::size_t i = 0; i < local; ++i) {
+    double* v = &values[W * i];
+    v[0] = out.drag_coefficient(i);
+    const std::array<double, 3> f = out.exchange_force(i);
+    for (int c = 0; c < 3; ++c) {
+      v[1 + c] = f[c];
+      v[4 + c] = p.v[i][c];
+    }
   }
-  return out;
+  const std::vector<double> ghost_values = sim.ghost_values(values, W);
+  for (std::size_t k = 0; k < g.size(); ++k) {
+    const double* v = &ghost_values[W * k];
+    out.ghost_x_[k] = arr(g.position(k));
+    out.ghost_radius_[k] = g.radius[k];
+    out.ghost_drag_[k] = v[0];
+    out.ghost_force_[k] = {v[1], v[2], v[3]};
+    out.ghost_v_[k] = {v[4], v[5], v[6]};
+  }
 }
 
 std::vector<double> DemLink::sum_onto_owners(const std::vector<double>& values,
@@ -239,17 +314,40 @@ std::vector<double> DemLink::sum_onto_owners(const std::vector<double>& values,
   return local;
 }
 
-void DemLink::set_fluid(std::vector<FluidAtParticle> samples,
+void DemLink::set_fluid(const std::vector<FluidAtParticle>& samples,
                         std::function<FluidAtParticle(const std::array<double, 3>&)> late) {
+  begin_fluid();
+  for (const FluidAtParticle& f : samples) add_fluid(f);
+  end_fluid(std::move(late));
+}
+
+void DemLink::begin_fluid() {
+  Impl& m = *impl_;
+  m.pending.clear();
+  m.pending.reserve(m.simulation().particles().size());
+}
+
+void DemLink::add_fluid(const FluidAtParticle& f) {
+  const Impl& m = *impl_;
+  // to_sample(f), built in place.
+  impl_->pending.push_back(
+      FluidSample{.velocity = vec(f.velocity),
+                  .void_fraction = f.void_fraction,
+                  .pressure_gradient = vec(f.pressure_gradient),
+                  .viscous_stress_divergence = vec(f.viscous_stress_divergence),
+                  .density = m.fluid_density,
+                  .viscosity = m.fluid_viscosity,
+                  .vorticity = vec(f.vorticity)});
+}
+
+void DemLink::end_fluid(std::function<FluidAtParticle(const std::array<double, 3>&)> late) {
   Impl& m = *impl_;
   const Particles& p = m.simulation().particles();
-  if (samples.size() != p.size())
-    throw std::logic_error("DemLink::set_fluid: " + std::to_string(samples.size()) +
-                           " samples for " + std::to_string(p.size()) + " particles");
-  std::vector<FluidSample> s;
-  s.reserve(samples.size());
-  for (const FluidAtParticle& f : samples) s.push_back(m.to_sample(f));
-  m.fluid->set(p.id, std::move(s));
+  if (m.pending.size() != p.size())
+    throw std::logic_error("DemLink: " + std::to_string(m.pending.size()) + " fluid samples for " +
+                           std::to_string(p.size()) + " particles");
+  m.fluid->set(p.id, std::move(m.pending));
+  m.pending = {};
   Impl* self = &m;
   m.fluid->set_sampler([self, late = std::move(late)](const Vec3& x) {
     return self->to_sample(late(arr(x)));

@@ -4,8 +4,9 @@
 // implementation (dem_link.cpp) owns a grainflow::Simulation behind a pointer.
 //
 // One coupled step (DESIGN.md §1), driven by grainFoam through coupling/foam/:
-//   particles(false) → sample the fluid at each local particle → set_fluid(...) →
-//   advance(N) → particles(true) → void fraction and momentum source on the mesh.
+//   sample the fluid at each local particle of the last view() → begin_fluid(),
+//   add_fluid() per particle, end_fluid() → advance(N) → view() → void fraction and
+//   momentum source on the mesh.
 #include <mpi.h>
 
 #include <array>
@@ -44,6 +45,45 @@ struct ParticleSet {
   std::vector<double> drag_coefficient;
   std::vector<std::array<double, 3>> exchange_force;
   std::size_t size() const { return id.size(); }
+};
+
+// This rank's particles and their ghosts as the coupling reads them every fluid step
+// (DemLink::view()), without copying the local ones: entries [0, local()) read the DEM's own
+// arrays and stay valid until the DEM next changes them (advance(), write_checkpoint(),
+// restore()); entries [local(), size()) are ghosts, copied (their positions are images).
+// The same values as particles(true).
+class ParticleView {
+ public:
+  std::size_t local() const { return local_; }
+  std::size_t size() const { return local_ + ghost_radius_.size(); }
+  const double* x(std::size_t i) const {
+    return i < local_ ? x_ + 3 * i : ghost_x_[i - local_].data();
+  }
+  const double* v(std::size_t i) const {
+    return i < local_ ? v_ + 3 * i : ghost_v_[i - local_].data();
+  }
+  double radius(std::size_t i) const { return i < local_ ? radius_[i] : ghost_radius_[i - local_]; }
+  // K [kg/s] of the last step (0 for a particle that has none yet).
+  double drag_coefficient(std::size_t i) const {
+    return i < local_ ? (i < drag_count_ ? drag_[i] : 0.0) : ghost_drag_[i - local_];
+  }
+  // The explicit force the fluid gets back [N] (zero when the last step left none).
+  std::array<double, 3> exchange_force(std::size_t i) const {
+    if (i >= local_) return ghost_force_[i - local_];
+    if (i >= force_count_) return {0, 0, 0};
+    return {force_[3 * i], force_[3 * i + 1], force_[3 * i + 2]};
+  }
+
+ private:
+  friend class DemLink;
+  std::size_t local_ = 0, drag_count_ = 0, force_count_ = 0;
+  const double* x_ = nullptr;  // 3 per particle
+  const double* v_ = nullptr;
+  const double* radius_ = nullptr;
+  const double* drag_ = nullptr;
+  const double* force_ = nullptr;
+  std::vector<std::array<double, 3>> ghost_x_, ghost_v_, ghost_force_;
+  std::vector<double> ghost_radius_, ghost_drag_;
 };
 
 // The processor grid the fluid mesh decomposition implies (shared_decomposition.hpp).
@@ -92,6 +132,11 @@ class DemLink {
   long steps() const;  // DEM steps since the start of the run (the checkpoint's count)
 
   ParticleSet particles(bool with_ghosts_and_exchange) const;
+  // The same, written into `out` in place: a set kept from one fluid step to the next is
+  // refilled without allocating (its arrays only grow).
+  void particles(bool with_ghosts_and_exchange, ParticleSet& out) const;
+  // particles(true) as a view (see ParticleView), refreshed in place. Collective.
+  void view(ParticleView& out) const;
 
   // Adds each ghost's `width` values (after the local ones, as in `values` sized
   // set.size()·width for the set of particles(true)) to its owner's entry; returns the
@@ -100,8 +145,14 @@ class DemLink {
 
   // The fluid at each local particle, in the order of particles(false) taken right before.
   // `late` samples a particle that reaches this rank during the next advance().
-  void set_fluid(std::vector<FluidAtParticle> samples,
+  void set_fluid(const std::vector<FluidAtParticle>& samples,
                  std::function<FluidAtParticle(const std::array<double, 3>&)> late);
+  // The same without a vector of samples in between (it would be written and read again
+  // every fluid step): begin_fluid(), then add_fluid() once per local particle in that
+  // order, then end_fluid(late).
+  void begin_fluid();
+  void add_fluid(const FluidAtParticle& f);
+  void end_fluid(std::function<FluidAtParticle(const std::array<double, 3>&)> late);
   // `steps` DEM steps (collective). After each, the NaN / Inf guard: the first non-finite
   // particle state stops the run with the particle, its forces and a diagnostic snapshot
   // of every particle in `diagnostic_directory`. Throws std::runtime_error with the DEM's

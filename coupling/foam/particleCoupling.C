@@ -12,12 +12,21 @@
 #include "coupling/shared_decomposition.hpp"
 #include "dem/io/output_directory.hpp"
 #include "zeroGradientFvPatchFields.H"
-#include "interpolationCellPoint.H"
+#include "volPointInterpolation.H"
 
 namespace grainflow::foam {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+// locate(): a point more than this many cells from the domain's corner is outside (and
+// its cell index would not fit an int).
+constexpr double kFarOutside = 1e9;
+
+// The viscous term's non-orthogonal correction is left out when every correction vector
+// (dimensionless, |k| <= 1; OpenFOAM's nonOrthCorrectionVectors) is below this: a mesh
+// orthogonal up to round-off (the correction changes the term by ~|k| relative).
+constexpr double kOrthogonalCorrection = 1e-9;
+
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
@@ -278,18 +287,50 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
     }
   }
   const label structuredRanks = returnReduce(label(structured_ ? 1 : 0), sumOp<label>());
+  if (sampling_ == Sampling::cellPoint) {
+    cellPointWeights_ = std::make_unique<CellPointWeights>(mesh);
+    const label boxCells = returnReduce(cellPointWeights_->boxCells(), sumOp<label>());
+    const double bytes = returnReduce(double(cellPointWeights_->bytes()), sumOp<double>());
+    Info << "grainFoam coupling: cellPoint weights prepared for "
+         << returnReduce(mesh.nCells(), sumOp<label>()) << " cells (" << boxCells
+         << " boxes: closed form; the others: their tetrahedra), " << bytes / 1e6 << " MB" << endl;
+  }
+
+  // --- the viscous term div(tau) = rho nu laplacian(U) at the particles ----------------
+  // Its non-orthogonal correction (corrected snGrad: correction vectors . interpolated
+  // grad U) needs grad U on the whole mesh, 30 % of the coupling's cost on the Goldschmidt
+  // case. On a mesh whose correction vectors are round-off (every axis-aligned block mesh:
+  // 6e-14 there) it changes the term by that relative amount only, so it is left out.
+  double worstCorrection = 0;
+  {
+    const surfaceVectorField& k = mesh.nonOrthCorrectionVectors();
+    for (const vector& v : k.primitiveField())
+      worstCorrection = std::max(worstCorrection, double(mag(v)));
+    for (const fvsPatchVectorField& patch : k.boundaryField())
+      for (const vector& v : patch) worstCorrection = std::max(worstCorrection, double(mag(v)));
+    reduce(worstCorrection, maxOp<double>());
+  }
+  const bool orthogonal = worstCorrection <= kOrthogonalCorrection;
+  if (orthogonal)
+    uncorrectedLaplacian_ =
+        fv::laplacianScheme<vector, scalar>::New(mesh, IStringStream("Gauss linear uncorrected")());
 
   Info << "grainFoam coupling: scene " << sceneFile << "\n"
-       << "  VANS model " << model_ << ", drag " << dem_->drag_law().c_str()
-       << ", void fraction " << coupling::void_fraction_method_name(vf) << " ("
-       << label(footprint_.size()) << " points per particle), sampling " << sampling
-       << ", minVoidFraction " << minVoidFraction_ << ", ddt(voidfraction) "
-       << (ddtVoidFraction_ ? "on" : "off") << "\n"
+       << "  VANS model " << model_ << ", drag " << dem_->drag_law().c_str() << ", void fraction "
+       << coupling::void_fraction_method_name(vf) << " (" << label(footprint_.size())
+       << " points per particle), sampling " << sampling << ", minVoidFraction " << minVoidFraction_
+       << ", ddt(voidfraction) " << (ddtVoidFraction_ ? "on" : "off") << "\n"
+       << "  viscous term at the particles: "
+       << (orthogonal ? "Gauss linear uncorrected (the mesh is orthogonal: largest "
+                        "non-orthogonal correction vector "
+                      : "the case's laplacian scheme (largest non-orthogonal correction "
+                        "vector ")
+       << worstCorrection << ")\n"
        << "  dt_CFD " << dtFluid << " s = " << subSteps_ << " x dt_DEM " << dtDem << " s\n"
-       << "  processor grid " << grid.dims[0] << " x " << grid.dims[1] << " x "
-       << grid.dims[2] << "; cell location "
+       << "  processor grid " << grid.dims[0] << " x " << grid.dims[1] << " x " << grid.dims[2]
+       << "; cell location "
        << (structuredRanks == Pstream::nProcs() ? "uniform grid (direct)"
-                                               : "octree search on some ranks")
+                                                : "octree search on some ranks")
        << endl;
 
   // Where these settings sit on the measured curves: cell edge over mean diameter.
@@ -352,37 +393,43 @@ ParticleCoupling::~ParticleCoupling() = default;
 
 Foam::label ParticleCoupling::locate(const Foam::point& x) const {
   if (structured_) {
-    std::array<int, 3> idx{};
-    for (int a = 0; a < 3; ++a) {
+    std::size_t k = 0;
+    for (int a = 2; a >= 0; --a) {
       // The global cell index, from the domain's corner and one spacing on every rank, so a
       // point on a cell face falls in the same cell whatever the rank layout; then local.
       const double s = (x[a] - domain_.lo[a]) / gridH_[a];
-      idx[a] = static_cast<int>(std::floor(s)) - gridOffset_[a];
+      // Below the domain (or NaN), or far beyond it (and beyond int): outside.
+      if (!(s >= 0) || s >= kFarOutside) return -1;
+      int idx = static_cast<int>(s) - gridOffset_[a];  // s >= 0: truncation is floor
       // A point on the domain's upper face belongs to the last cell.
-      if (idx[a] == gridN_[a] && std::abs(x[a] - domain_.hi[a]) <= 1e-12 * gridH_[a] * gridN_[a])
-        idx[a] = gridN_[a] - 1;
-      if (s < 0 || idx[a] < 0 || idx[a] >= gridN_[a]) return -1;
+      if (idx == gridN_[a] && std::abs(x[a] - domain_.hi[a]) <= 1e-12 * gridH_[a] * gridN_[a])
+        idx = gridN_[a] - 1;
+      if (idx < 0 || idx >= gridN_[a]) return -1;
+      k = k * static_cast<std::size_t>(gridN_[a]) + static_cast<std::size_t>(idx);
     }
-    return gridCell_[(static_cast<std::size_t>(idx[2]) * gridN_[1] + idx[1]) * gridN_[0] +
-                     idx[0]];
+    return gridCell_[k];
   }
   return mesh_.findCell(x);
 }
 
 void ParticleCoupling::buildFootprints() {
-  particles_ = dem_->particles(true);
+  dem_->view(particles_);  // the DEM's arrays, no copy
   const std::size_t n = particles_.size();
-  first_.assign(n + 1, 0);
-  points_.clear();
-  centreCell_.assign(particles_.local, -1);
-  std::vector<coupling::FootprintPoint> pts;
+  first_.resize(n + 1);
+  first_[0] = 0;
+  points_.clear();  // keeps its capacity
+  centreCell_.resize(particles_.local());
+  const std::vector<coupling::FootprintPoint>& unit = footprint_.unit_points();
   for (std::size_t i = 0; i < n; ++i) {
-    footprint_.points(particles_.radius[i], pts);
-    for (const coupling::FootprintPoint& q : pts) {
+    const double* centre = particles_.x(i);
+    const double r = particles_.radius(i);
+    const Foam::label centreCell = locate(Foam::point(centre[0], centre[1], centre[2]));
+    for (const coupling::FootprintPoint& q : unit) {
       Foam::point x;
       bool image = false;  // beyond a periodic side: the particle's image deposits it
       for (int a = 0; a < 3; ++a) {
-        double s = particles_.x[i][a] + q.offset[a];
+        // Footprint::points(): the unit offset scaled by the radius.
+        double s = centre[a] + q.offset[a] * r;
         // A bounded side reflects the part of a footprint that pokes through it.
         if (!periodic_[a]) {
           if (s < domain_.lo[a]) s = 2 * domain_.lo[a] - s;
@@ -393,32 +440,42 @@ void ParticleCoupling::buildFootprints() {
         x[a] = s;
       }
       if (image) continue;
-      const Foam::label c = locate(x);
+      // The centre itself (the `centre` footprint, or a centred part): its cell is known.
+      const bool atCentre = x[0] == centre[0] && x[1] == centre[1] && x[2] == centre[2];
+      const Foam::label c = atCentre ? centreCell : locate(x);
       if (c >= 0) points_.push_back({c, q.weight});
     }
     first_[i + 1] = points_.size();
-    if (i < particles_.local) {
-      Foam::point x(particles_.x[i][0], particles_.x[i][1], particles_.x[i][2]);
-      centreCell_[i] = locate(x);
-    }
+    if (i < particles_.local()) centreCell_[i] = centreCell;
   }
 }
 
 void ParticleCoupling::deposit() {
   using namespace Foam;
   const scalarField& V = mesh_.V().field();
-  scalarField solid(mesh_.nCells(), 0.0), K(mesh_.nCells(), 0.0);
-  vectorField KU(mesh_.nCells(), Zero), F(mesh_.nCells(), Zero);
-  const bool exchange = !particles_.drag_coefficient.empty();
+  // Sums per cell, kept from step to step (no allocation per step).
+  scalarField& solid = solid_;
+  scalarField& K = K_;
+  vectorField& KU = KU_;
+  vectorField& F = F_;
+  solid.setSize(mesh_.nCells());
+  K.setSize(mesh_.nCells());
+  KU.setSize(mesh_.nCells());
+  F.setSize(mesh_.nCells());
+  solid = 0.0;
+  K = 0.0;
+  KU = Zero;
+  F = Zero;
+  double particleVolume = 0;  // of the local particles
   for (std::size_t i = 0; i < particles_.size(); ++i) {
-    const double r = particles_.radius[i];
+    const double r = particles_.radius(i);
     const double volume = 4.0 / 3.0 * constant::mathematical::pi * r * r * r;
-    const vector v(particles_.v[i][0], particles_.v[i][1], particles_.v[i][2]);
-    const double k = exchange ? particles_.drag_coefficient[i] : 0.0;
-    const vector f = exchange ? vector(particles_.exchange_force[i][0],
-                                       particles_.exchange_force[i][1],
-                                       particles_.exchange_force[i][2])
-                              : vector::zero;
+    if (i < particles_.local()) particleVolume += volume;
+    const double* vi = particles_.v(i);
+    const vector v(vi[0], vi[1], vi[2]);
+    const double k = particles_.drag_coefficient(i);
+    const std::array<double, 3> fi = particles_.exchange_force(i);
+    const vector f(fi[0], fi[1], fi[2]);
     for (std::size_t j = first_[i]; j < first_[i + 1]; ++j) {
       const label c = points_[j].cell;
       const double w = points_[j].weight;
@@ -428,8 +485,14 @@ void ParticleCoupling::deposit() {
       F[c] -= w * f;
     }
   }
+  // One pass over the cells for eps and the exchange fields (the arithmetic of the field
+  // expressions K / V, sum(solid), sum((1 - eps) V), without their temporaries).
   scalarField& eps = voidFraction_.primitiveFieldRef();
+  scalarField& Ksl = Ksl_.primitiveFieldRef();
+  vectorField& KslUs = KslUs_.primitiveFieldRef();
+  vectorField& fExplicit = fExplicit_.primitiveFieldRef();
   stepClampedVolume_ = 0;
+  double depositedVolume = 0, meshSolidVolume = 0;
   forAll(eps, c) {
     const double raw = 1 - solid[c] / V[c];
     if (raw < minVoidFraction_) {
@@ -440,22 +503,19 @@ void ParticleCoupling::deposit() {
     } else {
       eps[c] = raw;
     }
+    Ksl[c] = K[c] / V[c];
+    KslUs[c] = KU[c] / V[c];
+    fExplicit[c] = F[c] / V[c];
+    depositedVolume += solid[c];
+    meshSolidVolume += (1 - eps[c]) * V[c];
   }
   voidFraction_.correctBoundaryConditions();
-  Ksl_.primitiveFieldRef() = K / V;
   Ksl_.correctBoundaryConditions();
-  KslUs_.primitiveFieldRef() = KU / V;
   KslUs_.correctBoundaryConditions();
-  fExplicit_.primitiveFieldRef() = F / V;
   fExplicit_.correctBoundaryConditions();
 
   // Volume not deposited anywhere (footprint points outside every rank's cells).
-  double particleVolume = 0;
-  for (std::size_t i = 0; i < particles_.local; ++i) {
-    const double r = particles_.radius[i];
-    particleVolume += 4.0 / 3.0 * constant::mathematical::pi * r * r * r;
-  }
-  double sums[4] = {particleVolume, sum(solid), sum((1 - eps) * V), stepClampedVolume_};
+  double sums[4] = {particleVolume, depositedVolume, meshSolidVolume, stepClampedVolume_};
   MPI_Allreduce(MPI_IN_PLACE, sums, 4, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
   lostVolume_ = std::max(0.0, sums[0] - sums[1]);
   particleVolume_ = sums[0];
@@ -463,35 +523,103 @@ void ParticleCoupling::deposit() {
   stepClampedVolume_ = sums[3];
 }
 
-std::vector<coupling::FluidAtParticle> ParticleCoupling::sample() const {
+Foam::tmp<Foam::volVectorField> ParticleCoupling::viscousLaplacian() const {
   using namespace Foam;
-  const volVectorField gradP(rho_ * fvc::grad(p_));
-  const volVectorField divTau(rho_ * fvc::laplacian(dimensionedScalar("nu", dimViscosity, nu_), U_));
+  const dimensionedScalar nu("nu", dimViscosity, nu_);
+  if (!uncorrectedLaplacian_.valid()) return fvc::laplacian(nu, U_);
+  // fvc::laplacian(nu, U) is div(nu_f snGrad(U) |S_f|) (gaussLaplacianScheme::fvcLaplacian,
+  // with nu_f the uniform face field it builds); the uncorrected snGrad is the corrected
+  // one without its non-orthogonal correction, which is round-off on this mesh.
+  const surfaceScalarField nuFaces(IOobject(nu.name(), U_.instance(), mesh_, IOobject::NO_READ),
+                                   mesh_, nu);
+  return uncorrectedLaplacian_.ref().fvcLaplacian(nuFaces, U_);  // ref(): the tmp owns it
+}
+
+template <int width>
+void ParticleCoupling::sampleCellPoint() {
+  const CellPointWeights& weights = *cellPointWeights_;
+  for (std::size_t i = 0; i < particles_.local(); ++i) {
+    coupling::FluidAtParticle f;  // outside the mesh: fluid at rest, eps = 1
+    const Foam::label c = centreCell_[i];
+    if (c < 0) {
+      dem_->add_fluid(f);
+      continue;
+    }
+    const CellPointWeight w =
+        weights.at(Foam::point(particles_.x(i)[0], particles_.x(i)[1], particles_.x(i)[2]), c);
+    // interpolationCellPoint<Type>::interpolate per component, in its order:
+    // cell * w0, then + point_k * w_k for k = 1, 2, 3.
+    const double* r[4] = {&cellRecords_[std::size_t{width} * c],
+                          &pointRecords_[std::size_t{width} * w.point[0]],
+                          &pointRecords_[std::size_t{width} * w.point[1]],
+                          &pointRecords_[std::size_t{width} * w.point[2]]};
+    double v[width];
+    for (int k = 0; k < width; ++k) v[k] = r[0][k] * w.w[0];
+    for (int j = 1; j < 4; ++j)
+      for (int k = 0; k < width; ++k) v[k] += r[j][k] * w.w[j];
+    f.velocity = {v[0], v[1], v[2]};
+    f.pressure_gradient = {v[3], v[4], v[5]};
+    f.viscous_stress_divergence = {v[6], v[7], v[8]};
+    f.void_fraction = std::max(minVoidFraction_, std::min(1.0, v[9]));
+    if constexpr (width == 13) f.vorticity = {v[10], v[11], v[12]};
+    dem_->add_fluid(f);
+  }
+}
+
+void ParticleCoupling::sample() {
+  using namespace Foam;
+  // rho grad p and rho nu laplacian(U), scaled in place (no second field).
+  const dimensionedScalar rho("rho", dimless, rho_);
+  tmp<volVectorField> tGradP(fvc::grad(p_)), tDivTau(viscousLaplacian());
+  tGradP.ref() *= rho;
+  tDivTau.ref() *= rho;
+  const volVectorField& gradP = tGradP();
+  const volVectorField& divTau = tDivTau();
   const bool curl = dem_->needs_vorticity();
   tmp<volVectorField> tCurlU;
   if (curl) tCurlU = fvc::curl(U_);
-  const std::size_t local = particles_.local;
-  std::vector<coupling::FluidAtParticle> out(local);
+  const std::size_t local = particles_.local();
+  dem_->begin_fluid();
   if (sampling_ == Sampling::cellPoint) {
-    interpolationCellPoint<vector> iU(U_), iG(gradP), iT(divTau);
-    std::unique_ptr<interpolationCellPoint<vector>> iC;
-    if (curl) iC = std::make_unique<interpolationCellPoint<vector>>(tCurlU());
-    interpolationCellPoint<scalar> iE(voidFraction_);
-    for (std::size_t i = 0; i < local; ++i) {
-      const label c = centreCell_[i];
-      if (c < 0) continue;
-      const point x(particles_.x[i][0], particles_.x[i][1], particles_.x[i][2]);
-      // The tetrahedron holding x and its weights, found once for all the fields
-      // (interpolate(x, c) would search and allocate again for each of them).
-      const cellPointWeight weight(mesh_, x, c);
-      coupling::FluidAtParticle& f = out[i];
-      f.velocity = toArray(iU.interpolate(weight));
-      f.void_fraction = std::max(minVoidFraction_, std::min(1.0, double(iE.interpolate(weight))));
-      f.pressure_gradient = toArray(iG.interpolate(weight));
-      f.viscous_stress_divergence = toArray(iT.interpolate(weight));
-      if (curl) f.vorticity = toArray(iC->interpolate(weight));
-    }
-    return out;
+    // OpenFOAM's cellPoint interpolation (interpolationCellPoint): the point values by
+    // volPointInterpolation, as its constructor computes them (not copied, as it copies
+    // them), the tetrahedron and its weights by cellPointWeights_, once per particle for all
+    // the fields (cellPointWeights.H: OpenFOAM's weights, to round-off in box cells).
+    const volPointInterpolation& toPoints = volPointInterpolation::New(mesh_);
+    const auto points = [&toPoints](const auto& field) {
+      return toPoints.interpolate(field, "volPointInterpolate(" + field.name() + ')', false);
+    };
+    const tmp<pointVectorField> pU(points(U_)), pG(points(gradP)), pT(points(divTau));
+    const tmp<pointScalarField> pE(points(voidFraction_));
+    tmp<pointVectorField> pC;
+    if (curl) pC = points(tCurlU());
+    // The fields side by side, one record per cell and per point (U 0-2, grad p 3-5,
+    // div tau 6-8, eps 9, curl U 10-12), so that a stencil reads four records.
+    const int width = curl ? 13 : 10;
+    const auto pack = [width](std::vector<double>& records, const UList<vector>& U,
+                              const UList<vector>& G, const UList<vector>& T,
+                              const UList<scalar>& E, const UList<vector>* C) {
+      records.resize(static_cast<std::size_t>(width) * U.size());
+      forAll(U, k) {
+        double* r = &records[static_cast<std::size_t>(width) * k];
+        for (int d = 0; d < 3; ++d) {
+          r[d] = U[k][d];
+          r[3 + d] = G[k][d];
+          r[6 + d] = T[k][d];
+          if (C) r[10 + d] = (*C)[k][d];
+        }
+        r[9] = E[k];
+      }
+    };
+    pack(cellRecords_, U_.primitiveField(), gradP.primitiveField(), divTau.primitiveField(),
+         voidFraction_.primitiveField(), curl ? &tCurlU().primitiveField() : nullptr);
+    pack(pointRecords_, pU(), pG(), pT(), pE(), curl ? &pC().primitiveField() : nullptr);
+    cellPointSamples_ += static_cast<long>(local);
+    if (curl)
+      sampleCellPoint<13>();
+    else
+      sampleCellPoint<10>();
+    return;
   }
   // Footprint-weighted cell values; ghosts' shares go back to their owners.
   constexpr std::size_t W = 14;
@@ -515,7 +643,7 @@ std::vector<coupling::FluidAtParticle> ParticleCoupling::sample() const {
   for (std::size_t i = 0; i < local; ++i) {
     const double* a = &sums[W * i];
     const double norm = a[13] > 0 ? 1 / a[13] : 0;
-    coupling::FluidAtParticle& f = out[i];
+    coupling::FluidAtParticle f;
     for (int d = 0; d < 3; ++d) {
       f.velocity[d] = a[d] * norm;
       f.pressure_gradient[d] = a[4 + d] * norm;
@@ -523,8 +651,8 @@ std::vector<coupling::FluidAtParticle> ParticleCoupling::sample() const {
       f.vorticity[d] = a[10 + d] * norm;
     }
     f.void_fraction = a[13] > 0 ? a[3] * norm : 1.0;
+    dem_->add_fluid(f);
   }
-  return out;
 }
 
 coupling::FluidAtParticle ParticleCoupling::sampleAt(const std::array<double, 3>& x) const {
@@ -551,10 +679,10 @@ void ParticleCoupling::checkBalance() {
     }
   const std::vector<double> u = dem_->sum_onto_owners(acc, W);
   double totals[7] = {0, 0, 0, 0, 0, 0, 0};  // particle force, fluid source, magnitude
-  for (std::size_t i = 0; i < particles_.local; ++i)
+  for (std::size_t i = 0; i < particles_.local(); ++i)
     for (int d = 0; d < 3; ++d) {
-      const double f = particles_.drag_coefficient[i] * (u[W * i + d] - particles_.v[i][d]) +
-                       particles_.exchange_force[i][d];
+      const double f = particles_.drag_coefficient(i) * (u[W * i + d] - particles_.v(i)[d]) +
+                       particles_.exchange_force(i)[d];
       totals[d] += f;
       totals[6] += std::abs(f);
     }
@@ -580,8 +708,8 @@ void ParticleCoupling::checkBalance() {
 
 void ParticleCoupling::evolve() {
   auto t0 = Clock::now();
-  std::vector<coupling::FluidAtParticle> samples = sample();
-  dem_->set_fluid(std::move(samples), [this](const std::array<double, 3>& x) { return sampleAt(x); });
+  sample();  // straight into the DEM (DemLink::add_fluid)
+  dem_->end_fluid([this](const std::array<double, 3>& x) { return sampleAt(x); });
   couplingSeconds_ += seconds_since(t0);
   t0 = Clock::now();
   try {
@@ -616,6 +744,10 @@ void ParticleCoupling::write() {
   info.add("demStep", label(dem_->steps()));
   info.add("demTime", dem_->time());
   info.regIOobject::write();
+  // The particle output is timed apart: like the fluid's field output (runTime.write()),
+  // it is not part of the DEM / coupling / fluid split.
+  outputSeconds_ += seconds_since(t0);
+  t0 = Clock::now();
   // Writing the checkpoint rebuilt the DEM's lists and reordered its particles: the next
   // fluid samples must follow the new order.
   buildFootprints();
@@ -623,10 +755,10 @@ void ParticleCoupling::write() {
   const coupling::DemSummary s = dem_->summary();
   double counts[3] = {double(clampedCells_), clampedVolume_, 0};
   MPI_Allreduce(MPI_IN_PLACE, counts, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
-  double times[3] = {demSeconds_, couplingSeconds_, fluidSeconds_};
-  MPI_Allreduce(MPI_IN_PLACE, times, 3, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-  double interval[3];
-  for (int k = 0; k < 3; ++k) {
+  double times[4] = {demSeconds_, couplingSeconds_, fluidSeconds_, outputSeconds_};
+  MPI_Allreduce(MPI_IN_PLACE, times, 4, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  double interval[4];
+  for (int k = 0; k < 4; ++k) {
     interval[k] = times[k] - reportedSeconds_[k];
     reportedSeconds_[k] = times[k];
   }
@@ -636,16 +768,30 @@ void ParticleCoupling::write() {
     std::ostringstream text;
     text.precision(3);
     text << "DEM " << t[0] << " s (" << share(t[0]) << " %), coupling " << t[1] << " s ("
-         << share(t[1]) << " %), fluid " << t[2] << " s (" << share(t[2]) << " %)";
+         << share(t[1]) << " %), fluid " << t[2] << " s (" << share(t[2]) << " %); particle output "
+         << t[3] << " s (snapshots, checkpoints; not in the shares)";
     return text.str();
   };
+  const std::string cellPoint = cellPointLine();
   Foam::Info << "grainFoam particles: " << s.particles << " particles, " << s.contacts
              << " contacts, max overlap " << s.max_overlap_ratio << " r, removed " << s.removed
              << ", sampled on arrival " << s.late_samples << "; void fraction clamped "
              << Foam::label(counts[0]) << " cell-steps (" << counts[1]
              << " m^3 solid volume removed), volume not deposited " << lostVolume_ << " m^3\n"
+             << cellPoint.c_str()
              << "grainFoam time split since the last write: " << split(interval).c_str() << "\n"
              << "grainFoam time split: " << split(times).c_str() << Foam::endl;
+}
+
+std::string ParticleCoupling::cellPointLine() const {
+  if (!cellPointWeights_) return {};
+  // Collective: every rank has the table when sampling is cellPoint.
+  double counts[2] = {double(cellPointSamples_), double(cellPointWeights_->outside())};
+  MPI_Allreduce(MPI_IN_PLACE, counts, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  std::ostringstream text;
+  text << "grainFoam cellPoint: " << static_cast<long>(counts[0]) << " particle samples, "
+       << static_cast<long>(counts[1]) << " outside their cell (OpenFOAM's nearest tetrahedron)\n";
+  return text.str();
 }
 
 void ParticleCoupling::report(Foam::Ostream&) const {}

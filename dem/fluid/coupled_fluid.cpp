@@ -12,12 +12,12 @@ void CoupledFluid::set(std::vector<GlobalId> ids, std::vector<FluidSample> sampl
   ids_ = std::move(ids);
   samples_ = std::move(samples);
   index_.clear();
-  mapped_ids_ = ids_;
-  mapped_ = samples_;
+  remapped_ = false;  // the samples themselves serve the particles while their order holds
 }
 
 const std::vector<FluidSample>& CoupledFluid::at_particles(const Particles& p) {
-  if (p.id == mapped_ids_) return mapped_;
+  if (!remapped_ && p.id == ids_) return samples_;
+  if (remapped_ && p.id == mapped_ids_) return mapped_;
   if (index_.empty()) {
     index_.reserve(ids_.size());
     for (std::size_t k = 0; k < ids_.size(); ++k) index_.emplace(ids_[k], k);
@@ -40,6 +40,7 @@ const std::vector<FluidSample>& CoupledFluid::at_particles(const Particles& p) {
     ++late_;
   }
   mapped_ids_ = p.id;
+  remapped_ = true;
   return mapped_;
 }
 

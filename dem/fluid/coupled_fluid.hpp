@@ -42,6 +42,9 @@ class CoupledFluid {
   std::vector<GlobalId> ids_;
   std::vector<FluidSample> samples_;
   std::unordered_map<GlobalId, std::size_t> index_;  // built on the first re-map after set()
+  // After a re-sort, migration or late arrival: the samples in the particles' new order.
+  // Until then the samples are served as set (no copy per fluid step).
+  bool remapped_ = false;
   std::vector<GlobalId> mapped_ids_;                 // order of `mapped_`
   std::vector<FluidSample> mapped_;
   Sampler sampler_;

@@ -30,6 +30,30 @@ if(NOT TARGET grainFoam)
   return()
 endif()
 
+# coupling.cellpoint_interpolation: the cellPoint weights of the coupling against OpenFOAM's
+# interpolationCellPoint on a uniform, a graded and a skewed mesh (cellpoint/cellpoint.cmake,
+# cellpoint/cellPointCheck.C). Under 10 s.
+add_executable(cellPointCheck ${CMAKE_CURRENT_LIST_DIR}/cellpoint/cellPointCheck.C
+                              ${PROJECT_SOURCE_DIR}/coupling/foam/cellPointWeights.C)
+target_include_directories(cellPointCheck PRIVATE ${PROJECT_SOURCE_DIR})
+target_link_libraries(cellPointCheck PRIVATE OpenFOAM::finiteVolume grainflow_warnings)
+set_target_properties(cellPointCheck PROPERTIES
+  CXX_STANDARD 17
+  CXX_STANDARD_REQUIRED ON
+  CXX_EXTENSIONS OFF
+  RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/bin)
+add_test(NAME coupling.cellpoint_interpolation
+         COMMAND ${CMAKE_COMMAND}
+                 -DFOAM_ENV=${PROJECT_SOURCE_DIR}/scripts/foam_env.sh
+                 -DCHECK=$<TARGET_FILE:cellPointCheck>
+                 -DCASES=${CMAKE_CURRENT_LIST_DIR}/cellpoint
+                 -DWORK=${CMAKE_CURRENT_BINARY_DIR}/coupling/cellpoint_interpolation
+                 -P ${CMAKE_CURRENT_LIST_DIR}/cellpoint/cellpoint.cmake)
+set_tests_properties(coupling.cellpoint_interpolation PROPERTIES
+  ENVIRONMENT "GRAINFLOW_FOAM_BASHRC=${OpenFOAM_BASHRC}"
+  LABELS "foam;coupling"
+  TIMEOUT 300)
+
 # h5py reads the particle snapshots: Debian's python3-h5py, as in tests/dem/app/tests.cmake.
 find_program(GRAINFLOW_COUPLING_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
 if(GRAINFLOW_COUPLING_PYTHON)

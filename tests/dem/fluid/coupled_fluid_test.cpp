@@ -1,0 +1,101 @@
+// CoupledFluid (dem/fluid/coupled_fluid.hpp): the samples a fluid solver sets by particle id
+// reach the right particles whatever the particles' order at each DEM sub-step. Reference:
+// each particle's sample carries its own id (void fraction id / 100, velocity (id, 0, 0)),
+// so a sample served to the wrong particle shows.
+#include "dem/fluid/coupled_fluid.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "dem/core/particles.hpp"
+
+namespace grainflow {
+namespace {
+
+FluidSample sampleOf(GlobalId id, double scale = 1) {
+  FluidSample s;
+  s.void_fraction = scale * static_cast<double>(id) / 100;
+  s.velocity = Vec3(static_cast<double>(id), 0, 0);
+  return s;
+}
+
+Particles fourParticles() {
+  Particles p;
+  for (GlobalId id : {3, 7, 11, 20})
+    p.add(id, Vec3(0.01 * static_cast<double>(id), 0, 0), Vec3::Zero(), Vec3::Zero(), 1e-3, 0,
+          2500);
+  return p;
+}
+
+// Samples for the particles' current order, `scale` telling one set from another.
+void setFor(CoupledFluid& fluid, const Particles& p, double scale) {
+  std::vector<FluidSample> samples;
+  for (GlobalId id : p.id) samples.push_back(sampleOf(id, scale));
+  fluid.set(p.id, samples);
+}
+
+void expectServed(CoupledFluid& fluid, const Particles& p, double scale) {
+  const std::vector<FluidSample>& s = fluid.at_particles(p);
+  ASSERT_EQ(s.size(), p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    EXPECT_EQ(s[i].void_fraction, sampleOf(p.id[i], scale).void_fraction) << "particle " << p.id[i];
+    EXPECT_EQ(s[i].velocity[0], static_cast<double>(p.id[i])) << "particle " << p.id[i];
+  }
+}
+
+TEST(CoupledFluid, ServesTheSamplesWhileTheOrderHolds) {
+  Particles p = fourParticles();
+  CoupledFluid fluid;
+  setFor(fluid, p, 1);
+  expectServed(fluid, p, 1);
+  expectServed(fluid, p, 1);  // every sub-step
+  EXPECT_EQ(fluid.late_samples(), 0);
+}
+
+TEST(CoupledFluid, FollowsAReorder) {
+  Particles p = fourParticles();
+  CoupledFluid fluid;
+  setFor(fluid, p, 1);
+  p.permute({2, 0, 3, 1});
+  expectServed(fluid, p, 1);
+  p.permute({3, 2, 1, 0});
+  expectServed(fluid, p, 1);
+  EXPECT_EQ(fluid.late_samples(), 0);
+}
+
+// After a re-map, a new set must be served, not the re-mapped copy of the old one: also when
+// the new set comes in the old order and the particles are still in the re-mapped order.
+TEST(CoupledFluid, ANewSetReplacesARemappedOne) {
+  Particles p = fourParticles();
+  const Particles original = p;
+  CoupledFluid fluid;
+  setFor(fluid, p, 1);
+  p.permute({1, 3, 0, 2});
+  expectServed(fluid, p, 1);  // re-mapped
+  setFor(fluid, p, 2);        // new samples, in the particles' (re-mapped) order
+  expectServed(fluid, p, 2);
+  setFor(fluid, original, 3);  // new samples in the original order
+  expectServed(fluid, p, 3);
+  EXPECT_EQ(fluid.late_samples(), 0);
+}
+
+TEST(CoupledFluid, SamplesALateArrivalOnce) {
+  Particles p = fourParticles();
+  CoupledFluid fluid;
+  setFor(fluid, p, 1);
+  int calls = 0;
+  fluid.set_sampler([&calls](const Vec3& x) {
+    ++calls;
+    return sampleOf(static_cast<GlobalId>(std::lround(x[0] / 0.01)));
+  });
+  p.add(42, Vec3(0.42, 0, 0), Vec3::Zero(), Vec3::Zero(), 1e-3, 0, 2500);  // migrated in
+  expectServed(fluid, p, 1);
+  expectServed(fluid, p, 1);
+  EXPECT_EQ(calls, 1);
+  EXPECT_EQ(fluid.late_samples(), 1);
+}
+
+}  // namespace
+}  // namespace grainflow
