@@ -195,7 +195,10 @@ class BrokenCsv : public ::testing::Test {
   // The error inserting a CSV file with `text` gives (or "no error"), in the scene of
   // one_material_scene: domain [-1, 1]^3, one material 'm'.
   std::string error_of(const std::string& text, bool periodic = false) {
-    const auto dir = std::filesystem::temp_directory_path() / "grainflow_broken_csv";
+    // One directory per test: CTest runs the tests of this suite in parallel.
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    const auto dir = std::filesystem::temp_directory_path() /
+                     ("grainflow_broken_csv." + std::string(info->name()));
     std::filesystem::create_directories(dir);
     file_ = (dir / "p.csv").string();
     std::ofstream(file_) << text;
