@@ -1,7 +1,9 @@
 #include "dem/engine/contact_sweep.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 
 #include "dem/engine/wall_sweep.hpp"
 
@@ -67,43 +69,91 @@ template <class Law>
   return Law::evaluate(g, s.table(a.material, b.material), s.constants, tangential, rolling, s.dt);
 }
 
+// The list entries found touching, gathered before the kernel runs on them: the apart test
+// decides whether an entry is kept without a branch (three in four entries are apart, in no
+// order a branch predictor could learn), and the kernel then runs over touching pairs only,
+// in list order, so every force is summed in the same order as entry by entry.
+struct Touching {
+  int i;  // local particle
+  int k;  // list entry
+};
+constexpr int kBatch = 64;
+
+// h unchanged when `keep`, else +0 in every component (what setZero() writes), without a
+// branch.
+inline void keep_or_zero(bool keep, Vec3& h) {
+  const std::uint64_t mask = -static_cast<std::uint64_t>(keep);
+  for (int a = 0; a < 3; ++a)
+    h[a] = std::bit_cast<double>(std::bit_cast<std::uint64_t>(h[a]) & mask);
+}
+
 template <class Law>
 void local_pair_sweep(ContactSweep& s) {
   Particles& p = s.p;
+  const int n = static_cast<int>(p.size());
+  // The arrays' addresses, read once: through the vectors, every store of a force would
+  // make the compiler load each array's address again.
+  const GlobalId* id = p.id.data();
+  const Vec3* x = p.x.data();
+  const Vec3* v = p.v.data();
+  const Vec3* w = p.omega.data();
+  const double* radius = p.radius.data();
+  const double* mass = p.mass.data();
+  const double* inertia = p.inertia.data();
+  const int* material = p.material.data();
+  Vec3* force = p.force.data();
+  Vec3* torque = p.torque.data();
+  const int* offsets = s.local_list.offsets.data();
+  const int* partner = s.local_list.j.data();
+  Vec3* springs_t = Law::keeps_tangential ? s.local_springs.tangential.data() : nullptr;
+  Vec3* springs_r = Law::keeps_rolling ? s.local_springs.rolling.data() : nullptr;
   Vec3 unused;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    for (int k = s.local_list.offsets[i]; k < s.local_list.offsets[i + 1]; ++k) {
-      const std::size_t j = s.local_list.j[k];
-      Vec3& ht = Law::keeps_tangential ? s.local_springs.tangential[k] : unused;
-      Vec3& hr = Law::keeps_rolling ? s.local_springs.rolling[k] : unused;
-      if (apart(p.x[i] - p.x[j], p.radius[i] + p.radius[j])) {
-        if constexpr (Law::keeps_tangential) ht.setZero();
-        if constexpr (Law::keeps_rolling) hr.setZero();
-        continue;
-      }
-      const std::size_t a = p.id[i] < p.id[j] ? i : j, b = a == i ? j : i;
-      double overlap;
-      const ContactResult r = pair_force<Law>(
-          s, p.x[a] - p.x[b],
-          Body{p.v[a], p.omega[a], p.radius[a], p.mass[a], p.inertia[a], p.material[a]},
-          Body{p.v[b], p.omega[b], p.radius[b], p.mass[b], p.inertia[b], p.material[b]}, ht, hr,
-          overlap);
-      p.force[a] += r.force;
-      p.force[b] -= r.force;
-      if constexpr (Law::needs_spin) {
-        p.torque[a] += r.torque_i;
-        p.torque[b] += r.torque_j;
-      }
-      ++s.contacts;
-      // The guard's details are gathered only for a new largest overlap (rare).
-      if (const double ratio = overlap / std::min(p.radius[a], p.radius[b]);
-          ratio > s.max_overlap_ratio)
-        s.worst.consider(ratio, s.max_overlap_ratio, p.id[a], p.id[b],
-                         (p.x[a] - p.x[b]).normalized().dot(p.v[b] - p.v[a]),
-                         p.radius[a] * p.radius[b] / (p.radius[a] + p.radius[b]),
-                         p.mass[a] * p.mass[b] / (p.mass[a] + p.mass[b]),
-                         s.table(p.material[a], p.material[b]).y_star);
+  Touching batch[kBatch];
+  const auto evaluate = [&](const Touching& t) __attribute__((always_inline)) {
+    const int i = t.i, k = t.k, j = partner[k];
+    Vec3& ht = Law::keeps_tangential ? springs_t[k] : unused;
+    Vec3& hr = Law::keeps_rolling ? springs_r[k] : unused;
+    const int a = id[i] < id[j] ? i : j, b = a == i ? j : i;
+    double overlap;
+    const ContactResult r =
+        pair_force<Law>(s, x[a] - x[b], Body{v[a], w[a], radius[a], mass[a], inertia[a], material[a]},
+                        Body{v[b], w[b], radius[b], mass[b], inertia[b], material[b]}, ht, hr,
+                        overlap);
+    force[a] += r.force;
+    force[b] -= r.force;
+    if constexpr (Law::needs_spin) {
+      torque[a] += r.torque_i;
+      torque[b] += r.torque_j;
     }
+    ++s.contacts;
+    // The guard's details are gathered only for a new largest overlap (rare).
+    if (const double ratio = overlap / std::min(radius[a], radius[b]);
+        ratio > s.max_overlap_ratio)
+      s.worst.consider(ratio, s.max_overlap_ratio, id[a], id[b],
+                       (x[a] - x[b]).normalized().dot(v[b] - v[a]),
+                       radius[a] * radius[b] / (radius[a] + radius[b]),
+                       mass[a] * mass[b] / (mass[a] + mass[b]),
+                       s.table(material[a], material[b]).y_star);
+  };
+  // Fills the batch, evaluates it, fills it again from where it stopped (within a
+  // particle's list if need be); one call site keeps the kernel inlined.
+  int i = 0, k = n > 0 ? offsets[0] : 0;
+  while (i < n) {
+    int m = 0;
+    for (; i < n; ++i, k = i < n ? offsets[i] : k) {
+      const Vec3 xi = x[i];
+      const double ri = radius[i];
+      const int end = offsets[i + 1], stop = std::min(end, k + (kBatch - m));
+      for (; k < stop; ++k) {
+        const bool touching = !apart(xi - x[partner[k]], ri + radius[partner[k]]);
+        batch[m] = {i, k};
+        m += touching;
+        if constexpr (Law::keeps_tangential) keep_or_zero(touching, springs_t[k]);
+        if constexpr (Law::keeps_rolling) keep_or_zero(touching, springs_r[k]);
+      }
+      if (k < end) break;  // batch offered its last free place: evaluate, then go on with i
+    }
+    for (int c = 0; c < m; ++c) evaluate(batch[c]);
   }
 }
 
@@ -111,38 +161,75 @@ template <class Law>
 void ghost_pair_sweep(ContactSweep& s) {
   Particles& p = s.p;
   const Ghosts& g = s.ghosts;
+  const int n = static_cast<int>(p.size());
+  const GlobalId* id = p.id.data();
+  const Vec3* x = p.x.data();
+  const Vec3* v = p.v.data();
+  const Vec3* w = p.omega.data();
+  const double* radius = p.radius.data();
+  const double* mass = p.mass.data();
+  const double* inertia = p.inertia.data();
+  const int* material = p.material.data();
+  Vec3* force = p.force.data();
+  Vec3* torque = p.torque.data();
+  const GlobalId* g_id = g.id.data();
+  const Vec3* g_x = g.x.data();
+  const Vec3* g_shift = g.shift.data();
+  const Vec3* g_v = g.v.data();
+  const Vec3* g_w = g.omega.data();
+  const double* g_radius = g.radius.data();
+  const double* g_mass = g.mass.data();
+  const double* g_inertia = g.inertia.data();
+  const int* g_material = g.material.data();
+  const int* offsets = s.ghost_list.offsets.data();
+  const int* partner = s.ghost_list.j.data();
+  Vec3* springs_t = Law::keeps_tangential ? s.ghost_springs.tangential.data() : nullptr;
+  Vec3* springs_r = Law::keeps_rolling ? s.ghost_springs.rolling.data() : nullptr;
   Vec3 unused;
   const Vec3 zero = Vec3::Zero();
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    for (int k = s.ghost_list.offsets[i]; k < s.ghost_list.offsets[i + 1]; ++k) {
-      const std::size_t q = s.ghost_list.j[k];
-      Vec3& ht = Law::keeps_tangential ? s.ghost_springs.tangential[k] : unused;
-      Vec3& hr = Law::keeps_rolling ? s.ghost_springs.rolling[k] : unused;
-      if (apart((p.x[i] - g.x[q]) + (zero - g.shift[q]), p.radius[i] + g.radius[q])) {
-        if constexpr (Law::keeps_tangential) ht.setZero();
-        if constexpr (Law::keeps_rolling) hr.setZero();
-        continue;
+  Touching batch[kBatch];
+  const auto evaluate = [&](const Touching& t) __attribute__((always_inline)) {
+    const int i = t.i, k = t.k, q = partner[k];
+    Vec3& ht = Law::keeps_tangential ? springs_t[k] : unused;
+    Vec3& hr = Law::keeps_rolling ? springs_r[k] : unused;
+    const Body local{v[i], w[i], radius[i], mass[i], inertia[i], material[i]};
+    const Body ghost{g_v[q], g_w[q], g_radius[q], g_mass[q], g_inertia[q], g_material[q]};
+    const bool local_first = id[i] < g_id[q];
+    double overlap;
+    const ContactResult r = local_first
+                                ? pair_force<Law>(s, (x[i] - g_x[q]) + (zero - g_shift[q]), local,
+                                                  ghost, ht, hr, overlap)
+                                : pair_force<Law>(s, (g_x[q] - x[i]) + (g_shift[q] - zero), ghost,
+                                                  local, ht, hr, overlap);
+    force[i] += local_first ? r.force : Vec3(-r.force);
+    if constexpr (Law::needs_spin) torque[i] += local_first ? r.torque_i : r.torque_j;
+    // Both owners see this contact; the owner of the lower id counts it.
+    if (local_first) ++s.contacts;
+    if (const double ratio = overlap / std::min(local.r, ghost.r); ratio > s.max_overlap_ratio)
+      s.worst.consider(ratio, s.max_overlap_ratio, id[i], g_id[q],
+                       ((x[i] - g_x[q]) - g_shift[q]).normalized().dot(ghost.v - local.v),
+                       local.r * ghost.r / (local.r + ghost.r),
+                       local.m * ghost.m / (local.m + ghost.m),
+                       s.table(local.material, ghost.material).y_star);
+  };
+  int i = 0, k = n > 0 ? offsets[0] : 0;
+  while (i < n) {
+    int m = 0;
+    for (; i < n; ++i, k = i < n ? offsets[i] : k) {
+      const Vec3 xi = x[i];
+      const double ri = radius[i];
+      const int end = offsets[i + 1], stop = std::min(end, k + (kBatch - m));
+      for (; k < stop; ++k) {
+        const int q = partner[k];
+        const bool touching = !apart((xi - g_x[q]) + (zero - g_shift[q]), ri + g_radius[q]);
+        batch[m] = {i, k};
+        m += touching;
+        if constexpr (Law::keeps_tangential) keep_or_zero(touching, springs_t[k]);
+        if constexpr (Law::keeps_rolling) keep_or_zero(touching, springs_r[k]);
       }
-      const Body local{p.v[i], p.omega[i], p.radius[i], p.mass[i], p.inertia[i], p.material[i]};
-      const Body ghost{g.v[q], g.omega[q], g.radius[q], g.mass[q], g.inertia[q], g.material[q]};
-      const bool local_first = p.id[i] < g.id[q];
-      double overlap;
-      const ContactResult r = local_first
-                                  ? pair_force<Law>(s, (p.x[i] - g.x[q]) + (zero - g.shift[q]),
-                                                    local, ghost, ht, hr, overlap)
-                                  : pair_force<Law>(s, (g.x[q] - p.x[i]) + (g.shift[q] - zero),
-                                                    ghost, local, ht, hr, overlap);
-      p.force[i] += local_first ? r.force : Vec3(-r.force);
-      if constexpr (Law::needs_spin) p.torque[i] += local_first ? r.torque_i : r.torque_j;
-      // Both owners see this contact; the owner of the lower id counts it.
-      if (local_first) ++s.contacts;
-      if (const double ratio = overlap / std::min(local.r, ghost.r); ratio > s.max_overlap_ratio)
-        s.worst.consider(ratio, s.max_overlap_ratio, p.id[i], g.id[q],
-                         ((p.x[i] - g.x[q]) - g.shift[q]).normalized().dot(ghost.v - local.v),
-                         local.r * ghost.r / (local.r + ghost.r),
-                         local.m * ghost.m / (local.m + ghost.m),
-                         s.table(local.material, ghost.material).y_star);
+      if (k < end) break;
     }
+    for (int c = 0; c < m; ++c) evaluate(batch[c]);
   }
 }
 
