@@ -69,6 +69,21 @@ template <class Law>
   return Law::evaluate(g, s.table(a.material, b.material), s.constants, tangential, rolling, s.dt);
 }
 
+// The overlap guard keeps the largest overlap / min(r_a, r_b) of the sweep, R. A contact
+// beats R only if fl(overlap / m) > R, hence overlap > R m exactly; and with c = 1 - 2^-50,
+// fl(fl(R c) m) <= R m c (1 + 2^-53)^2 < R m. So `overlap > fl(fl(R c) m)` lets through every
+// contact that beats R (and a few that do not), and only those pay for the division, which
+// then decides exactly as before. (Assumes R m is not subnormal: overlaps of 1e-300 m.)
+class OverlapGate {
+ public:
+  explicit OverlapGate(double largest) { set(largest); }
+  void set(double largest) { scaled_ = largest * (1 - 0x1p-50); }
+  bool may_beat(double overlap, double min_radius) const { return overlap > scaled_ * min_radius; }
+
+ private:
+  double scaled_;
+};
+
 // The list entries found touching, gathered before the kernel runs on them: the apart test
 // decides whether an entry is kept without a branch (three in four entries are apart, in no
 // order a branch predictor could learn), and the kernel then runs over touching pairs only,
@@ -109,6 +124,7 @@ void local_pair_sweep(ContactSweep& s) {
   Vec3* springs_r = Law::keeps_rolling ? s.local_springs.rolling.data() : nullptr;
   Vec3 unused;
   Touching batch[kBatch];
+  OverlapGate gate(s.max_overlap_ratio);
   const auto evaluate = [&](const Touching& t) __attribute__((always_inline)) {
     const int i = t.i, k = t.k, j = partner[k];
     Vec3& ht = Law::keeps_tangential ? springs_t[k] : unused;
@@ -127,13 +143,16 @@ void local_pair_sweep(ContactSweep& s) {
     }
     ++s.contacts;
     // The guard's details are gathered only for a new largest overlap (rare).
-    if (const double ratio = overlap / std::min(radius[a], radius[b]);
-        ratio > s.max_overlap_ratio)
-      s.worst.consider(ratio, s.max_overlap_ratio, id[a], id[b],
-                       (x[a] - x[b]).normalized().dot(v[b] - v[a]),
-                       radius[a] * radius[b] / (radius[a] + radius[b]),
-                       mass[a] * mass[b] / (mass[a] + mass[b]),
-                       s.table(material[a], material[b]).y_star);
+    const double min_r = std::min(radius[a], radius[b]);
+    if (gate.may_beat(overlap, min_r)) [[unlikely]]
+      if (const double ratio = overlap / min_r; ratio > s.max_overlap_ratio) {
+        s.worst.consider(ratio, s.max_overlap_ratio, id[a], id[b],
+                         (x[a] - x[b]).normalized().dot(v[b] - v[a]),
+                         radius[a] * radius[b] / (radius[a] + radius[b]),
+                         mass[a] * mass[b] / (mass[a] + mass[b]),
+                         s.table(material[a], material[b]).y_star);
+        gate.set(s.max_overlap_ratio);
+      }
   };
   // Fills the batch, evaluates it, fills it again from where it stopped (within a
   // particle's list if need be); one call site keeps the kernel inlined.
@@ -188,6 +207,7 @@ void ghost_pair_sweep(ContactSweep& s) {
   Vec3 unused;
   const Vec3 zero = Vec3::Zero();
   Touching batch[kBatch];
+  OverlapGate gate(s.max_overlap_ratio);
   const auto evaluate = [&](const Touching& t) __attribute__((always_inline)) {
     const int i = t.i, k = t.k, q = partner[k];
     Vec3& ht = Law::keeps_tangential ? springs_t[k] : unused;
@@ -205,12 +225,16 @@ void ghost_pair_sweep(ContactSweep& s) {
     if constexpr (Law::needs_spin) torque[i] += local_first ? r.torque_i : r.torque_j;
     // Both owners see this contact; the owner of the lower id counts it.
     if (local_first) ++s.contacts;
-    if (const double ratio = overlap / std::min(local.r, ghost.r); ratio > s.max_overlap_ratio)
-      s.worst.consider(ratio, s.max_overlap_ratio, id[i], g_id[q],
-                       ((x[i] - g_x[q]) - g_shift[q]).normalized().dot(ghost.v - local.v),
-                       local.r * ghost.r / (local.r + ghost.r),
-                       local.m * ghost.m / (local.m + ghost.m),
-                       s.table(local.material, ghost.material).y_star);
+    const double min_r = std::min(local.r, ghost.r);
+    if (gate.may_beat(overlap, min_r)) [[unlikely]]
+      if (const double ratio = overlap / min_r; ratio > s.max_overlap_ratio) {
+        s.worst.consider(ratio, s.max_overlap_ratio, id[i], g_id[q],
+                         ((x[i] - g_x[q]) - g_shift[q]).normalized().dot(ghost.v - local.v),
+                         local.r * ghost.r / (local.r + ghost.r),
+                         local.m * ghost.m / (local.m + ghost.m),
+                         s.table(local.material, ghost.material).y_star);
+        gate.set(s.max_overlap_ratio);
+      }
   };
   int i = 0, k = n > 0 ? offsets[0] : 0;
   while (i < n) {
