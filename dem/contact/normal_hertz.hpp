@@ -12,14 +12,16 @@ namespace grainflow {
 
 struct HertzNormal {
   static constexpr const char* name = "hertz";
-  [[gnu::always_inline]] static SpringDashpot coefficients(const PairCoefficients& pc, const ContactConstants&,
-                                    double r_star, double m_star, double overlap) {
+  static constexpr bool lanes = true;  // also evaluates Lanes2 (dem/core/lanes.hpp)
+  template <class V, class PC>
+  [[gnu::always_inline]] static SpringDashpotT<V> coefficients(const PC& pc, const ContactConstants&,
+                                                              V r_star, V m_star, V overlap) {
     constexpr double two_sqrt_5_6 = 1.8257418583505538;  // 2 sqrt(5/6)
-    const double a = std::sqrt(r_star * overlap);
-    const double sn = 2 * pc.y_star * a;
-    const double st = 8 * pc.g_star * a;
-    return {(2.0 / 3.0) * sn, two_sqrt_5_6 * pc.hertz_beta * std::sqrt(sn * m_star), st,
-            two_sqrt_5_6 * pc.hertz_beta * std::sqrt(st * m_star)};
+    const V a = lane_sqrt(r_star * overlap);
+    const V sn = 2 * pc.y_star * a;
+    const V st = 8 * pc.g_star * a;
+    return {(2.0 / 3.0) * sn, two_sqrt_5_6 * pc.hertz_beta * lane_sqrt(sn * m_star), st,
+            two_sqrt_5_6 * pc.hertz_beta * lane_sqrt(st * m_star)};
   }
 };
 

@@ -21,13 +21,23 @@ void UnresolvedContact::record(double vn, double rs, double ms, double ys, doubl
 
 namespace {
 
-// The state of one body of a pair, as the pair kernel reads it.
+// The state of one body of a pair, as the pair kernel reads it: of one contact (V = double)
+// or of one body of each of the contacts in the lanes of V.
+template <class V>
 struct Body {
-  const Vec3& v;
-  const Vec3& w;
-  double r, m, inertia;
-  int material;
+  V3<V> v, w;
+  V r, m, inertia;
 };
+
+// The material-pair constants a lane-capable law reads (HertzNormal, HistoryTangential), for
+// the contacts in the lanes of a Lanes2.
+struct PairCoefficientLanes {
+  Lanes2 y_star, g_star, hertz_beta, friction;
+};
+inline PairCoefficientLanes pack_coefficients(const PairCoefficients& a, const PairCoefficients& b) {
+  return {pack(a.y_star, b.y_star), pack(a.g_star, b.g_star), pack(a.hertz_beta, b.hertz_beta),
+          pack(a.friction, b.friction)};
+}
 
 // Whether a listed pair is apart: the Verlet lists hold every pair within the skin, and in
 // a packed bed about three in four of them do not touch. This test comes first, on the
@@ -36,15 +46,17 @@ struct Body {
 // squares; + is commutative), so it is asked before the pair is put in canonical order.
 inline bool apart(const Vec3& d, double rs) { return d.squaredNorm() >= rs * rs; }
 
-// Evaluates the touching pair (a, b) with displacement d = x_a - x_b. Inlined into the
-// sweeps, like the law's evaluation: the geometry and the result then stay in registers
-// instead of going through memory.
-template <class Law>
-[[gnu::always_inline]] inline ContactResult pair_force(const ContactSweep& s, const Vec3& d, const Body& a, const Body& b,
-                         Vec3& tangential, Vec3& rolling, double& overlap) {
-  const double rs = a.r + b.r;
-  const double dist = std::sqrt(d.squaredNorm());
-  ContactGeometry g;
+// Evaluates the touching pair (a, b) with displacement d = x_a - x_b, or the pairs in the
+// lanes of V. Inlined into the sweeps, like the law's evaluation: the geometry and the result
+// then stay in registers instead of going through memory.
+template <class Law, class V, class PC>
+[[gnu::always_inline]] inline ContactResultT<V> pair_force(const ContactSweep& s, const V3<V>& d,
+                                                          const Body<V>& a, const Body<V>& b,
+                                                          const PC& pc, V3<V>& tangential,
+                                                          V3<V>& rolling, V& overlap) {
+  const V rs = a.r + b.r;
+  const V dist = lane_sqrt(squared_norm(d));
+  ContactGeometryT<V> g;
   g.n = d / dist;
   g.overlap = overlap = rs - dist;
   g.distance = dist;
@@ -57,8 +69,8 @@ template <class Law>
   g.wall = false;
   if constexpr (Law::needs_spin) {
     // Evaluated first: GCC does not inline Eigen's cross product of an expression.
-    const Vec3 arm_w = g.arm_i * a.w + g.arm_j * b.w;
-    g.v_rel = a.v - b.v - arm_w.cross(g.n);
+    const V3<V> arm_w = g.arm_i * a.w + g.arm_j * b.w;
+    g.v_rel = a.v - b.v - cross(arm_w, g.n);
     g.w_rel = a.w - b.w;
   } else {
     g.v_rel = a.v - b.v;
@@ -66,7 +78,7 @@ template <class Law>
   if constexpr (Law::needs_roll_inertia)
     g.roll_inertia =
         1.0 / (1.0 / (a.inertia + a.m * a.r * a.r) + 1.0 / (b.inertia + b.m * b.r * b.r));
-  return Law::evaluate(g, s.table(a.material, b.material), s.constants, tangential, rolling, s.dt);
+  return Law::evaluate(g, pc, s.constants, tangential, rolling, s.dt);
 }
 
 // The overlap guard keeps the largest overlap / min(r_a, r_b) of the sweep, R. A contact
@@ -122,37 +134,80 @@ void local_pair_sweep(ContactSweep& s) {
   const int* partner = s.local_list.j.data();
   Vec3* springs_t = Law::keeps_tangential ? s.local_springs.tangential.data() : nullptr;
   Vec3* springs_r = Law::keeps_rolling ? s.local_springs.rolling.data() : nullptr;
-  Vec3 unused;
   Touching batch[kBatch];
   OverlapGate gate(s.max_overlap_ratio);
-  const auto evaluate = [&](const Touching& t) __attribute__((always_inline)) {
-    const int i = t.i, k = t.k, j = partner[k];
-    Vec3& ht = Law::keeps_tangential ? springs_t[k] : unused;
-    Vec3& hr = Law::keeps_rolling ? springs_r[k] : unused;
-    const int a = id[i] < id[j] ? i : j, b = a == i ? j : i;
-    double overlap;
-    const ContactResult r =
-        pair_force<Law>(s, x[a] - x[b], Body{v[a], w[a], radius[a], mass[a], inertia[a], material[a]},
-                        Body{v[b], w[b], radius[b], mass[b], inertia[b], material[b]}, ht, hr,
-                        overlap);
-    force[a] += r.force;
-    force[b] -= r.force;
+  // A touching entry in canonical orientation: a has the lower global id.
+  struct Pair {
+    int a, b, k;
+  };
+  const auto canonical = [&](const Touching& t) {
+    const int j = partner[t.k];
+    const int first = id[t.i] < id[j] ? t.i : j;
+    return Pair{first, first == t.i ? j : t.i, t.k};
+  };
+  const auto body = [&](int q) {
+    return Body<double>{v[q], w[q], radius[q], mass[q], inertia[q]};
+  };
+  // The contact's forces and torques on both bodies, its count and the overlap guard.
+  const auto apply = [&](const Pair& c, const ContactResult& r, double overlap) {
+    force[c.a] += r.force;
+    force[c.b] -= r.force;
     if constexpr (Law::needs_spin) {
-      torque[a] += r.torque_i;
-      torque[b] += r.torque_j;
+      torque[c.a] += r.torque_i;
+      torque[c.b] += r.torque_j;
     }
     ++s.contacts;
     // The guard's details are gathered only for a new largest overlap (rare).
-    const double min_r = std::min(radius[a], radius[b]);
+    const double min_r = std::min(radius[c.a], radius[c.b]);
     if (gate.may_beat(overlap, min_r)) [[unlikely]]
       if (const double ratio = overlap / min_r; ratio > s.max_overlap_ratio) {
-        s.worst.consider(ratio, s.max_overlap_ratio, id[a], id[b],
-                         (x[a] - x[b]).normalized().dot(v[b] - v[a]),
-                         radius[a] * radius[b] / (radius[a] + radius[b]),
-                         mass[a] * mass[b] / (mass[a] + mass[b]),
-                         s.table(material[a], material[b]).y_star);
+        s.worst.consider(ratio, s.max_overlap_ratio, id[c.a], id[c.b],
+                         (x[c.a] - x[c.b]).normalized().dot(v[c.b] - v[c.a]),
+                         radius[c.a] * radius[c.b] / (radius[c.a] + radius[c.b]),
+                         mass[c.a] * mass[c.b] / (mass[c.a] + mass[c.b]),
+                         s.table(material[c.a], material[c.b]).y_star);
         gate.set(s.max_overlap_ratio);
       }
+  };
+  // The touching entries batch[0, m), in order: two at a time in the lanes of a Lanes2 when
+  // the law can (the last one alone is evaluated twice, its copy discarded), else one by one.
+  const auto evaluate = [&](int m) __attribute__((always_inline)) {
+    if constexpr (Law::lanes) {
+      for (int c = 0; c < m; c += 2) {
+        const Pair p0 = canonical(batch[c]), p1 = canonical(batch[c + 1 < m ? c + 1 : c]);
+        const Body<double> a0 = body(p0.a), b0 = body(p0.b), a1 = body(p1.a), b1 = body(p1.b);
+        const Body<Lanes2> a{pack(a0.v, a1.v), pack(a0.w, a1.w), pack(a0.r, a1.r),
+                             pack(a0.m, a1.m), pack(a0.inertia, a1.inertia)};
+        const Body<Lanes2> b{pack(b0.v, b1.v), pack(b0.w, b1.w), pack(b0.r, b1.r),
+                             pack(b0.m, b1.m), pack(b0.inertia, b1.inertia)};
+        const PairCoefficientLanes pc = pack_coefficients(s.table(material[p0.a], material[p0.b]),
+                                             s.table(material[p1.a], material[p1.b]));
+        Lanes3 ht = zero3<Lanes2>(), hr = zero3<Lanes2>();
+        if constexpr (Law::keeps_tangential) ht = pack(springs_t[p0.k], springs_t[p1.k]);
+        Lanes2 overlap;
+        const ContactResultT<Lanes2> r = pair_force<Law>(
+            s, pack(Vec3(x[p0.a] - x[p0.b]), Vec3(x[p1.a] - x[p1.b])), a, b, pc, ht, hr, overlap);
+        if constexpr (Law::keeps_tangential) springs_t[p0.k] = lane(ht, 0);
+        apply(p0, ContactResult{lane(r.force, 0), lane(r.torque_i, 0), lane(r.torque_j, 0)},
+              overlap[0]);
+        if (c + 1 == m) break;
+        if constexpr (Law::keeps_tangential) springs_t[p1.k] = lane(ht, 1);
+        apply(p1, ContactResult{lane(r.force, 1), lane(r.torque_i, 1), lane(r.torque_j, 1)},
+              overlap[1]);
+      }
+    } else {
+      Vec3 unused;
+      for (int c = 0; c < m; ++c) {
+        const Pair p0 = canonical(batch[c]);
+        Vec3& ht = Law::keeps_tangential ? springs_t[p0.k] : unused;
+        Vec3& hr = Law::keeps_rolling ? springs_r[p0.k] : unused;
+        double overlap;
+        const ContactResult r =
+            pair_force<Law>(s, Vec3(x[p0.a] - x[p0.b]), body(p0.a), body(p0.b),
+                            s.table(material[p0.a], material[p0.b]), ht, hr, overlap);
+        apply(p0, r, overlap);
+      }
+    }
   };
   // Fills the batch, evaluates it, fills it again from where it stopped (within a
   // particle's list if need be); one call site keeps the kernel inlined.
@@ -172,7 +227,7 @@ void local_pair_sweep(ContactSweep& s) {
       }
       if (k < end) break;  // batch offered its last free place: evaluate, then go on with i
     }
-    for (int c = 0; c < m; ++c) evaluate(batch[c]);
+    evaluate(m);
   }
 }
 
@@ -204,37 +259,82 @@ void ghost_pair_sweep(ContactSweep& s) {
   const int* partner = s.ghost_list.j.data();
   Vec3* springs_t = Law::keeps_tangential ? s.ghost_springs.tangential.data() : nullptr;
   Vec3* springs_r = Law::keeps_rolling ? s.ghost_springs.rolling.data() : nullptr;
-  Vec3 unused;
   const Vec3 zero = Vec3::Zero();
   Touching batch[kBatch];
   OverlapGate gate(s.max_overlap_ratio);
-  const auto evaluate = [&](const Touching& t) __attribute__((always_inline)) {
-    const int i = t.i, k = t.k, q = partner[k];
-    Vec3& ht = Law::keeps_tangential ? springs_t[k] : unused;
-    Vec3& hr = Law::keeps_rolling ? springs_r[k] : unused;
-    const Body local{v[i], w[i], radius[i], mass[i], inertia[i], material[i]};
-    const Body ghost{g_v[q], g_w[q], g_radius[q], g_mass[q], g_inertia[q], g_material[q]};
+  // A touching entry, its two bodies in canonical orientation (the lower global id first) and
+  // their displacement.
+  struct Pair {
+    int i, q, k;
+    bool local_first;
+    Body<double> first, second;
+    Vec3 d;
+  };
+  const auto canonical = [&](const Touching& t) {
+    const int i = t.i, q = partner[t.k];
+    const Body<double> local{v[i], w[i], radius[i], mass[i], inertia[i]};
+    const Body<double> ghost{g_v[q], g_w[q], g_radius[q], g_mass[q], g_inertia[q]};
     const bool local_first = id[i] < g_id[q];
-    double overlap;
-    const ContactResult r = local_first
-                                ? pair_force<Law>(s, (x[i] - g_x[q]) + (zero - g_shift[q]), local,
-                                                  ghost, ht, hr, overlap)
-                                : pair_force<Law>(s, (g_x[q] - x[i]) + (g_shift[q] - zero), ghost,
-                                                  local, ht, hr, overlap);
-    force[i] += local_first ? r.force : Vec3(-r.force);
-    if constexpr (Law::needs_spin) torque[i] += local_first ? r.torque_i : r.torque_j;
+    return local_first ? Pair{i, q, t.k, true, local, ghost, (x[i] - g_x[q]) + (zero - g_shift[q])}
+                       : Pair{i, q, t.k, false, ghost, local, (g_x[q] - x[i]) + (g_shift[q] - zero)};
+  };
+  const auto table = [&](const Pair& c) -> const PairCoefficients& {
+    return c.local_first ? s.table(material[c.i], g_material[c.q])
+                         : s.table(g_material[c.q], material[c.i]);
+  };
+  const auto apply = [&](const Pair& c, const ContactResult& r, double overlap) {
+    const int i = c.i, q = c.q;
+    force[i] += c.local_first ? r.force : Vec3(-r.force);
+    if constexpr (Law::needs_spin) torque[i] += c.local_first ? r.torque_i : r.torque_j;
     // Both owners see this contact; the owner of the lower id counts it.
-    if (local_first) ++s.contacts;
-    const double min_r = std::min(local.r, ghost.r);
+    if (c.local_first) ++s.contacts;
+    const double min_r = std::min(radius[i], g_radius[q]);
     if (gate.may_beat(overlap, min_r)) [[unlikely]]
       if (const double ratio = overlap / min_r; ratio > s.max_overlap_ratio) {
         s.worst.consider(ratio, s.max_overlap_ratio, id[i], g_id[q],
-                         ((x[i] - g_x[q]) - g_shift[q]).normalized().dot(ghost.v - local.v),
-                         local.r * ghost.r / (local.r + ghost.r),
-                         local.m * ghost.m / (local.m + ghost.m),
-                         s.table(local.material, ghost.material).y_star);
+                         ((x[i] - g_x[q]) - g_shift[q]).normalized().dot(g_v[q] - v[i]),
+                         radius[i] * g_radius[q] / (radius[i] + g_radius[q]),
+                         mass[i] * g_mass[q] / (mass[i] + g_mass[q]),
+                         s.table(material[i], g_material[q]).y_star);
         gate.set(s.max_overlap_ratio);
       }
+  };
+  const auto evaluate = [&](int m) __attribute__((always_inline)) {
+    if constexpr (Law::lanes) {
+      for (int c = 0; c < m; c += 2) {
+        const Pair p0 = canonical(batch[c]), p1 = canonical(batch[c + 1 < m ? c + 1 : c]);
+        const Body<Lanes2> a{pack(p0.first.v, p1.first.v), pack(p0.first.w, p1.first.w),
+                             pack(p0.first.r, p1.first.r), pack(p0.first.m, p1.first.m),
+                             pack(p0.first.inertia, p1.first.inertia)};
+        const Body<Lanes2> b{pack(p0.second.v, p1.second.v), pack(p0.second.w, p1.second.w),
+                             pack(p0.second.r, p1.second.r), pack(p0.second.m, p1.second.m),
+                             pack(p0.second.inertia, p1.second.inertia)};
+        const PairCoefficientLanes pc = pack_coefficients(table(p0), table(p1));
+        Lanes3 ht = zero3<Lanes2>(), hr = zero3<Lanes2>();
+        if constexpr (Law::keeps_tangential) ht = pack(springs_t[p0.k], springs_t[p1.k]);
+        Lanes2 overlap;
+        const ContactResultT<Lanes2> r =
+            pair_force<Law>(s, pack(p0.d, p1.d), a, b, pc, ht, hr, overlap);
+        if constexpr (Law::keeps_tangential) springs_t[p0.k] = lane(ht, 0);
+        apply(p0, ContactResult{lane(r.force, 0), lane(r.torque_i, 0), lane(r.torque_j, 0)},
+              overlap[0]);
+        if (c + 1 == m) break;
+        if constexpr (Law::keeps_tangential) springs_t[p1.k] = lane(ht, 1);
+        apply(p1, ContactResult{lane(r.force, 1), lane(r.torque_i, 1), lane(r.torque_j, 1)},
+              overlap[1]);
+      }
+    } else {
+      Vec3 unused;
+      for (int c = 0; c < m; ++c) {
+        const Pair p0 = canonical(batch[c]);
+        Vec3& ht = Law::keeps_tangential ? springs_t[p0.k] : unused;
+        Vec3& hr = Law::keeps_rolling ? springs_r[p0.k] : unused;
+        double overlap;
+        const ContactResult r =
+            pair_force<Law>(s, p0.d, p0.first, p0.second, table(p0), ht, hr, overlap);
+        apply(p0, r, overlap);
+      }
+    }
   };
   int i = 0, k = n > 0 ? offsets[0] : 0;
   while (i < n) {
@@ -253,7 +353,7 @@ void ghost_pair_sweep(ContactSweep& s) {
       }
       if (k < end) break;
     }
-    for (int c = 0; c < m; ++c) evaluate(batch[c]);
+    evaluate(m);
   }
 }
 
