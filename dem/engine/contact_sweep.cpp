@@ -19,6 +19,24 @@ void UnresolvedContact::record(double vn, double rs, double ms, double ys, doubl
   contact.consider(1, unused, ia, ib, vn, rs, ms, ys);
 }
 
+UniformPairs find_uniform_pairs(const Particles& p, const Ghosts& g) {
+  UniformPairs u;
+  if (p.size() == 0) return u;
+  const double r = p.radius[0], m = p.mass[0];
+  const int material = p.material[0];
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.radius[i] != r || p.mass[i] != m || p.material[i] != material) return u;
+  for (std::size_t k = 0; k < g.size(); ++k)
+    if (g.radius[k] != r || g.mass[k] != m || g.material[k] != material) return u;
+  u.all_alike = true;
+  u.radius = r;
+  u.mass = m;
+  u.material = material;
+  u.r_star = r * r / (r + r);
+  u.m_star = m * m / (m + m);
+  return u;
+}
+
 namespace {
 
 // The state of one body of a pair, as the pair kernel reads it: of one contact (V = double)
@@ -49,11 +67,22 @@ inline bool apart(const Vec3& d, double rs) { return d.squaredNorm() >= rs * rs;
 // Evaluates the touching pair (a, b) with displacement d = x_a - x_b, or the pairs in the
 // lanes of V. Inlined into the sweeps, like the law's evaluation: the geometry and the result
 // then stay in registers instead of going through memory.
+// R* and m* are the caller's: r_a r_b / (r_a + r_b) and m_a m_b / (m_a + m_b) (reduced_radius,
+// reduced_mass), or those of UniformPairs.
+template <class V>
+[[gnu::always_inline]] inline V reduced_radius(const Body<V>& a, const Body<V>& b) {
+  return a.r * b.r / (a.r + b.r);
+}
+template <class V>
+[[gnu::always_inline]] inline V reduced_mass(const Body<V>& a, const Body<V>& b) {
+  return a.m * b.m / (a.m + b.m);
+}
 template <class Law, class V, class PC>
 [[gnu::always_inline]] inline ContactResultT<V> pair_force(const ContactSweep& s, const V3<V>& d,
                                                           const Body<V>& a, const Body<V>& b,
-                                                          const PC& pc, V3<V>& tangential,
-                                                          V3<V>& rolling, V& overlap) {
+                                                          V r_star, V m_star, const PC& pc,
+                                                          V3<V>& tangential, V3<V>& rolling,
+                                                          V& overlap) {
   const V rs = a.r + b.r;
   const V dist = lane_sqrt(squared_norm(d));
   ContactGeometryT<V> g;
@@ -64,8 +93,8 @@ template <class Law, class V, class PC>
   g.r_j = b.r;
   g.arm_i = a.r - 0.5 * g.overlap;
   g.arm_j = b.r - 0.5 * g.overlap;
-  g.r_star = a.r * b.r / rs;
-  g.m_star = a.m * b.m / (a.m + b.m);
+  g.r_star = r_star;
+  g.m_star = m_star;
   g.wall = false;
   if constexpr (Law::needs_spin) {
     // Evaluated first: GCC does not inline Eigen's cross product of an expression.
@@ -171,40 +200,70 @@ void local_pair_sweep(ContactSweep& s) {
   };
   // The touching entries batch[0, m), in order: two at a time in the lanes of a Lanes2 when
   // the law can (the last one alone is evaluated twice, its copy discarded), else one by one.
+  const UniformPairs& u = s.uniform;
+  const PairCoefficientLanes uniform_pc =
+      u.all_alike ? pack_coefficients(s.table(u.material, u.material), s.table(u.material, u.material))
+                  : PairCoefficientLanes{};
+  // With UniformPairs, radii, masses, R*, m* and the material pair are the same for all.
+  const auto lanes = [&]<bool Alike>(int m) __attribute__((always_inline)) {
+    for (int c = 0; c < m; c += 2) {
+      const Pair p0 = canonical(batch[c]), p1 = canonical(batch[c + 1 < m ? c + 1 : c]);
+      Body<Lanes2> a, b;
+      a.v = pack(v[p0.a], v[p1.a]);
+      a.w = pack(w[p0.a], w[p1.a]);
+      b.v = pack(v[p0.b], v[p1.b]);
+      b.w = pack(w[p0.b], w[p1.b]);
+      Lanes2 r_star, m_star;
+      PairCoefficientLanes pc;
+      if constexpr (Alike) {
+        a.r = b.r = pack(u.radius, u.radius);
+        a.m = b.m = pack(u.mass, u.mass);
+        r_star = pack(u.r_star, u.r_star);
+        m_star = pack(u.m_star, u.m_star);
+        pc = uniform_pc;
+      } else {
+        a.r = pack(radius[p0.a], radius[p1.a]);
+        a.m = pack(mass[p0.a], mass[p1.a]);
+        b.r = pack(radius[p0.b], radius[p1.b]);
+        b.m = pack(mass[p0.b], mass[p1.b]);
+        r_star = reduced_radius(a, b);
+        m_star = reduced_mass(a, b);
+        pc = pack_coefficients(s.table(material[p0.a], material[p0.b]),
+                               s.table(material[p1.a], material[p1.b]));
+      }
+      Lanes3 ht = zero3<Lanes2>(), hr = zero3<Lanes2>();
+      if constexpr (Law::keeps_tangential) ht = pack(springs_t[p0.k], springs_t[p1.k]);
+      Lanes2 overlap;
+      const ContactResultT<Lanes2> r =
+          pair_force<Law>(s, pack(Vec3(x[p0.a] - x[p0.b]), Vec3(x[p1.a] - x[p1.b])), a, b,
+                          r_star, m_star, pc, ht, hr, overlap);
+      if constexpr (Law::keeps_tangential) springs_t[p0.k] = lane(ht, 0);
+      apply(p0, ContactResult{lane(r.force, 0), lane(r.torque_i, 0), lane(r.torque_j, 0)},
+            overlap[0]);
+      if (c + 1 == m) break;
+      if constexpr (Law::keeps_tangential) springs_t[p1.k] = lane(ht, 1);
+      apply(p1, ContactResult{lane(r.force, 1), lane(r.torque_i, 1), lane(r.torque_j, 1)},
+            overlap[1]);
+    }
+  };
   const auto evaluate = [&](int m) __attribute__((always_inline)) {
     if constexpr (Law::lanes) {
-      for (int c = 0; c < m; c += 2) {
-        const Pair p0 = canonical(batch[c]), p1 = canonical(batch[c + 1 < m ? c + 1 : c]);
-        const Body<double> a0 = body(p0.a), b0 = body(p0.b), a1 = body(p1.a), b1 = body(p1.b);
-        const Body<Lanes2> a{pack(a0.v, a1.v), pack(a0.w, a1.w), pack(a0.r, a1.r),
-                             pack(a0.m, a1.m), pack(a0.inertia, a1.inertia)};
-        const Body<Lanes2> b{pack(b0.v, b1.v), pack(b0.w, b1.w), pack(b0.r, b1.r),
-                             pack(b0.m, b1.m), pack(b0.inertia, b1.inertia)};
-        const PairCoefficientLanes pc = pack_coefficients(s.table(material[p0.a], material[p0.b]),
-                                             s.table(material[p1.a], material[p1.b]));
-        Lanes3 ht = zero3<Lanes2>(), hr = zero3<Lanes2>();
-        if constexpr (Law::keeps_tangential) ht = pack(springs_t[p0.k], springs_t[p1.k]);
-        Lanes2 overlap;
-        const ContactResultT<Lanes2> r = pair_force<Law>(
-            s, pack(Vec3(x[p0.a] - x[p0.b]), Vec3(x[p1.a] - x[p1.b])), a, b, pc, ht, hr, overlap);
-        if constexpr (Law::keeps_tangential) springs_t[p0.k] = lane(ht, 0);
-        apply(p0, ContactResult{lane(r.force, 0), lane(r.torque_i, 0), lane(r.torque_j, 0)},
-              overlap[0]);
-        if (c + 1 == m) break;
-        if constexpr (Law::keeps_tangential) springs_t[p1.k] = lane(ht, 1);
-        apply(p1, ContactResult{lane(r.force, 1), lane(r.torque_i, 1), lane(r.torque_j, 1)},
-              overlap[1]);
-      }
+      if (u.all_alike)
+        lanes.template operator()<true>(m);
+      else
+        lanes.template operator()<false>(m);
     } else {
       Vec3 unused;
       for (int c = 0; c < m; ++c) {
         const Pair p0 = canonical(batch[c]);
         Vec3& ht = Law::keeps_tangential ? springs_t[p0.k] : unused;
         Vec3& hr = Law::keeps_rolling ? springs_r[p0.k] : unused;
+        const Body<double> a = body(p0.a), b = body(p0.b);
         double overlap;
-        const ContactResult r =
-            pair_force<Law>(s, Vec3(x[p0.a] - x[p0.b]), body(p0.a), body(p0.b),
-                            s.table(material[p0.a], material[p0.b]), ht, hr, overlap);
+        const ContactResult r = pair_force<Law>(s, Vec3(x[p0.a] - x[p0.b]), a, b,
+                                                reduced_radius(a, b), reduced_mass(a, b),
+                                                s.table(material[p0.a], material[p0.b]), ht, hr,
+                                                overlap);
         apply(p0, r, overlap);
       }
     }
@@ -314,7 +373,8 @@ void ghost_pair_sweep(ContactSweep& s) {
         if constexpr (Law::keeps_tangential) ht = pack(springs_t[p0.k], springs_t[p1.k]);
         Lanes2 overlap;
         const ContactResultT<Lanes2> r =
-            pair_force<Law>(s, pack(p0.d, p1.d), a, b, pc, ht, hr, overlap);
+            pair_force<Law>(s, pack(p0.d, p1.d), a, b, reduced_radius(a, b), reduced_mass(a, b),
+                            pc, ht, hr, overlap);
         if constexpr (Law::keeps_tangential) springs_t[p0.k] = lane(ht, 0);
         apply(p0, ContactResult{lane(r.force, 0), lane(r.torque_i, 0), lane(r.torque_j, 0)},
               overlap[0]);
@@ -330,8 +390,9 @@ void ghost_pair_sweep(ContactSweep& s) {
         Vec3& ht = Law::keeps_tangential ? springs_t[p0.k] : unused;
         Vec3& hr = Law::keeps_rolling ? springs_r[p0.k] : unused;
         double overlap;
-        const ContactResult r =
-            pair_force<Law>(s, p0.d, p0.first, p0.second, table(p0), ht, hr, overlap);
+        const ContactResult r = pair_force<Law>(
+            s, p0.d, p0.first, p0.second, reduced_radius(p0.first, p0.second),
+            reduced_mass(p0.first, p0.second), table(p0), ht, hr, overlap);
         apply(p0, r, overlap);
       }
     }

@@ -426,6 +426,7 @@ void Simulation::rebuild(bool keep_drag) {
     for (int b = 0; b < table_.size(); ++b)
       largest_y_star_ = std::max(largest_y_star_, table_(a, b).y_star);
   }
+  uniform_ = find_uniform_pairs(p_, ghosts_);
   wall_neighbours_.build(p_, walls_, skin_);
   wall_neighbours_.end_unlisted_springs(walls_, wall_history_);
   x_at_build_ = p_.x;
@@ -441,7 +442,7 @@ void Simulation::compute_forces() {
   ContactSweep s{
       p_,     ghosts_,       local_list_,      ghost_list_, local_springs_, ghost_springs_,
       walls_, wall_history_, wall_neighbours_, table_,      constants_,     dt_,
-      0,      0.0,           WorstContact{},   UnresolvedContact{}};
+      uniform_, 0,           0.0,              WorstContact{}, UnresolvedContact{}};
   sweep_.run(s);
   if (scene_.contact.normal == NormalModel::hertz && scene_.time.min_steps_per_contact > 0 &&
       contact_may_be_unresolved()) {

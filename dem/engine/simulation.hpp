@@ -183,6 +183,7 @@ class Simulation {
   ListSprings local_springs_, ghost_springs_;              // parallel to the lists' entries
   std::vector<std::vector<ContactHistory>> wall_history_;  // [WallSet column][particle]
   WallNeighbours wall_neighbours_;                         // rebuilt with the Verlet lists
+  UniformPairs uniform_;                                   // found with the Verlet lists
   WallSet walls_;
   StreamInsertion streams_;
   std::vector<Vec3> x_at_build_;
