@@ -1,10 +1,17 @@
 #pragma once
 // Arithmetic on several contacts at once. The pair kernel is written once for a lane type V:
-// `double` (one contact; 3-vectors are Eigen's Vec3) or `Lanes2` (two contacts side by side,
-// one SSE2 register per quantity; 3-vectors are Lanes3). Every operation is the IEEE operation
-// of each lane — no fused multiply-add, no reassociation, the operands in the order the scalar
-// code uses — so a contact gets bit for bit the same result in either lane of a Lanes2 as it
-// gets alone as a double. Branches of the scalar code become `select`s that compute both sides.
+// `double` (one contact; 3-vectors are Eigen's Vec3), or Lanes2 / Lanes4 (two or four contacts
+// side by side, one vector per quantity; 3-vectors are Lanes3<V>). Every operation is the IEEE
+// operation of each lane — no fused multiply-add, no reassociation, the operands in the order
+// the scalar code uses — so a contact gets bit for bit the same result in any lane of any
+// width as it gets alone as a double. Branches of the scalar code become `select`s that
+// compute both sides.
+//
+// Why lanes: a touching pair's force is one long chain of dependent operations (a square root,
+// a division, the spring's rotation with another of each, the Hertz coefficients with two more
+// square roots), about 150 cycles from the positions to the force, and one pair's chain fills
+// the processor's reorder window, so consecutive pairs hardly overlap. Lanes run several
+// pairs' chains in the same instructions.
 #include <algorithm>
 #include <cmath>
 #include <type_traits>
@@ -15,24 +22,49 @@
 #include <emmintrin.h>
 #endif
 
+// Every function here is inlined: that a Lanes4 would be passed in AVX registers by an
+// out-of-line call, and in memory without AVX, does not matter.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+
 namespace grainflow {
 
-// Two doubles in one vector register (GCC/Clang vector extension: +, -, *, / per lane, and a
-// scalar operand is applied to both lanes). A comparison gives a Mask2 (all bits set or clear).
+// Vectors of doubles (GCC/Clang vector extension: +, -, *, / per lane, and a scalar operand
+// is applied to every lane). Without AVX a Lanes4 is two SSE2 registers. A comparison gives a
+// mask of 64-bit integers, all bits set or clear.
 using Lanes2 = double __attribute__((vector_size(16)));
-using Mask2 = decltype(Lanes2{} < Lanes2{});  // 64-bit integer lanes
+using Lanes4 = double __attribute__((vector_size(32)));
+template <class V>
+concept LaneVector = std::is_same_v<V, Lanes2> || std::is_same_v<V, Lanes4>;
+template <class V>
+inline constexpr int lane_count = std::is_same_v<V, double> ? 1 : sizeof(V) / sizeof(double);
 
-inline Lanes2 lane_sqrt(Lanes2 a) {
+[[gnu::always_inline]] inline Lanes2 lane_sqrt(Lanes2 a) {
 #if defined(__SSE2__)
   return _mm_sqrt_pd(a);
 #else
   return Lanes2{std::sqrt(a[0]), std::sqrt(a[1])};
 #endif
 }
-inline Lanes2 select(Mask2 m, Lanes2 a, Lanes2 b) { return m ? a : b; }
-inline bool any(Mask2 m) { return (m[0] | m[1]) != 0; }
+[[gnu::always_inline]] inline Lanes4 lane_sqrt(Lanes4 a) {
+  const Lanes2 lo = lane_sqrt(Lanes2{a[0], a[1]}), hi = lane_sqrt(Lanes2{a[2], a[3]});
+  return Lanes4{lo[0], lo[1], hi[0], hi[1]};
+}
+template <LaneVector V, class M>
+[[gnu::always_inline]] inline V select(M m, V a, V b) {
+  return m ? a : b;
+}
+template <class M>
+[[gnu::always_inline]] inline bool any(M m) {
+  bool r = false;
+  for (int k = 0; k < static_cast<int>(sizeof(M) / 8); ++k) r |= m[k] != 0;
+  return r;
+}
 // std::max(a, 0.0) lane by lane: a unless a < 0 (a NaN stays NaN).
-inline Lanes2 max0(Lanes2 a) { return select(a < 0.0, Lanes2{0.0, 0.0}, a); }
+template <LaneVector V>
+[[gnu::always_inline]] inline V max0(V a) {
+  return select(a < 0.0, V{}, a);
+}
 
 inline double lane_sqrt(double a) { return std::sqrt(a); }
 inline double select(bool m, double a, double b) { return m ? a : b; }
@@ -41,26 +73,60 @@ inline double max0(double a) { return std::max(a, 0.0); }
 
 // A 3-vector of lanes, with the Eigen operations the kernel uses, component by component in
 // Eigen's order (dot and squared norm as (x + y) + z, the cross product as Eigen writes it).
+template <LaneVector V>
 struct Lanes3 {
-  Lanes2 x, y, z;
+  V x, y, z;
 };
-inline Lanes3 operator+(const Lanes3& a, const Lanes3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline Lanes3 operator-(const Lanes3& a, const Lanes3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline Lanes3 operator-(const Lanes3& a) { return {-a.x, -a.y, -a.z}; }
-inline Lanes3 operator*(Lanes2 s, const Lanes3& a) { return {s * a.x, s * a.y, s * a.z}; }
-inline Lanes3 operator*(const Lanes3& a, Lanes2 s) { return {a.x * s, a.y * s, a.z * s}; }
-inline Lanes3 operator/(const Lanes3& a, Lanes2 s) { return {a.x / s, a.y / s, a.z / s}; }
-inline Lanes3 operator*(double s, const Lanes3& a) { return {s * a.x, s * a.y, s * a.z}; }
-inline Lanes3 operator*(const Lanes3& a, double s) { return {a.x * s, a.y * s, a.z * s}; }
-inline Lanes3& operator+=(Lanes3& a, const Lanes3& b) { return a = a + b; }
-inline Lanes3& operator-=(Lanes3& a, const Lanes3& b) { return a = a - b; }
-inline Lanes3& operator*=(Lanes3& a, Lanes2 s) { return a = a * s; }
-inline Lanes2 dot(const Lanes3& a, const Lanes3& b) { return (a.x * b.x + a.y * b.y) + a.z * b.z; }
-inline Lanes2 squared_norm(const Lanes3& a) { return dot(a, a); }
-inline Lanes3 cross(const Lanes3& a, const Lanes3& b) {
+#define GRAINFLOW_LANES3(op)                                                                   \
+  template <LaneVector V>                                                                      \
+  [[gnu::always_inline]] inline Lanes3<V> operator op(const Lanes3<V>& a, const Lanes3<V>& b) { \
+    return {a.x op b.x, a.y op b.y, a.z op b.z};                                               \
+  }
+GRAINFLOW_LANES3(+)
+GRAINFLOW_LANES3(-)
+#undef GRAINFLOW_LANES3
+template <LaneVector V>
+[[gnu::always_inline]] inline Lanes3<V> operator-(const Lanes3<V>& a) {
+  return {-a.x, -a.y, -a.z};
+}
+template <LaneVector V, class S>
+[[gnu::always_inline]] inline Lanes3<V> operator*(S s, const Lanes3<V>& a) {
+  return {s * a.x, s * a.y, s * a.z};
+}
+template <LaneVector V, class S>
+[[gnu::always_inline]] inline Lanes3<V> operator*(const Lanes3<V>& a, S s) {
+  return {a.x * s, a.y * s, a.z * s};
+}
+template <LaneVector V, class S>
+[[gnu::always_inline]] inline Lanes3<V> operator/(const Lanes3<V>& a, S s) {
+  return {a.x / s, a.y / s, a.z / s};
+}
+template <LaneVector V>
+[[gnu::always_inline]] inline Lanes3<V>& operator+=(Lanes3<V>& a, const Lanes3<V>& b) {
+  return a = a + b;
+}
+template <LaneVector V>
+[[gnu::always_inline]] inline Lanes3<V>& operator-=(Lanes3<V>& a, const Lanes3<V>& b) {
+  return a = a - b;
+}
+template <LaneVector V, class S>
+[[gnu::always_inline]] inline Lanes3<V>& operator*=(Lanes3<V>& a, S s) {
+  return a = a * s;
+}
+template <LaneVector V>
+[[gnu::always_inline]] inline V dot(const Lanes3<V>& a, const Lanes3<V>& b) {
+  return (a.x * b.x + a.y * b.y) + a.z * b.z;
+}
+template <LaneVector V>
+[[gnu::always_inline]] inline V squared_norm(const Lanes3<V>& a) {
+  return dot(a, a);
+}
+template <LaneVector V>
+[[gnu::always_inline]] inline Lanes3<V> cross(const Lanes3<V>& a, const Lanes3<V>& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-inline Lanes3 select(Mask2 m, const Lanes3& a, const Lanes3& b) {
+template <LaneVector V, class M>
+[[gnu::always_inline]] inline Lanes3<V> select(M m, const Lanes3<V>& a, const Lanes3<V>& b) {
   return {select(m, a.x, b.x), select(m, a.y, b.y), select(m, a.z, b.z)};
 }
 
@@ -71,20 +137,49 @@ inline Vec3 select(bool m, const Vec3& a, const Vec3& b) { return m ? a : b; }
 
 // The 3-vector of a lane type, and its zero.
 template <class V>
-using V3 = std::conditional_t<std::is_same_v<V, double>, Vec3, Lanes3>;
+struct V3Of {
+  using type = Lanes3<V>;
+};
+template <>
+struct V3Of<double> {
+  using type = Vec3;
+};
 template <class V>
-V3<V> zero3() {
+using V3 = typename V3Of<V>::type;
+template <class V>
+[[gnu::always_inline]] inline V3<V> zero3() {
   if constexpr (std::is_same_v<V, double>)
     return Vec3::Zero();
   else
-    return Lanes3{V{0.0, 0.0}, V{0.0, 0.0}, V{0.0, 0.0}};
+    return Lanes3<V>{V{}, V{}, V{}};
 }
 
-// Two contacts' values into the lanes of one, and back.
-inline Lanes2 pack(double a, double b) { return Lanes2{a, b}; }
-inline Lanes3 pack(const Vec3& a, const Vec3& b) {
-  return {Lanes2{a[0], b[0]}, Lanes2{a[1], b[1]}, Lanes2{a[2], b[2]}};
+// The values of W contacts into the lanes of one: get(l) gives lane l's value.
+template <class V, class Get>
+[[gnu::always_inline]] inline V gather(Get get) {
+  if constexpr (lane_count<V> == 2)
+    return V{get(0), get(1)};
+  else
+    return V{get(0), get(1), get(2), get(3)};
 }
-inline Vec3 lane(const Lanes3& a, int k) { return Vec3(a.x[k], a.y[k], a.z[k]); }
+template <class V, class Get>
+[[gnu::always_inline]] inline Lanes3<V> gather3(Get get) {
+  if constexpr (lane_count<V> == 2)
+    return {V{get(0)[0], get(1)[0]}, V{get(0)[1], get(1)[1]}, V{get(0)[2], get(1)[2]}};
+  else
+    return {V{get(0)[0], get(1)[0], get(2)[0], get(3)[0]},
+            V{get(0)[1], get(1)[1], get(2)[1], get(3)[1]},
+            V{get(0)[2], get(1)[2], get(2)[2], get(3)[2]}};
+}
+template <LaneVector V>
+[[gnu::always_inline]] inline V broadcast(double a) {
+  return gather<V>([a](int) { return a; });
+}
+template <LaneVector V>
+[[gnu::always_inline]] inline Vec3 lane(const Lanes3<V>& a, int k) {
+  return Vec3(a.x[k], a.y[k], a.z[k]);
+}
 
 }  // namespace grainflow
+
+#pragma GCC diagnostic pop

@@ -48,14 +48,22 @@ struct Body {
 };
 
 // The material-pair constants a lane-capable law reads (HertzNormal, HistoryTangential), for
-// the contacts in the lanes of a Lanes2.
+// the contacts in the lanes of V.
+template <class V>
 struct PairCoefficientLanes {
-  Lanes2 y_star, g_star, hertz_beta, friction;
+  V y_star, g_star, hertz_beta, friction;
 };
-inline PairCoefficientLanes pack_coefficients(const PairCoefficients& a, const PairCoefficients& b) {
-  return {pack(a.y_star, b.y_star), pack(a.g_star, b.g_star), pack(a.hertz_beta, b.hertz_beta),
-          pack(a.friction, b.friction)};
+template <class V, class Get>
+[[gnu::always_inline]] inline PairCoefficientLanes<V> gather_coefficients(Get get) {
+  return {gather<V>([&](int l) { return get(l).y_star; }),
+          gather<V>([&](int l) { return get(l).g_star; }),
+          gather<V>([&](int l) { return get(l).hertz_beta; }),
+          gather<V>([&](int l) { return get(l).friction; })};
 }
+
+// The lane type of the pair sweeps: two pairs at a time, one SSE2 register per quantity (a
+// Lanes4 in two SSE2 registers was slower: GCC moves its halves through memory).
+using PairLanes = Lanes2;
 
 // Whether a listed pair is apart: the Verlet lists hold every pair within the skin, and in
 // a packed bed about three in four of them do not touch. This test comes first, on the
@@ -198,52 +206,61 @@ void local_pair_sweep(ContactSweep& s) {
         gate.set(s.max_overlap_ratio);
       }
   };
-  // The touching entries batch[0, m), in order: two at a time in the lanes of a Lanes2 when
-  // the law can (the last one alone is evaluated twice, its copy discarded), else one by one.
+  // The touching entries batch[0, m), in order: W at a time in the lanes of PairLanes when the
+  // law can (the last group filled up with copies of the last entry, whose results are
+  // discarded), else one by one. With UniformPairs, radii, masses, R*, m* and the material pair
+  // are the same for all.
   const UniformPairs& u = s.uniform;
-  const PairCoefficientLanes uniform_pc =
-      u.all_alike ? pack_coefficients(s.table(u.material, u.material), s.table(u.material, u.material))
-                  : PairCoefficientLanes{};
-  // With UniformPairs, radii, masses, R*, m* and the material pair are the same for all.
+  using V = PairLanes;
+  constexpr int W = lane_count<V>;
+  const PairCoefficientLanes<V> uniform_pc =
+      u.all_alike ? gather_coefficients<V>([&](int) -> const PairCoefficients& {
+        return s.table(u.material, u.material);
+      })
+                  : PairCoefficientLanes<V>{};
   const auto lanes = [&]<bool Alike>(int m) __attribute__((always_inline)) {
-    for (int c = 0; c < m; c += 2) {
-      const Pair p0 = canonical(batch[c]), p1 = canonical(batch[c + 1 < m ? c + 1 : c]);
-      Body<Lanes2> a, b;
-      a.v = pack(v[p0.a], v[p1.a]);
-      a.w = pack(w[p0.a], w[p1.a]);
-      b.v = pack(v[p0.b], v[p1.b]);
-      b.w = pack(w[p0.b], w[p1.b]);
-      Lanes2 r_star, m_star;
-      PairCoefficientLanes pc;
+    for (int c = 0; c < m; c += W) {
+      Pair group[W];
+#pragma GCC unroll 4
+      for (int l = 0; l < W; ++l) group[l] = canonical(batch[std::min(c + l, m - 1)]);
+      Body<V> a, b;
+      a.v = gather3<V>([&](int l) -> const Vec3& { return v[group[l].a]; });
+      a.w = gather3<V>([&](int l) -> const Vec3& { return w[group[l].a]; });
+      b.v = gather3<V>([&](int l) -> const Vec3& { return v[group[l].b]; });
+      b.w = gather3<V>([&](int l) -> const Vec3& { return w[group[l].b]; });
+      V r_star, m_star;
+      PairCoefficientLanes<V> pc;
       if constexpr (Alike) {
-        a.r = b.r = pack(u.radius, u.radius);
-        a.m = b.m = pack(u.mass, u.mass);
-        r_star = pack(u.r_star, u.r_star);
-        m_star = pack(u.m_star, u.m_star);
+        a.r = b.r = broadcast<V>(u.radius);
+        a.m = b.m = broadcast<V>(u.mass);
+        r_star = broadcast<V>(u.r_star);
+        m_star = broadcast<V>(u.m_star);
         pc = uniform_pc;
       } else {
-        a.r = pack(radius[p0.a], radius[p1.a]);
-        a.m = pack(mass[p0.a], mass[p1.a]);
-        b.r = pack(radius[p0.b], radius[p1.b]);
-        b.m = pack(mass[p0.b], mass[p1.b]);
+        a.r = gather<V>([&](int l) { return radius[group[l].a]; });
+        a.m = gather<V>([&](int l) { return mass[group[l].a]; });
+        b.r = gather<V>([&](int l) { return radius[group[l].b]; });
+        b.m = gather<V>([&](int l) { return mass[group[l].b]; });
         r_star = reduced_radius(a, b);
         m_star = reduced_mass(a, b);
-        pc = pack_coefficients(s.table(material[p0.a], material[p0.b]),
-                               s.table(material[p1.a], material[p1.b]));
+        pc = gather_coefficients<V>([&](int l) -> const PairCoefficients& {
+          return s.table(material[group[l].a], material[group[l].b]);
+        });
       }
-      Lanes3 ht = zero3<Lanes2>(), hr = zero3<Lanes2>();
-      if constexpr (Law::keeps_tangential) ht = pack(springs_t[p0.k], springs_t[p1.k]);
-      Lanes2 overlap;
-      const ContactResultT<Lanes2> r =
-          pair_force<Law>(s, pack(Vec3(x[p0.a] - x[p0.b]), Vec3(x[p1.a] - x[p1.b])), a, b,
-                          r_star, m_star, pc, ht, hr, overlap);
-      if constexpr (Law::keeps_tangential) springs_t[p0.k] = lane(ht, 0);
-      apply(p0, ContactResult{lane(r.force, 0), lane(r.torque_i, 0), lane(r.torque_j, 0)},
-            overlap[0]);
-      if (c + 1 == m) break;
-      if constexpr (Law::keeps_tangential) springs_t[p1.k] = lane(ht, 1);
-      apply(p1, ContactResult{lane(r.force, 1), lane(r.torque_i, 1), lane(r.torque_j, 1)},
-            overlap[1]);
+      V3<V> ht = zero3<V>(), hr = zero3<V>();
+      if constexpr (Law::keeps_tangential)
+        ht = gather3<V>([&](int l) -> const Vec3& { return springs_t[group[l].k]; });
+      V overlap;
+      const ContactResultT<V> r = pair_force<Law>(
+          s, gather3<V>([&](int l) { return Vec3(x[group[l].a] - x[group[l].b]); }), a, b, r_star,
+          m_star, pc, ht, hr, overlap);
+#pragma GCC unroll 4
+      for (int l = 0; l < W; ++l) {
+        if (c + l == m) break;
+        if constexpr (Law::keeps_tangential) springs_t[group[l].k] = lane(ht, l);
+        apply(group[l], ContactResult{lane(r.force, l), lane(r.torque_i, l), lane(r.torque_j, l)},
+              overlap[l]);
+      }
     }
   };
   const auto evaluate = [&](int m) __attribute__((always_inline)) {
@@ -358,30 +375,39 @@ void ghost_pair_sweep(ContactSweep& s) {
         gate.set(s.max_overlap_ratio);
       }
   };
+  using V = PairLanes;
+  constexpr int W = lane_count<V>;
   const auto evaluate = [&](int m) __attribute__((always_inline)) {
     if constexpr (Law::lanes) {
-      for (int c = 0; c < m; c += 2) {
-        const Pair p0 = canonical(batch[c]), p1 = canonical(batch[c + 1 < m ? c + 1 : c]);
-        const Body<Lanes2> a{pack(p0.first.v, p1.first.v), pack(p0.first.w, p1.first.w),
-                             pack(p0.first.r, p1.first.r), pack(p0.first.m, p1.first.m),
-                             pack(p0.first.inertia, p1.first.inertia)};
-        const Body<Lanes2> b{pack(p0.second.v, p1.second.v), pack(p0.second.w, p1.second.w),
-                             pack(p0.second.r, p1.second.r), pack(p0.second.m, p1.second.m),
-                             pack(p0.second.inertia, p1.second.inertia)};
-        const PairCoefficientLanes pc = pack_coefficients(table(p0), table(p1));
-        Lanes3 ht = zero3<Lanes2>(), hr = zero3<Lanes2>();
-        if constexpr (Law::keeps_tangential) ht = pack(springs_t[p0.k], springs_t[p1.k]);
-        Lanes2 overlap;
-        const ContactResultT<Lanes2> r =
-            pair_force<Law>(s, pack(p0.d, p1.d), a, b, reduced_radius(a, b), reduced_mass(a, b),
-                            pc, ht, hr, overlap);
-        if constexpr (Law::keeps_tangential) springs_t[p0.k] = lane(ht, 0);
-        apply(p0, ContactResult{lane(r.force, 0), lane(r.torque_i, 0), lane(r.torque_j, 0)},
-              overlap[0]);
-        if (c + 1 == m) break;
-        if constexpr (Law::keeps_tangential) springs_t[p1.k] = lane(ht, 1);
-        apply(p1, ContactResult{lane(r.force, 1), lane(r.torque_i, 1), lane(r.torque_j, 1)},
-              overlap[1]);
+      for (int c = 0; c < m; c += W) {
+        Pair group[W];
+#pragma GCC unroll 4
+        for (int l = 0; l < W; ++l) group[l] = canonical(batch[std::min(c + l, m - 1)]);
+        Body<V> a, b;
+        a.v = gather3<V>([&](int l) -> const Vec3& { return group[l].first.v; });
+        a.w = gather3<V>([&](int l) -> const Vec3& { return group[l].first.w; });
+        a.r = gather<V>([&](int l) { return group[l].first.r; });
+        a.m = gather<V>([&](int l) { return group[l].first.m; });
+        b.v = gather3<V>([&](int l) -> const Vec3& { return group[l].second.v; });
+        b.w = gather3<V>([&](int l) -> const Vec3& { return group[l].second.w; });
+        b.r = gather<V>([&](int l) { return group[l].second.r; });
+        b.m = gather<V>([&](int l) { return group[l].second.m; });
+        const PairCoefficientLanes<V> pc =
+            gather_coefficients<V>([&](int l) -> const PairCoefficients& { return table(group[l]); });
+        V3<V> ht = zero3<V>(), hr = zero3<V>();
+        if constexpr (Law::keeps_tangential)
+          ht = gather3<V>([&](int l) -> const Vec3& { return springs_t[group[l].k]; });
+        V overlap;
+        const ContactResultT<V> r =
+            pair_force<Law>(s, gather3<V>([&](int l) -> const Vec3& { return group[l].d; }), a, b,
+                            reduced_radius(a, b), reduced_mass(a, b), pc, ht, hr, overlap);
+#pragma GCC unroll 4
+        for (int l = 0; l < W; ++l) {
+          if (c + l == m) break;
+          if constexpr (Law::keeps_tangential) springs_t[group[l].k] = lane(ht, l);
+          apply(group[l], ContactResult{lane(r.force, l), lane(r.torque_i, l), lane(r.torque_j, l)},
+                overlap[l]);
+        }
       }
     } else {
       Vec3 unused;
