@@ -130,7 +130,7 @@ void Simulation::initialise() {
   if (restoring)
     restore_implicit_drag();
   else
-    compute_forces();
+    check_contacts(compute_forces(), true);
   initialised_ = true;
 }
 
@@ -433,7 +433,7 @@ void Simulation::rebuild(bool keep_drag) {
   ++counters_.rebuilds;
 }
 
-void Simulation::compute_forces() {
+ContactGuards Simulation::compute_forces() {
   const Vec3 g = scene_.gravity;
   for (std::size_t i = 0; i < p_.size(); ++i) {
     p_.force[i] = p_.mass[i] * g;
@@ -451,8 +451,8 @@ void Simulation::compute_forces() {
   }
   counters_.contacts = s.contacts;
   counters_.max_overlap_ratio = s.max_overlap_ratio;
-  check_contacts(s);
   apply_force_terms();
+  return {s.worst, s.unresolved};
 }
 
 bool Simulation::contact_may_be_unresolved() const {
@@ -471,17 +471,20 @@ bool Simulation::contact_may_be_unresolved() const {
   return 4 * v2 >= floor * floor;
 }
 
-void Simulation::check_contacts(const ContactSweep& s) const {
-  // One reduction serves both guards, and they speak only when some rank is beyond a
-  // limit, which every rank learns through it: keep the common path to that one call.
+bool Simulation::check_contacts(const ContactGuards& s, bool finite_here) const {
+  // One reduction serves both guards and the finiteness of the step's end, and the guards
+  // speak only when some rank is beyond a limit, which every rank learns through it: keep
+  // the common path to that one call.
   const double limit = scene_.time.max_overlap;
   const double n_min = scene_.time.min_steps_per_contact;
-  // Largest overlap ratio; fewest steps per contact as N_min / N (> 1 when under-resolved).
-  const double mine[2] = {counters_.max_overlap_ratio,
-                          s.unresolved.fewest > 0 ? n_min / s.unresolved.fewest : 0.0};
-  double worst[2] = {mine[0], mine[1]};
-  if (decomp_->size() > 1) MPI_Allreduce(MPI_IN_PLACE, worst, 2, MPI_DOUBLE, MPI_MAX, comm_);
-  if (worst[0] <= limit && worst[1] <= 1) return;
+  // Largest overlap ratio; fewest steps per contact as N_min / N (> 1 when under-resolved);
+  // 1 when this rank holds a non-finite state.
+  const double mine[3] = {counters_.max_overlap_ratio,
+                          s.unresolved.fewest > 0 ? n_min / s.unresolved.fewest : 0.0,
+                          finite_here ? 0.0 : 1.0};
+  double worst[3] = {mine[0], mine[1], mine[2]};
+  if (decomp_->size() > 1) MPI_Allreduce(MPI_IN_PLACE, worst, 3, MPI_DOUBLE, MPI_MAX, comm_);
+  if (worst[0] <= limit && worst[1] <= 1) return worst[2] == 0;
   std::ostringstream o;
   o.precision(4);
   o << scene_.file << ": error: t = " << time_ << " s (step " << counters_.steps + 1 << "): ";
@@ -489,7 +492,7 @@ void Simulation::check_contacts(const ContactSweep& s) const {
   const WorstContact& w = overlap ? s.worst : s.unresolved.contact;
   if (overlap ? mine[0] != worst[0] : mine[1] != worst[1]) {
     agree_on_error(comm_, "");  // another rank holds the contact and speaks
-    return;
+    return worst[2] == 0;       // not reached
   }
   if (w.b >= 0)
     o << "particles " << w.a << " and " << w.b;
@@ -526,6 +529,7 @@ void Simulation::check_contacts(const ContactSweep& s) const {
         << "raise the Young's modulus";
   }
   agree_on_error(comm_, o.str());  // the rank holding the worst contact speaks
+  return worst[2] == 0;              // not reached: agree_on_error throws on every rank
 }
 
 void Simulation::restore_implicit_drag() {
@@ -598,8 +602,9 @@ void Simulation::step() {
     exchange_->forward(p_, ghosts_);
   time_ += dt_;
   walls_.move_to(time_);
-  compute_forces();
+  const ContactGuards guards = compute_forces();
   state_finite_ = half_kick<true>();
+  finite_everywhere_ = check_contacts(guards, state_finite_);
   ++counters_.steps;
 }
 

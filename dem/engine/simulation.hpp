@@ -55,6 +55,12 @@ struct GlobalState {
   double kinetic_rotational = 0;
 };
 
+// What the contact sweep of a step found for the guards (Simulation::check_contacts).
+struct ContactGuards {
+  WorstContact worst;            // the contact with the largest overlap ratio
+  UnresolvedContact unresolved;  // the least-resolved Hertz contact
+};
+
 class Simulation {
  public:
   // Inserts the scene's particles (every rank inserts the same set; initialise()
@@ -98,6 +104,9 @@ class Simulation {
   // Whether every position, velocity and spin of this rank's particles was finite at the
   // end of the last step() (checked in its last pass over the particles).
   bool state_finite() const { return state_finite_; }
+  // The same for every rank's particles, agreed in the step's one reduction (collective
+  // answer, no communication here).
+  bool state_finite_everywhere() const { return finite_everywhere_; }
   const Ghosts& ghosts() const { return ghosts_; }
   const Scene& scene() const { return scene_; }
   const WallSet& walls() const { return walls_; }               // current wall positions
@@ -137,14 +146,15 @@ class Simulation {
  private:
   void rebuild(bool keep_drag = false);
   void balance_cuts();  // moves cut planes toward equal particle counts (collective)
-  void compute_forces();     // gravity, contacts, then the force terms
+  ContactGuards compute_forces();  // gravity, contacts, then the force terms
   void apply_force_terms();  // non-contact terms only
   void restore_implicit_drag();  // initialise() after restore()
   // Stops the run (ParallelError on every rank) when a contact overlaps beyond
   // time.max_overlap, or when a Hertz contact gets fewer than time.min_steps_per_contact
   // steps at its own approach speed; the message names the contact and a time step that
-  // would resolve it.
-  void check_contacts(const ContactSweep& sweep) const;
+  // would resolve it. Returns whether every rank's state is finite (`finite_here`: this
+  // rank's). Collective: the step's one reduction.
+  bool check_contacts(const ContactGuards& guards, bool finite_here) const;
   // Whether any contact of this step could fail the steps-per-contact test (else the
   // sweep skips it): a bound from the fastest local or ghost particle.
   bool contact_may_be_unresolved() const;
@@ -198,6 +208,7 @@ class Simulation {
   std::optional<CarriedState> pending_carried_;     // springs for the first rebuild
   bool moved_beyond_half_skin_ = false;             // by the last drift(), since the last rebuild
   bool state_finite_ = true;                        // after the last step(), this rank's particles
+  bool finite_everywhere_ = true;                   // the same, every rank's
   bool restored_ = false;                           // initialise() keeps the forces read
   bool initialised_ = false;
 };
