@@ -309,6 +309,7 @@ void local_pair_sweep(ContactSweep& s) {
 
 template <class Law>
 void ghost_pair_sweep(ContactSweep& s) {
+  if (s.ghost_list.pairs() == 0) return;  // one rank without periodic sides
   Particles& p = s.p;
   const Ghosts& g = s.ghosts;
   const int n = static_cast<int>(p.size());
@@ -427,9 +428,11 @@ void ghost_pair_sweep(ContactSweep& s) {
   while (i < n) {
     int m = 0;
     for (; i < n; ++i, k = i < n ? offsets[i] : k) {
+      const int end = offsets[i + 1];
+      if (k == end) continue;  // most particles have no ghost partner
       const Vec3 xi = x[i];
       const double ri = radius[i];
-      const int end = offsets[i + 1], stop = std::min(end, k + (kBatch - m));
+      const int stop = std::min(end, k + (kBatch - m));
       for (; k < stop; ++k) {
         const int q = partner[k];
         const bool touching = !apart((xi - g_x[q]) + (zero - g_shift[q]), ri + g_radius[q]);

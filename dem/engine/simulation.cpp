@@ -145,9 +145,12 @@ void Simulation::mark_leaving() {
       }
 }
 
-void Simulation::drift() {
-  // One pass: x += dt v, then the tests of mark_leaving() and of the skin, on the new x.
-  // A periodic side has infinite bounds here: nothing leaves through it.
+void Simulation::kick_and_drift() {
+  // One pass over the particles: the first half kick (as half_kick()), x += dt v, then the
+  // tests of mark_leaving() and of the skin on the new x, and the largest |v|^2 for
+  // contact_may_be_unresolved(). Each particle's operations are those of the separate
+  // passes, in the same order. A periodic side has infinite bounds here: nothing leaves
+  // through it.
   const Domain& d = scene_.domain;
   constexpr double inf = std::numeric_limits<double>::infinity();
   Vec3 lo, hi;
@@ -157,19 +160,51 @@ void Simulation::drift() {
   }
   const double limit2 = 0.25 * skin_ * skin_;
   const std::size_t n = p_.size();
-  bool moved_far = false;
+  // The arrays' addresses and dt read once: a store through x could otherwise change them.
+  const double dt = dt_, h = 0.5 * dt_;
+  Vec3* xs = p_.x.data();
+  Vec3* vs = p_.v.data();
+  Vec3* ws = p_.omega.data();
+  const Vec3* force = p_.force.data();
+  const Vec3* torque = p_.torque.data();
+  const double* mass = p_.mass.data();
+  const double* inertia = p_.inertia.data();
+  const double* drag_k = drag_.coefficient.data();
+  const Vec3* fluid_u = drag_.fluid_velocity.data();
+  const Vec3* built = x_at_build_.data();
   leaving_.clear();
-  for (std::size_t i = 0; i < n; ++i) {
-    Vec3& x = p_.x[i];
-    x += dt_ * p_.v[i];
-    moved_far |= (x - x_at_build_[i]).squaredNorm() > limit2;
-    if (x[0] < lo[0] || x[0] > hi[0] || x[1] < lo[1] || x[1] > hi[1] || x[2] < lo[2] ||
-        x[2] > hi[2]) {
-      leaving_.resize(n, 0);
-      leaving_[i] = 1;
+  const auto pass = [&]<bool Drag, bool Spin>() {
+    bool moved_far = false;
+    double v2 = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      Vec3& v = vs[i];
+      if constexpr (!Drag) {
+        v += (h / mass[i]) * force[i];
+      } else {
+        const double a = h / mass[i], k = drag_k[i];
+        v = (v + a * (force[i] + k * fluid_u[i])) / (1 + a * k);
+      }
+      if constexpr (Spin) ws[i] += (h / inertia[i]) * torque[i];
+      Vec3& x = xs[i];
+      x += dt * v;
+      moved_far |= (x - built[i]).squaredNorm() > limit2;
+      // | rather than ||: one branch, taken only by a particle that leaves.
+      if ((x[0] < lo[0]) | (x[0] > hi[0]) | (x[1] < lo[1]) | (x[1] > hi[1]) | (x[2] < lo[2]) |
+          (x[2] > hi[2])) [[unlikely]] {
+        leaving_.resize(n, 0);
+        leaving_[i] = 1;
+      }
+      v2 = std::max(v2, v.squaredNorm());
     }
-  }
-  moved_beyond_half_skin_ = moved_far;
+    moved_beyond_half_skin_ = moved_far;
+    local_speed2_ = v2;
+  };
+  const bool drag = !drag_.coefficient.empty(), spin = sweep_.needs_spin;
+  if (drag)
+    spin ? pass.template operator()<true, true>() : pass.template operator()<true, false>();
+  else
+    spin ? pass.template operator()<false, true>() : pass.template operator()<false, false>();
+  local_speed2_known_ = true;
 }
 
 bool Simulation::needs_rebuild() const {
@@ -449,6 +484,7 @@ ContactGuards Simulation::compute_forces() {
     s.unresolved.set(scene_.time.min_steps_per_contact, dt_);
     steps_per_contact_sweep(s);
   }
+  local_speed2_known_ = false;
   counters_.contacts = s.contacts;
   counters_.max_overlap_ratio = s.max_overlap_ratio;
   apply_force_terms();
@@ -464,7 +500,10 @@ bool Simulation::contact_may_be_unresolved() const {
   for (const WallSet::Entry& w : walls_.walls())
     if (w.pose.moving() || w.surface_velocity.squaredNorm() > 0) return true;
   double v2 = 0;
-  for (const Vec3& v : p_.v) v2 = std::max(v2, v.squaredNorm());
+  if (local_speed2_known_)
+    v2 = local_speed2_;  // found by kick_and_drift() in the same order
+  else
+    for (const Vec3& v : p_.v) v2 = std::max(v2, v.squaredNorm());
   for (const Vec3& v : ghosts_.v) v2 = std::max(v2, v.squaredNorm());
   const double k = std::pow(scene_.time.min_steps_per_contact * dt_ / 2.868, 5);
   const double floor = lightest_q_ / (4 * k * largest_y_star_ * largest_y_star_);
@@ -563,42 +602,61 @@ void Simulation::apply_force_terms() {
   }
 }
 
+namespace {
+// One half kick of velocity Verlet over n particles: v += h/m F (implicit in v where drag
+// is set), and w += h/I T when the law has torques. Written on the arrays' addresses, one
+// loop per case, so that the loops hold no branch and no reload of an address. With Guard,
+// returns whether every x, v and w is finite after it: x - x is 0 for a finite x and NaN
+// for an infinite or NaN one, and NaN stays in a sum.
+template <bool Guard, bool Drag, bool Spin>
+bool kick(std::size_t n, double h, const Vec3* x, Vec3* v, Vec3* w, const Vec3* force,
+          const Vec3* torque, const double* mass, const double* inertia, const double* drag_k,
+          const Vec3* fluid_u) {
+  double nan_if_any = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if constexpr (!Drag) {
+      v[i] += (h / mass[i]) * force[i];
+    } else {
+      // v' = v + h/m (F + K (u - v'))  =>  v' = (v + h/m (F + K u)) / (1 + h K / m)
+      const double a = h / mass[i], k = drag_k[i];
+      v[i] = (v[i] + a * (force[i] + k * fluid_u[i])) / (1 + a * k);
+    }
+    if constexpr (Spin) w[i] += (h / inertia[i]) * torque[i];
+    if constexpr (Guard) nan_if_any += ((x[i] - x[i]) + (v[i] - v[i]) + (w[i] - w[i])).sum();
+  }
+  return nan_if_any == 0;
+}
+}  // namespace
+
 template <bool Guard>
 bool Simulation::half_kick() {
   const double h = 0.5 * dt_;
   const std::size_t n = p_.size();
+  const double* k = drag_.coefficient.data();
+  const Vec3* u = drag_.fluid_velocity.data();
+  Particles& p = p_;
+  const auto run = [&]<bool Drag, bool Spin>() {
+    return kick<Guard, Drag, Spin>(n, h, p.x.data(), p.v.data(), p.omega.data(), p.force.data(),
+                                   p.torque.data(), p.mass.data(), p.inertia.data(), k, u);
+  };
   const bool drag = !drag_.coefficient.empty(), spin = sweep_.needs_spin;
-  // x - x is 0 for a finite x and NaN for an infinite or NaN one, and NaN stays in a sum:
-  // `nan_if_any` ends 0 exactly when every component was finite.
-  double nan_if_any = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!drag) {
-      p_.v[i] += (h / p_.mass[i]) * p_.force[i];
-    } else {
-      // v' = v + h/m (F + K (u - v'))  =>  v' = (v + h/m (F + K u)) / (1 + h K / m)
-      const double a = h / p_.mass[i], k = drag_.coefficient[i];
-      p_.v[i] = (p_.v[i] + a * (p_.force[i] + k * drag_.fluid_velocity[i])) / (1 + a * k);
-    }
-    if (spin) p_.omega[i] += (h / p_.inertia[i]) * p_.torque[i];
-    if constexpr (Guard)
-      nan_if_any += ((p_.x[i] - p_.x[i]) + (p_.v[i] - p_.v[i]) + (p_.omega[i] - p_.omega[i])).sum();
-  }
-  return nan_if_any == 0;
+  if (drag) return spin ? run.template operator()<true, true>() : run.template operator()<true, false>();
+  return spin ? run.template operator()<false, true>() : run.template operator()<false, false>();
 }
 
 void Simulation::step() {
   if (!initialised_) initialise();
   // Velocity Verlet: half kick, drift, new forces, half kick.
-  half_kick<false>();
-  drift();
+  kick_and_drift();
   // Stream insertion (dem/insert/stream_insertion.hpp); new particles force a rebuild.
   const bool inserted = !streams_.empty() && streams_.insert(time_ + dt_, p_, ghosts_, walls_,
                                                              *decomp_, next_id_, comm_) > 0;
   for (auto& column : wall_history_) column.resize(p_.size());
   if (inserted) mark_leaving();  // the new particles too
-  if (inserted || needs_rebuild())
+  if (inserted || needs_rebuild()) {
     rebuild();
-  else
+    local_speed2_known_ = false;  // particles came, left or arrived from other ranks
+  } else
     exchange_->forward(p_, ghosts_);
   time_ += dt_;
   walls_.move_to(time_);
