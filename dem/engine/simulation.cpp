@@ -148,9 +148,10 @@ void Simulation::mark_leaving() {
 void Simulation::kick_and_drift() {
   // One pass over the particles: the first half kick (as half_kick()), x += dt v, then the
   // tests of mark_leaving() and of the skin on the new x, and the largest |v|^2 for
-  // contact_may_be_unresolved(). Each particle's operations are those of the separate
-  // passes, in the same order. A periodic side has infinite bounds here: nothing leaves
-  // through it.
+  // contact_may_be_unresolved(). The kick is the last use of the step's forces, so the same
+  // pass sets them to gravity for the next evaluation (compute_forces()). Each particle's
+  // operations are those of the separate passes, in the same order. A periodic side has
+  // infinite bounds here: nothing leaves through it.
   const Domain& d = scene_.domain;
   constexpr double inf = std::numeric_limits<double>::infinity();
   Vec3 lo, hi;
@@ -165,8 +166,9 @@ void Simulation::kick_and_drift() {
   Vec3* xs = p_.x.data();
   Vec3* vs = p_.v.data();
   Vec3* ws = p_.omega.data();
-  const Vec3* force = p_.force.data();
-  const Vec3* torque = p_.torque.data();
+  Vec3* force = p_.force.data();
+  Vec3* torque = p_.torque.data();
+  const Vec3 g = scene_.gravity;
   const double* mass = p_.mass.data();
   const double* inertia = p_.inertia.data();
   const double* drag_k = drag_.coefficient.data();
@@ -185,6 +187,8 @@ void Simulation::kick_and_drift() {
         v = (v + a * (force[i] + k * fluid_u[i])) / (1 + a * k);
       }
       if constexpr (Spin) ws[i] += (h / inertia[i]) * torque[i];
+      force[i] = mass[i] * g;
+      torque[i].setZero();
       Vec3& x = xs[i];
       x += dt * v;
       moved_far |= (x - built[i]).squaredNorm() > limit2;
@@ -204,7 +208,7 @@ void Simulation::kick_and_drift() {
     spin ? pass.template operator()<true, true>() : pass.template operator()<true, false>();
   else
     spin ? pass.template operator()<false, true>() : pass.template operator()<false, false>();
-  local_speed2_known_ = true;
+  fresh_from_kick_ = true;
 }
 
 bool Simulation::needs_rebuild() const {
@@ -469,10 +473,12 @@ void Simulation::rebuild(bool keep_drag) {
 }
 
 ContactGuards Simulation::compute_forces() {
-  const Vec3 g = scene_.gravity;
-  for (std::size_t i = 0; i < p_.size(); ++i) {
-    p_.force[i] = p_.mass[i] * g;
-    p_.torque[i].setZero();
+  if (!fresh_from_kick_) {  // else kick_and_drift() has set them
+    const Vec3 g = scene_.gravity;
+    for (std::size_t i = 0; i < p_.size(); ++i) {
+      p_.force[i] = p_.mass[i] * g;
+      p_.torque[i].setZero();
+    }
   }
   ContactSweep s{
       p_,     ghosts_,       local_list_,      ghost_list_, local_springs_, ghost_springs_,
@@ -484,7 +490,7 @@ ContactGuards Simulation::compute_forces() {
     s.unresolved.set(scene_.time.min_steps_per_contact, dt_);
     steps_per_contact_sweep(s);
   }
-  local_speed2_known_ = false;
+  fresh_from_kick_ = false;
   counters_.contacts = s.contacts;
   counters_.max_overlap_ratio = s.max_overlap_ratio;
   apply_force_terms();
@@ -500,7 +506,7 @@ bool Simulation::contact_may_be_unresolved() const {
   for (const WallSet::Entry& w : walls_.walls())
     if (w.pose.moving() || w.surface_velocity.squaredNorm() > 0) return true;
   double v2 = 0;
-  if (local_speed2_known_)
+  if (fresh_from_kick_)
     v2 = local_speed2_;  // found by kick_and_drift() in the same order
   else
     for (const Vec3& v : p_.v) v2 = std::max(v2, v.squaredNorm());
@@ -655,7 +661,7 @@ void Simulation::step() {
   if (inserted) mark_leaving();  // the new particles too
   if (inserted || needs_rebuild()) {
     rebuild();
-    local_speed2_known_ = false;  // particles came, left or arrived from other ranks
+    fresh_from_kick_ = false;  // particles came, left or arrived from other ranks
   } else
     exchange_->forward(p_, ghosts_);
   time_ += dt_;

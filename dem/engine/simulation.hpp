@@ -161,7 +161,8 @@ class Simulation {
   bool needs_rebuild() const;  // collective
   void mark_leaving();         // particles beyond a bounded side of the domain
   // The first half kick and x += dt v in one pass, with mark_leaving()'s test, the skin test
-  // and the largest local |v|^2 (for contact_may_be_unresolved()).
+  // and the largest local |v|^2 (for contact_may_be_unresolved()); forces and torques set to
+  // gravity and zero for the next evaluation.
   void kick_and_drift();
   // v += dt/2 F/m (implicit in v where drag is set), same for spin. With Guard: returns
   // whether every position, velocity and spin is finite after it (false otherwise).
@@ -208,8 +209,8 @@ class Simulation {
   std::unordered_map<GlobalId, std::pair<double, Vec3>> restored_drag_;
   std::optional<CarriedState> pending_carried_;     // springs for the first rebuild
   bool moved_beyond_half_skin_ = false;             // by the last drift(), since the last rebuild
-  double local_speed2_ = 0;           // largest local |v|^2 after this step's drift
-  bool local_speed2_known_ = false;   // ... when no rebuild came since
+  double local_speed2_ = 0;      // largest local |v|^2 after this step's drift
+  bool fresh_from_kick_ = false;  // kick_and_drift() ran (speeds, gravity) and no rebuild since
   bool state_finite_ = true;                        // after the last step(), this rank's particles
   bool finite_everywhere_ = true;                   // the same, every rank's
   bool restored_ = false;                           // initialise() keeps the forces read
