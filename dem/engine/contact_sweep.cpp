@@ -286,23 +286,20 @@ void local_pair_sweep(ContactSweep& s) {
       }
     }
   };
-  // Fills the batch, evaluates it, fills it again from where it stopped (within a
-  // particle's list if need be); one call site keeps the kernel inlined.
-  int i = 0, k = n > 0 ? offsets[0] : 0;
-  while (i < n) {
+  // Over all entries in one loop (NeighbourList::owner), kBatch at a time: the touching ones
+  // of each group are evaluated before the next group is tested; one call site keeps the
+  // kernel inlined.
+  const int* owner = s.local_list.owner.data();
+  const int entries = n > 0 ? offsets[n] : 0;
+  for (int k = n > 0 ? offsets[0] : 0; k < entries;) {
     int m = 0;
-    for (; i < n; ++i, k = i < n ? offsets[i] : k) {
-      const Vec3 xi = x[i];
-      const double ri = radius[i];
-      const int end = offsets[i + 1], stop = std::min(end, k + (kBatch - m));
-      for (; k < stop; ++k) {
-        const bool touching = !apart(xi - x[partner[k]], ri + radius[partner[k]]);
-        batch[m] = {i, k};
-        m += touching;
-        if constexpr (Law::keeps_tangential) keep_or_zero(touching, springs_t[k]);
-        if constexpr (Law::keeps_rolling) keep_or_zero(touching, springs_r[k]);
-      }
-      if (k < end) break;  // batch offered its last free place: evaluate, then go on with i
+    for (const int stop = std::min(entries, k + kBatch); k < stop; ++k) {
+      const int i = owner[k], j = partner[k];
+      const bool touching = !apart(x[i] - x[j], radius[i] + radius[j]);
+      batch[m] = {i, k};
+      m += touching;
+      if constexpr (Law::keeps_tangential) keep_or_zero(touching, springs_t[k]);
+      if constexpr (Law::keeps_rolling) keep_or_zero(touching, springs_r[k]);
     }
     evaluate(m);
   }
@@ -310,7 +307,6 @@ void local_pair_sweep(ContactSweep& s) {
 
 template <class Law>
 void ghost_pair_sweep(ContactSweep& s) {
-  if (s.ghost_list.pairs() == 0) return;  // one rank without periodic sides
   Particles& p = s.p;
   const Ghosts& g = s.ghosts;
   const int n = static_cast<int>(p.size());
@@ -425,24 +421,17 @@ void ghost_pair_sweep(ContactSweep& s) {
       }
     }
   };
-  int i = 0, k = n > 0 ? offsets[0] : 0;
-  while (i < n) {
+  const int* owner = s.ghost_list.owner.data();
+  const int entries = n > 0 ? offsets[n] : 0;
+  for (int k = n > 0 ? offsets[0] : 0; k < entries;) {
     int m = 0;
-    for (; i < n; ++i, k = i < n ? offsets[i] : k) {
-      const int end = offsets[i + 1];
-      if (k == end) continue;  // most particles have no ghost partner
-      const Vec3 xi = x[i];
-      const double ri = radius[i];
-      const int stop = std::min(end, k + (kBatch - m));
-      for (; k < stop; ++k) {
-        const int q = partner[k];
-        const bool touching = !apart((xi - g_x[q]) + (zero - g_shift[q]), ri + g_radius[q]);
-        batch[m] = {i, k};
-        m += touching;
-        if constexpr (Law::keeps_tangential) keep_or_zero(touching, springs_t[k]);
-        if constexpr (Law::keeps_rolling) keep_or_zero(touching, springs_r[k]);
-      }
-      if (k < end) break;
+    for (const int stop = std::min(entries, k + kBatch); k < stop; ++k) {
+      const int i = owner[k], q = partner[k];
+      const bool touching = !apart((x[i] - g_x[q]) + (zero - g_shift[q]), radius[i] + g_radius[q]);
+      batch[m] = {i, k};
+      m += touching;
+      if constexpr (Law::keeps_tangential) keep_or_zero(touching, springs_t[k]);
+      if constexpr (Law::keeps_rolling) keep_or_zero(touching, springs_r[k]);
     }
     evaluate(m);
   }
