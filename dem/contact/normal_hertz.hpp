@@ -2,7 +2,10 @@
 // Hertz-Mindlin normal and tangential stiffness with restitution damping.
 // S_n = 2 Y* sqrt(R* d), S_t = 8 G* sqrt(R* d), k_n = (4/3) Y* sqrt(R* d), k_t = S_t,
 // gamma_{n,t} = 2 sqrt(5/6) b sqrt(S_{n,t} m*)   (Hertz 1881; Mindlin 1949; Tsuji et al. 1992),
-// with b mapped exactly to the requested restitution (restitution_mapping.hpp).
+// with b mapped exactly to the requested restitution (restitution_mapping.hpp). Since
+// S_t / S_n = 4 G*/Y* for every overlap, gamma_t = gamma_n sqrt(4 G*/Y*), the square root
+// taken once per material pair (PairCoefficients::hertz_gt_per_gn): two square roots per
+// contact instead of three (rounding differs from sqrt(S_t m*) in the last bits).
 #include <cmath>
 
 #include "dem/contact/contact_geometry.hpp"
@@ -20,8 +23,8 @@ struct HertzNormal {
     const V a = lane_sqrt(r_star * overlap);
     const V sn = 2 * pc.y_star * a;
     const V st = 8 * pc.g_star * a;
-    return {(2.0 / 3.0) * sn, two_sqrt_5_6 * pc.hertz_beta * lane_sqrt(sn * m_star), st,
-            two_sqrt_5_6 * pc.hertz_beta * lane_sqrt(st * m_star)};
+    const V gn = two_sqrt_5_6 * pc.hertz_beta * lane_sqrt(sn * m_star);
+    return {(2.0 / 3.0) * sn, gn, st, gn * pc.hertz_gt_per_gn};
   }
 };
 

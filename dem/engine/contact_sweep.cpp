@@ -51,13 +51,14 @@ struct Body {
 // the contacts in the lanes of V.
 template <class V>
 struct PairCoefficientLanes {
-  V y_star, g_star, hertz_beta, friction;
+  V y_star, g_star, hertz_beta, hertz_gt_per_gn, friction;
 };
 template <class V, class Get>
 [[gnu::always_inline]] inline PairCoefficientLanes<V> gather_coefficients(Get get) {
   return {gather<V>([&](int l) { return get(l).y_star; }),
           gather<V>([&](int l) { return get(l).g_star; }),
           gather<V>([&](int l) { return get(l).hertz_beta; }),
+          gather<V>([&](int l) { return get(l).hertz_gt_per_gn; }),
           gather<V>([&](int l) { return get(l).friction; })};
 }
 
