@@ -96,7 +96,7 @@ template <class Law, class V, class PC>
   const V rs = a.r + b.r;
   const V dist = lane_sqrt(squared_norm(d));
   ContactGeometryT<V> g;
-  g.n = d / dist;
+  g.n = d * (1.0 / dist);  // one division, not three (rounding differs in the last bit)
   g.overlap = overlap = rs - dist;
   g.distance = dist;
   g.r_i = a.r;
