@@ -82,19 +82,24 @@ struct ContactConstants {
 };
 
 // Keeps a history vector in the current tangent plane: project out the normal
-// part (the contact frame has rotated) and restore the magnitude.
+// part (the contact frame has rotated) and restore the magnitude. The projection's squared
+// length is |h|^2 - (n.h)^2 (n a unit vector; h is nearly tangent, so no cancellation), which
+// the processor has before the projection itself: a shorter chain of dependent operations
+// than |h - (n.h) n|^2 (rounding differs in the last bits).
 template <class V3T>
 [[gnu::always_inline]] inline void rotate_into_tangent_plane(V3T& h, const V3T& n) {
   if constexpr (std::is_same_v<V3T, Vec3>) {
     const double before = h.squaredNorm();
     if (before == 0) return;
-    h -= n.dot(h) * n;
-    const double after = h.squaredNorm();
+    const double along = n.dot(h);
+    h -= along * n;
+    const double after = before - along * along;
     if (after > 0) h *= std::sqrt(before / after);
   } else {  // the same, lane by lane, both ways computed
     const auto before = squared_norm(h);
-    const V3T projected = h - dot(n, h) * n;
-    const auto after = squared_norm(projected);
+    const auto along = dot(n, h);
+    const V3T projected = h - along * n;
+    const auto after = before - along * along;
     const V3T scaled = projected * lane_sqrt(before / after);
     h = select(before == 0, h, select(after > 0, scaled, projected));
   }
