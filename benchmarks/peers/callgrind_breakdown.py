@@ -64,7 +64,7 @@ def find(b, pattern):
 
 
 def breakdown(path):
-    tree = subprocess.run(["callgrind_annotate", "--inclusive=yes", "--tree=calling", path],
+    tree = subprocess.run(["callgrind_annotate", "--show=Ir", "--inclusive=yes", "--tree=calling", path],
                           capture_output=True, text=True, check=True).stdout
     b = blocks(tree)
     loop = 0
