@@ -45,15 +45,15 @@ struct ListSprings {
 // dem/core/lanes.hpp).
 template <class V>
 struct ContactGeometryT {
-  V3<V> n;              // unit normal, pointing from j (or the wall) towards i
-  V overlap;            // > 0 [m]
-  V distance;           // centre distance (particle pairs) [m]
-  V r_i, r_j;           // radii; r_j unused for walls
-  V arm_i, arm_j;       // centre to contact point; arm_j = 0 for walls
+  V3<V> n;         // unit normal, pointing from j (or the wall) towards i
+  V overlap;       // > 0 [m]
+  V distance;      // centre distance (particle pairs) [m]
+  V r_i, r_j;      // radii; r_j unused for walls
+  V arm_i, arm_j;  // centre to contact point; arm_j = 0 for walls
   V r_star, m_star;
-  V roll_inertia;       // EPSD: 1/I_r = 1/(I_i + m_i r_i^2) + 1/(I_j + m_j r_j^2)
-  V3<V> v_rel;          // velocity of i relative to j at the contact point
-  V3<V> w_rel;          // angular velocity of i minus that of j
+  V roll_inertia;  // EPSD: 1/I_r = 1/(I_i + m_i r_i^2) + 1/(I_j + m_j r_j^2)
+  V3<V> v_rel;     // velocity of i relative to j at the contact point
+  V3<V> w_rel;     // angular velocity of i minus that of j
   bool wall;
 };
 using ContactGeometry = ContactGeometryT<double>;

@@ -37,10 +37,9 @@ struct ContactLaw {
   // `rolling` are the contact's springs (each touched only by a law that has it).
   template <class V, class PC>
   [[gnu::always_inline]] static ContactResultT<V> evaluate(const ContactGeometryT<V>& g,
-                                                          const PC& pc,
-                                                          const ContactConstants& cc,
-                                                          V3<V>& tangential, V3<V>& rolling,
-                                                          double dt) {
+                                                           const PC& pc, const ContactConstants& cc,
+                                                           V3<V>& tangential, V3<V>& rolling,
+                                                           double dt) {
     const SpringDashpotT<V> s = Normal::coefficients(pc, cc, g.r_star, g.m_star, g.overlap);
     const V vn = dot(g.v_rel, g.n);
     const V fn = s.kn * g.overlap - s.gn * vn;
@@ -51,8 +50,8 @@ struct ContactLaw {
     ContactResultT<V> r{fn_total * g.n, zero3<V>(), zero3<V>()};
     if constexpr (Tangential::enabled) {
       const V3<V> vt = g.v_rel - vn * g.n;
-      const V3<V> ft = Tangential::template force<V>(vt, s.kt, s.gt, pc.friction * fn_pos, g.n,
-                                                     tangential, dt);
+      const V3<V> ft =
+          Tangential::template force<V>(vt, s.kt, s.gt, pc.friction * fn_pos, g.n, tangential, dt);
       r.force += ft;
       const V3<V> n_x_ft = cross(g.n, ft);
       r.torque_i = -g.arm_i * n_x_ft;

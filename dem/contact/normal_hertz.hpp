@@ -17,8 +17,9 @@ struct HertzNormal {
   static constexpr const char* name = "hertz";
   static constexpr bool lanes = true;  // also evaluates Lanes2 (dem/core/lanes.hpp)
   template <class V, class PC>
-  [[gnu::always_inline]] static SpringDashpotT<V> coefficients(const PC& pc, const ContactConstants&,
-                                                              V r_star, V m_star, V overlap) {
+  [[gnu::always_inline]] static SpringDashpotT<V> coefficients(const PC& pc,
+                                                               const ContactConstants&, V r_star,
+                                                               V m_star, V overlap) {
     constexpr double two_sqrt_5_6 = 1.8257418583505538;  // 2 sqrt(5/6)
     const V a = lane_sqrt(r_star * overlap);
     const V sn = 2 * pc.y_star * a;

@@ -18,7 +18,7 @@ struct HistoryTangential {
   static constexpr const char* name = "history";
   template <class V>
   [[gnu::always_inline]] static V3<V> force(const V3<V>& vt, V kt, V gt, V coulomb_limit,
-                                           const V3<V>& n, V3<V>& xi, double dt) {
+                                            const V3<V>& n, V3<V>& xi, double dt) {
     rotate_into_tangent_plane(xi, n);
     xi += vt * dt;
     V3<V> ft = -kt * xi - gt * vt;

@@ -48,24 +48,24 @@ template <int K>
 struct Mask2xK {
   Mask2 part[K];
 };
-#define GRAINFLOW_LANES2XK(op, R)                                                          \
-  template <int K>                                                                         \
+#define GRAINFLOW_LANES2XK(op, R)                                                              \
+  template <int K>                                                                             \
   [[gnu::always_inline]] inline R<K> operator op(const Lanes2xK<K>& a, const Lanes2xK<K>& b) { \
-    R<K> r;                                                                                \
-    _Pragma("GCC unroll 8") for (int q = 0; q < K; ++q) r.part[q] = a.part[q] op b.part[q]; \
-    return r;                                                                              \
-  }                                                                                        \
-  template <int K>                                                                         \
-  [[gnu::always_inline]] inline R<K> operator op(const Lanes2xK<K>& a, double b) {          \
-    R<K> r;                                                                                \
-    _Pragma("GCC unroll 8") for (int q = 0; q < K; ++q) r.part[q] = a.part[q] op b;         \
-    return r;                                                                              \
-  }                                                                                        \
-  template <int K>                                                                         \
-  [[gnu::always_inline]] inline R<K> operator op(double a, const Lanes2xK<K>& b) {          \
-    R<K> r;                                                                                \
-    _Pragma("GCC unroll 8") for (int q = 0; q < K; ++q) r.part[q] = a op b.part[q];         \
-    return r;                                                                              \
+    R<K> r;                                                                                    \
+    _Pragma("GCC unroll 8") for (int q = 0; q < K; ++q) r.part[q] = a.part[q] op b.part[q];    \
+    return r;                                                                                  \
+  }                                                                                            \
+  template <int K>                                                                             \
+  [[gnu::always_inline]] inline R<K> operator op(const Lanes2xK<K>& a, double b) {             \
+    R<K> r;                                                                                    \
+    _Pragma("GCC unroll 8") for (int q = 0; q < K; ++q) r.part[q] = a.part[q] op b;            \
+    return r;                                                                                  \
+  }                                                                                            \
+  template <int K>                                                                             \
+  [[gnu::always_inline]] inline R<K> operator op(double a, const Lanes2xK<K>& b) {             \
+    R<K> r;                                                                                    \
+    _Pragma("GCC unroll 8") for (int q = 0; q < K; ++q) r.part[q] = a op b.part[q];            \
+    return r;                                                                                  \
   }
 GRAINFLOW_LANES2XK(+, Lanes2xK)
 GRAINFLOW_LANES2XK(-, Lanes2xK)
@@ -149,10 +149,10 @@ template <LaneVector V>
 struct Lanes3 {
   V x, y, z;
 };
-#define GRAINFLOW_LANES3(op)                                                                   \
-  template <LaneVector V>                                                                      \
+#define GRAINFLOW_LANES3(op)                                                                    \
+  template <LaneVector V>                                                                       \
   [[gnu::always_inline]] inline Lanes3<V> operator op(const Lanes3<V>& a, const Lanes3<V>& b) { \
-    return {a.x op b.x, a.y op b.y, a.z op b.z};                                               \
+    return {a.x op b.x, a.y op b.y, a.z op b.z};                                                \
   }
 GRAINFLOW_LANES3(+)
 GRAINFLOW_LANES3(-)

@@ -89,10 +89,10 @@ template <class V>
 }
 template <class Law, class V, class PC>
 [[gnu::always_inline]] inline ContactResultT<V> pair_force(const ContactSweep& s, const V3<V>& d,
-                                                          const Body<V>& a, const Body<V>& b,
-                                                          V r_star, V m_star, const PC& pc,
-                                                          V3<V>& tangential, V3<V>& rolling,
-                                                          V& overlap) {
+                                                           const Body<V>& a, const Body<V>& b,
+                                                           V r_star, V m_star, const PC& pc,
+                                                           V3<V>& tangential, V3<V>& rolling,
+                                                           V& overlap) {
   const V rs = a.r + b.r;
   const V dist = lane_sqrt(squared_norm(d));
   ContactGeometryT<V> g;
@@ -184,9 +184,7 @@ void local_pair_sweep(ContactSweep& s) {
     const int first = id[t.i] < id[j] ? t.i : j;
     return Pair{first, first == t.i ? j : t.i, t.k};
   };
-  const auto body = [&](int q) {
-    return Body<double>{v[q], w[q], radius[q], mass[q], inertia[q]};
-  };
+  const auto body = [&](int q) { return Body<double>{v[q], w[q], radius[q], mass[q], inertia[q]}; };
   // The contact's forces and torques on both bodies, its count and the overlap guard.
   const auto apply = [&](const Pair& c, const ContactResult& r, double overlap) {
     force[c.a] += r.force;
@@ -253,9 +251,9 @@ void local_pair_sweep(ContactSweep& s) {
       if constexpr (Law::keeps_tangential)
         ht = gather3<V>([&](int l) -> const Vec3& { return springs_t[group[l].k]; });
       V overlap;
-      const ContactResultT<V> r = pair_force<Law>(
-          s, gather3<V>([&](int l) { return Vec3(x[group[l].a] - x[group[l].b]); }), a, b, r_star,
-          m_star, pc, ht, hr, overlap);
+      const ContactResultT<V> r =
+          pair_force<Law>(s, gather3<V>([&](int l) { return Vec3(x[group[l].a] - x[group[l].b]); }),
+                          a, b, r_star, m_star, pc, ht, hr, overlap);
 #pragma GCC unroll 4
       for (int l = 0; l < W; ++l) {
         if (c + l == m) break;
@@ -279,10 +277,9 @@ void local_pair_sweep(ContactSweep& s) {
         Vec3& hr = Law::keeps_rolling ? springs_r[p0.k] : unused;
         const Body<double> a = body(p0.a), b = body(p0.b);
         double overlap;
-        const ContactResult r = pair_force<Law>(s, Vec3(x[p0.a] - x[p0.b]), a, b,
-                                                reduced_radius(a, b), reduced_mass(a, b),
-                                                s.table(material[p0.a], material[p0.b]), ht, hr,
-                                                overlap);
+        const ContactResult r = pair_force<Law>(
+            s, Vec3(x[p0.a] - x[p0.b]), a, b, reduced_radius(a, b), reduced_mass(a, b),
+            s.table(material[p0.a], material[p0.b]), ht, hr, overlap);
         apply(p0, r, overlap);
       }
     }
@@ -350,8 +347,9 @@ void ghost_pair_sweep(ContactSweep& s) {
     const Body<double> local{v[i], w[i], radius[i], mass[i], inertia[i]};
     const Body<double> ghost{g_v[q], g_w[q], g_radius[q], g_mass[q], g_inertia[q]};
     const bool local_first = id[i] < g_id[q];
-    return local_first ? Pair{i, q, t.k, true, local, ghost, (x[i] - g_x[q]) + (zero - g_shift[q])}
-                       : Pair{i, q, t.k, false, ghost, local, (g_x[q] - x[i]) + (g_shift[q] - zero)};
+    return local_first
+               ? Pair{i, q, t.k, true, local, ghost, (x[i] - g_x[q]) + (zero - g_shift[q])}
+               : Pair{i, q, t.k, false, ghost, local, (g_x[q] - x[i]) + (g_shift[q] - zero)};
   };
   const auto table = [&](const Pair& c) -> const PairCoefficients& {
     return c.local_first ? s.table(material[c.i], g_material[c.q])
@@ -391,8 +389,8 @@ void ghost_pair_sweep(ContactSweep& s) {
         b.w = gather3<V>([&](int l) -> const Vec3& { return group[l].second.w; });
         b.r = gather<V>([&](int l) { return group[l].second.r; });
         b.m = gather<V>([&](int l) { return group[l].second.m; });
-        const PairCoefficientLanes<V> pc =
-            gather_coefficients<V>([&](int l) -> const PairCoefficients& { return table(group[l]); });
+        const PairCoefficientLanes<V> pc = gather_coefficients<V>(
+            [&](int l) -> const PairCoefficients& { return table(group[l]); });
         V3<V> ht = zero3<V>(), hr = zero3<V>();
         if constexpr (Law::keeps_tangential)
           ht = gather3<V>([&](int l) -> const Vec3& { return springs_t[group[l].k]; });
@@ -415,9 +413,9 @@ void ghost_pair_sweep(ContactSweep& s) {
         Vec3& ht = Law::keeps_tangential ? springs_t[p0.k] : unused;
         Vec3& hr = Law::keeps_rolling ? springs_r[p0.k] : unused;
         double overlap;
-        const ContactResult r = pair_force<Law>(
-            s, p0.d, p0.first, p0.second, reduced_radius(p0.first, p0.second),
-            reduced_mass(p0.first, p0.second), table(p0), ht, hr, overlap);
+        const ContactResult r =
+            pair_force<Law>(s, p0.d, p0.first, p0.second, reduced_radius(p0.first, p0.second),
+                            reduced_mass(p0.first, p0.second), table(p0), ht, hr, overlap);
         apply(p0, r, overlap);
       }
     }

@@ -480,10 +480,12 @@ ContactGuards Simulation::compute_forces() {
       p_.torque[i].setZero();
     }
   }
+  // clang-format off
   ContactSweep s{
-      p_,     ghosts_,       local_list_,      ghost_list_, local_springs_, ghost_springs_,
-      walls_, wall_history_, wall_neighbours_, table_,      constants_,     dt_,
-      uniform_, 0,           0.0,              WorstContact{}, UnresolvedContact{}};
+      p_,       ghosts_,       local_list_,      ghost_list_, local_springs_, ghost_springs_,
+      walls_,   wall_history_, wall_neighbours_, table_,      constants_,     dt_,
+      uniform_, 0,             0.0,              WorstContact{}, UnresolvedContact{}};
+  // clang-format on
   sweep_.run(s);
   if (scene_.contact.normal == NormalModel::hertz && scene_.time.min_steps_per_contact > 0 &&
       contact_may_be_unresolved()) {
@@ -574,7 +576,7 @@ bool Simulation::check_contacts(const ContactGuards& s, bool finite_here) const 
         << "raise the Young's modulus";
   }
   agree_on_error(comm_, o.str());  // the rank holding the worst contact speaks
-  return worst[2] == 0;              // not reached: agree_on_error throws on every rank
+  return worst[2] == 0;            // not reached: agree_on_error throws on every rank
 }
 
 void Simulation::restore_implicit_drag() {
@@ -646,7 +648,8 @@ bool Simulation::half_kick() {
                                    p.torque.data(), p.mass.data(), p.inertia.data(), k, u);
   };
   const bool drag = !drag_.coefficient.empty(), spin = sweep_.needs_spin;
-  if (drag) return spin ? run.template operator()<true, true>() : run.template operator()<true, false>();
+  if (drag)
+    return spin ? run.template operator()<true, true>() : run.template operator()<true, false>();
   return spin ? run.template operator()<false, true>() : run.template operator()<false, false>();
 }
 

@@ -209,7 +209,7 @@ class Simulation {
   std::unordered_map<GlobalId, std::pair<double, Vec3>> restored_drag_;
   std::optional<CarriedState> pending_carried_;     // springs for the first rebuild
   bool moved_beyond_half_skin_ = false;             // by the last drift(), since the last rebuild
-  double local_speed2_ = 0;      // largest local |v|^2 after this step's drift
+  double local_speed2_ = 0;                         // largest local |v|^2 after this step's drift
   bool fresh_from_kick_ = false;  // kick_and_drift() ran (speeds, gravity) and no rebuild since
   bool state_finite_ = true;                        // after the last step(), this rank's particles
   bool finite_everywhere_ = true;                   // the same, every rank's

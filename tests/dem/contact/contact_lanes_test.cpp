@@ -76,7 +76,9 @@ std::vector<Case> random_cases(int count) {
   return cases;
 }
 
-bool same(double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); }
+bool same(double a, double b) {
+  return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
+}
 bool same(const Vec3& a, const Vec3& b) {
   return same(a[0], b[0]) && same(a[1], b[1]) && same(a[2], b[2]);
 }
@@ -186,8 +188,7 @@ TEST(ContactLanes, ElasticNormalForceIsHertzInEveryLane) {
       Law::evaluate(g, lanes_pc, ContactConstants{}, spring, rolling, 1e-5);
   for (int l = 0; l < 4; ++l) {
     const ContactGeometry& c = cases[l].g;
-    const double hertz =
-        4.0 / 3.0 * pc.y_star * std::sqrt(c.r_star) * std::pow(c.overlap, 1.5);
+    const double hertz = 4.0 / 3.0 * pc.y_star * std::sqrt(c.r_star) * std::pow(c.overlap, 1.5);
     EXPECT_NEAR(lane(r.force, l).dot(c.n) / hertz, 1.0, 1e-12) << "lane " << l;
     EXPECT_LT((lane(r.force, l) - lane(r.force, l).dot(c.n) * c.n).norm(), 1e-12 * hertz);
   }
