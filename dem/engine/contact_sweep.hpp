@@ -86,7 +86,8 @@ struct ContactSweep {
   ListSprings& local_springs;  // parallel to local_list.j
   ListSprings& ghost_springs;  // parallel to ghost_list.j
   const WallSet& walls;        // current wall positions (dem/walls/wall_set.hpp)
-  std::vector<std::vector<ContactHistory>>& wall_history;  // [wall][particle]
+  // [WallSet column][entry of the wall's neighbour list, or particle] (wall_neighbours.hpp)
+  std::vector<std::vector<ContactHistory>>& wall_history;
   const WallNeighbours& wall_neighbours;                   // the particles each wall may touch
   const PairTable& table;
   const ContactConstants& constants;

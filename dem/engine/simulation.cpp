@@ -98,19 +98,19 @@ void Simulation::initialise() {
   for (std::size_t i = 0; i < p_.size(); ++i) foreign[i] = !decomp_->owns(p_.x[i]);
   p_.remove_if(foreign);
   if (!restored_springs_.empty()) {
+    // Each rank keeps the springs of the particles it owns (the file lists a pair's
+    // spring under each partner).
     CarriedState c;
-    c.wall.assign(walls_.history_columns(), std::vector<ContactHistory>(p_.size()));
-    c.pairs.resize(p_.size());
-    std::unordered_map<GlobalId, std::size_t> index;
-    for (std::size_t i = 0; i < p_.size(); ++i) index[p_.id[i]] = i;
+    c.springs = CarriedSprings(sweep_.keeps_tangential, sweep_.keeps_rolling);
+    std::vector<GlobalId> owned = p_.id;
+    std::sort(owned.begin(), owned.end());
     for (const CheckpointSpring& sp : restored_springs_) {
-      const auto it = index.find(sp.particle);
-      if (it == index.end()) continue;
-      const ContactHistory h{sp.tangential, sp.rolling};
+      if (!std::binary_search(owned.begin(), owned.end(), sp.particle)) continue;
       if (sp.partner >= 0)
-        c.pairs[it->second].push_back({sp.partner, h});
-      else if (static_cast<std::size_t>(-1 - sp.partner) < c.wall.size())
-        c.wall[-1 - sp.partner][it->second] = h;
+        c.springs.add_pair(sp.particle, sp.partner, sp.tangential, sp.rolling);
+      else if (static_cast<std::size_t>(-1 - sp.partner) < walls_.history_columns())
+        c.springs.add_wall(sp.particle, static_cast<int>(-1 - sp.partner),
+                           {sp.tangential, sp.rolling});
     }
     pending_carried_ = std::move(c);
     restored_springs_.clear();
@@ -118,7 +118,6 @@ void Simulation::initialise() {
 
   grid_ = std::make_unique<BinGrid>(decomp_->lo() - Vec3::Constant(cutoff_),
                                     decomp_->hi() + Vec3::Constant(cutoff_), cutoff_);
-  wall_history_.assign(walls_.history_columns(), std::vector<ContactHistory>(p_.size()));
   walls_.move_to(time_);
   walls_.fit_grids(r_max);  // mesh search cells of one particle diameter
   const bool restoring = restored_;
@@ -219,79 +218,82 @@ bool Simulation::needs_rebuild() const {
   return any;
 }
 
-CarriedState Simulation::save_histories() const {
-  CarriedState c = pair_histories();
-  c.wall = wall_history_;
-  return c;
-}
-
 CarriedState Simulation::take_histories() {
-  CarriedState c = pair_histories();
-  c.wall = std::move(wall_history_);
-  local_springs_.reset(0, false, false);  // released before the new lists are built
-  ghost_springs_.reset(0, false, false);
-  return c;
-}
-
-CarriedState Simulation::pair_histories() const {
   CarriedState c;
-  c.pairs.resize(p_.size());
-  if (!sweep_.has_history) return c;
-  // Counted first, so that each particle's springs take one allocation of the exact size
-  // (grown one push_back at a time they took several, and left the freed ones behind).
-  const std::size_t lists = local_list_.offsets.size();
-  std::vector<int> count(p_.size(), 0);
-  for (std::size_t i = 0; i + 1 < lists; ++i) {
-    for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k)
-      if (is_set(local_springs_[k])) {
-        ++count[i];
-        ++count[local_list_.j[k]];
-      }
-    for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k)
-      if (is_set(ghost_springs_[k])) ++count[i];
+  c.springs = CarriedSprings(sweep_.keeps_tangential, sweep_.keeps_rolling);
+  if (sweep_.has_history) {
+    // Counted first, so that the records take one allocation of the exact size.
+    const std::size_t lists = local_list_.offsets.size();
+    std::size_t pairs = 0, walls = 0;
+    for (std::size_t i = 0; i + 1 < lists; ++i) {
+      for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k)
+        pairs += is_set(local_springs_[k]);
+      for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k)
+        pairs += is_set(ghost_springs_[k]);
+    }
+    for (const auto& column : wall_history_)
+      for (const ContactHistory& h : column) walls += is_set(h);
+    c.springs.reserve(pairs, walls);
+    for (std::size_t i = 0; i + 1 < lists; ++i) {
+      for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k)
+        if (const ContactHistory h = local_springs_[k]; is_set(h))
+          c.springs.add_pair(p_.id[i], p_.id[local_list_.j[k]], h.tangential, h.rolling);
+      for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k)
+        if (const ContactHistory h = ghost_springs_[k]; is_set(h))
+          c.springs.add_pair(p_.id[i], ghosts_.id[ghost_list_.j[k]], h.tangential, h.rolling);
+    }
+    for (std::size_t col = 0; col < wall_history_.size(); ++col)
+      for (std::size_t k = 0; k < wall_history_[col].size(); ++k)
+        if (is_set(wall_history_[col][k]))
+          c.springs.add_wall(p_.id[wall_neighbours_.particle_of(col, k)], static_cast<int>(col),
+                             wall_history_[col][k]);
   }
-  for (std::size_t i = 0; i < p_.size(); ++i)
-    if (count[i] > 0) c.pairs[i].reserve(count[i]);
-  for (std::size_t i = 0; i + 1 < lists; ++i) {
-    for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k)
-      if (const ContactHistory h = local_springs_[k]; is_set(h)) {
-        const std::size_t j = local_list_.j[k];
-        c.pairs[i].push_back({p_.id[j], h});
-        c.pairs[j].push_back({p_.id[i], h});
-      }
-    for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k)
-      if (const ContactHistory h = ghost_springs_[k]; is_set(h))
-        c.pairs[i].push_back({ghosts_.id[ghost_list_.j[k]], h});
-  }
+  // Released before the new lists are built: the old and new copies do not coexist.
+  local_springs_.reset(0, false, false);
+  ghost_springs_.reset(0, false, false);
+  std::vector<std::vector<ContactHistory>>().swap(wall_history_);
   return c;
 }
 
 void Simulation::restore_histories(CarriedState& carried) {
-  wall_history_ = std::move(carried.wall);
+  CarriedSprings& cs = carried.springs;
+  cs.index();
   local_springs_.reset(local_list_.pairs(), sweep_.keeps_tangential, sweep_.keeps_rolling);
   ghost_springs_.reset(ghost_list_.pairs(), sweep_.keeps_tangential, sweep_.keeps_rolling);
-  if (!sweep_.has_history) return;
-  // Each particle carries all its springs (both partners of a local pair carry the same
-  // one), so an entry's spring is found in the few its own particle carries.
-  const auto find = [&](std::size_t i, GlobalId partner) -> const ContactHistory* {
-    for (const PartnerHistory& ph : carried.pairs[i])
-      if (ph.partner == partner) return &ph.history;
-    return nullptr;
-  };
-  for (std::size_t i = 0; i < p_.size(); ++i) {
-    if (carried.pairs[i].empty()) continue;
-    for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k)
-      if (const ContactHistory* h = find(i, p_.id[local_list_.j[k]])) local_springs_.set(k, *h);
-    for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k)
-      if (const ContactHistory* h = find(i, ghosts_.id[ghost_list_.j[k]]))
-        ghost_springs_.set(k, *h);
+  wall_history_.assign(walls_.history_columns(), {});
+  if (!sweep_.has_history) {
+    cs.clear();
+    return;
   }
+  // The wall springs along the new wall lists: a particle now off a wall's list cannot touch
+  // the wall before the next rebuild (and does not now), so its spring there ends.
+  for (std::size_t col = 0; col < wall_history_.size(); ++col)
+    wall_history_[col].assign(wall_neighbours_.column_size(col, p_.size()), ContactHistory{});
+  if (cs.walls() > 0)
+    for (std::size_t col = 0; col < wall_history_.size(); ++col)
+      for (std::size_t k = 0; k < wall_history_[col].size(); ++k) {
+        const GlobalId id = p_.id[wall_neighbours_.particle_of(col, k)];
+        if (const std::size_t r = cs.find_wall(id, static_cast<int>(col));
+            r != CarriedSprings::npos)
+          wall_history_[col][k] = cs.wall(r);
+      }
+  if (cs.pairs() > 0)
+    for (std::size_t i = 0; i < p_.size(); ++i) {
+      const GlobalId a = p_.id[i];
+      for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k)
+        if (const std::size_t r = cs.find_pair(a, p_.id[local_list_.j[k]]);
+            r != CarriedSprings::npos)
+          local_springs_.set(k, cs.pair(r));
+      for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k)
+        if (const std::size_t r = cs.find_pair(a, ghosts_.id[ghost_list_.j[k]]);
+            r != CarriedSprings::npos)
+          ghost_springs_.set(k, cs.pair(r));
+    }
+  cs.clear();
 }
 
 void Simulation::apply_order(const std::vector<std::size_t>& perm, CarriedState& carried) {
   p_.permute(perm);
-  for (auto& wh : carried.wall) reorder(wh, perm);
-  reorder(carried.pairs, perm);
   if (carried.carries_drag) reorder(carried.drag, perm);
 }
 
@@ -396,21 +398,36 @@ void Simulation::write_checkpoint(const std::string& path) {
     d.drag_fluid_velocity = drag_.fluid_velocity;
   }
   d.streams = streams_.save_state();
-  const CarriedState c = save_histories();
-  for (std::size_t i = 0; i < p_.size(); ++i)
-    for (const PartnerHistory& ph : c.pairs[i])
-      d.springs.push_back({p_.id[i], ph.partner, ph.history.tangential, ph.history.rolling});
-  for (std::size_t w = 0; w < c.wall.size(); ++w)
-    for (std::size_t i = 0; i < p_.size(); ++i)
-      if (is_set(c.wall[w][i]))
-        d.springs.push_back({p_.id[i], -1 - static_cast<GlobalId>(w), c.wall[w][i].tangential,
-                             c.wall[w][i].rolling});
+  // Every spring, listed under each partner that this rank owns.
+  if (sweep_.has_history) {
+    const std::size_t lists = local_list_.offsets.size();
+    for (std::size_t i = 0; i + 1 < lists; ++i) {
+      for (int k = local_list_.offsets[i]; k < local_list_.offsets[i + 1]; ++k)
+        if (const ContactHistory h = local_springs_[k]; is_set(h)) {
+          const std::size_t j = local_list_.j[k];
+          d.springs.push_back({p_.id[i], p_.id[j], h.tangential, h.rolling});
+          d.springs.push_back({p_.id[j], p_.id[i], h.tangential, h.rolling});
+        }
+      for (int k = ghost_list_.offsets[i]; k < ghost_list_.offsets[i + 1]; ++k)
+        if (const ContactHistory h = ghost_springs_[k]; is_set(h))
+          d.springs.push_back({p_.id[i], ghosts_.id[ghost_list_.j[k]], h.tangential, h.rolling});
+    }
+  }
+  for (std::size_t w = 0; w < wall_history_.size(); ++w)
+    for (std::size_t k = 0; k < wall_history_[w].size(); ++k)
+      if (is_set(wall_history_[w][k]))
+        d.springs.push_back({p_.id[wall_neighbours_.particle_of(w, k)],
+                             -1 - static_cast<GlobalId>(w), wall_history_[w][k].tangential,
+                             wall_history_[w][k].rolling});
   grainflow::write_checkpoint(comm_, path, d);
   mark_leaving();
   rebuild(/*keep_drag=*/true);  // the next half kick uses the drag of this step's end
 }
 
 void Simulation::rebuild(bool keep_drag) {
+  // The positions of the last build are done with (the skin test asked them); released
+  // now, they do not add to the memory peak of the rebuild.
+  std::vector<Vec3>().swap(x_at_build_);
   // Springs by global ids (indices change below); after a restore, those of the checkpoint.
   CarriedState carried = pending_carried_ ? std::move(*pending_carried_) : take_histories();
   pending_carried_.reset();
@@ -426,9 +443,7 @@ void Simulation::rebuild(bool keep_drag) {
     balance_cuts();
   if (!leaving_.empty()) {
     const long before = static_cast<long>(p_.size());
-    p_.remove_if(leaving_);
-    for (auto& wh : carried.wall) keep_unflagged(wh, leaving_);
-    keep_unflagged(carried.pairs, leaving_);
+    p_.remove_if(leaving_);  // their springs stay behind in `carried`, never looked up
     if (carried.carries_drag) keep_unflagged(carried.drag, leaving_);
     counters_.removed += before - static_cast<long>(p_.size());
     leaving_.clear();
@@ -437,6 +452,7 @@ void Simulation::rebuild(bool keep_drag) {
   apply_order(grid_->sort_permutation(p_), carried);
   exchange_->borders(p_, cutoff_, ghosts_);
   grid_->build(p_, ghosts_, skin_, local_list_, ghost_list_);
+  wall_neighbours_.build(p_, walls_, skin_);
   restore_histories(carried);
   if (carried.carries_drag) {
     drag_.coefficient.resize(p_.size());
@@ -450,9 +466,11 @@ void Simulation::rebuild(bool keep_drag) {
   // Bounds for contact_may_be_unresolved, over the particles that can touch anything here:
   // the least m^2/r, and the largest Y* of a pair with one of their materials.
   lightest_q_ = std::numeric_limits<double>::infinity();
+  smallest_radius_ = std::numeric_limits<double>::infinity();
   std::vector<char> present(table_.size(), 0);
   for (std::size_t i = 0; i < p_.size(); ++i) {
     lightest_q_ = std::min(lightest_q_, p_.mass[i] * p_.mass[i] / p_.radius[i]);
+    smallest_radius_ = std::min(smallest_radius_, p_.radius[i]);
     present[p_.material[i]] = 1;
   }
   for (std::size_t k = 0; k < ghosts_.size(); ++k) {
@@ -466,8 +484,6 @@ void Simulation::rebuild(bool keep_drag) {
       largest_y_star_ = std::max(largest_y_star_, table_(a, b).y_star);
   }
   uniform_ = find_uniform_pairs(p_, ghosts_);
-  wall_neighbours_.build(p_, walls_, skin_);
-  wall_neighbours_.end_unlisted_springs(walls_, wall_history_);
   x_at_build_ = p_.x;
   ++counters_.rebuilds;
 }
@@ -487,8 +503,15 @@ ContactGuards Simulation::compute_forces() {
       uniform_, 0,             0.0,              WorstContact{}, UnresolvedContact{}};
   // clang-format on
   sweep_.run(s);
+  // The fastest local particle bounds both the steps-per-contact gate and the travel guard;
+  // kick_and_drift() has found it (in the same order) unless a rebuild came since.
+  double v2_local = 0;
+  if (fresh_from_kick_)
+    v2_local = local_speed2_;
+  else
+    for (const Vec3& v : p_.v) v2_local = std::max(v2_local, v.squaredNorm());
   if (scene_.contact.normal == NormalModel::hertz && scene_.time.min_steps_per_contact > 0 &&
-      contact_may_be_unresolved()) {
+      contact_may_be_unresolved(v2_local)) {
     s.unresolved.set(scene_.time.min_steps_per_contact, dt_);
     steps_per_contact_sweep(s);
   }
@@ -496,10 +519,28 @@ ContactGuards Simulation::compute_forces() {
   counters_.contacts = s.contacts;
   counters_.max_overlap_ratio = s.max_overlap_ratio;
   apply_force_terms();
-  return {s.worst, s.unresolved};
+  return {s.worst, s.unresolved, fastest_particle(v2_local)};
 }
 
-bool Simulation::contact_may_be_unresolved() const {
+FastParticle Simulation::fastest_particle(double v2_max) const {
+  // A particle that moves more than its radius r in one step can cross a (two-sided,
+  // thin) mesh wall, or pass through another particle, without the two ever overlapping at
+  // the end of a step, so no contact guard can see it (docs/stability.md). The drift just
+  // made moved each particle by |v| dt with the velocity of the half kick before it. The
+  // gate needs no division: nobody can exceed the limit while v_max dt <= limit r_min.
+  FastParticle fast;
+  const double limit = scene_.time.max_step_travel;
+  if (limit <= 0 || v2_max * dt_ * dt_ <= limit * limit * smallest_radius_ * smallest_radius_)
+    return fast;
+  for (std::size_t i = 0; i < p_.size(); ++i) {
+    const double speed = std::sqrt(p_.v[i].squaredNorm());
+    const double ratio = speed * dt_ / (limit * p_.radius[i]);
+    if (ratio > fast.ratio) fast = {ratio, i, speed};
+  }
+  return fast;
+}
+
+bool Simulation::contact_may_be_unresolved(double v2_local) const {
   // A Hertz contact fails when m*^2 < k R* Y*^2 v (contact_sweep.hpp). Its approach speed
   // v is at most |v_a| + |v_b| (a fixed wall: |v_a|); m*^2/R* >= q/4 with q = m_s^2/r_s of
   // the lighter partner s (m* >= m_s/2, R* <= min(r_a, r_b)); and Y* <= the table's
@@ -507,11 +548,7 @@ bool Simulation::contact_may_be_unresolved() const {
   // the sweep need not ask: one pass over the velocities instead of a test per contact.
   for (const WallSet::Entry& w : walls_.walls())
     if (w.pose.moving() || w.surface_velocity.squaredNorm() > 0) return true;
-  double v2 = 0;
-  if (fresh_from_kick_)
-    v2 = local_speed2_;  // found by kick_and_drift() in the same order
-  else
-    for (const Vec3& v : p_.v) v2 = std::max(v2, v.squaredNorm());
+  double v2 = v2_local;
   for (const Vec3& v : ghosts_.v) v2 = std::max(v2, v.squaredNorm());
   const double k = std::pow(scene_.time.min_steps_per_contact * dt_ / 2.868, 5);
   const double floor = lightest_q_ / (4 * k * largest_y_star_ * largest_y_star_);
@@ -519,27 +556,59 @@ bool Simulation::contact_may_be_unresolved() const {
 }
 
 bool Simulation::check_contacts(const ContactGuards& s, bool finite_here) const {
-  // One reduction serves both guards and the finiteness of the step's end, and the guards
-  // speak only when some rank is beyond a limit, which every rank learns through it: keep
-  // the common path to that one call.
+  // One reduction serves the three guards and the finiteness of the step's end, and the
+  // guards speak only when some rank is beyond a limit, which every rank learns through it:
+  // keep the common path to that one call.
   const double limit = scene_.time.max_overlap;
   const double n_min = scene_.time.min_steps_per_contact;
+  const FastParticle& fast = s.fast;
   // Largest overlap ratio; fewest steps per contact as N_min / N (> 1 when under-resolved);
-  // 1 when this rank holds a non-finite state.
-  const double mine[3] = {counters_.max_overlap_ratio,
+  // the longest travel in the last drift over its limit (> 1 beyond it); 1 when this rank
+  // holds a non-finite state.
+  const double mine[4] = {counters_.max_overlap_ratio,
                           s.unresolved.fewest > 0 ? n_min / s.unresolved.fewest : 0.0,
-                          finite_here ? 0.0 : 1.0};
-  double worst[3] = {mine[0], mine[1], mine[2]};
-  if (decomp_->size() > 1) MPI_Allreduce(MPI_IN_PLACE, worst, 3, MPI_DOUBLE, MPI_MAX, comm_);
-  if (worst[0] <= limit && worst[1] <= 1) return worst[2] == 0;
+                          fast.ratio, finite_here ? 0.0 : 1.0};
+  double worst[4] = {mine[0], mine[1], mine[2], mine[3]};
+  if (decomp_->size() > 1) MPI_Allreduce(MPI_IN_PLACE, worst, 4, MPI_DOUBLE, MPI_MAX, comm_);
+  if (worst[0] <= limit && worst[1] <= 1 && worst[2] <= 1) return worst[3] == 0;
   std::ostringstream o;
   o.precision(4);
   o << scene_.file << ": error: t = " << time_ << " s (step " << counters_.steps + 1 << "): ";
+  if (worst[0] <= limit && worst[1] <= 1) {  // the travel guard (a contact's guard comes first)
+    if (mine[2] != worst[2]) {
+      agree_on_error(comm_, "");  // another rank holds the particle and speaks
+      return worst[3] == 0;       // not reached: agree_on_error throws on every rank
+    }
+    const std::size_t i = fast.index;
+    // The speed of the drift (the last half kick has changed v since).
+    const double speed = fast.speed, r = p_.radius[i];
+    const double travel_limit = scene_.time.max_step_travel;
+    const Vec3& x = p_.x[i];
+    o << "particle " << p_.id[i] << " moves " << speed * dt_ / r
+      << " of its radii per step (speed " << speed << " m/s, radius " << r << " m, dt = "
+      << dt_ << " s, at (" << x[0] << ", " << x[1] << ", " << x[2] << ") m); the limit is "
+      << travel_limit
+      << " (key time.max_step_travel). So fast a particle can pass through a mesh wall or "
+         "another particle between two steps without ever overlapping it, which no contact "
+         "guard can see. A step of at most "
+      << travel_limit * r / speed << " s keeps it within the limit";
+    if (scene_.contact.normal == NormalModel::hertz) {
+      // An impact at that speed on a wall of its own material: R* = r, m* = m.
+      const double tc =
+          hertz_contact_time(table_(p_.material[i], p_.material[i]).y_star, r, p_.mass[i], speed);
+      o << "; resolving an impact at that speed needs at most " << tc / 20
+        << " s (1/20 of the Hertz contact time against a wall of its own material)";
+    }
+    o << ". If the speed itself is unphysical, look for what caused it (an initial velocity, a "
+         "fluid force, a contact in the steps before)";
+    agree_on_error(comm_, o.str());
+    return worst[3] == 0;  // not reached
+  }
   const bool overlap = worst[0] > limit;  // the overlap guard speaks first
   const WorstContact& w = overlap ? s.worst : s.unresolved.contact;
   if (overlap ? mine[0] != worst[0] : mine[1] != worst[1]) {
     agree_on_error(comm_, "");  // another rank holds the contact and speaks
-    return worst[2] == 0;       // not reached
+    return worst[3] == 0;       // not reached
   }
   if (w.b >= 0)
     o << "particles " << w.a << " and " << w.b;
@@ -576,7 +645,7 @@ bool Simulation::check_contacts(const ContactGuards& s, bool finite_here) const 
         << "raise the Young's modulus";
   }
   agree_on_error(comm_, o.str());  // the rank holding the worst contact speaks
-  return worst[2] == 0;            // not reached: agree_on_error throws on every rank
+  return worst[3] == 0;            // not reached: agree_on_error throws on every rank
 }
 
 void Simulation::restore_implicit_drag() {
@@ -660,7 +729,9 @@ void Simulation::step() {
   // Stream insertion (dem/insert/stream_insertion.hpp); new particles force a rebuild.
   const bool inserted = !streams_.empty() && streams_.insert(time_ + dt_, p_, ghosts_, walls_,
                                                              *decomp_, next_id_, comm_) > 0;
-  for (auto& column : wall_history_) column.resize(p_.size());
+  if (sweep_.has_history)  // inserted particles: a spring in the columns of every particle
+    for (std::size_t col = 0; col < wall_history_.size(); ++col)
+      if (wall_neighbours_.list_of_column(col).all) wall_history_[col].resize(p_.size());
   if (inserted) mark_leaving();  // the new particles too
   if (inserted || needs_rebuild()) {
     rebuild();

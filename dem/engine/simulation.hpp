@@ -55,10 +55,20 @@ struct GlobalState {
   double kinetic_rotational = 0;
 };
 
-// What the contact sweep of a step found for the guards (Simulation::check_contacts).
+// The particle that moved the most of its own radius in the last drift, when any could have
+// moved more than time.max_step_travel radii (ratio: travel / (limit r); 0: none), with the
+// speed it drifted at.
+struct FastParticle {
+  double ratio = 0;
+  std::size_t index = 0;
+  double speed = 0;
+};
+
+// What a step's force evaluation found for the guards (Simulation::check_contacts).
 struct ContactGuards {
   WorstContact worst;            // the contact with the largest overlap ratio
   UnresolvedContact unresolved;  // the least-resolved Hertz contact
+  FastParticle fast;             // the travel guard's candidate
 };
 
 class Simulation {
@@ -152,12 +162,14 @@ class Simulation {
   // Stops the run (ParallelError on every rank) when a contact overlaps beyond
   // time.max_overlap, or when a Hertz contact gets fewer than time.min_steps_per_contact
   // steps at its own approach speed; the message names the contact and a time step that
-  // would resolve it. Returns whether every rank's state is finite (`finite_here`: this
-  // rank's). Collective: the step's one reduction.
+  // would resolve it; and when a particle moved more than time.max_step_travel of its
+  // radii in the last drift (`guards.fast`). Returns whether every rank's state is finite
+  // (`finite_here`: this rank's). Collective: the step's one reduction.
   bool check_contacts(const ContactGuards& guards, bool finite_here) const;
+  FastParticle fastest_particle(double v2_max) const;  // v2_max: largest local |v|^2
   // Whether any contact of this step could fail the steps-per-contact test (else the
-  // sweep skips it): a bound from the fastest local or ghost particle.
-  bool contact_may_be_unresolved() const;
+  // sweep skips it): a bound from the fastest local (v2_local: its |v|^2) or ghost particle.
+  bool contact_may_be_unresolved(double v2_local) const;
   bool needs_rebuild() const;  // collective
   void mark_leaving();         // particles beyond a bounded side of the domain
   // The first half kick and x += dt v in one pass, with mark_leaving()'s test, the skin test
@@ -168,12 +180,11 @@ class Simulation {
   // whether every position, velocity and spin is finite after it (false otherwise).
   template <bool Guard>
   bool half_kick();
-  CarriedState save_histories() const;  // a copy of every spring, by global ids
-  // The same, moving the wall springs out and releasing the lists' springs (at a rebuild,
-  // which makes them anew: the old and new copies do not coexist at the memory peak).
+  // Every stretched spring by global ids (CarriedSprings); the lists' and walls' springs are
+  // released (a rebuild makes them anew: the old and new copies do not coexist).
   CarriedState take_histories();
-  CarriedState pair_histories() const;  // the particle pairs' part
-  void restore_histories(CarriedState& carried);  // takes carried.wall
+  // The springs of the new lists and walls, from `carried` (whose springs it releases).
+  void restore_histories(CarriedState& carried);
   void apply_order(const std::vector<std::size_t>& perm, CarriedState& carried);
 
   Scene scene_;
@@ -190,12 +201,14 @@ class Simulation {
   // For contact_may_be_unresolved, set at each rebuild: min m^2/r over local and ghost
   // particles, and the largest Y* of a pair involving one of their materials.
   double lightest_q_ = 0, largest_y_star_ = 0;
+  double smallest_radius_ = 0;  // of the local particles, set at each rebuild (travel guard)
   std::unique_ptr<BinGrid> grid_;
   NeighbourList local_list_, ghost_list_;
   ListSprings local_springs_, ghost_springs_;              // parallel to the lists' entries
-  std::vector<std::vector<ContactHistory>> wall_history_;  // [WallSet column][particle]
-  WallNeighbours wall_neighbours_;                         // rebuilt with the Verlet lists
-  UniformPairs uniform_;                                   // found with the Verlet lists
+  // [WallSet column][entry of the wall's list, or particle]: the layout of wall_neighbours.hpp
+  std::vector<std::vector<ContactHistory>> wall_history_;
+  WallNeighbours wall_neighbours_;  // rebuilt with the Verlet lists
+  UniformPairs uniform_;            // found with the Verlet lists
   WallSet walls_;
   StreamInsertion streams_;
   std::vector<Vec3> x_at_build_;

@@ -159,6 +159,22 @@ TimeStepReport check_time_step(const Scene& scene, const Particles& p, const Pai
     rep.notes.push_back(o.str());
     o.str("");
     accuracy_note(scene, rep, impacts);
+    // The travel guard (Simulation::fastest_particle): speed x dt above max_step_travel of a
+    // particle's radius stops the run; the smallest particles set the lowest such speed.
+    double r_smallest = inf;
+    for (int m = 0; m < nm; ++m) r_smallest = std::min(r_smallest, r_min[m]);
+    const double travel = scene.time.max_step_travel;
+    if (travel > 0 && r_smallest < inf) {
+      const double v_stop = travel * r_smallest / rep.dt;
+      o << "travel guard: a particle that moves more than " << travel
+        << " x its radius in one step stops the run (key time.max_step_travel): above " << v_stop
+        << " m/s for the smallest, r = " << r_smallest << " m";
+      if (v >= v_stop) o << "; warning: that is below time.expected_max_speed = " << v << " m/s";
+      rep.notes.push_back(o.str());
+      o.str("");
+      if (v >= v_stop && rep.verdict == TimeStepReport::Verdict::ok)
+        rep.verdict = TimeStepReport::Verdict::warn;
+    }
     const double fr = rep.dt / rep.rayleigh_time;
     const double steps = rep.contact_time / rep.dt;
     if (fr > kRefuseRayleighFraction || steps < kRefuseStepsPerContact) {

@@ -50,7 +50,8 @@ void apply_wall_contact(ContactSweep& s, std::size_t i, const WallTouch& t, int 
 }
 
 // A plane or a cylinder, against the particles of its neighbour list (all of them when
-// `list.all`; the others cannot touch it, and their springs were ended at the rebuild).
+// `list.all`; the others cannot touch it before the next rebuild). `history` holds the
+// springs in list order (one per particle when `list.all`; wall_neighbours.hpp).
 template <class Law, class Touch>
 void wall_sweep_one(ContactSweep& s, const WallSet::Entry& wall, const WallNeighbours::List& list,
                     std::vector<ContactHistory>& history, Touch touch) {
@@ -61,12 +62,12 @@ void wall_sweep_one(ContactSweep& s, const WallSet::Entry& wall, const WallNeigh
     const std::size_t i = list.all ? k : static_cast<std::size_t>(list.i[k]);
     WallTouch t;
     if (!touch(p.x[i], p.radius[i], t)) {
-      if constexpr (Law::has_history) history[i] = ContactHistory{};
+      if constexpr (Law::has_history) history[k] = ContactHistory{};
       continue;
     }
     if (wall.pose.moving())
       t.surface_velocity += wall.pose.velocity_at(p.x[i] - (p.radius[i] - t.overlap) * t.n);
-    apply_wall_contact<Law>(s, i, t, wall.material, Law::has_history ? history[i] : unused);
+    apply_wall_contact<Law>(s, i, t, wall.material, Law::has_history ? history[k] : unused);
   }
 }
 

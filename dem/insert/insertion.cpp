@@ -353,8 +353,9 @@ void read_csv(const Scene& scene, const Insertion& ins, Particles& p, GlobalId& 
                       "or remove the insertion");
 }
 
+// `grid_needed`: whether a later entry checks overlaps against this one's particles.
 void read_snapshot_entry(const Scene& scene, const Insertion& ins, Particles& p,
-                         GlobalId& next_id, OverlapGrid& grid) {
+                         GlobalId& next_id, OverlapGrid& grid, bool grid_needed) {
   Snapshot snap;
   try {
     snap = read_snapshot(ins.snapshot_file);
@@ -381,8 +382,23 @@ void read_snapshot_entry(const Scene& scene, const Insertion& ins, Particles& p,
     if (overlaps_with_images(grid, scene.domain, q.x[i], q.radius[i]))
       fail("overlaps a particle of an earlier insertion entry");
   }
+  if (grid_needed)
+    for (std::size_t i = 0; i < q.size(); ++i) grid.add(q.x[i], q.radius[i]);
+  if (p.size() == 0) {
+    // The first entry: the snapshot's arrays become the particles' (no second copy of a
+    // large bed at start-up, on every rank), with new ids and the velocities asked for.
+    p = std::move(snap.particles);
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      p.id[i] = next_id++;
+      if (!ins.keep_velocity) {
+        p.v[i] = Vec3::Zero();
+        p.omega[i] = Vec3::Zero();
+      }
+    }
+    return;
+  }
+  p.reserve(p.size() + q.size());
   for (std::size_t i = 0; i < q.size(); ++i) {
-    grid.add(q.x[i], q.radius[i]);
     const Vec3 v = ins.keep_velocity ? q.v[i] : Vec3::Zero();
     const Vec3 w = ins.keep_velocity ? q.omega[i] : Vec3::Zero();
     p.add_raw(next_id++, q.x[i], v, w, q.radius[i], q.mass[i], q.inertia[i], q.material[i]);
@@ -400,11 +416,17 @@ void insert_particles(const Scene& scene, Particles& p, GlobalId& next_id, const
   // larger spheres (e.g. from a CSV file), so correctness does not depend on it.
   OverlapGrid grid(r_max > 0 ? 2 * r_max : (scene.domain.hi - scene.domain.lo).minCoeff() / 50);
   for (std::size_t i = 0; i < p.size(); ++i) grid.add(p.x[i], p.radius[i]);
-  for (const Insertion& ins : scene.insertions) {
+  for (std::size_t e = 0; e < scene.insertions.size(); ++e) {
+    const Insertion& ins = scene.insertions[e];
+    const bool later_checks = std::any_of(
+        scene.insertions.begin() + static_cast<std::ptrdiff_t>(e) + 1, scene.insertions.end(),
+        [](const Insertion& later) { return later.kind != Insertion::Kind::stream; });
     switch (ins.kind) {
       case Insertion::Kind::fill: fill_region(scene, walls, ins, p, next_id, grid); break;
       case Insertion::Kind::csv: read_csv(scene, ins, p, next_id, grid); break;
-      case Insertion::Kind::snapshot: read_snapshot_entry(scene, ins, p, next_id, grid); break;
+      case Insertion::Kind::snapshot:
+        read_snapshot_entry(scene, ins, p, next_id, grid, later_checks);
+        break;
       case Insertion::Kind::stream: break;  // during the run: StreamInsertion
     }
   }

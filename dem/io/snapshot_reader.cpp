@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 namespace grainflow {
@@ -32,7 +33,8 @@ struct File {
   }
 };
 
-// Reads dataset `name` with `comps` components per particle; returns the count.
+// Reads dataset `name` with `comps` components per particle straight into `out` (a Vec3
+// holds the 3 components of one particle, any other T one); returns the count.
 template <class T>
 std::size_t read(hid_t file, const std::string& path, const char* name, int comps, hid_t type,
                  std::vector<T>& out) {
@@ -50,7 +52,9 @@ std::size_t read(hid_t file, const std::string& path, const char* name, int comp
     throw SnapshotReadError(path + ": error: dataset '" + name + "' should have " +
                             std::to_string(comps) + " component(s) per particle");
   }
-  out.resize(dims[0] * static_cast<std::size_t>(comps));
+  static_assert(sizeof(Vec3) == 3 * sizeof(double));
+  constexpr int per_element = std::is_same_v<T, Vec3> ? 3 : 1;
+  out.resize(dims[0] * static_cast<std::size_t>(comps / per_element));
   const herr_t status =
       out.empty() ? 0 : H5Dread(d, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data());
   H5Dclose(d);
@@ -65,36 +69,35 @@ Snapshot read_snapshot(const std::string& path) {
   File f{H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT)};
   if (f.id < 0)
     throw SnapshotReadError(path + ": error: cannot open as an HDF5 file; check the path");
-  std::vector<std::int64_t> id;
-  std::vector<double> x, v, w, r, m;
-  std::vector<int> mat;
-  const std::size_t n = read(f.id, path, "/id", 1, H5T_NATIVE_INT64, id);
-  const std::size_t counts[] = {read(f.id, path, "/position", 3, H5T_NATIVE_DOUBLE, x),
-                                read(f.id, path, "/velocity", 3, H5T_NATIVE_DOUBLE, v),
-                                read(f.id, path, "/angular_velocity", 3, H5T_NATIVE_DOUBLE, w),
-                                read(f.id, path, "/radius", 1, H5T_NATIVE_DOUBLE, r),
-                                read(f.id, path, "/mass", 1, H5T_NATIVE_DOUBLE, m),
-                                read(f.id, path, "/material", 1, H5T_NATIVE_INT, mat)};
+  // Read straight into the particle arrays: no second copy of the file's data.
+  Snapshot s;
+  Particles& p = s.particles;
+  static_assert(std::is_same_v<GlobalId, std::int64_t>);
+  const std::size_t n = read(f.id, path, "/id", 1, H5T_NATIVE_INT64, p.id);
+  const std::size_t counts[] = {
+      read(f.id, path, "/position", 3, H5T_NATIVE_DOUBLE, p.x),
+      read(f.id, path, "/velocity", 3, H5T_NATIVE_DOUBLE, p.v),
+      read(f.id, path, "/angular_velocity", 3, H5T_NATIVE_DOUBLE, p.omega),
+      read(f.id, path, "/radius", 1, H5T_NATIVE_DOUBLE, p.radius),
+      read(f.id, path, "/mass", 1, H5T_NATIVE_DOUBLE, p.mass),
+      read(f.id, path, "/material", 1, H5T_NATIVE_INT, p.material)};
   for (std::size_t c : counts)
     if (c != n)
       throw SnapshotReadError(path + ": error: datasets have different particle counts (" +
                               std::to_string(n) + " ids, " + std::to_string(c) + " values)");
-  Snapshot s;
   if (H5Aexists(f.id, "time") > 0) {
     const hid_t a = H5Aopen(f.id, "time", H5P_DEFAULT);
     H5Aread(a, H5T_NATIVE_DOUBLE, &s.time);
     H5Aclose(a);
   }
-  s.particles.reserve(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 xi(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
-    if (!xi.allFinite() || !(r[i] > 0) || !(m[i] > 0))
-      throw SnapshotReadError(path + ": error: particle id " + std::to_string(id[i]) +
+  for (std::size_t i = 0; i < n; ++i)
+    if (!p.x[i].allFinite() || !(p.radius[i] > 0) || !(p.mass[i] > 0))
+      throw SnapshotReadError(path + ": error: particle id " + std::to_string(p.id[i]) +
                               " has a non-finite position or a non-positive radius or mass");
-    s.particles.add_raw(id[i], xi, Vec3(v[3 * i], v[3 * i + 1], v[3 * i + 2]),
-                        Vec3(w[3 * i], w[3 * i + 1], w[3 * i + 2]), r[i], m[i],
-                        0.4 * m[i] * r[i] * r[i], mat[i]);
-  }
+  p.inertia.resize(n);
+  for (std::size_t i = 0; i < n; ++i) p.inertia[i] = 0.4 * p.mass[i] * p.radius[i] * p.radius[i];
+  p.force.assign(n, Vec3::Zero());
+  p.torque.assign(n, Vec3::Zero());
   return s;
 }
 

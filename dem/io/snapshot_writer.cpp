@@ -277,19 +277,21 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step) {
     const OpenFile out{file.get(), dcpl.get(), dxpl.get()};
 
     write_dataset(out, agreement, field("id"), slice, p.id.data());
-    const auto vectors = [&](const std::vector<Vec3>& a) {
-      scratch_.resize(3 * a.size());
-      for (std::size_t i = 0; i < a.size(); ++i)
-        for (int k = 0; k < 3; ++k) scratch_[3 * i + static_cast<std::size_t>(k)] = a[i][k];
-      return scratch_.data();
+    // A Vec3 is three contiguous doubles: its array is the (n, 3) dataset as it stands.
+    static_assert(sizeof(Vec3) == 3 * sizeof(double));
+    const auto vectors = [](const std::vector<Vec3>& a) {
+      return a.empty() ? nullptr : a.front().data();
     };
     write_dataset(out, agreement, field("position"), slice, vectors(p.x));
     write_dataset(out, agreement, field("velocity"), slice, vectors(p.v));
     write_dataset(out, agreement, field("angular_velocity"), slice, vectors(p.omega));
     write_dataset(out, agreement, field("radius"), slice, p.radius.data());
-    scratch_.resize(p.size());
-    for (std::size_t i = 0; i < p.size(); ++i) scratch_[i] = 2.0 * p.radius[i];
-    write_dataset(out, agreement, field("diameter"), slice, scratch_.data());
+    {
+      // Not kept between snapshots: it would add 8 bytes per particle to the run's peak.
+      std::vector<double> diameter(p.size());
+      for (std::size_t i = 0; i < p.size(); ++i) diameter[i] = 2.0 * p.radius[i];
+      write_dataset(out, agreement, field("diameter"), slice, diameter.data());
+    }
     write_dataset(out, agreement, field("mass"), slice, p.mass.data());
     write_dataset(out, agreement, field("material"), slice, p.material.data());
     static_assert(snapshot_fields.size() == 8, "a new snapshot field needs its write above");

@@ -48,7 +48,6 @@ class SnapshotWriter {
   std::string directory_;
   std::string basename_;
   std::vector<XdmfEntry> entries_;
-  std::vector<double> scratch_;  // one field packed for HDF5, reused across writes
 };
 
 }  // namespace grainflow

@@ -1,5 +1,6 @@
 #include "dem/neighbour/wall_neighbours.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace grainflow {
@@ -14,31 +15,26 @@ double wall_gap(const WallSet::Entry& wall, const Vec3& x, double r) {
 
 void WallNeighbours::build(const Particles& p, const WallSet& walls, double skin) {
   lists.resize(walls.walls().size());
+  column_wall_.assign(walls.history_columns(), 0);
   for (std::size_t w = 0; w < walls.walls().size(); ++w) {
     const WallSet::Entry& wall = walls.walls()[w];
     List& list = lists[w];
     list.i.clear();
     list.all = wall.kind == Wall::Kind::mesh || wall.pose.moving();
+    for (std::size_t c = 0; c < WallSet::columns_of(wall); ++c)
+      column_wall_[wall.column + c] = static_cast<int>(w);
     if (list.all) continue;
     for (std::size_t i = 0; i < p.size(); ++i)
       if (wall_gap(wall, p.x[i], p.radius[i]) < skin) list.i.push_back(static_cast<int>(i));
   }
 }
 
-void WallNeighbours::end_unlisted_springs(const WallSet& walls,
-                                          std::vector<std::vector<ContactHistory>>& history) const {
-  for (std::size_t w = 0; w < lists.size(); ++w) {
-    const List& list = lists[w];
-    if (list.all) continue;
-    std::vector<ContactHistory>& column = history[walls.walls()[w].column];
-    std::size_t next = 0;  // position in the ascending list
-    for (std::size_t i = 0; i < column.size(); ++i) {
-      if (next < list.i.size() && static_cast<std::size_t>(list.i[next]) == i)
-        ++next;
-      else
-        column[i] = ContactHistory{};
-    }
-  }
+std::size_t WallNeighbours::entry_of(std::size_t c, std::size_t i) const {
+  const List& l = list_of_column(c);
+  if (l.all) return i;
+  const auto it = std::lower_bound(l.i.begin(), l.i.end(), static_cast<int>(i));
+  return it != l.i.end() && *it == static_cast<int>(i) ? static_cast<std::size_t>(it - l.i.begin())
+                                                       : npos;
 }
 
 }  // namespace grainflow

@@ -9,6 +9,7 @@
 //
 // Moving walls (their distance changes without the particles moving) and meshes (their
 // own search grid, triangle_mesh.hpp) are not listed: the sweep visits every particle.
+#include <cstddef>
 #include <vector>
 
 #include "dem/contact/contact_geometry.hpp"
@@ -30,11 +31,29 @@ struct WallNeighbours {
 
   void build(const Particles& p, const WallSet& walls, double skin);
 
-  // Ends the springs of particles off a wall's list: they do not touch the wall now (the
-  // sweep would end them at this step's force evaluation) nor before the next rebuild.
-  // history: Simulation's wall history columns (WallSet::history_columns()).
-  void end_unlisted_springs(const WallSet& walls,
-                            std::vector<std::vector<ContactHistory>>& history) const;
+  // The wall springs (Simulation's wall history: one vector per WallSet history column)
+  // follow these lists: a listed wall's column holds one spring per entry of its list (the
+  // spring of particle list.i[k] at k), the column of a wall listing every particle one per
+  // particle. So only the few particles near a fixed plane or cylinder hold a spring for it;
+  // an unlisted particle cannot touch it before the next rebuild, and has none.
+  static constexpr std::size_t npos = static_cast<std::size_t>(-1);
+  // The list that history column c follows (after build()).
+  const List& list_of_column(std::size_t c) const { return lists[column_wall_[c]]; }
+  // How many springs column c holds, with `particles` particles.
+  std::size_t column_size(std::size_t c, std::size_t particles) const {
+    const List& l = list_of_column(c);
+    return l.all ? particles : l.i.size();
+  }
+  // The particle of spring k of column c.
+  std::size_t particle_of(std::size_t c, std::size_t k) const {
+    const List& l = list_of_column(c);
+    return l.all ? k : static_cast<std::size_t>(l.i[k]);
+  }
+  // The spring of particle i in column c, or npos when i is not on the column's list.
+  std::size_t entry_of(std::size_t c, std::size_t i) const;
+
+ private:
+  std::vector<int> column_wall_;  // history column -> wall
 };
 
 }  // namespace grainflow

@@ -80,7 +80,8 @@ void Exchange::migrate(Particles& p, CarriedState& carried) {
       }
 
   std::string error;
-  const std::size_t walls = carried.wall.size();
+  CarriedSprings& springs = carried.springs;
+  const bool tangential = springs.keeps_tangential(), rolling = springs.keeps_rolling();
   for (int a = 0; a < 3; ++a) {
     if (d_.dims()[a] == 1) continue;  // after wrapping, this rank spans the whole axis
     for (int dir = 0; dir < 2; ++dir) {
@@ -88,14 +89,19 @@ void Exchange::migrate(Particles& p, CarriedState& carried) {
       Vec3 shift = Vec3::Zero();  // across the periodic side: back into the domain
       if (dom.periodic[a] && dir == 0 && d_.coords()[a] == 0) shift[a] = length[a];
       if (dom.periodic[a] && dir == 1 && d_.coords()[a] == d_.dims()[a] - 1) shift[a] = -length[a];
+      // The message: the particles, then the pair springs naming one of them, then their
+      // wall springs, each part preceded by its count.
       std::vector<double> out;
       Writer w{out};
       std::vector<char> leaving(p.size(), 0);
+      std::vector<GlobalId> gone;  // ids of the leaving particles, sorted below
+      out.push_back(0);
       for (std::size_t i = 0; i < p.size(); ++i) {
         const bool outside = dir == 0 ? p.x[i][a] < d_.lo()[a] : p.x[i][a] >= d_.hi()[a];
         // The last box along a bounded axis keeps x == hi; beyond it particles were removed.
         if (!outside || to == MPI_PROC_NULL) continue;
         leaving[i] = 1;
+        gone.push_back(p.id[i]);
         w.put_id(p.id[i]);
         w.put(Vec3(p.x[i] + shift));
         w.put(p.v[i]);
@@ -106,31 +112,54 @@ void Exchange::migrate(Particles& p, CarriedState& carried) {
         w.put(p.mass[i]);
         w.put(p.inertia[i]);
         w.put(static_cast<double>(p.material[i]));
-        for (std::size_t k = 0; k < walls; ++k) w.put(carried.wall[k][i]);
-        w.put(static_cast<double>(carried.pairs[i].size()));
-        for (const PartnerHistory& ph : carried.pairs[i]) {
-          w.put_id(ph.partner);
-          w.put(ph.history);
-        }
         if (carried.carries_drag)
           for (double x : carried.drag[i]) w.put(x);
       }
-      p.remove_if(leaving);
-      for (auto& wh : carried.wall) {
-        std::size_t keep = 0;
-        for (std::size_t r = 0; r < wh.size(); ++r)
-          if (!leaving[r]) wh[keep++] = wh[r];
-        wh.resize(keep);
+      out[0] = static_cast<double>(gone.size());
+      std::sort(gone.begin(), gone.end());
+      const auto is_gone = [&gone](GlobalId id) {
+        return std::binary_search(gone.begin(), gone.end(), id);
+      };
+      // A pair spring goes along with either partner; this rank keeps it unless both left
+      // (the other partner may stay here, or be a ghost here: then it is simply not used).
+      {
+        const std::size_t count_at = out.size();
+        out.push_back(0);
+        std::vector<char> drop(gone.empty() ? 0 : springs.pairs(), 0);
+        long sent = 0;
+        for (std::size_t r = 0; r < springs.pairs() && !gone.empty(); ++r) {
+          const CarriedSprings::PairKey& key = springs.pair_key(r);
+          const bool lo_gone = is_gone(key.lo), hi_gone = is_gone(key.hi);
+          if (!lo_gone && !hi_gone) continue;
+          drop[r] = lo_gone && hi_gone;
+          const ContactHistory h = springs.pair(r);
+          w.put_id(key.lo);
+          w.put_id(key.hi);
+          if (tangential) w.put(h.tangential);
+          if (rolling) w.put(h.rolling);
+          ++sent;
+        }
+        out[count_at] = static_cast<double>(sent);
+        if (!gone.empty()) springs.drop_pairs(drop);
       }
       {
-        std::size_t keep = 0;
-        for (std::size_t r = 0; r < carried.pairs.size(); ++r)
-          if (!leaving[r]) {
-            if (keep != r) carried.pairs[keep] = std::move(carried.pairs[r]);  // no self-move
-            ++keep;
-          }
-        carried.pairs.resize(keep);
+        const std::size_t count_at = out.size();
+        out.push_back(0);
+        std::vector<char> drop(gone.empty() ? 0 : springs.walls(), 0);
+        long sent = 0;
+        for (std::size_t r = 0; r < springs.walls() && !gone.empty(); ++r) {
+          const CarriedSprings::WallKey& key = springs.wall_key(r);
+          if (!is_gone(key.particle)) continue;
+          drop[r] = 1;
+          w.put_id(key.particle);
+          w.put(static_cast<double>(key.column));
+          w.put(springs.wall(r));
+          ++sent;
+        }
+        out[count_at] = static_cast<double>(sent);
+        if (!gone.empty()) springs.drop_walls(drop);
       }
+      p.remove_if(leaving);
       if (carried.carries_drag) {
         std::size_t keep = 0;
         for (std::size_t r = 0; r < carried.drag.size(); ++r)
@@ -138,8 +167,9 @@ void Exchange::migrate(Particles& p, CarriedState& carried) {
         carried.drag.resize(keep);
       }
       const std::vector<double> in = sendrecv(d_.comm(), out, to, from, 100 + 2 * a + dir);
+      if (in.empty()) continue;  // from MPI_PROC_NULL
       Reader r{in};
-      while (r.k < in.size()) {
+      for (auto n = static_cast<std::size_t>(r.get()); n > 0; --n) {
         const GlobalId id = r.get_id();
         const Vec3 x = r.get_vec(), v = r.get_vec(), w_spin = r.get_vec();
         const Vec3 force = r.get_vec(), torque = r.get_vec();
@@ -148,15 +178,18 @@ void Exchange::migrate(Particles& p, CarriedState& carried) {
         p.add_raw(id, x, v, w_spin, radius, mass, inertia, mat);
         p.force.back() = force;
         p.torque.back() = torque;
-        for (std::size_t k = 0; k < walls; ++k) carried.wall[k].push_back(r.get_history());
-        const auto n = static_cast<std::size_t>(r.get());
-        std::vector<PartnerHistory> pairs(n);
-        for (auto& ph : pairs) {
-          ph.partner = r.get_id();
-          ph.history = r.get_history();
-        }
-        carried.pairs.push_back(std::move(pairs));
         if (carried.carries_drag) carried.drag.push_back({r.get(), r.get(), r.get(), r.get()});
+      }
+      for (auto n = static_cast<std::size_t>(r.get()); n > 0; --n) {
+        const GlobalId lo = r.get_id(), hi = r.get_id();
+        const Vec3 t = tangential ? r.get_vec() : Vec3::Zero();
+        const Vec3 roll = rolling ? r.get_vec() : Vec3::Zero();
+        springs.add_pair(lo, hi, t, roll);
+      }
+      for (auto n = static_cast<std::size_t>(r.get()); n > 0; --n) {
+        const GlobalId id = r.get_id();
+        const int column = static_cast<int>(r.get());
+        springs.add_wall(id, column, r.get_history());
       }
     }
     // Everything this rank now holds must lie in its slab along this axis.

@@ -1,7 +1,8 @@
 #pragma once
 // Particle exchange between neighbouring ranks of the processor grid (DESIGN.md §2):
 // - migrate(): at neighbour rebuilds, every particle moves to the rank whose box
-//   holds it, carrying its contact springs and wall histories;
+//   holds it, carrying its contact springs and wall springs (CarriedSprings: the records
+//   that name it);
 // - borders(): at rebuilds, builds the ghosts of every face, edge and corner (axis
 //   by axis: the y exchange forwards ghosts received along x, and so on) and
 //   records which particles go where;
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include "dem/core/particles.hpp"
+#include "dem/neighbour/carried_springs.hpp"
 #include "dem/parallel/decomposition.hpp"
 #include "dem/parallel/ghosts.hpp"
 

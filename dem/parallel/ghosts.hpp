@@ -7,10 +7,8 @@
 // geometry is then computed as (x_a - x_b) + (shift_a - shift_b) on every rank, so
 // both ranks of a pair that crosses a rank boundary get bit-identical forces.
 #include <cstddef>
-#include <array>
 #include <vector>
 
-#include "dem/contact/contact_geometry.hpp"
 #include "dem/core/types.hpp"
 
 namespace grainflow {
@@ -34,25 +32,6 @@ struct Ghosts {
     inertia.clear();
     material.clear();
   }
-};
-
-// Contact springs of one particle with one partner, keyed by the partner's global id:
-// the form in which springs travel with a migrating particle.
-struct PartnerHistory {
-  GlobalId partner;
-  ContactHistory history;
-};
-
-// Per-particle data that moves with its particle between ranks (and is permuted
-// and compacted with it).
-struct CarriedState {
-  std::vector<std::vector<ContactHistory>> wall;  // [wall][particle]
-  std::vector<std::vector<PartnerHistory>> pairs; // [particle]
-  // The implicit drag (K, u) of the step's end, [particle]; carried only across the
-  // rebuild after a checkpoint, where the next half kick still needs it. The flag is
-  // the same on every rank (a rank may hold no particles).
-  bool carries_drag = false;
-  std::vector<std::array<double, 4>> drag;
 };
 
 }  // namespace grainflow

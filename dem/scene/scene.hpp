@@ -63,6 +63,9 @@ struct TimeSettings {
   // Hertz contacts: t_c(v)/dt at a contact's own approach speed v below this stops the
   // run (the start-up refusal threshold of grain check); 0 turns the check off.
   double min_steps_per_contact = 5;
+  // Largest distance a particle may move in one step, in its own radii; beyond it the run
+  // stops (a particle that fast can pass a mesh wall or another particle unseen); 0: off.
+  double max_step_travel = 1;
 };
 
 struct PlaneWall {

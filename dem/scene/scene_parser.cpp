@@ -81,7 +81,7 @@ Domain parse_domain(const Field& f) {
 
 TimeSettings parse_time(const Field& f) {
   const Map m = f.map({"step", "rayleigh_fraction", "end", "expected_max_speed", "max_overlap",
-                       "min_steps_per_contact"});
+                       "min_steps_per_contact", "max_step_travel"});
   m.exactly_one_of("step", "rayleigh_fraction",
                    "`step` is the time step in s, `rayleigh_fraction` sets it as a fraction of "
                    "the Rayleigh time");
@@ -92,6 +92,7 @@ TimeSettings parse_time(const Field& f) {
   t.expected_max_speed = m.number_or("expected_max_speed", 1.0, kPositive);
   t.max_overlap = m.number_or("max_overlap", 0.25, Range{0, 1, false, true});
   t.min_steps_per_contact = m.number_or("min_steps_per_contact", 5, kNonNegative);
+  t.max_step_travel = m.number_or("max_step_travel", 1.0, kNonNegative);
   return t;
 }
 

@@ -46,10 +46,8 @@ WallSet::WallSet(const Scene& scene) {
       e.mesh = static_cast<int>(meshes_.size());
       e.surface_velocity = w.mesh.surface_velocity;
       meshes_.push_back(std::move(m));
-      columns_ += 2 * kMeshSlots;
-    } else {
-      columns_ += 1;
     }
+    columns_ += columns_of(e);
     walls_.push_back(std::move(e));
   }
 }

@@ -1,14 +1,14 @@
 #pragma once
 // All walls of a run in their current position: planes, cylinders and triangle
 // meshes, each with its prescribed motion (wall_motion.hpp), and the layout of the
-// per-particle contact histories the walls need.
+// contact histories the walls need.
 //
-// Histories are stored per particle in "columns" (Simulation's wall_history, one
-// vector of ContactHistory per column, permuted, compacted and migrated with the
-// particles): a plane or a cylinder uses one column; a mesh uses kMeshSlots slots of
-// two columns each, the slot's spring and its key, the contact normal of the last
-// step (kept in the key column's `tangential`). A mesh contact takes the slot whose
-// key is closest to its normal (within ~37 degrees), so a spring follows a particle
+// Histories are stored in "columns" (Simulation's wall_history, one vector of
+// ContactHistory per column, parallel to the wall's neighbour list or to the particles,
+// dem/neighbour/wall_neighbours.hpp): a plane or a cylinder uses one column; a mesh uses
+// kMeshSlots slots of two columns each, the slot's spring and its key, the contact normal
+// of the last step (kept in the key column's `tangential`). A mesh contact takes the slot
+// whose key is closest to its normal (within ~37 degrees), so a spring follows a particle
 // that slides or rolls across triangle boundaries of a flat or gently curved mesh.
 #include <string>
 #include <vector>
@@ -54,6 +54,10 @@ class WallSet {
   const std::vector<Entry>& walls() const { return walls_; }
   const TriangleMesh& mesh(const Entry& e) const { return meshes_[e.mesh]; }
   std::size_t history_columns() const { return columns_; }
+  // The history columns of one wall: 2 kMeshSlots for a mesh, 1 for a plane or a cylinder.
+  static std::size_t columns_of(const Entry& e) {
+    return e.kind == Wall::Kind::mesh ? 2 * kMeshSlots : 1;
+  }
   bool empty() const { return walls_.empty(); }
 
   // True if a sphere at x with radius r touches any wall (insertion).

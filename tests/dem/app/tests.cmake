@@ -26,6 +26,14 @@ grain_cli_test(missing_scene_file 2 "no_such.yaml: error: cannot open the scene 
                CMD ${_grain} check ${_scenes}/no_such.yaml)
 grain_cli_test(check_minimal 0 "Rayleigh time t_R = ;contact time t_c = ;steps per impact"
                CMD ${_grain} check ${_scenes}/minimal.yaml)
+# The travel guard's speed for the smallest bead: r / dt = 0.4004 mm / (0.07 t_R), with
+# t_R = pi r sqrt(rho / G) / (0.1631 nu + 0.8766) = 4.896e-5 s (DESIGN.md §3): 116.8 m/s.
+grain_cli_test(check_reports_travel_limit 0
+               "travel guard: a particle that moves more than 1 x its radius in one step stops the run [(]key time.max_step_travel[)]: above 116.[78] m/s for the smallest"
+               CMD ${_grain} check ${_scenes}/minimal.yaml FORBID "warning")
+grain_cli_test(check_warns_travel_limit 0
+               "above 116.[78] m/s for the smallest.*; warning: that is below time.expected_max_speed = 150 m/s"
+               CMD ${_grain} check ${_scenes}/fast_impacts.yaml)
 # The time step placed on the measured accuracy curve (docs/accuracy-vs-cost.md):
 # minimal.yaml runs at 0.07 t_R with e = 0.9 between its glass beads. (';' separates the
 # regexes that must all match.)
@@ -59,12 +67,18 @@ grain_cli_test(runs_on_two_ranks 0 "MPI ranks: 2 as a;done: [0-9]+ steps, 300 pa
                FILES out/particles.xdmf out/log.csv out/particles_000010.h5)
 set_tests_properties(grain.runs_on_two_ranks PROPERTIES PROCESSORS 2)
 # Forced past the refusal, the run is stopped by the steps-per-contact guard at the first
-# contact it cannot resolve; with that guard off, by the overlap guard (docs/stability.md).
+# contact it cannot resolve; with that guard off, by the travel guard (a bead thrown faster
+# than one radius per step); with both off, by the overlap guard (docs/stability.md).
 grain_cli_test(steps_guard_stops_run 1
                "particles? [0-9]+ and [a-z0-9 ]+ approach at [0-9.e-]+ m/s;only [0-9.e-]+ steps of dt = 0.001 s [(]fewer than 5, key time.min_steps_per_contact[)]"
                CMD ${_grain} run ${_scenes}/bad/huge_time_step.yaml --allow-large-dt --no-progress
                    --output out
                WORKDIR ${_work}/steps_guard)
+grain_cli_test(travel_guard_stops_run 1
+               "particle [0-9]+ moves [0-9.]+ of its radii per step;key time.max_step_travel"
+               CMD ${_grain} run ${_scenes}/bad/huge_time_step_travel_guard.yaml --allow-large-dt
+                   --no-progress --output out
+               WORKDIR ${_work}/travel_guard)
 grain_cli_test(overlap_guard_stops_run 1
                "particle [0-9]+ and a wall overlap by [0-9.]+ % of the smaller radius"
                CMD ${_grain} run ${_scenes}/bad/huge_time_step_no_steps_guard.yaml --allow-large-dt

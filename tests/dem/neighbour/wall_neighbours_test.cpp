@@ -12,6 +12,7 @@
 
 #include "dem/walls/wall_contact.hpp"
 #include "tests/dem/support/test_scene.hpp"
+#include "tests/dem/walls/mesh_support.hpp"
 
 namespace grainflow {
 namespace {
@@ -37,7 +38,8 @@ Scene walled_scene() {
   return s;
 }
 
-// Spheres inside the walled region (clear of every wall), like a packing in a container.
+// Spheres inside the walled region (clear of every plane and cylinder), like a packing in a
+// container.
 Particles random_spheres(const WallSet& walls, int n, unsigned seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-0.7, 0.7), ur(0.01, 0.03);
@@ -45,8 +47,9 @@ Particles random_spheres(const WallSet& walls, int n, unsigned seed) {
   while (static_cast<int>(p.size()) < n) {
     const Vec3 x(u(rng), u(rng), u(rng));
     const double r = ur(rng);
-    if (std::all_of(walls.walls().begin(), walls.walls().end(),
-                    [&](const WallSet::Entry& w) { return wall_gap(w, x, r) >= 0; }))
+    if (std::all_of(walls.walls().begin(), walls.walls().end(), [&](const WallSet::Entry& w) {
+          return w.kind == Wall::Kind::mesh || wall_gap(w, x, r) >= 0;
+        }))
       p.add(static_cast<GlobalId>(p.size()) + 1, x, Vec3::Zero(), Vec3::Zero(), r, 0, 2500);
   }
   return p;
@@ -101,28 +104,45 @@ TEST(WallNeighbours, MovingWallsAndMeshesListEveryParticle) {
   EXPECT_TRUE(lists.lists[1].i.empty());
 }
 
-// Springs of listed spheres are kept; every other sphere's spring with that wall ends; the
-// column of a moving wall (every particle listed) is left alone.
-TEST(WallNeighbours, EndsTheSpringsOfUnlistedSpheres) {
+// The wall springs follow the lists (Simulation's wall history): a listed wall's column has
+// one spring per list entry, a moving wall's or a mesh's columns one per particle. Reference:
+// the lists themselves and WallSet's column numbering (a mesh takes 2 kMeshSlots columns).
+TEST(WallNeighbours, SpringColumnsFollowTheLists) {
   Scene s = walled_scene();
-  s.walls[2].motion.angular_velocity = 1;
+  s.walls[2].motion.angular_velocity = 1;  // the drum turns: every particle
+  s.walls.insert(s.walls.begin() + 1, test::mesh_wall(test::write_mesh(
+                                          test::box(Vec3::Constant(-0.9), Vec3::Constant(0.9)),
+                                          "wall_neighbours_box.stl")));
   const WallSet walls(s);
+  ASSERT_EQ(walls.history_columns(), 4 + 2 * WallSet::kMeshSlots);
   const Particles p = random_spheres(walls, 2000, 3);
   WallNeighbours lists;
   lists.build(p, walls, 0.02);
-  const ContactHistory stretched{Vec3(1e-5, 0, 0), Vec3::Zero()};
-  std::vector<std::vector<ContactHistory>> history(
-      walls.history_columns(), std::vector<ContactHistory>(p.size(), stretched));
-  lists.end_unlisted_springs(walls, history);
+  std::size_t column = 0;
   for (std::size_t w = 0; w < walls.walls().size(); ++w) {
     const WallNeighbours::List& list = lists.lists[w];
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      const bool listed =
-          list.all || std::binary_search(list.i.begin(), list.i.end(), static_cast<int>(i));
-      EXPECT_EQ(history[walls.walls()[w].column][i].tangential.x(), listed ? 1e-5 : 0.0)
-          << "wall " << w << ", sphere " << i;
+    const bool every = w == 1 || w == 3;  // the mesh and the turning drum
+    EXPECT_EQ(list.all, every) << "wall " << w;
+    EXPECT_EQ(walls.walls()[w].column, static_cast<int>(column));
+    for (std::size_t c = column; c < column + WallSet::columns_of(walls.walls()[w]); ++c) {
+      EXPECT_EQ(&lists.list_of_column(c), &list) << "column " << c;
+      ASSERT_EQ(lists.column_size(c, p.size()), every ? p.size() : list.i.size());
+      if (!every) {
+        EXPECT_GT(list.i.size(), 10u) << "wall " << w << " lists nothing to check";
+      }
+      for (std::size_t k = 0; k < lists.column_size(c, p.size()); ++k) {
+        const std::size_t i = lists.particle_of(c, k);
+        EXPECT_EQ(i, every ? k : static_cast<std::size_t>(list.i[k]));
+        EXPECT_EQ(lists.entry_of(c, i), k);
+      }
+      for (std::size_t i = 0; i < p.size(); ++i)
+        if (!every && !std::binary_search(list.i.begin(), list.i.end(), static_cast<int>(i))) {
+          EXPECT_EQ(lists.entry_of(c, i), WallNeighbours::npos) << "sphere " << i;
+        }
     }
+    column += WallSet::columns_of(walls.walls()[w]);
   }
+  EXPECT_EQ(column, walls.history_columns());
 }
 
 }  // namespace

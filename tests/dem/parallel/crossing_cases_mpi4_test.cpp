@@ -109,8 +109,10 @@ TEST(Crossings, EmptyRanksDoNotStall) {
 
 TEST(Crossings, JumpOverASubdomainIsAClearError) {
   // Four ranks along x, 10 mm each; a particle at 30 m/s with dt = 1 ms moves 30 mm
-  // in one step: it would skip a whole subdomain.
+  // in one step: it would skip a whole subdomain. The travel guard (30 radii per step,
+  // limit 1) would stop it before it moves; off here, to test the migration's own error.
   Scene s = floor_scene(false);
+  s.time.max_step_travel = 0;
   s.gravity = Vec3::Zero();
   s.domain.hi = Vec3(0.04, 0.01, 0.01);
   Simulation sim(s, false, MPI_COMM_WORLD, {4, 1, 1});

@@ -90,6 +90,7 @@ TEST(SceneParser, BaseSceneIsValidAndTakesDefaults) {
   EXPECT_DOUBLE_EQ(s.time.expected_max_speed, 1.0);
   EXPECT_DOUBLE_EQ(s.time.max_overlap, 0.25);
   EXPECT_DOUBLE_EQ(s.time.min_steps_per_contact, 5.0);  // grain check's refusal threshold
+  EXPECT_DOUBLE_EQ(s.time.max_step_travel, 1.0);  // radii per step (docs/stability.md)
   ASSERT_EQ(s.pairs.size(), 1u);
   EXPECT_DOUBLE_EQ(s.pairs[0].restitution, 0.9);
   EXPECT_DOUBLE_EQ(s.pairs[0].friction, 0.5);
@@ -416,6 +417,13 @@ TEST(SceneErrors, ValueOutOfRangeStatesRangeAndValue) {
       parse_scene(with("end: 0.5", "end: 0.5\n  min_steps_per_contact: 0"), kLabel)
           .time.min_steps_per_contact,
       0.0);  // 0 turns the steps-per-contact guard off
+  const std::string travel =
+      expect_at(error_of(with("end: 0.5", "end: 0.5\n  max_step_travel: -0.5")), 7, 20);
+  EXPECT_THAT(travel, HasSubstr("time.max_step_travel: value -0.5 is out of range; it must be "
+                                ">= 0"));
+  EXPECT_DOUBLE_EQ(
+      parse_scene(with("end: 0.5", "end: 0.5\n  max_step_travel: 0"), kLabel).time.max_step_travel,
+      0.0);  // 0 turns the travel guard off
 
   const std::string end = expect_at(error_of(with("end: 0.5", "end: 0")), 6, 8);
   EXPECT_THAT(end, HasSubstr("time.end: value 0 is out of range; it must be > 0"));

@@ -65,5 +65,40 @@ TEST(ContactGuards, TwoRanksStopWithTheOneRankMessage) {
   }
 }
 
+// The travel guard (time.max_step_travel, 1 r) mid-run, on the rank that owns the particle
+// only: sphere 1, right of the cut, falls freely at 9.995 m/s under g = 9.81 m/s^2 with
+// dt = 1e-4 s. The drift of step k moves it with v = 9.995 + g dt (k - 1/2) (velocity
+// Verlet's half kick), which first exceeds r / dt = 10 m/s at k = 6 (closed form:
+// k - 1/2 > 0.005 / (g dt) = 5.097; 1.0004 radii, printed to 4 digits). Both ranks must
+// stop at step 6 with the 1-rank message.
+std::string travel_stop(MPI_Comm comm, std::array<int, 3> grid) {
+  Scene s = test::one_material_scene(1e7, 0.3, kRho, 0.5, 0.5);
+  s.domain.lo = Vec3::Zero();
+  s.domain.hi = Vec3(0.012, 0.012, 0.03);
+  s.gravity = Vec3(0, 0, -9.81);
+  s.walls = {test::plane(Vec3::Zero(), Vec3::UnitZ())};
+  Simulation sim(s, false, comm, grid);
+  sim.particles().add(1, Vec3(0.010, 0.006, 0.025), Vec3(0, 0, -9.995), Vec3::Zero(), kR, 0,
+                      kRho);
+  sim.set_dt(1e-4);
+  try {
+    sim.initialise();
+    for (int k = 0; k < 15; ++k) sim.step();
+  } catch (const ParallelError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ContactGuards, TravelGuardStopsBothRanksWithTheOneRankMessage) {
+  const std::string serial = travel_stop(MPI_COMM_SELF, {1, 1, 1});
+  const std::string parallel = travel_stop(MPI_COMM_WORLD, {2, 1, 1});
+  ASSERT_FALSE(serial.empty()) << "the 1-rank run should stop";
+  EXPECT_EQ(parallel, serial) << "rank " << test::world_rank();
+  EXPECT_NE(serial.find("(step 6): particle 1 moves 1 of its radii"), std::string::npos) << serial;
+  EXPECT_NE(serial.find("key time.max_step_travel"), std::string::npos) << serial;
+  if (test::world_rank() == 0) std::printf("travel guard: %s\n", serial.c_str());
+}
+
 }  // namespace
 }  // namespace grainflow

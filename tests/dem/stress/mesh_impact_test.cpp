@@ -23,9 +23,13 @@
 //   travel past the limit, the centre still on the mesh's side.
 // A last case is faster than one radius per step (50 m/s with dt = 3e-5 s, 1.5 r per
 // step): the engine does not claim to resolve that (theory/walls.md: keep overlaps a small
-// fraction of r). The sphere lands with its centre 0.5 r past the two-sided mesh, and the
-// overlap guard must stop it at that step with a message that says it tunnelled and
-// gives a step that, rerun, resolves the impact.
+// fraction of r), and the travel guard (time.max_step_travel, 1 r) refuses it before the
+// first drift (MeshImpactTravel below). With that guard off, the sphere lands with its
+// centre 0.5 r past the two-sided mesh, and the overlap guard must stop it at that step
+// with a message that says it tunnelled and gives a step that, rerun, resolves the impact.
+// Faster still, 2.5 r per step (dt = 5e-5 s), the sphere jumps from above the mesh to
+// 1.5 r below it in one step and never overlaps it at the end of a step: with the travel
+// guard off it is through the wall unseen, which is what that guard is for.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -82,8 +86,10 @@ struct ImpactRun {
   double dt = 0, max_overlap_ratio = 0;
 };
 
-ImpactRun impact(const MeshImpact& c, double dt) {
+ImpactRun impact(const MeshImpact& c, double dt, double max_step_travel = 1,
+                 long max_steps = 2000 * test::stress_scale()) {
   Scene s = test::one_material_scene(c.youngs, kNu, kRho, kE);
+  s.time.max_step_travel = max_step_travel;
   if (dt > 0) {
     s.time.step = dt;
   } else {
@@ -104,11 +110,11 @@ ImpactRun impact(const MeshImpact& c, double dt) {
   const Vec3 start = target + kR * normal + (1e-6 / std::cos(c.tilt)) * Vec3::UnitZ();
   Simulation sim(s, false);
   sim.particles().add(1, start, velocity, Vec3::Zero(), kR, 0, kRho);
-  sim.initialise();
   ImpactRun r;
-  r.dt = sim.dt();
   try {
-    for (long k = 0; k < 2000 * test::stress_scale(); ++k) {
+    sim.initialise();
+    r.dt = sim.dt();
+    for (long k = 0; k < max_steps; ++k) {
       sim.step();
       const Particles& p = sim.particles();
       EXPECT_EQ(p.size(), 1u);
@@ -142,7 +148,10 @@ TEST_P(MeshImpactTest, NeverTunnelsThroughTheMesh) {
   const Vec3 v_tangential = v_in + vn * normal;
   const double expected = predicted_overlap_ratio(c.youngs, vn);
   const double limit = 0.25;  // time.max_overlap, default
-  const ImpactRun r = impact(c, c.dt);
+  // Beyond one radius per step the travel guard would stop the run before anything
+  // moves (MeshImpactTravel): off here, to test the overlap guard behind it.
+  const bool too_fast = c.dt > 0 && c.speed * c.dt > kR;
+  const ImpactRun r = impact(c, c.dt, too_fast ? 0 : 1);
   const double travel = c.speed * r.dt / kR;  // per step, in radii
 
   if (travel > 1) {
@@ -211,6 +220,60 @@ TEST_P(MeshImpactTest, NeverTunnelsThroughTheMesh) {
         "%s at %4.0f m/s: stopped by the overlap guard at %.1f %% r (closed form %.0f "
         "%%), dt = %.3e s, suggested dt %.3e s\n",
         c.name, c.speed, 100 * r.max_overlap_ratio, 100 * expected, r.dt, suggested);
+  }
+}
+
+// The travel guard: 1.5 and 2.5 r per step at 50 m/s on glass (dt = 3e-5 and 5e-5 s).
+TEST(MeshImpactTravel, FasterThanOneRadiusPerStepIsStoppedBeforeItMoves) {
+  for (const double dt : {3e-5, 5e-5}) {
+    const MeshImpact c{"glass_vertex_travel", 60e9, 50, 0, 0, 0, dt};
+    const double travel = c.speed * dt / kR;
+    SCOPED_TRACE(travel);
+
+    // Guard on (default 1 r): stopped at start-up, before the first drift, the sphere
+    // still 1 um above the mesh.
+    const ImpactRun on = impact(c, dt);
+    ASSERT_FALSE(on.stop.empty()) << "the travel guard did not stop a sphere moving " << travel
+                                  << " r per step";
+    EXPECT_NE(on.stop.find("t = 0 s (step 1): particle 1 moves"), std::string::npos) << on.stop;
+    EXPECT_NEAR(test::number_after(on.stop, "particle 1 moves "), travel, 1e-3) << on.stop;
+    EXPECT_NE(on.stop.find("key time.max_step_travel"), std::string::npos) << on.stop;
+    EXPECT_EQ(on.lowest, 1.0);  // nothing moved
+    // The step that keeps it within one radius, r / v, exactly (4 printed digits).
+    EXPECT_NEAR(test::number_after(on.stop, "A step of at most ") / (kR / c.speed), 1.0, 1e-3)
+        << on.stop;
+    // The step that resolves the impact: t_c / 20 at 50 m/s against a glass wall, Hertz
+    // closed form (DESIGN.md §3) with R* = r, m* = m.
+    const double tc =
+        hertz_contact_time(y_star(c.youngs), kR, kRho * sphere_volume(kR), c.speed);
+    const double suggested = test::number_after(on.stop, "needs at most ");
+    EXPECT_NEAR(suggested / (tc / 20), 1.0, 1e-3) << on.stop;
+
+    // Rerun with the suggested step: resolved, e within 3 % as for the other glass impacts.
+    const ImpactRun fine = impact(c, suggested);
+    EXPECT_TRUE(fine.stop.empty()) << fine.stop;
+    ASSERT_TRUE(fine.rebounded);
+    EXPECT_GT(fine.lowest, 0.0);
+    const double e = fine.v_out[2] / c.speed;
+    EXPECT_NEAR(e / kE, 1.0, 0.03);
+
+    // Guard off, at 2.5 r per step: the centre goes from 1 um above touching to 1.5 r
+    // below the plane in one step, more than r from it, so it never overlaps the mesh at
+    // a step's end. No contact guard sees anything, and the sphere is through the wall.
+    // (One step: it would then leave the domain through its floor.)
+    if (travel > 2) {
+      const ImpactRun off = impact(c, dt, 0, 1);
+      EXPECT_TRUE(off.stop.empty()) << off.stop;
+      EXPECT_EQ(off.max_contacts, 0);
+      EXPECT_LT(off.lowest, -1.0) << "expected the unguarded sphere to pass the mesh";
+      std::printf("glass vertex at 50 m/s, %.1f r per step, travel guard off: passed the mesh "
+                  "unseen (centre %.3f r below it, 0 contacts)\n",
+                  travel, -off.lowest);
+    }
+    std::printf(
+        "glass vertex at 50 m/s, dt = %.1e s (%.1f r per step): stopped by the travel guard "
+        "at start-up; suggested dt %.3e s resolves it: e = %.4f, deepest %.2f %% r\n",
+        dt, travel, suggested, e, 100 * (1 - fine.lowest));
   }
 }
 
