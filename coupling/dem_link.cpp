@@ -384,7 +384,7 @@ void DemLink::advance(int steps, const std::string& diagnostic_directory) {
   try {
     for (int k = 0; k < steps; ++k) {
       sim.step();
-      guard_finite(sim, !sim.state_finite(), diagnostic_directory, impl_->dem_comm);
+      guard_finite_after_step(sim, diagnostic_directory, impl_->dem_comm);
     }
   } catch (const std::exception& e) {
     throw std::runtime_error(e.what());

@@ -31,9 +31,9 @@ PHASES = [
     ("particles leaving the domain (mark_leaving)", [("Simulation::step()", "mark_leaving()", 1)]),
     ("communication (ghost update; migration and ghost lists at rebuilds; contact guards' check)",
      [("Simulation::step()", "Exchange::forward(", 1), ("Simulation::rebuild(", "Exchange::migrate(", 1),
-      ("Simulation::rebuild(", "Exchange::borders(", 1), ("Simulation::compute_forces()", "check_contacts(", 1)]),
+      ("Simulation::rebuild(", "Exchange::borders(", 1), ("Simulation::compute_forces()", "check_contacts(", 1), ("Simulation::step()", "check_contacts(", 1)]),
     ("steps-per-contact guard (its gate every step; its pass when the gate opens)",
-     [("Simulation::compute_forces()", "contact_may_be_unresolved()", 1),
+     [("Simulation::compute_forces()", "contact_may_be_unresolved(", 1),
       ("Simulation::compute_forces()", "steps_per_contact_sweep(", 1)]),
     ("non-finite guard (run loop, every step)", [("run_scene(", "guard_finite(", 1)]),
     ("output (log rows, snapshots)", [("run_scene(", "global_state()", 1), ("run_scene(", "SnapshotWriter::write", 1),
@@ -64,7 +64,7 @@ def find(b, pattern):
 
 
 def breakdown(path):
-    tree = subprocess.run(["callgrind_annotate", "--inclusive=yes", "--tree=calling", path],
+    tree = subprocess.run(["callgrind_annotate", "--show=Ir", "--inclusive=yes", "--tree=calling", path],
                           capture_output=True, text=True, check=True).stdout
     b = blocks(tree)
     loop = 0

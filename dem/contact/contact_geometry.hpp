@@ -2,8 +2,10 @@
 // What one contact law evaluation sees, and what it returns.
 #include <cmath>
 #include <cstddef>
+#include <type_traits>
 #include <vector>
 
+#include "dem/core/lanes.hpp"
 #include "dem/core/types.hpp"
 
 namespace grainflow {
@@ -39,29 +41,37 @@ struct ListSprings {
   }
 };
 
-struct ContactGeometry {
-  Vec3 n;               // unit normal, pointing from j (or the wall) towards i
-  double overlap;       // > 0 [m]
-  double distance;      // centre distance (particle pairs) [m]
-  double r_i, r_j;      // radii; r_j unused for walls
-  double arm_i, arm_j;  // centre to contact point; arm_j = 0 for walls
-  double r_star, m_star;
-  double roll_inertia;  // EPSD: 1/I_r = 1/(I_i + m_i r_i^2) + 1/(I_j + m_j r_j^2)
-  Vec3 v_rel;           // velocity of i relative to j at the contact point
-  Vec3 w_rel;           // angular velocity of i minus that of j
+// The geometry of one contact (V = double), or of several side by side (V = Lanes2,
+// dem/core/lanes.hpp).
+template <class V>
+struct ContactGeometryT {
+  V3<V> n;         // unit normal, pointing from j (or the wall) towards i
+  V overlap;       // > 0 [m]
+  V distance;      // centre distance (particle pairs) [m]
+  V r_i, r_j;      // radii; r_j unused for walls
+  V arm_i, arm_j;  // centre to contact point; arm_j = 0 for walls
+  V r_star, m_star;
+  V roll_inertia;  // EPSD: 1/I_r = 1/(I_i + m_i r_i^2) + 1/(I_j + m_j r_j^2)
+  V3<V> v_rel;     // velocity of i relative to j at the contact point
+  V3<V> w_rel;     // angular velocity of i minus that of j
   bool wall;
 };
+using ContactGeometry = ContactGeometryT<double>;
 
-struct ContactResult {
-  Vec3 force;     // on i (j receives -force)
-  Vec3 torque_i;  // on i
-  Vec3 torque_j;  // on j (ignored for walls)
+template <class V>
+struct ContactResultT {
+  V3<V> force;     // on i (j receives -force)
+  V3<V> torque_i;  // on i
+  V3<V> torque_j;  // on j (ignored for walls)
 };
+using ContactResult = ContactResultT<double>;
 
 // Stiffness and damping of one contact, from the normal slot.
-struct SpringDashpot {
-  double kn, gn, kt, gt;
+template <class V>
+struct SpringDashpotT {
+  V kn, gn, kt, gt;
 };
+using SpringDashpot = SpringDashpotT<double>;
 
 // Settings that are the same for every pair (from the scene's `contact:` block).
 struct ContactConstants {
@@ -72,13 +82,27 @@ struct ContactConstants {
 };
 
 // Keeps a history vector in the current tangent plane: project out the normal
-// part (the contact frame has rotated) and restore the magnitude.
-inline void rotate_into_tangent_plane(Vec3& h, const Vec3& n) {
-  const double before = h.squaredNorm();
-  if (before == 0) return;
-  h -= n.dot(h) * n;
-  const double after = h.squaredNorm();
-  if (after > 0) h *= std::sqrt(before / after);
+// part (the contact frame has rotated) and restore the magnitude. The projection's squared
+// length is |h|^2 - (n.h)^2 (n a unit vector; h is nearly tangent, so no cancellation), which
+// the processor has before the projection itself: a shorter chain of dependent operations
+// than |h - (n.h) n|^2 (rounding differs in the last bits).
+template <class V3T>
+[[gnu::always_inline]] inline void rotate_into_tangent_plane(V3T& h, const V3T& n) {
+  if constexpr (std::is_same_v<V3T, Vec3>) {
+    const double before = h.squaredNorm();
+    if (before == 0) return;
+    const double along = n.dot(h);
+    h -= along * n;
+    const double after = before - along * along;
+    if (after > 0) h *= std::sqrt(before / after);
+  } else {  // the same, lane by lane, both ways computed
+    const auto before = squared_norm(h);
+    const auto along = dot(n, h);
+    const V3T projected = h - along * n;
+    const auto after = before - along * along;
+    const V3T scaled = projected * lane_sqrt(before / after);
+    h = select(before == 0, h, select(after > 0, scaled, projected));
+  }
 }
 
 }  // namespace grainflow

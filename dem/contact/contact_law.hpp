@@ -27,26 +27,33 @@ struct ContactLaw {
   static constexpr bool needs_spin = Tangential::enabled || Rolling::enabled;
   static constexpr bool needs_roll_inertia = Rolling::needs_inertia;
 
-  // Force on i (and torques on both) for one touching pair. The normal force has
-  // no lower clamp: the contact ends when the overlap returns to zero, which is
-  // the end-of-contact definition the restitution mappings assume. `tangential` and
+  // Whether the law also evaluates two contacts at once (V = Lanes2, dem/core/lanes.hpp):
+  // the rolling and cohesion slots take one contact at a time.
+  static constexpr bool lanes = Normal::lanes && !Rolling::enabled && !Cohesion::enabled;
+
+  // Force on i (and torques on both) for one touching pair, or for the pairs in the lanes of
+  // V. The normal force has no lower clamp: the contact ends when the overlap returns to zero,
+  // which is the end-of-contact definition the restitution mappings assume. `tangential` and
   // `rolling` are the contact's springs (each touched only by a law that has it).
-  [[gnu::always_inline]] static ContactResult evaluate(const ContactGeometry& g, const PairCoefficients& pc,
-                                const ContactConstants& cc, Vec3& tangential, Vec3& rolling,
-                                double dt) {
-    const SpringDashpot s = Normal::coefficients(pc, cc, g.r_star, g.m_star, g.overlap);
-    const double vn = g.v_rel.dot(g.n);
-    const double fn = s.kn * g.overlap - s.gn * vn;
-    const double fn_pos = std::max(fn, 0.0);
-    double fn_total = fn;
+  template <class V, class PC>
+  [[gnu::always_inline]] static ContactResultT<V> evaluate(const ContactGeometryT<V>& g,
+                                                           const PC& pc, const ContactConstants& cc,
+                                                           V3<V>& tangential, V3<V>& rolling,
+                                                           double dt) {
+    const SpringDashpotT<V> s = Normal::coefficients(pc, cc, g.r_star, g.m_star, g.overlap);
+    const V vn = dot(g.v_rel, g.n);
+    const V fn = s.kn * g.overlap - s.gn * vn;
+    const V fn_pos = max0(fn);
+    V fn_total = fn;
     if constexpr (Cohesion::enabled) fn_total -= Cohesion::force(g, pc.cohesion_energy_density);
 
-    ContactResult r{fn_total * g.n, Vec3::Zero(), Vec3::Zero()};
+    ContactResultT<V> r{fn_total * g.n, zero3<V>(), zero3<V>()};
     if constexpr (Tangential::enabled) {
-      const Vec3 vt = g.v_rel - vn * g.n;
-      const Vec3 ft = Tangential::force(vt, s.kt, s.gt, pc.friction * fn_pos, g.n, tangential, dt);
+      const V3<V> vt = g.v_rel - vn * g.n;
+      const V3<V> ft =
+          Tangential::template force<V>(vt, s.kt, s.gt, pc.friction * fn_pos, g.n, tangential, dt);
       r.force += ft;
-      const Vec3 n_x_ft = g.n.cross(ft);
+      const V3<V> n_x_ft = cross(g.n, ft);
       r.torque_i = -g.arm_i * n_x_ft;
       r.torque_j = -g.arm_j * n_x_ft;
     }

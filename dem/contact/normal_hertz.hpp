@@ -2,7 +2,10 @@
 // Hertz-Mindlin normal and tangential stiffness with restitution damping.
 // S_n = 2 Y* sqrt(R* d), S_t = 8 G* sqrt(R* d), k_n = (4/3) Y* sqrt(R* d), k_t = S_t,
 // gamma_{n,t} = 2 sqrt(5/6) b sqrt(S_{n,t} m*)   (Hertz 1881; Mindlin 1949; Tsuji et al. 1992),
-// with b mapped exactly to the requested restitution (restitution_mapping.hpp).
+// with b mapped exactly to the requested restitution (restitution_mapping.hpp). Since
+// S_t / S_n = 4 G*/Y* for every overlap, gamma_t = gamma_n sqrt(4 G*/Y*), the square root
+// taken once per material pair (PairCoefficients::hertz_gt_per_gn): two square roots per
+// contact instead of three (rounding differs from sqrt(S_t m*) in the last bits).
 #include <cmath>
 
 #include "dem/contact/contact_geometry.hpp"
@@ -12,14 +15,17 @@ namespace grainflow {
 
 struct HertzNormal {
   static constexpr const char* name = "hertz";
-  [[gnu::always_inline]] static SpringDashpot coefficients(const PairCoefficients& pc, const ContactConstants&,
-                                    double r_star, double m_star, double overlap) {
+  static constexpr bool lanes = true;  // also evaluates Lanes2 (dem/core/lanes.hpp)
+  template <class V, class PC>
+  [[gnu::always_inline]] static SpringDashpotT<V> coefficients(const PC& pc,
+                                                               const ContactConstants&, V r_star,
+                                                               V m_star, V overlap) {
     constexpr double two_sqrt_5_6 = 1.8257418583505538;  // 2 sqrt(5/6)
-    const double a = std::sqrt(r_star * overlap);
-    const double sn = 2 * pc.y_star * a;
-    const double st = 8 * pc.g_star * a;
-    return {(2.0 / 3.0) * sn, two_sqrt_5_6 * pc.hertz_beta * std::sqrt(sn * m_star), st,
-            two_sqrt_5_6 * pc.hertz_beta * std::sqrt(st * m_star)};
+    const V a = lane_sqrt(r_star * overlap);
+    const V sn = 2 * pc.y_star * a;
+    const V st = 8 * pc.g_star * a;
+    const V gn = two_sqrt_5_6 * pc.hertz_beta * lane_sqrt(sn * m_star);
+    return {(2.0 / 3.0) * sn, gn, st, gn * pc.hertz_gt_per_gn};
   }
 };
 

@@ -14,6 +14,7 @@ namespace grainflow {
 
 struct HookeNormal {
   static constexpr const char* name = "hooke";
+  static constexpr bool lanes = false;  // one contact at a time (std::pow)
   static SpringDashpot coefficients(const PairCoefficients& pc, const ContactConstants& cc,
                                     double r_star, double m_star, double /*overlap*/) {
     double kn, kt;

@@ -21,6 +21,7 @@ PairTable::PairTable(const Scene& scene) : n_(static_cast<int>(scene.materials.s
                         (1 - mb.poisson_ratio * mb.poisson_ratio) / mb.youngs_modulus);
       c.g_star = 1.0 / (2 * (2 - ma.poisson_ratio) * (1 + ma.poisson_ratio) / ma.youngs_modulus +
                         2 * (2 - mb.poisson_ratio) * (1 + mb.poisson_ratio) / mb.youngs_modulus);
+      c.hertz_gt_per_gn = std::sqrt(4 * c.g_star / c.y_star);
       c.restitution = pair.restitution;
       auto it = beta_of_e.find(pair.restitution);
       if (it == beta_of_e.end())

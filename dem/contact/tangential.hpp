@@ -16,15 +16,18 @@ struct NoTangential {
 struct HistoryTangential {
   static constexpr bool enabled = true;
   static constexpr const char* name = "history";
-  [[gnu::always_inline]] static Vec3 force(const Vec3& vt, double kt, double gt, double coulomb_limit, const Vec3& n,
-                    Vec3& xi, double dt) {
+  template <class V>
+  [[gnu::always_inline]] static V3<V> force(const V3<V>& vt, V kt, V gt, V coulomb_limit,
+                                            const V3<V>& n, V3<V>& xi, double dt) {
     rotate_into_tangent_plane(xi, n);
     xi += vt * dt;
-    Vec3 ft = -kt * xi - gt * vt;
-    const double f2 = ft.squaredNorm();
-    if (f2 > coulomb_limit * coulomb_limit) {
-      ft *= coulomb_limit / std::sqrt(f2);
-      xi = -(ft + gt * vt) / kt;
+    V3<V> ft = -kt * xi - gt * vt;
+    const V f2 = squared_norm(ft);
+    const auto sliding = f2 > coulomb_limit * coulomb_limit;
+    if (any(sliding)) {  // lanes that stick keep ft and xi
+      const V3<V> ft_slip = ft * (coulomb_limit / lane_sqrt(f2));
+      xi = select(sliding, V3<V>(-(ft_slip + gt * vt) / kt), xi);
+      ft = select(sliding, ft_slip, ft);
     }
     return ft;
   }

@@ -67,6 +67,17 @@ struct UnresolvedContact {
               GlobalId ib, double dt);
 };
 
+// Whether every local and ghost particle has the same radius, mass and material (a
+// monodisperse bed of one material; found at each neighbour rebuild). The pair kernel then
+// takes R* and m* of every pair from here: they are computed once with the same operands and
+// operations as per pair (r r / (r + r), m m / (m + m)), so they are the same to the last bit.
+struct UniformPairs {
+  bool all_alike = false;
+  double radius = 0, mass = 0, r_star = 0, m_star = 0;
+  int material = 0;
+};
+UniformPairs find_uniform_pairs(const Particles& p, const Ghosts& g);
+
 struct ContactSweep {
   Particles& p;
   const Ghosts& ghosts;
@@ -81,6 +92,7 @@ struct ContactSweep {
   const PairTable& table;
   const ContactConstants& constants;
   double dt;
+  const UniformPairs& uniform;
   // results of the sweep
   long contacts = 0;             // each contact once over all ranks
   double max_overlap_ratio = 0;  // overlap / smaller radius

@@ -80,4 +80,9 @@ void guard_finite(const Simulation& sim, bool local_bad, const std::string& dire
   agree_on_error(comm, mine.empty() ? mine : mine + where);
 }
 
+void guard_finite_after_step(const Simulation& sim, const std::string& directory, MPI_Comm comm) {
+  if (sim.state_finite_everywhere()) return;  // the same answer on every rank
+  guard_finite(sim, !sim.state_finite(), directory, comm);
+}
+
 }  // namespace grainflow

@@ -31,5 +31,9 @@ class Simulation;
 // without another pass). Collective.
 void guard_finite(const Simulation& sim, bool local_bad, const std::string& directory,
                   MPI_Comm comm);
+// The guard after Simulation::step(), which has already agreed on every rank whether all
+// states are finite (Simulation::state_finite_everywhere, in the step's one reduction):
+// communicates only when one is not. Collective.
+void guard_finite_after_step(const Simulation& sim, const std::string& directory, MPI_Comm comm);
 
 }  // namespace grainflow

@@ -191,7 +191,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   std::ostringstream stop_message;
   for (long k = first_step + 1; k <= total_steps; ++k) {
     sim.step();
-    guard_finite(sim, !sim.state_finite(), dir, comm);
+    guard_finite_after_step(sim, dir, comm);
     particle_steps += static_cast<double>(sim.particles().size());
     const double t = sim.time();
     const bool last = k == total_steps;

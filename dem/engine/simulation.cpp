@@ -129,7 +129,7 @@ void Simulation::initialise() {
   if (restoring)
     restore_implicit_drag();
   else
-    compute_forces();
+    check_contacts(compute_forces(), true);
   initialised_ = true;
 }
 
@@ -144,9 +144,13 @@ void Simulation::mark_leaving() {
       }
 }
 
-void Simulation::drift() {
-  // One pass: x += dt v, then the tests of mark_leaving() and of the skin, on the new x.
-  // A periodic side has infinite bounds here: nothing leaves through it.
+void Simulation::kick_and_drift() {
+  // One pass over the particles: the first half kick (as half_kick()), x += dt v, then the
+  // tests of mark_leaving() and of the skin on the new x, and the largest |v|^2 for
+  // contact_may_be_unresolved(). The kick is the last use of the step's forces, so the same
+  // pass sets them to gravity for the next evaluation (compute_forces()). Each particle's
+  // operations are those of the separate passes, in the same order. A periodic side has
+  // infinite bounds here: nothing leaves through it.
   const Domain& d = scene_.domain;
   constexpr double inf = std::numeric_limits<double>::infinity();
   Vec3 lo, hi;
@@ -156,19 +160,54 @@ void Simulation::drift() {
   }
   const double limit2 = 0.25 * skin_ * skin_;
   const std::size_t n = p_.size();
-  bool moved_far = false;
+  // The arrays' addresses and dt read once: a store through x could otherwise change them.
+  const double dt = dt_, h = 0.5 * dt_;
+  Vec3* xs = p_.x.data();
+  Vec3* vs = p_.v.data();
+  Vec3* ws = p_.omega.data();
+  Vec3* force = p_.force.data();
+  Vec3* torque = p_.torque.data();
+  const Vec3 g = scene_.gravity;
+  const double* mass = p_.mass.data();
+  const double* inertia = p_.inertia.data();
+  const double* drag_k = drag_.coefficient.data();
+  const Vec3* fluid_u = drag_.fluid_velocity.data();
+  const Vec3* built = x_at_build_.data();
   leaving_.clear();
-  for (std::size_t i = 0; i < n; ++i) {
-    Vec3& x = p_.x[i];
-    x += dt_ * p_.v[i];
-    moved_far |= (x - x_at_build_[i]).squaredNorm() > limit2;
-    if (x[0] < lo[0] || x[0] > hi[0] || x[1] < lo[1] || x[1] > hi[1] || x[2] < lo[2] ||
-        x[2] > hi[2]) {
-      leaving_.resize(n, 0);
-      leaving_[i] = 1;
+  const auto pass = [&]<bool Drag, bool Spin>() {
+    bool moved_far = false;
+    double v2 = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      Vec3& v = vs[i];
+      if constexpr (!Drag) {
+        v += (h / mass[i]) * force[i];
+      } else {
+        const double a = h / mass[i], k = drag_k[i];
+        v = (v + a * (force[i] + k * fluid_u[i])) / (1 + a * k);
+      }
+      if constexpr (Spin) ws[i] += (h / inertia[i]) * torque[i];
+      force[i] = mass[i] * g;
+      torque[i].setZero();
+      Vec3& x = xs[i];
+      x += dt * v;
+      moved_far |= (x - built[i]).squaredNorm() > limit2;
+      // | rather than ||: one branch, taken only by a particle that leaves.
+      if ((x[0] < lo[0]) | (x[0] > hi[0]) | (x[1] < lo[1]) | (x[1] > hi[1]) | (x[2] < lo[2]) |
+          (x[2] > hi[2])) [[unlikely]] {
+        leaving_.resize(n, 0);
+        leaving_[i] = 1;
+      }
+      v2 = std::max(v2, v.squaredNorm());
     }
-  }
-  moved_beyond_half_skin_ = moved_far;
+    moved_beyond_half_skin_ = moved_far;
+    local_speed2_ = v2;
+  };
+  const bool drag = !drag_.coefficient.empty(), spin = sweep_.needs_spin;
+  if (drag)
+    spin ? pass.template operator()<true, true>() : pass.template operator()<true, false>();
+  else
+    spin ? pass.template operator()<false, true>() : pass.template operator()<false, false>();
+  fresh_from_kick_ = true;
 }
 
 bool Simulation::needs_rebuild() const {
@@ -444,36 +483,46 @@ void Simulation::rebuild(bool keep_drag) {
     for (int b = 0; b < table_.size(); ++b)
       largest_y_star_ = std::max(largest_y_star_, table_(a, b).y_star);
   }
+  uniform_ = find_uniform_pairs(p_, ghosts_);
   x_at_build_ = p_.x;
   ++counters_.rebuilds;
 }
 
-void Simulation::compute_forces() {
-  const Vec3 g = scene_.gravity;
-  for (std::size_t i = 0; i < p_.size(); ++i) {
-    p_.force[i] = p_.mass[i] * g;
-    p_.torque[i].setZero();
+ContactGuards Simulation::compute_forces() {
+  if (!fresh_from_kick_) {  // else kick_and_drift() has set them
+    const Vec3 g = scene_.gravity;
+    for (std::size_t i = 0; i < p_.size(); ++i) {
+      p_.force[i] = p_.mass[i] * g;
+      p_.torque[i].setZero();
+    }
   }
+  // clang-format off
   ContactSweep s{
-      p_,     ghosts_,       local_list_,      ghost_list_, local_springs_, ghost_springs_,
-      walls_, wall_history_, wall_neighbours_, table_,      constants_,     dt_,
-      0,      0.0,           WorstContact{},   UnresolvedContact{}};
+      p_,       ghosts_,       local_list_,      ghost_list_, local_springs_, ghost_springs_,
+      walls_,   wall_history_, wall_neighbours_, table_,      constants_,     dt_,
+      uniform_, 0,             0.0,              WorstContact{}, UnresolvedContact{}};
+  // clang-format on
   sweep_.run(s);
-  // The fastest local particle bounds both the steps-per-contact gate and the travel guard.
+  // The fastest local particle bounds both the steps-per-contact gate and the travel guard;
+  // kick_and_drift() has found it (in the same order) unless a rebuild came since.
   double v2_local = 0;
-  for (const Vec3& v : p_.v) v2_local = std::max(v2_local, v.squaredNorm());
+  if (fresh_from_kick_)
+    v2_local = local_speed2_;
+  else
+    for (const Vec3& v : p_.v) v2_local = std::max(v2_local, v.squaredNorm());
   if (scene_.contact.normal == NormalModel::hertz && scene_.time.min_steps_per_contact > 0 &&
       contact_may_be_unresolved(v2_local)) {
     s.unresolved.set(scene_.time.min_steps_per_contact, dt_);
     steps_per_contact_sweep(s);
   }
+  fresh_from_kick_ = false;
   counters_.contacts = s.contacts;
   counters_.max_overlap_ratio = s.max_overlap_ratio;
-  check_contacts(s, fastest_particle(v2_local));
   apply_force_terms();
+  return {s.worst, s.unresolved, fastest_particle(v2_local)};
 }
 
-Simulation::FastParticle Simulation::fastest_particle(double v2_max) const {
+FastParticle Simulation::fastest_particle(double v2_max) const {
   // A particle that moves more than its radius r in one step can cross a (two-sided,
   // thin) mesh wall, or pass through another particle, without the two ever overlapping at
   // the end of a step, so no contact guard can see it (docs/stability.md). The drift just
@@ -484,8 +533,9 @@ Simulation::FastParticle Simulation::fastest_particle(double v2_max) const {
   if (limit <= 0 || v2_max * dt_ * dt_ <= limit * limit * smallest_radius_ * smallest_radius_)
     return fast;
   for (std::size_t i = 0; i < p_.size(); ++i) {
-    const double ratio = std::sqrt(p_.v[i].squaredNorm()) * dt_ / (limit * p_.radius[i]);
-    if (ratio > fast.ratio) fast = {ratio, i};
+    const double speed = std::sqrt(p_.v[i].squaredNorm());
+    const double ratio = speed * dt_ / (limit * p_.radius[i]);
+    if (ratio > fast.ratio) fast = {ratio, i, speed};
   }
   return fast;
 }
@@ -505,29 +555,33 @@ bool Simulation::contact_may_be_unresolved(double v2_local) const {
   return 4 * v2 >= floor * floor;
 }
 
-void Simulation::check_contacts(const ContactSweep& s, const FastParticle& fast) const {
-  // One reduction serves the three guards, and they speak only when some rank is beyond a
-  // limit, which every rank learns through it: keep the common path to that one call.
+bool Simulation::check_contacts(const ContactGuards& s, bool finite_here) const {
+  // One reduction serves the three guards and the finiteness of the step's end, and the
+  // guards speak only when some rank is beyond a limit, which every rank learns through it:
+  // keep the common path to that one call.
   const double limit = scene_.time.max_overlap;
   const double n_min = scene_.time.min_steps_per_contact;
+  const FastParticle& fast = s.fast;
   // Largest overlap ratio; fewest steps per contact as N_min / N (> 1 when under-resolved);
-  // the longest travel in the last drift over its limit (> 1 beyond it).
-  const double mine[3] = {counters_.max_overlap_ratio,
+  // the longest travel in the last drift over its limit (> 1 beyond it); 1 when this rank
+  // holds a non-finite state.
+  const double mine[4] = {counters_.max_overlap_ratio,
                           s.unresolved.fewest > 0 ? n_min / s.unresolved.fewest : 0.0,
-                          fast.ratio};
-  double worst[3] = {mine[0], mine[1], mine[2]};
-  if (decomp_->size() > 1) MPI_Allreduce(MPI_IN_PLACE, worst, 3, MPI_DOUBLE, MPI_MAX, comm_);
-  if (worst[0] <= limit && worst[1] <= 1 && worst[2] <= 1) return;
+                          fast.ratio, finite_here ? 0.0 : 1.0};
+  double worst[4] = {mine[0], mine[1], mine[2], mine[3]};
+  if (decomp_->size() > 1) MPI_Allreduce(MPI_IN_PLACE, worst, 4, MPI_DOUBLE, MPI_MAX, comm_);
+  if (worst[0] <= limit && worst[1] <= 1 && worst[2] <= 1) return worst[3] == 0;
   std::ostringstream o;
   o.precision(4);
   o << scene_.file << ": error: t = " << time_ << " s (step " << counters_.steps + 1 << "): ";
   if (worst[0] <= limit && worst[1] <= 1) {  // the travel guard (a contact's guard comes first)
     if (mine[2] != worst[2]) {
       agree_on_error(comm_, "");  // another rank holds the particle and speaks
-      return;
+      return worst[3] == 0;       // not reached: agree_on_error throws on every rank
     }
     const std::size_t i = fast.index;
-    const double speed = std::sqrt(p_.v[i].squaredNorm()), r = p_.radius[i];
+    // The speed of the drift (the last half kick has changed v since).
+    const double speed = fast.speed, r = p_.radius[i];
     const double travel_limit = scene_.time.max_step_travel;
     const Vec3& x = p_.x[i];
     o << "particle " << p_.id[i] << " moves " << speed * dt_ / r
@@ -548,13 +602,13 @@ void Simulation::check_contacts(const ContactSweep& s, const FastParticle& fast)
     o << ". If the speed itself is unphysical, look for what caused it (an initial velocity, a "
          "fluid force, a contact in the steps before)";
     agree_on_error(comm_, o.str());
-    return;
+    return worst[3] == 0;  // not reached
   }
   const bool overlap = worst[0] > limit;  // the overlap guard speaks first
   const WorstContact& w = overlap ? s.worst : s.unresolved.contact;
   if (overlap ? mine[0] != worst[0] : mine[1] != worst[1]) {
     agree_on_error(comm_, "");  // another rank holds the contact and speaks
-    return;
+    return worst[3] == 0;       // not reached
   }
   if (w.b >= 0)
     o << "particles " << w.a << " and " << w.b;
@@ -591,6 +645,7 @@ void Simulation::check_contacts(const ContactSweep& s, const FastParticle& fast)
         << "raise the Young's modulus";
   }
   agree_on_error(comm_, o.str());  // the rank holding the worst contact speaks
+  return worst[3] == 0;            // not reached: agree_on_error throws on every rank
 }
 
 void Simulation::restore_implicit_drag() {
@@ -624,34 +679,53 @@ void Simulation::apply_force_terms() {
   }
 }
 
+namespace {
+// One half kick of velocity Verlet over n particles: v += h/m F (implicit in v where drag
+// is set), and w += h/I T when the law has torques. Written on the arrays' addresses, one
+// loop per case, so that the loops hold no branch and no reload of an address. With Guard,
+// returns whether every x, v and w is finite after it: x - x is 0 for a finite x and NaN
+// for an infinite or NaN one, and NaN stays in a sum.
+template <bool Guard, bool Drag, bool Spin>
+bool kick(std::size_t n, double h, const Vec3* x, Vec3* v, Vec3* w, const Vec3* force,
+          const Vec3* torque, const double* mass, const double* inertia, const double* drag_k,
+          const Vec3* fluid_u) {
+  double nan_if_any = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if constexpr (!Drag) {
+      v[i] += (h / mass[i]) * force[i];
+    } else {
+      // v' = v + h/m (F + K (u - v'))  =>  v' = (v + h/m (F + K u)) / (1 + h K / m)
+      const double a = h / mass[i], k = drag_k[i];
+      v[i] = (v[i] + a * (force[i] + k * fluid_u[i])) / (1 + a * k);
+    }
+    if constexpr (Spin) w[i] += (h / inertia[i]) * torque[i];
+    if constexpr (Guard) nan_if_any += ((x[i] - x[i]) + (v[i] - v[i]) + (w[i] - w[i])).sum();
+  }
+  return nan_if_any == 0;
+}
+}  // namespace
+
 template <bool Guard>
 bool Simulation::half_kick() {
   const double h = 0.5 * dt_;
   const std::size_t n = p_.size();
+  const double* k = drag_.coefficient.data();
+  const Vec3* u = drag_.fluid_velocity.data();
+  Particles& p = p_;
+  const auto run = [&]<bool Drag, bool Spin>() {
+    return kick<Guard, Drag, Spin>(n, h, p.x.data(), p.v.data(), p.omega.data(), p.force.data(),
+                                   p.torque.data(), p.mass.data(), p.inertia.data(), k, u);
+  };
   const bool drag = !drag_.coefficient.empty(), spin = sweep_.needs_spin;
-  // x - x is 0 for a finite x and NaN for an infinite or NaN one, and NaN stays in a sum:
-  // `nan_if_any` ends 0 exactly when every component was finite.
-  double nan_if_any = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!drag) {
-      p_.v[i] += (h / p_.mass[i]) * p_.force[i];
-    } else {
-      // v' = v + h/m (F + K (u - v'))  =>  v' = (v + h/m (F + K u)) / (1 + h K / m)
-      const double a = h / p_.mass[i], k = drag_.coefficient[i];
-      p_.v[i] = (p_.v[i] + a * (p_.force[i] + k * drag_.fluid_velocity[i])) / (1 + a * k);
-    }
-    if (spin) p_.omega[i] += (h / p_.inertia[i]) * p_.torque[i];
-    if constexpr (Guard)
-      nan_if_any += ((p_.x[i] - p_.x[i]) + (p_.v[i] - p_.v[i]) + (p_.omega[i] - p_.omega[i])).sum();
-  }
-  return nan_if_any == 0;
+  if (drag)
+    return spin ? run.template operator()<true, true>() : run.template operator()<true, false>();
+  return spin ? run.template operator()<false, true>() : run.template operator()<false, false>();
 }
 
 void Simulation::step() {
   if (!initialised_) initialise();
   // Velocity Verlet: half kick, drift, new forces, half kick.
-  half_kick<false>();
-  drift();
+  kick_and_drift();
   // Stream insertion (dem/insert/stream_insertion.hpp); new particles force a rebuild.
   const bool inserted = !streams_.empty() && streams_.insert(time_ + dt_, p_, ghosts_, walls_,
                                                              *decomp_, next_id_, comm_) > 0;
@@ -659,14 +733,16 @@ void Simulation::step() {
     for (std::size_t col = 0; col < wall_history_.size(); ++col)
       if (wall_neighbours_.list_of_column(col).all) wall_history_[col].resize(p_.size());
   if (inserted) mark_leaving();  // the new particles too
-  if (inserted || needs_rebuild())
+  if (inserted || needs_rebuild()) {
     rebuild();
-  else
+    fresh_from_kick_ = false;  // particles came, left or arrived from other ranks
+  } else
     exchange_->forward(p_, ghosts_);
   time_ += dt_;
   walls_.move_to(time_);
-  compute_forces();
+  const ContactGuards guards = compute_forces();
   state_finite_ = half_kick<true>();
+  finite_everywhere_ = check_contacts(guards, state_finite_);
   ++counters_.steps;
 }
 

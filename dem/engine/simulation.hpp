@@ -55,6 +55,22 @@ struct GlobalState {
   double kinetic_rotational = 0;
 };
 
+// The particle that moved the most of its own radius in the last drift, when any could have
+// moved more than time.max_step_travel radii (ratio: travel / (limit r); 0: none), with the
+// speed it drifted at.
+struct FastParticle {
+  double ratio = 0;
+  std::size_t index = 0;
+  double speed = 0;
+};
+
+// What a step's force evaluation found for the guards (Simulation::check_contacts).
+struct ContactGuards {
+  WorstContact worst;            // the contact with the largest overlap ratio
+  UnresolvedContact unresolved;  // the least-resolved Hertz contact
+  FastParticle fast;             // the travel guard's candidate
+};
+
 class Simulation {
  public:
   // Inserts the scene's particles (every rank inserts the same set; initialise()
@@ -98,6 +114,9 @@ class Simulation {
   // Whether every position, velocity and spin of this rank's particles was finite at the
   // end of the last step() (checked in its last pass over the particles).
   bool state_finite() const { return state_finite_; }
+  // The same for every rank's particles, agreed in the step's one reduction (collective
+  // answer, no communication here).
+  bool state_finite_everywhere() const { return finite_everywhere_; }
   const Ghosts& ghosts() const { return ghosts_; }
   const Scene& scene() const { return scene_; }
   const WallSet& walls() const { return walls_; }               // current wall positions
@@ -137,29 +156,26 @@ class Simulation {
  private:
   void rebuild(bool keep_drag = false);
   void balance_cuts();  // moves cut planes toward equal particle counts (collective)
-  void compute_forces();     // gravity, contacts, then the force terms
+  ContactGuards compute_forces();  // gravity, contacts, then the force terms
   void apply_force_terms();  // non-contact terms only
   void restore_implicit_drag();  // initialise() after restore()
   // Stops the run (ParallelError on every rank) when a contact overlaps beyond
   // time.max_overlap, or when a Hertz contact gets fewer than time.min_steps_per_contact
   // steps at its own approach speed; the message names the contact and a time step that
   // would resolve it; and when a particle moved more than time.max_step_travel of its
-  // radii in the last drift (`fast`).
-  // The particle that moved the most of its own radius in the last drift, when any could
-  // have moved more than time.max_step_travel radii (ratio: travel / (limit r); 0: none).
-  struct FastParticle {
-    double ratio = 0;
-    std::size_t index = 0;
-  };
+  // radii in the last drift (`guards.fast`). Returns whether every rank's state is finite
+  // (`finite_here`: this rank's). Collective: the step's one reduction.
+  bool check_contacts(const ContactGuards& guards, bool finite_here) const;
   FastParticle fastest_particle(double v2_max) const;  // v2_max: largest local |v|^2
-  void check_contacts(const ContactSweep& sweep, const FastParticle& fast) const;
   // Whether any contact of this step could fail the steps-per-contact test (else the
   // sweep skips it): a bound from the fastest local (v2_local: its |v|^2) or ghost particle.
   bool contact_may_be_unresolved(double v2_local) const;
   bool needs_rebuild() const;  // collective
   void mark_leaving();         // particles beyond a bounded side of the domain
-  // x += dt v, with mark_leaving()'s test and the skin test in the same pass.
-  void drift();
+  // The first half kick and x += dt v in one pass, with mark_leaving()'s test, the skin test
+  // and the largest local |v|^2 (for contact_may_be_unresolved()); forces and torques set to
+  // gravity and zero for the next evaluation.
+  void kick_and_drift();
   // v += dt/2 F/m (implicit in v where drag is set), same for spin. With Guard: returns
   // whether every position, velocity and spin is finite after it (false otherwise).
   template <bool Guard>
@@ -192,6 +208,7 @@ class Simulation {
   // [WallSet column][entry of the wall's list, or particle]: the layout of wall_neighbours.hpp
   std::vector<std::vector<ContactHistory>> wall_history_;
   WallNeighbours wall_neighbours_;  // rebuilt with the Verlet lists
+  UniformPairs uniform_;            // found with the Verlet lists
   WallSet walls_;
   StreamInsertion streams_;
   std::vector<Vec3> x_at_build_;
@@ -205,7 +222,10 @@ class Simulation {
   std::unordered_map<GlobalId, std::pair<double, Vec3>> restored_drag_;
   std::optional<CarriedState> pending_carried_;     // springs for the first rebuild
   bool moved_beyond_half_skin_ = false;             // by the last drift(), since the last rebuild
+  double local_speed2_ = 0;                         // largest local |v|^2 after this step's drift
+  bool fresh_from_kick_ = false;  // kick_and_drift() ran (speeds, gravity) and no rebuild since
   bool state_finite_ = true;                        // after the last step(), this rank's particles
+  bool finite_everywhere_ = true;                   // the same, every rank's
   bool restored_ = false;                           // initialise() keeps the forces read
   bool initialised_ = false;
 };

@@ -114,6 +114,13 @@ void BinGrid::build(const Particles& p, const Ghosts& g, double skin, NeighbourL
     local.offsets[i + 1] = static_cast<int>(local.j.size());
     ghost.offsets[i + 1] = static_cast<int>(ghost.j.size());
   }
+  for (NeighbourList* list : {&local, &ghost}) {
+    list->owner.resize(list->j.size());
+    list->owner.shrink_to_fit();
+    for (std::size_t i = 0; i < n; ++i)
+      for (int k = list->offsets[i]; k < list->offsets[i + 1]; ++k)
+        list->owner[k] = static_cast<int>(i);
+  }
 }
 
 std::vector<std::pair<GlobalId, GlobalId>> brute_force_pairs(const Particles& p, const Box& box,

@@ -272,25 +272,45 @@ void Exchange::borders(const Particles& p, double cutoff, Ghosts& g) {
 }
 
 void Exchange::forward(const Particles& p, Ghosts& g) {
-  for (const Swap& s : swaps_) {
-    const int to = d_.neighbour(s.axis, s.dir), from = d_.neighbour(s.axis, 1 - s.dir);
-    if (to == MPI_PROC_NULL && from == MPI_PROC_NULL) continue;
-    std::vector<double> out;
-    out.reserve(9 * s.send.size());
-    Writer w{out};
-    for (int idx : s.send) {
-      const bool local = static_cast<std::size_t>(idx) < nlocal_;
-      const std::size_t k = local ? idx : idx - nlocal_;
-      w.put(local ? p.x[k] : g.x[k]);
-      w.put(local ? p.v[k] : g.v[k]);
-      w.put(local ? p.omega[k] : g.omega[k]);
+  // Every step, so one message per swap: the sizes are those of borders(). The two swaps of
+  // an axis go at once (their lists hold particles and ghosts of earlier axes only), the
+  // axes one after the other (the y swaps forward ghosts received along x).
+  constexpr int kWidth = 9;  // x, v, omega
+  buffers_.resize(2 * swaps_.size());
+  for (std::size_t first = 0; first < swaps_.size(); first += 2) {
+    MPI_Request requests[4];
+    int n = 0;
+    for (std::size_t w = first; w < first + 2 && w < swaps_.size(); ++w) {
+      const Swap& s = swaps_[w];
+      const int to = d_.neighbour(s.axis, s.dir), from = d_.neighbour(s.axis, 1 - s.dir);
+      if (to == MPI_PROC_NULL && from == MPI_PROC_NULL) continue;
+      std::vector<double>& in = buffers_[2 * w];
+      std::vector<double>& out = buffers_[2 * w + 1];
+      in.resize(kWidth * s.recv_count);
+      out.resize(kWidth * s.send.size());
+      double* o = out.data();
+      for (int idx : s.send) {
+        const bool local = static_cast<std::size_t>(idx) < nlocal_;
+        const std::size_t k = local ? idx : idx - nlocal_;
+        for (const Vec3* q : {local ? &p.x[k] : &g.x[k], local ? &p.v[k] : &g.v[k],
+                              local ? &p.omega[k] : &g.omega[k]})
+          for (int c = 0; c < 3; ++c) *o++ = (*q)[c];
+      }
+      const int tag = 300 + 2 * s.axis + s.dir;
+      MPI_Irecv(in.data(), static_cast<int>(in.size()), MPI_DOUBLE, from, tag, d_.comm(),
+                &requests[n++]);
+      MPI_Isend(out.data(), static_cast<int>(out.size()), MPI_DOUBLE, to, tag, d_.comm(),
+                &requests[n++]);
     }
-    const std::vector<double> in = sendrecv(d_.comm(), out, to, from, 300 + 2 * s.axis + s.dir);
-    Reader r{in};
-    for (std::size_t k = s.recv_first; k < s.recv_first + s.recv_count; ++k) {
-      g.x[k] = r.get_vec();
-      g.v[k] = r.get_vec();
-      g.omega[k] = r.get_vec();
+    MPI_Waitall(n, requests, MPI_STATUSES_IGNORE);
+    for (std::size_t w = first; w < first + 2 && w < swaps_.size(); ++w) {
+      const Swap& s = swaps_[w];
+      const double* q = buffers_[2 * w].data();
+      for (std::size_t k = s.recv_first; k < s.recv_first + s.recv_count; ++k, q += kWidth) {
+        g.x[k] = Vec3(q[0], q[1], q[2]);
+        g.v[k] = Vec3(q[3], q[4], q[5]);
+        g.omega[k] = Vec3(q[6], q[7], q[8]);
+      }
     }
   }
 }

@@ -67,7 +67,8 @@ class Exchange {
     std::size_t recv_first = 0, recv_count = 0;
   };
   const Decomposition& d_;
-  std::vector<Swap> swaps_;
+  std::vector<Swap> swaps_;                   // per axis the swaps of dir 0 and 1, axis after axis
+  std::vector<std::vector<double>> buffers_;  // forward(): per swap, what it receives and sends
   std::size_t nlocal_ = 0;
   long sent_ = 0;
 };

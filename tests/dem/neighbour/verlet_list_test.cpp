@@ -49,6 +49,15 @@ TEST_P(VerletVsBruteForce, SamePairs) {
 
     std::vector<std::pair<GlobalId, GlobalId>> half;
     std::set<std::pair<GlobalId, GlobalId>> all;
+    // Each entry names its owner (the sweeps' one loop over all entries relies on it).
+    ASSERT_EQ(local.owner.size(), local.j.size());
+    ASSERT_EQ(ghost.owner.size(), ghost.j.size());
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      for (int k = local.offsets[i]; k < local.offsets[i + 1]; ++k)
+        EXPECT_EQ(local.owner[k], static_cast<int>(i));
+      for (int k = ghost.offsets[i]; k < ghost.offsets[i + 1]; ++k)
+        EXPECT_EQ(ghost.owner[k], static_cast<int>(i));
+    }
     for (std::size_t i = 0; i < p.size(); ++i) {
       for (int k = local.offsets[i]; k < local.offsets[i + 1]; ++k) {
         const GlobalId a = p.id[i], b = p.id[local.j[k]];
