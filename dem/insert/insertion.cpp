@@ -362,7 +362,26 @@ void read_snapshot_entry(const Scene& scene, const Insertion& ins, Particles& p,
   } catch (const SnapshotReadError& e) {
     throw InsertionError(std::string(e.what()) + " (snapshot insertion at " + ins.source + ")");
   }
-  const Particles& q = snap.particles;
+  // Between neighbour-list rebuilds a periodic run lets centres drift past a periodic side
+  // (they are moved back to [lo, hi) at the next rebuild), so its snapshots may hold centres
+  // up to half a skin outside that range: such a centre is the same sphere as its image
+  // inside, and is moved there. Farther out (a snapshot of another domain) is an error.
+  Particles& q = snap.particles;
+  const Domain& dom = scene.domain;
+  const double drift = scene.neighbour.skin ? 0.5 * *scene.neighbour.skin : 0.0;
+  for (std::size_t i = 0; i < q.size(); ++i)
+    for (int a = 0; a < 3; ++a) {
+      if (!dom.periodic[a]) continue;
+      const double period = dom.hi[a] - dom.lo[a];
+      const double reach = std::max(q.radius[i], drift);
+      double& c = q.x[i][a];
+      if (c < dom.lo[a] && c >= dom.lo[a] - reach) {
+        c += period;
+        if (c >= dom.hi[a]) c = dom.lo[a];  // lo - 1e-20 + period rounds to hi
+      } else if (c >= dom.hi[a] && c < dom.hi[a] + reach) {
+        c -= period;
+      }
+    }
   for (std::size_t i = 0; i < q.size(); ++i) {
     auto fail = [&](const std::string& what) {
       throw InsertionError(ins.source + ": error: particle id " + std::to_string(q.id[i]) +
@@ -375,8 +394,9 @@ void read_snapshot_entry(const Scene& scene, const Insertion& ins, Particles& p,
     // A snapshot of a settled bed has particles overlapping walls on the domain's sides by
     // up to the overlap the run allowed.
     if (!inside_domain(scene.domain, q.x[i], q.radius[i], scene.time.max_overlap * q.radius[i]))
-      fail("lies outside the domain (or crosses a bounded side by more than time.max_overlap "
-           "of its radius)");
+      fail("lies outside the domain: " + outside_domain_reason(dom, q.x[i], q.radius[i]) +
+           " (a bounded side may be crossed by up to time.max_overlap of the radius, a periodic "
+           "range left by up to the larger of the radius and half the skin)");
     // Touching neighbours of a settled bed overlap slightly: only particles of
     // earlier entries are checked (the grid holds this snapshot's only afterwards).
     if (overlaps_with_images(grid, scene.domain, q.x[i], q.radius[i]))

@@ -178,5 +178,57 @@ TEST(SnapshotInsertion, ContinuesABedFromASnapshot) {
   EXPECT_THROW(insert_particles(s, r, next), InsertionError);
 }
 
+// A periodic run moves centres back into [lo, hi) only at neighbour-list rebuilds, so its
+// snapshots may hold centres just past a periodic side: they are the same spheres as their
+// images one period away, and come back there. A centre farther out is an error naming it.
+TEST(SnapshotInsertion, CentresJustPastAPeriodicSideComeBackAsTheirImages) {
+  const std::filesystem::path dir =
+      std::filesystem::path(GRAINFLOW_BINARY_DIR) / "test_output" / "snapshot_insertion_periodic";
+  std::filesystem::remove_all(dir);
+  prepare_output_directory(dir.string());
+  Scene s = test::one_material_scene(5e6, 0.3, kRho, 0.3);  // domain [-1, 1]^3
+  s.domain.periodic = {true, true, false};
+  const double r = 0.01;
+  Particles p;
+  p.add(1, Vec3(-1 - 0.3 * r, 0, 0), Vec3::Zero(), Vec3::Zero(), r, 0, kRho);
+  p.add(2, Vec3(0, 1 + 0.1 * r, 0), Vec3::Zero(), Vec3::Zero(), r, 0, kRho);
+  p.add(3, Vec3(0.5, 0.5, 0.5), Vec3::Zero(), Vec3::Zero(), r, 0, kRho);
+  SnapshotWriter w(MPI_COMM_WORLD, dir.string());
+  Insertion ins;
+  ins.kind = Insertion::Kind::snapshot;
+  ins.snapshot_file = w.write(p, 0.5, 10);
+  ins.source = "scene.yaml:9";
+  s.insertions.push_back(ins);
+  Particles q;
+  GlobalId next = 1;
+  insert_particles(s, q, next);
+  ASSERT_EQ(q.size(), 3u);
+  EXPECT_DOUBLE_EQ(q.x[0][0], 1 - 0.3 * r);  // one period (2 m) further
+  EXPECT_EQ(q.x[0][1], 0.0);
+  EXPECT_DOUBLE_EQ(q.x[1][1], -1 + 0.1 * r);
+  EXPECT_EQ(q.x[2], p.x[2]);
+
+  // Two radii past the side (default skin 0.4 r): not a periodic run's drift.
+  p.x[0][0] = -1 - 2 * r;
+  s.insertions[0].snapshot_file = w.write(p, 0.6, 11);
+  Particles bad;
+  next = 1;
+  try {
+    insert_particles(s, bad, next);
+    FAIL() << "expected InsertionError";
+  } catch (const InsertionError& e) {
+    EXPECT_NE(std::string(e.what()).find("scene.yaml:9: error: particle id 1 of snapshot"),
+              std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("its centre x = -1.02 is outside the periodic range [-1, 1)"),
+              std::string::npos) << e.what();
+  }
+  // A scene skin of 6 r lets a run drift 3 r between rebuilds: accepted then.
+  s.neighbour.skin = 6 * r;
+  Particles ok;
+  next = 1;
+  insert_particles(s, ok, next);
+  EXPECT_DOUBLE_EQ(ok.x[0][0], 1 - 2 * r);
+}
+
 }  // namespace
 }  // namespace grainflow
