@@ -128,8 +128,37 @@ double DemLink::end_time() const { return impl_->scene.time.end; }
 
 void DemLink::use_processor_grid(const ProcessorGrid& grid) { impl_->grid = grid; }
 
+namespace {
+
+// OpenFOAM traps floating-point exceptions (FOAM_SIGFPE): a NaN born in the DEM would kill
+// the run with a stack trace before the DEM's own guard could name the particle. Everything
+// that runs DEM code (initialise: the first forces; restore; advance; write_checkpoint: a
+// list rebuild) runs with the traps off, and the guard checks every step instead. The DEM's
+// pair kernel also relies on it: it evaluates four contacts at a time and computes both
+// sides of a branch in every lane (e.g. 0/0 for a fresh spring's rotation), keeping the
+// side that applies.
+class FloatingPointTrapsOff {
+ public:
+  FloatingPointTrapsOff() : traps_(fegetexcept()) {
+    if (traps_ != 0) fedisableexcept(traps_);
+  }
+  ~FloatingPointTrapsOff() {
+    if (traps_ == 0) return;
+    feclearexcept(FE_ALL_EXCEPT);  // flags raised (and checked) in the DEM
+    feenableexcept(traps_);
+  }
+  FloatingPointTrapsOff(const FloatingPointTrapsOff&) = delete;
+  FloatingPointTrapsOff& operator=(const FloatingPointTrapsOff&) = delete;
+
+ private:
+  int traps_;
+};
+
+}  // namespace
+
 void DemLink::initialise() {
   Impl& m = *impl_;
+  const FloatingPointTrapsOff traps_off;
   std::array<int, 3> dims{0, 0, 0};
   if (m.grid) {
     dims = m.grid->dims;
@@ -167,6 +196,7 @@ void DemLink::initialise() {
 }
 
 void DemLink::restore(const std::string& checkpoint) {
+  const FloatingPointTrapsOff traps_off;
   if (!std::filesystem::exists(checkpoint))
     throw std::runtime_error("the DEM checkpoint '" + checkpoint +
                              "' does not exist (a coupled run writes one at every write time; "
@@ -354,29 +384,6 @@ void DemLink::end_fluid(std::function<FluidAtParticle(const std::array<double, 3
   });
 }
 
-namespace {
-
-// OpenFOAM traps floating-point exceptions (FOAM_SIGFPE): a NaN born in the DEM would kill
-// the run with a stack trace before the DEM's own guard could name the particle. The DEM
-// steps run with the traps off, and the guard checks every step instead.
-class FloatingPointTrapsOff {
- public:
-  FloatingPointTrapsOff() : traps_(fegetexcept()) {
-    if (traps_ != 0) fedisableexcept(traps_);
-  }
-  ~FloatingPointTrapsOff() {
-    if (traps_ == 0) return;
-    feclearexcept(FE_ALL_EXCEPT);  // flags raised (and checked) in the DEM
-    feenableexcept(traps_);
-  }
-  FloatingPointTrapsOff(const FloatingPointTrapsOff&) = delete;
-  FloatingPointTrapsOff& operator=(const FloatingPointTrapsOff&) = delete;
-
- private:
-  int traps_;
-};
-
-}  // namespace
 
 void DemLink::advance(int steps, const std::string& diagnostic_directory) {
   Simulation& sim = impl_->simulation();
@@ -423,6 +430,7 @@ void DemLink::write_snapshot(const std::string& directory, long step, long conti
 
 std::string DemLink::write_checkpoint(const std::string& directory, int keep) {
   Impl& m = *impl_;
+  const FloatingPointTrapsOff traps_off;
   try {
     if (!m.checkpoints) {
       prepare_output_directory(directory);
