@@ -357,6 +357,31 @@ void DemLink::begin_fluid() {
   m.pending.reserve(m.simulation().particles().size());
 }
 
+double* DemLink::fluid_samples(SampleLayout& layout) {
+  Impl& m = *impl_;
+  // A FluidSample is doubles only (Vec3 = 3 doubles, no padding): a record of doubles.
+  static_assert(sizeof(FluidSample) == 18 * sizeof(double));
+  const std::size_t n = m.simulation().particles().size();
+  std::vector<FluidSample>& s = m.pending;
+  s = m.fluid->take_spare();  // the storage of the set before last (empty at first)
+  // Every record keeps density, viscosity and a zero material derivative (and vorticity,
+  // when not sampled) from when it was made here or in add_fluid().
+  s.resize(n, FluidSample{.density = m.fluid_density, .viscosity = m.fluid_viscosity});
+  const FluidSample probe;
+  const auto at = [&probe](const auto& member) {
+    return static_cast<std::size_t>(reinterpret_cast<const char*>(&member) -
+                                    reinterpret_cast<const char*>(&probe)) /
+           sizeof(double);
+  };
+  layout = SampleLayout{sizeof(FluidSample) / sizeof(double),
+                        at(probe.velocity),
+                        at(probe.void_fraction),
+                        at(probe.pressure_gradient),
+                        at(probe.viscous_stress_divergence),
+                        at(probe.vorticity)};
+  return reinterpret_cast<double*>(s.data());
+}
+
 void DemLink::add_fluid(const FluidAtParticle& f) {
   const Impl& m = *impl_;
   // to_sample(f), built in place.
@@ -377,7 +402,7 @@ void DemLink::end_fluid(std::function<FluidAtParticle(const std::array<double, 3
     throw std::logic_error("DemLink: " + std::to_string(m.pending.size()) + " fluid samples for " +
                            std::to_string(p.size()) + " particles");
   m.fluid->set(p.id, std::move(m.pending));
-  m.pending = {};
+  m.pending = {};  // moved from: empty
   Impl* self = &m;
   m.fluid->set_sampler([self, late = std::move(late)](const Vec3& x) {
     return self->to_sample(late(arr(x)));

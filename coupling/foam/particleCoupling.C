@@ -510,9 +510,17 @@ void ParticleCoupling::deposit() {
     meshSolidVolume += (1 - eps[c]) * V[c];
   }
   voidFraction_.correctBoundaryConditions();
-  Ksl_.correctBoundaryConditions();
-  KslUs_.correctBoundaryConditions();
-  fExplicit_.correctBoundaryConditions();
+  Ksl_.correctBoundaryConditions();  // written at write times: every patch
+  // KslUs and fParticles are read on a boundary only by grainFoam's fixedFluxPressure
+  // patches (the drag balance there), which are never constraint patches, and are not
+  // written: their symmetry-plane, processor and cyclic values are left unevaluated (on the
+  // Goldschmidt bed, two vector transforms over 5 400 symmetry faces per fluid step).
+  const polyBoundaryMesh& patches = mesh_.boundaryMesh();
+  forAll(patches, patch) {
+    if (polyPatch::constraintType(patches[patch].type())) continue;
+    KslUs_.boundaryFieldRef()[patch].evaluate();
+    fExplicit_.boundaryFieldRef()[patch].evaluate();
+  }
 
   // Volume not deposited anywhere (footprint points outside every rank's cells).
   double sums[4] = {particleVolume, depositedVolume, meshSolidVolume, stepClampedVolume_};
@@ -538,31 +546,37 @@ Foam::tmp<Foam::volVectorField> ParticleCoupling::viscousLaplacian() const {
 template <int width>
 void ParticleCoupling::sampleCellPoint() {
   const CellPointWeights& weights = *cellPointWeights_;
+  // Written straight into the DEM's sample records (no per-particle call or copy).
+  coupling::DemLink::SampleLayout at{};
+  double* const records = dem_->fluid_samples(at);
   for (std::size_t i = 0; i < particles_.local(); ++i) {
-    coupling::FluidAtParticle f;  // outside the mesh: fluid at rest, eps = 1
+    double* s = records + at.stride * i;
     const Foam::label c = centreCell_[i];
-    if (c < 0) {
-      dem_->add_fluid(f);
-      continue;
-    }
-    const CellPointWeight w =
-        weights.at(Foam::point(particles_.x(i)[0], particles_.x(i)[1], particles_.x(i)[2]), c);
-    // interpolationCellPoint<Type>::interpolate per component, in its order:
-    // cell * w0, then + point_k * w_k for k = 1, 2, 3.
-    const double* r[4] = {&cellRecords_[std::size_t{width} * c],
-                          &pointRecords_[std::size_t{width} * w.point[0]],
-                          &pointRecords_[std::size_t{width} * w.point[1]],
-                          &pointRecords_[std::size_t{width} * w.point[2]]};
     double v[width];
-    for (int k = 0; k < width; ++k) v[k] = r[0][k] * w.w[0];
-    for (int j = 1; j < 4; ++j)
-      for (int k = 0; k < width; ++k) v[k] += r[j][k] * w.w[j];
-    f.velocity = {v[0], v[1], v[2]};
-    f.pressure_gradient = {v[3], v[4], v[5]};
-    f.viscous_stress_divergence = {v[6], v[7], v[8]};
-    f.void_fraction = std::max(minVoidFraction_, std::min(1.0, v[9]));
-    if constexpr (width == 13) f.vorticity = {v[10], v[11], v[12]};
-    dem_->add_fluid(f);
+    if (c < 0) {  // outside the mesh: fluid at rest, eps = 1
+      for (int k = 0; k < width; ++k) v[k] = 0;
+      v[9] = 1;
+    } else {
+      const CellPointWeight w =
+          weights.at(Foam::point(particles_.x(i)[0], particles_.x(i)[1], particles_.x(i)[2]), c);
+      // interpolationCellPoint<Type>::interpolate per component, in its order:
+      // cell * w0, then + point_k * w_k for k = 1, 2, 3.
+      const double* r[4] = {&cellRecords_[std::size_t{width} * c],
+                            &pointRecords_[std::size_t{width} * w.point[0]],
+                            &pointRecords_[std::size_t{width} * w.point[1]],
+                            &pointRecords_[std::size_t{width} * w.point[2]]};
+      for (int k = 0; k < width; ++k) v[k] = r[0][k] * w.w[0];
+      for (int j = 1; j < 4; ++j)
+        for (int k = 0; k < width; ++k) v[k] += r[j][k] * w.w[j];
+      v[9] = std::max(minVoidFraction_, std::min(1.0, v[9]));
+    }
+    for (int d = 0; d < 3; ++d) {
+      s[at.velocity + d] = v[d];
+      s[at.pressure_gradient + d] = v[3 + d];
+      s[at.viscous_stress_divergence + d] = v[6 + d];
+      if constexpr (width == 13) s[at.vorticity + d] = v[10 + d];
+    }
+    s[at.void_fraction] = v[9];
   }
 }
 
@@ -579,20 +593,30 @@ void ParticleCoupling::sample() {
   tmp<volVectorField> tCurlU;
   if (curl) tCurlU = fvc::curl(U_);
   const std::size_t local = particles_.local();
-  dem_->begin_fluid();
   if (sampling_ == Sampling::cellPoint) {
     // OpenFOAM's cellPoint interpolation (interpolationCellPoint): the point values by
     // volPointInterpolation, as its constructor computes them (not copied, as it copies
     // them), the tetrahedron and its weights by cellPointWeights_, once per particle for all
     // the fields (cellPointWeights.H: OpenFOAM's weights, to round-off in box cells).
     const volPointInterpolation& toPoints = volPointInterpolation::New(mesh_);
-    const auto points = [&toPoints](const auto& field) {
-      return toPoints.interpolate(field, "volPointInterpolate(" + field.name() + ')', false);
+    const pointMesh& pMesh = pointMesh::New(mesh_);
+    // interpolate(field) would make a new point field (calculated patches) each call and
+    // fill it with interpolate(field, pointField); the same fields are kept and refilled.
+    const auto points = [&](auto& store, const auto& field) -> const auto& {
+      using PointField = typename std::remove_reference_t<decltype(store)>::element_type;
+      if (!store)
+        store.reset(new PointField(
+            IOobject("volPointInterpolate(" + field.name() + ')', field.instance(), pMesh.thisDb(),
+                     IOobject::NO_READ, IOobject::NO_WRITE, false),
+            pMesh, field.dimensions()));
+      toPoints.interpolate(field, *store);
+      return *store;
     };
-    const tmp<pointVectorField> pU(points(U_)), pG(points(gradP)), pT(points(divTau));
-    const tmp<pointScalarField> pE(points(voidFraction_));
-    tmp<pointVectorField> pC;
-    if (curl) pC = points(tCurlU());
+    const pointVectorField& pU = points(pointU_, U_);
+    const pointVectorField& pG = points(pointGradP_, gradP);
+    const pointVectorField& pT = points(pointDivTau_, divTau);
+    const pointScalarField& pE = points(pointEps_, voidFraction_);
+    const pointVectorField* pC = curl ? &points(pointCurlU_, tCurlU()) : nullptr;
     // The fields side by side, one record per cell and per point (U 0-2, grad p 3-5,
     // div tau 6-8, eps 9, curl U 10-12), so that a stencil reads four records.
     const int width = curl ? 13 : 10;
@@ -613,7 +637,7 @@ void ParticleCoupling::sample() {
     };
     pack(cellRecords_, U_.primitiveField(), gradP.primitiveField(), divTau.primitiveField(),
          voidFraction_.primitiveField(), curl ? &tCurlU().primitiveField() : nullptr);
-    pack(pointRecords_, pU(), pG(), pT(), pE(), curl ? &pC().primitiveField() : nullptr);
+    pack(pointRecords_, pU, pG, pT, pE, curl ? &pC->primitiveField() : nullptr);
     cellPointSamples_ += static_cast<long>(local);
     if (curl)
       sampleCellPoint<13>();
@@ -622,6 +646,7 @@ void ParticleCoupling::sample() {
     return;
   }
   // Footprint-weighted cell values; ghosts' shares go back to their owners.
+  dem_->begin_fluid();
   constexpr std::size_t W = 14;
   std::vector<double> acc(W * particles_.size(), 0.0);
   for (std::size_t i = 0; i < particles_.size(); ++i) {
@@ -708,7 +733,7 @@ void ParticleCoupling::checkBalance() {
 
 void ParticleCoupling::evolve() {
   auto t0 = Clock::now();
-  sample();  // straight into the DEM (DemLink::add_fluid)
+  sample();  // straight into the DEM (DemLink::fluid_samples or add_fluid)
   dem_->end_fluid([this](const std::array<double, 3>& x) { return sampleAt(x); });
   couplingSeconds_ += seconds_since(t0);
   t0 = Clock::now();

@@ -10,6 +10,7 @@ void CoupledFluid::set(std::vector<GlobalId> ids, std::vector<FluidSample> sampl
     throw std::invalid_argument("CoupledFluid::set: " + std::to_string(ids.size()) + " ids but " +
                                 std::to_string(samples.size()) + " samples");
   ids_ = std::move(ids);
+  spare_ = std::move(samples_);
   samples_ = std::move(samples);
   index_.clear();
   remapped_ = false;  // the samples themselves serve the particles while their order holds

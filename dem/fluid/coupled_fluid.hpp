@@ -26,6 +26,9 @@ class CoupledFluid {
 
   // Samples of the particles `ids` (any order). Replaces the previous set.
   void set(std::vector<GlobalId> ids, std::vector<FluidSample> samples);
+  // The storage of the set before the last set() (its values stale), for the next set to
+  // be written into without a new allocation each fluid step; empty if taken already.
+  std::vector<FluidSample> take_spare() { return std::move(spare_); }
   void set_sampler(Sampler sampler) { sampler_ = std::move(sampler); }
 
   // The samples in the current order of `p` (cheap when the order has not changed).
@@ -41,6 +44,7 @@ class CoupledFluid {
  private:
   std::vector<GlobalId> ids_;
   std::vector<FluidSample> samples_;
+  std::vector<FluidSample> spare_;  // the previous samples_ (take_spare)
   std::unordered_map<GlobalId, std::size_t> index_;  // built on the first re-map after set()
   // After a re-sort, migration or late arrival: the samples in the particles' new order.
   // Until then the samples are served as set (no copy per fluid step).

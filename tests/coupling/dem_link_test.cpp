@@ -92,5 +92,85 @@ TEST(DemLink, RunsWithTheProcessTrappingFloatingPointExceptions) {
   EXPECT_TRUE(std::isfinite(s.kinetic_energy));
 }
 
+// DemLink::fluid_samples() (the coupling writes into the DEM's sample records) serves the DEM
+// exactly what add_fluid() per particle does: the same particles after three fluid steps of
+// different samples, to the last bit, with the storage reused between the steps (the
+// density and viscosity the drag needs are the DEM's own in either path).
+TEST(DemLink, SampleRecordsActLikeAddFluid) {
+  const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "dem_link_records";
+  fs::remove_all(dir);
+  prepare_output_directory(dir.string());
+  const std::string scene = (dir / "scene.yaml").string();
+  std::ofstream(scene) << "domain: {min: [0, 0, 0], max: [0.02, 0.02, 0.04]}\n"
+                          "gravity: [0, 0, -9.81]\n"
+                          "time: {step: 1.0e-5, end: 1.0}\n"
+                          "materials: [{name: glass, youngs_modulus: 1.0e7, poisson_ratio: 0.3, "
+                          "density: 2500}]\n"
+                          "interaction_defaults: {restitution: 0.5, friction: 0.3}\n"
+                          "contact: {normal: hertz, tangential: history}\n"
+                          "walls: [{type: plane, name: floor, point: [0, 0, 0], normal: [0, 0, 1], "
+                          "material: glass}]\n"
+                          "insert: [{type: fill, region: {box: {min: [0, 0, 0], max: [0.02, 0.02, "
+                          "0.04]}}, count: 300, material: glass, radius: {distribution: uniform, "
+                          "min: 4.0e-4, max: 6.0e-4}}]\n"
+                          "fluid: {density: 1.2, viscosity: 1.8e-5, drag: di_felice, model: A, "
+                          "pressure: {hydrostatic: false}, forces: [drag, pressure_gradient, "
+                          "viscous, buoyancy]}\n";
+  // The fluid at particle i in round k: not uniform, so that an entry out of order shows.
+  const auto fluid_at = [](std::size_t i, int k) {
+    FluidAtParticle f;
+    f.velocity = {0.01 * std::sin(0.1 * i + k), -0.02 * std::cos(0.3 * i), 0.5 + 0.001 * i};
+    f.void_fraction = 0.4 + 0.5 * std::abs(std::sin(0.7 * i + k));
+    f.pressure_gradient = {1.0 * k, 2.0, -30.0 - 0.1 * i};
+    f.viscous_stress_divergence = {0.01 * i, -0.5, 0.25 * k};
+    return f;
+  };
+  const auto late = [](const std::array<double, 3>&) { return FluidAtParticle{}; };
+  // A third run in still air (eps = 1, no gradients) shows that the samples matter.
+  DemLink by_call(scene, 1.2, 1.8e-5, MPI_COMM_WORLD), by_record(scene, 1.2, 1.8e-5, MPI_COMM_WORLD),
+      still(scene, 1.2, 1.8e-5, MPI_COMM_WORLD);
+  by_call.initialise();
+  by_record.initialise();
+  still.initialise();
+  for (int k = 0; k < 3; ++k) {
+    const std::size_t n = by_call.particles(false).local;
+    ASSERT_EQ(by_record.particles(false).local, n);
+    by_call.begin_fluid();
+    for (std::size_t i = 0; i < n; ++i) by_call.add_fluid(fluid_at(i, k));
+    by_call.end_fluid(late);
+    DemLink::SampleLayout at{};
+    double* records = by_record.fluid_samples(at);
+    for (std::size_t i = 0; i < n; ++i) {
+      const FluidAtParticle f = fluid_at(i, k);
+      double* r = records + at.stride * i;
+      for (int d = 0; d < 3; ++d) {
+        r[at.velocity + d] = f.velocity[d];
+        r[at.pressure_gradient + d] = f.pressure_gradient[d];
+        r[at.viscous_stress_divergence + d] = f.viscous_stress_divergence[d];
+      }
+      r[at.void_fraction] = f.void_fraction;
+    }
+    by_record.end_fluid(late);
+    still.begin_fluid();
+    for (std::size_t i = 0; i < n; ++i) still.add_fluid(FluidAtParticle{});
+    still.end_fluid(late);
+    by_call.advance(50, (dir / "diagnostics").string());
+    by_record.advance(50, (dir / "diagnostics").string());
+    still.advance(50, (dir / "diagnostics").string());
+  }
+  const ParticleSet a = by_call.particles(false), b = by_record.particles(false),
+                    c = still.particles(false);
+  ASSERT_EQ(a.local, b.local);
+  ASSERT_EQ(a.local, c.local);
+  std::size_t differ_from_still = 0;
+  for (std::size_t i = 0; i < a.local; ++i) {
+    EXPECT_EQ(a.id[i], b.id[i]);
+    EXPECT_EQ(a.x[i], b.x[i]) << "particle " << a.id[i];
+    EXPECT_EQ(a.v[i], b.v[i]) << "particle " << a.id[i];
+    differ_from_still += a.v[i] != c.v[i];
+  }
+  EXPECT_EQ(differ_from_still, a.local);
+}
+
 }  // namespace
 }  // namespace grainflow::coupling
