@@ -12,6 +12,7 @@
 #include "coupling/shared_decomposition.hpp"
 #include "dem/io/output_directory.hpp"
 #include "zeroGradientFvPatchFields.H"
+#include "extrapolatedCalculatedFvPatchField.H"
 #include "volPointInterpolation.H"
 
 namespace grainflow::foam {
@@ -531,16 +532,53 @@ void ParticleCoupling::deposit() {
   stepClampedVolume_ = sums[3];
 }
 
-Foam::tmp<Foam::volVectorField> ParticleCoupling::viscousLaplacian() const {
+Foam::volVectorField& ParticleCoupling::viscousLaplacian() {
   using namespace Foam;
   const dimensionedScalar nu("nu", dimViscosity, nu_);
-  if (!uncorrectedLaplacian_.valid()) return fvc::laplacian(nu, U_);
-  // fvc::laplacian(nu, U) is div(nu_f snGrad(U) |S_f|) (gaussLaplacianScheme::fvcLaplacian,
-  // with nu_f the uniform face field it builds); the uncorrected snGrad is the corrected
-  // one without its non-orthogonal correction, which is round-off on this mesh.
-  const surfaceScalarField nuFaces(IOobject(nu.name(), U_.instance(), mesh_, IOobject::NO_READ),
-                                   mesh_, nu);
-  return uncorrectedLaplacian_.ref().fvcLaplacian(nuFaces, U_);  // ref(): the tmp owns it
+  if (!uncorrectedLaplacian_.valid()) {
+    divTau_.reset(fvc::laplacian(nu, U_).ptr());
+    return *divTau_;
+  }
+  // fvc::laplacian(nu, U) with `Gauss linear uncorrected` (gaussLaplacianScheme::fvcLaplacian:
+  // fvc::div(nu_f * snGrad(U) * |S_f|), snGrad = nonOrthDeltaCoeffs (U_N - U_P), the patches'
+  // own snGrad on the boundary; fvc::div = surfaceIntegrate, then / V and the
+  // extrapolatedCalculated boundary values), the same operations in the same order in one
+  // pass, into a field kept from step to step: no face fields made per step.
+  if (!divTau_ || !divTauKept_) {
+    divTauKept_ = true;
+    divTau_.reset(new volVectorField(
+        IOobject("laplacian(nu," + U_.name() + ')', U_.instance(), mesh_, IOobject::NO_READ,
+                 IOobject::NO_WRITE, false),
+        mesh_, dimensionedVector("zero", nu.dimensions() * U_.dimensions() / dimArea, Zero),
+        extrapolatedCalculatedFvPatchField<vector>::typeName));
+  }
+  volVectorField& lap = *divTau_;
+  vectorField& ivf = lap.primitiveFieldRef();
+  ivf = Zero;
+  const labelUList& owner = mesh_.owner();
+  const labelUList& neighbour = mesh_.neighbour();
+  const surfaceScalarField& deltaCoeffs = mesh_.nonOrthDeltaCoeffs();
+  const scalarField& dc = deltaCoeffs.primitiveField();
+  const scalarField& magSf = mesh_.magSf().primitiveField();
+  const vectorField& U = U_.primitiveField();
+  const double n = nu.value();
+  forAll(owner, facei) {
+    const vector flux = (n * (dc[facei] * (U[neighbour[facei]] - U[owner[facei]]))) * magSf[facei];
+    ivf[owner[facei]] += flux;
+    ivf[neighbour[facei]] -= flux;
+  }
+  forAll(mesh_.boundary(), patchi) {
+    const fvPatchVectorField& pU = U_.boundaryField()[patchi];
+    const tmp<vectorField> tsn =
+        pU.coupled() ? pU.snGrad(deltaCoeffs.boundaryField()[patchi]) : pU.snGrad();
+    const vectorField& sn = tsn();
+    const scalarField& pMagSf = mesh_.magSf().boundaryField()[patchi];
+    const labelUList& faceCells = mesh_.boundary()[patchi].faceCells();
+    forAll(faceCells, facei) ivf[faceCells[facei]] += (n * sn[facei]) * pMagSf[facei];
+  }
+  ivf /= mesh_.Vsc();
+  lap.correctBoundaryConditions();
+  return lap;
 }
 
 template <int width>
@@ -584,11 +622,11 @@ void ParticleCoupling::sample() {
   using namespace Foam;
   // rho grad p and rho nu laplacian(U), scaled in place (no second field).
   const dimensionedScalar rho("rho", dimless, rho_);
-  tmp<volVectorField> tGradP(fvc::grad(p_)), tDivTau(viscousLaplacian());
+  tmp<volVectorField> tGradP(fvc::grad(p_));
   tGradP.ref() *= rho;
-  tDivTau.ref() *= rho;
+  volVectorField& divTau = viscousLaplacian();
+  divTau *= rho;
   const volVectorField& gradP = tGradP();
-  const volVectorField& divTau = tDivTau();
   const bool curl = dem_->needs_vorticity();
   tmp<volVectorField> tCurlU;
   if (curl) tCurlU = fvc::curl(U_);
