@@ -42,7 +42,9 @@ struct DemLink::Impl {
   long restored_step = -1;                // the checkpoint's DEM step, after a restart
   std::unique_ptr<CheckpointSeries> checkpoints;
   std::vector<double> forwarded;     // particles(): the values forwarded to ghosts, reused
-  std::vector<FluidSample> pending;  // begin_fluid() .. end_fluid()
+  std::vector<CoupledSample> pending;  // begin_fluid() .. end_fluid()
+  std::vector<Vec3> pending_vorticity;  // the same, when a force reads the vorticity
+  bool curl = false;                    // needs_vorticity()
 
   ~Impl() {
     sim.reset();
@@ -83,6 +85,8 @@ DemLink::DemLink(const std::string& scene_file, double fluid_density, double flu
     throw std::runtime_error(scene_file +
                              ": error: a coupled run needs a `fluid:` block (drag law, VANS "
                              "model, force list); see docs/scene-reference.md");
+  m.fluid->set_constants(fluid_density, fluid_viscosity);
+  m.curl = needs_vorticity();
   const FluidSettings& f = *m.scene.fluid;
   std::ostringstream why;
   if (!close(f.field.density, fluid_density))
@@ -353,46 +357,50 @@ void DemLink::set_fluid(const std::vector<FluidAtParticle>& samples,
 
 void DemLink::begin_fluid() {
   Impl& m = *impl_;
+  const std::size_t n = m.simulation().particles().size();
+  m.pending = m.fluid->take_spare();  // the storage of the set before last, if any
   m.pending.clear();
-  m.pending.reserve(m.simulation().particles().size());
+  m.pending.reserve(n);
+  if (m.curl) {
+    m.pending_vorticity = m.fluid->take_spare_vorticity();
+    m.pending_vorticity.clear();
+    m.pending_vorticity.reserve(n);
+  }
 }
 
-double* DemLink::fluid_samples(SampleLayout& layout) {
+DemLink::SampleRecords DemLink::fluid_samples() {
   Impl& m = *impl_;
-  // A FluidSample is doubles only (Vec3 = 3 doubles, no padding): a record of doubles.
-  static_assert(sizeof(FluidSample) == 18 * sizeof(double));
+  // A CoupledSample is doubles only (Vec3 = 3 doubles, no padding): a record of doubles.
+  static_assert(sizeof(CoupledSample) == 10 * sizeof(double));
+  static_assert(sizeof(Vec3) == 3 * sizeof(double));
   const std::size_t n = m.simulation().particles().size();
-  std::vector<FluidSample>& s = m.pending;
-  s = m.fluid->take_spare();  // the storage of the set before last (empty at first)
-  // Every record keeps density, viscosity and a zero material derivative (and vorticity,
-  // when not sampled) from when it was made here or in add_fluid().
-  s.resize(n, FluidSample{.density = m.fluid_density, .viscosity = m.fluid_viscosity});
-  const FluidSample probe;
+  // The storage of the set before last (empty at first): every value is written again.
+  m.pending = m.fluid->take_spare();
+  m.pending.resize(n);
+  if (m.curl) {
+    m.pending_vorticity = m.fluid->take_spare_vorticity();
+    m.pending_vorticity.resize(n);
+  }
+  const CoupledSample probe;
   const auto at = [&probe](const auto& member) {
     return static_cast<std::size_t>(reinterpret_cast<const char*>(&member) -
                                     reinterpret_cast<const char*>(&probe)) /
            sizeof(double);
   };
-  layout = SampleLayout{sizeof(FluidSample) / sizeof(double),
-                        at(probe.velocity),
-                        at(probe.void_fraction),
-                        at(probe.pressure_gradient),
-                        at(probe.viscous_stress_divergence),
-                        at(probe.vorticity)};
-  return reinterpret_cast<double*>(s.data());
+  return SampleRecords{reinterpret_cast<double*>(m.pending.data()),
+                       sizeof(CoupledSample) / sizeof(double),
+                       at(probe.velocity),
+                       at(probe.void_fraction),
+                       at(probe.pressure_gradient),
+                       at(probe.viscous_stress_divergence),
+                       m.curl ? m.pending_vorticity.data()->data() : nullptr};
 }
 
 void DemLink::add_fluid(const FluidAtParticle& f) {
-  const Impl& m = *impl_;
-  // to_sample(f), built in place.
-  impl_->pending.push_back(
-      FluidSample{.velocity = vec(f.velocity),
-                  .void_fraction = f.void_fraction,
-                  .pressure_gradient = vec(f.pressure_gradient),
-                  .viscous_stress_divergence = vec(f.viscous_stress_divergence),
-                  .density = m.fluid_density,
-                  .viscosity = m.fluid_viscosity,
-                  .vorticity = vec(f.vorticity)});
+  Impl& m = *impl_;
+  m.pending.push_back(CoupledSample{vec(f.velocity), f.void_fraction, vec(f.pressure_gradient),
+                                    vec(f.viscous_stress_divergence)});
+  if (m.curl) m.pending_vorticity.push_back(vec(f.vorticity));
 }
 
 void DemLink::end_fluid(std::function<FluidAtParticle(const std::array<double, 3>&)> late) {
@@ -401,8 +409,13 @@ void DemLink::end_fluid(std::function<FluidAtParticle(const std::array<double, 3
   if (m.pending.size() != p.size())
     throw std::logic_error("DemLink: " + std::to_string(m.pending.size()) + " fluid samples for " +
                            std::to_string(p.size()) + " particles");
-  m.fluid->set(p.id, std::move(m.pending));
+  if (m.curl && m.pending_vorticity.size() != p.size())
+    throw std::logic_error("DemLink: " + std::to_string(m.pending_vorticity.size()) +
+                           " vorticity samples for " + std::to_string(p.size()) + " particles");
+  m.fluid->set(p.id, std::move(m.pending), m.curl ? std::move(m.pending_vorticity)
+                                                  : std::vector<Vec3>{});
   m.pending = {};  // moved from: empty
+  m.pending_vorticity = {};
   Impl* self = &m;
   m.fluid->set_sampler([self, late = std::move(late)](const Vec3& x) {
     return self->to_sample(late(arr(x)));

@@ -154,16 +154,17 @@ class DemLink {
   void add_fluid(const FluidAtParticle& f);
   void end_fluid(std::function<FluidAtParticle(const std::array<double, 3>&)> late);
   // Instead of begin_fluid() and add_fluid() per particle: the DEM's own sample storage,
-  // one record of `layout.stride` doubles per local particle in the order of
-  // particles(false), for the caller to write every field of `layout` into (vorticity only
-  // when needs_vorticity()); the DEM's constants (density, viscosity) are in place already.
-  // Then end_fluid(late). No copy and no call per particle; the storage is reused from
-  // step to step.
-  struct SampleLayout {
+  // one record of `stride` doubles per local particle in the order of particles(false), for
+  // the caller to write every field into (and, when needs_vorticity(), 3 doubles per
+  // particle at `vorticity`). Then end_fluid(late). No copy and no call per particle; the
+  // storage is reused from step to step, so every value must be written each time.
+  struct SampleRecords {
+    double* records;
     std::size_t stride;  // doubles per particle
-    std::size_t velocity, void_fraction, pressure_gradient, viscous_stress_divergence, vorticity;
+    std::size_t velocity, void_fraction, pressure_gradient, viscous_stress_divergence;
+    double* vorticity;  // 3 per particle, or null: no force reads it
   };
-  double* fluid_samples(SampleLayout& layout);
+  SampleRecords fluid_samples();
   // `steps` DEM steps (collective). After each, the NaN / Inf guard: the first non-finite
   // particle state stops the run with the particle, its forces and a diagnostic snapshot
   // of every particle in `diagnostic_directory`. Throws std::runtime_error with the DEM's

@@ -585,10 +585,9 @@ template <int width>
 void ParticleCoupling::sampleCellPoint() {
   const CellPointWeights& weights = *cellPointWeights_;
   // Written straight into the DEM's sample records (no per-particle call or copy).
-  coupling::DemLink::SampleLayout at{};
-  double* const records = dem_->fluid_samples(at);
+  const coupling::DemLink::SampleRecords at = dem_->fluid_samples();
   for (std::size_t i = 0; i < particles_.local(); ++i) {
-    double* s = records + at.stride * i;
+    double* s = at.records + at.stride * i;
     const Foam::label c = centreCell_[i];
     double v[width];
     if (c < 0) {  // outside the mesh: fluid at rest, eps = 1
@@ -612,7 +611,7 @@ void ParticleCoupling::sampleCellPoint() {
       s[at.velocity + d] = v[d];
       s[at.pressure_gradient + d] = v[3 + d];
       s[at.viscous_stress_divergence + d] = v[6 + d];
-      if constexpr (width == 13) s[at.vorticity + d] = v[10 + d];
+      if constexpr (width == 13) at.vorticity[3 * i + d] = v[10 + d];
     }
     s[at.void_fraction] = v[9];
   }

@@ -20,20 +20,57 @@
 
 namespace grainflow {
 
+// What the fluid solver gives per particle: the fields that vary from particle to particle
+// (80 B). The fluid's density and viscosity are the run's constants (set_constants), the
+// vorticity is kept beside the records only when a force needs it, and the material
+// derivative is not sampled (zero). Written once per fluid step for every particle and read
+// at every DEM sub-step, so its size is the coupling's memory traffic.
+struct CoupledSample {
+  Vec3 velocity = Vec3::Zero();                   // u_f [m/s]
+  double void_fraction = 1;                       // ε in (0, 1]
+  Vec3 pressure_gradient = Vec3::Zero();          // ∇p [Pa/m]
+  Vec3 viscous_stress_divergence = Vec3::Zero();  // ∇·τ [Pa/m]
+};
+
 class CoupledFluid {
  public:
   using Sampler = std::function<FluidSample(const Vec3& x)>;
+  // The samples in the particles' current order (at_particles): `vorticity` is null when
+  // the set carries none (the forces that read it then see zero).
+  struct View {
+    const CoupledSample* samples = nullptr;
+    const Vec3* vorticity = nullptr;
+    std::size_t size = 0;
+  };
 
-  // Samples of the particles `ids` (any order). Replaces the previous set.
-  void set(std::vector<GlobalId> ids, std::vector<FluidSample> samples);
+  void set_constants(double density, double viscosity) {
+    density_ = density;
+    viscosity_ = viscosity;
+  }
+  // Samples of the particles `ids` (any order), with their vorticity when `vorticity` is not
+  // empty (then one per id). Replaces the previous set.
+  void set(std::vector<GlobalId> ids, std::vector<CoupledSample> samples,
+           std::vector<Vec3> vorticity = {});
   // The storage of the set before the last set() (its values stale), for the next set to
   // be written into without a new allocation each fluid step; empty if taken already.
-  std::vector<FluidSample> take_spare() { return std::move(spare_); }
+  std::vector<CoupledSample> take_spare() { return std::move(spare_); }
+  std::vector<Vec3> take_spare_vorticity() { return std::move(spare_vorticity_); }
   void set_sampler(Sampler sampler) { sampler_ = std::move(sampler); }
-
   // The samples in the current order of `p` (cheap when the order has not changed).
-  const std::vector<FluidSample>& at_particles(const Particles& p);
-
+  View at_particles(const Particles& p);
+  // Sample i of a view as the force terms read it.
+  FluidSample sample(const View& v, std::size_t i) const {
+    const CoupledSample& c = v.samples[i];
+    FluidSample f;
+    f.velocity = c.velocity;
+    f.void_fraction = c.void_fraction;
+    f.pressure_gradient = c.pressure_gradient;
+    f.viscous_stress_divergence = c.viscous_stress_divergence;
+    f.density = density_;
+    f.viscosity = viscosity_;
+    if (v.vorticity) f.vorticity = v.vorticity[i];
+    return f;
+  }
   long late_samples() const { return late_; }
   void reset_late_samples() { late_ = 0; }
 
@@ -42,15 +79,19 @@ class CoupledFluid {
   std::vector<Vec3> exchange_force;
 
  private:
+  double density_ = 0, viscosity_ = 0;
   std::vector<GlobalId> ids_;
-  std::vector<FluidSample> samples_;
-  std::vector<FluidSample> spare_;  // the previous samples_ (take_spare)
+  std::vector<CoupledSample> samples_;
+  std::vector<Vec3> vorticity_;  // empty, or one per entry of samples_
+  std::vector<CoupledSample> spare_;  // the previous samples_ (take_spare)
+  std::vector<Vec3> spare_vorticity_;
   std::unordered_map<GlobalId, std::size_t> index_;  // built on the first re-map after set()
   // After a re-sort, migration or late arrival: the samples in the particles' new order.
   // Until then the samples are served as set (no copy per fluid step).
   bool remapped_ = false;
   std::vector<GlobalId> mapped_ids_;                 // order of `mapped_`
-  std::vector<FluidSample> mapped_;
+  std::vector<CoupledSample> mapped_;
+  std::vector<Vec3> mapped_vorticity_;
   Sampler sampler_;
   long late_ = 0;
 };

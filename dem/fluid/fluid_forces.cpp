@@ -51,14 +51,15 @@ class FluidForcesWith final : public ForceTerm {
 
   void add(Particles& p, double /*time*/, ImplicitDrag& drag) override {
     if (grid_) grid_->update(p, comm_);
-    const std::vector<FluidSample>* samples = nullptr;
+    CoupledFluid::View samples;
     if (coupled_) {
-      samples = &coupled_->at_particles(p);
+      samples = coupled_->at_particles(p);
       coupled_->exchange_force.assign(p.size(), Vec3::Zero());
     }
     const bool b = s_.model == VansModel::B;
     for (std::size_t i = 0; i < p.size(); ++i) {
-      FluidSample f = samples ? (*samples)[i] : s_.field.sample(p.x[i], gravity_);
+      FluidSample f =
+          coupled_ ? coupled_->sample(samples, i) : s_.field.sample(p.x[i], gravity_);
       if (grid_) f.void_fraction = grid_->at(p.x[i]);
       const double d = 2 * p.radius[i];
       const double volume = sphere_volume(p.radius[i]);

@@ -95,7 +95,7 @@ TEST(DemLink, RunsWithTheProcessTrappingFloatingPointExceptions) {
 // DemLink::fluid_samples() (the coupling writes into the DEM's sample records) serves the DEM
 // exactly what add_fluid() per particle does: the same particles after three fluid steps of
 // different samples, to the last bit, with the storage reused between the steps (the
-// density and viscosity the drag needs are the DEM's own in either path).
+// density and viscosity the drag needs are the run's constants in either path).
 TEST(DemLink, SampleRecordsActLikeAddFluid) {
   const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "dem_link_records";
   fs::remove_all(dir);
@@ -138,11 +138,11 @@ TEST(DemLink, SampleRecordsActLikeAddFluid) {
     by_call.begin_fluid();
     for (std::size_t i = 0; i < n; ++i) by_call.add_fluid(fluid_at(i, k));
     by_call.end_fluid(late);
-    DemLink::SampleLayout at{};
-    double* records = by_record.fluid_samples(at);
+    const DemLink::SampleRecords at = by_record.fluid_samples();
+    EXPECT_EQ(at.vorticity, nullptr);  // no lift force in this scene
     for (std::size_t i = 0; i < n; ++i) {
       const FluidAtParticle f = fluid_at(i, k);
-      double* r = records + at.stride * i;
+      double* r = at.records + at.stride * i;
       for (int d = 0; d < 3; ++d) {
         r[at.velocity + d] = f.velocity[d];
         r[at.pressure_gradient + d] = f.pressure_gradient[d];

@@ -14,8 +14,8 @@
 namespace grainflow {
 namespace {
 
-FluidSample sampleOf(GlobalId id, double scale = 1) {
-  FluidSample s;
+CoupledSample sampleOf(GlobalId id, double scale = 1) {
+  CoupledSample s;
   s.void_fraction = scale * static_cast<double>(id) / 100;
   s.velocity = Vec3(static_cast<double>(id), 0, 0);
   return s;
@@ -31,17 +31,19 @@ Particles fourParticles() {
 
 // Samples for the particles' current order, `scale` telling one set from another.
 void setFor(CoupledFluid& fluid, const Particles& p, double scale) {
-  std::vector<FluidSample> samples;
+  std::vector<CoupledSample> samples;
   for (GlobalId id : p.id) samples.push_back(sampleOf(id, scale));
   fluid.set(p.id, samples);
 }
 
 void expectServed(CoupledFluid& fluid, const Particles& p, double scale) {
-  const std::vector<FluidSample>& s = fluid.at_particles(p);
-  ASSERT_EQ(s.size(), p.size());
+  const CoupledFluid::View v = fluid.at_particles(p);
+  ASSERT_EQ(v.size, p.size());
+  EXPECT_EQ(v.vorticity, nullptr);  // the sets of these tests carry none
   for (std::size_t i = 0; i < p.size(); ++i) {
-    EXPECT_EQ(s[i].void_fraction, sampleOf(p.id[i], scale).void_fraction) << "particle " << p.id[i];
-    EXPECT_EQ(s[i].velocity[0], static_cast<double>(p.id[i])) << "particle " << p.id[i];
+    const FluidSample s = fluid.sample(v, i);
+    EXPECT_EQ(s.void_fraction, sampleOf(p.id[i], scale).void_fraction) << "particle " << p.id[i];
+    EXPECT_EQ(s.velocity[0], static_cast<double>(p.id[i])) << "particle " << p.id[i];
   }
 }
 
@@ -88,13 +90,51 @@ TEST(CoupledFluid, SamplesALateArrivalOnce) {
   int calls = 0;
   fluid.set_sampler([&calls](const Vec3& x) {
     ++calls;
-    return sampleOf(static_cast<GlobalId>(std::lround(x[0] / 0.01)));
+    const CoupledSample c = sampleOf(static_cast<GlobalId>(std::lround(x[0] / 0.01)));
+    FluidSample f;
+    f.velocity = c.velocity;
+    f.void_fraction = c.void_fraction;
+    return f;
   });
   p.add(42, Vec3(0.42, 0, 0), Vec3::Zero(), Vec3::Zero(), 1e-3, 0, 2500);  // migrated in
   expectServed(fluid, p, 1);
   expectServed(fluid, p, 1);
   EXPECT_EQ(calls, 1);
   EXPECT_EQ(fluid.late_samples(), 1);
+}
+
+// The run's density and viscosity reach every sample; the vorticity, when a set carries it,
+// follows its particle through a reorder and comes with a late arrival.
+TEST(CoupledFluid, ConstantsAndVorticityReachTheirParticles) {
+  Particles p = fourParticles();
+  CoupledFluid fluid;
+  fluid.set_constants(1.2, 1.8e-5);
+  std::vector<CoupledSample> samples;
+  std::vector<Vec3> vorticity;
+  for (GlobalId id : p.id) {
+    samples.push_back(sampleOf(id));
+    vorticity.push_back(Vec3(0, 0, -static_cast<double>(id)));
+  }
+  fluid.set(p.id, samples, vorticity);
+  fluid.set_sampler([](const Vec3& x) {
+    FluidSample f;
+    f.vorticity = Vec3(0, 0, -std::round(x[0] / 0.01));
+    return f;
+  });
+  p.permute({3, 1, 0, 2});
+  p.add(42, Vec3(0.42, 0, 0), Vec3::Zero(), Vec3::Zero(), 1e-3, 0, 2500);
+  const CoupledFluid::View v = fluid.at_particles(p);
+  ASSERT_NE(v.vorticity, nullptr);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const FluidSample s = fluid.sample(v, i);
+    EXPECT_EQ(s.density, 1.2);
+    EXPECT_EQ(s.viscosity, 1.8e-5);
+    EXPECT_EQ(s.vorticity, Vec3(0, 0, -static_cast<double>(p.id[i]))) << "particle " << p.id[i];
+    EXPECT_EQ(s.material_derivative, Vec3::Zero());
+  }
+  EXPECT_EQ(fluid.late_samples(), 1);
+  EXPECT_THROW(fluid.set(p.id, std::vector<CoupledSample>(p.size()), std::vector<Vec3>(2)),
+               std::invalid_argument);
 }
 
 }  // namespace
