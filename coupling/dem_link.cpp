@@ -45,6 +45,10 @@ struct DemLink::Impl {
   std::vector<CoupledSample> pending;  // begin_fluid() .. end_fluid()
   std::vector<Vec3> pending_vorticity;  // the same, when a force reads the vorticity
   bool curl = false;                    // needs_vorticity()
+  // The coupling's sampler of late arrivals (end_fluid), and whether the CoupledFluid's
+  // sampler calls it already.
+  std::function<FluidAtParticle(const std::array<double, 3>&)> late;
+  bool sampler_set = false;
 
   ~Impl() {
     sim.reset();
@@ -405,6 +409,13 @@ void DemLink::add_fluid(const FluidAtParticle& f) {
 
 void DemLink::end_fluid(std::function<FluidAtParticle(const std::array<double, 3>&)> late) {
   Impl& m = *impl_;
+  m.late = std::move(late);
+  end_fluid();
+}
+
+void DemLink::end_fluid() {
+  Impl& m = *impl_;
+  if (!m.late) throw std::logic_error("DemLink::end_fluid(): no sampler for late arrivals yet");
   const Particles& p = m.simulation().particles();
   if (m.pending.size() != p.size())
     throw std::logic_error("DemLink: " + std::to_string(m.pending.size()) + " fluid samples for " +
@@ -416,10 +427,11 @@ void DemLink::end_fluid(std::function<FluidAtParticle(const std::array<double, 3
                                                   : std::vector<Vec3>{});
   m.pending = {};  // moved from: empty
   m.pending_vorticity = {};
-  Impl* self = &m;
-  m.fluid->set_sampler([self, late = std::move(late)](const Vec3& x) {
-    return self->to_sample(late(arr(x)));
-  });
+  if (!m.sampler_set) {
+    Impl* self = &m;
+    m.fluid->set_sampler([self](const Vec3& x) { return self->to_sample(self->late(arr(x))); });
+    m.sampler_set = true;
+  }
 }
 
 

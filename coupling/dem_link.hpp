@@ -153,6 +153,8 @@ class DemLink {
   void begin_fluid();
   void add_fluid(const FluidAtParticle& f);
   void end_fluid(std::function<FluidAtParticle(const std::array<double, 3>&)> late);
+  // The same, keeping the `late` of the previous end_fluid(late) (none before it: an error).
+  void end_fluid();
   // Instead of begin_fluid() and add_fluid() per particle: the DEM's own sample storage,
   // one record of `stride` doubles per local particle in the order of particles(false), for
   // the caller to write every field into (and, when needs_vorticity(), 3 doubles per

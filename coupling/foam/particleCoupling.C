@@ -421,10 +421,27 @@ void ParticleCoupling::buildFootprints() {
   points_.clear();  // keeps its capacity
   centreCell_.resize(particles_.local());
   const std::vector<coupling::FootprintPoint>& unit = footprint_.unit_points();
+  // The `centre` footprint: one point at the centre, weight 1. For a centre inside the
+  // domain (on a periodic axis in [lo, hi)) the general loop below gives that point itself
+  // (offset 0, no reflection, no image), so it is taken directly.
+  const bool centreOnly = unit.size() == 1 && unit[0].offset[0] == 0 && unit[0].offset[1] == 0 &&
+                          unit[0].offset[2] == 0;
   for (std::size_t i = 0; i < n; ++i) {
     const double* centre = particles_.x(i);
     const double r = particles_.radius(i);
     const Foam::label centreCell = locate(Foam::point(centre[0], centre[1], centre[2]));
+    if (centreOnly) {
+      bool inside = true;
+      for (int a = 0; a < 3; ++a)
+        inside = inside && centre[a] >= domain_.lo[a] &&
+                 (periodic_[a] ? centre[a] < domain_.hi[a] : centre[a] <= domain_.hi[a]);
+      if (inside) {
+        if (centreCell >= 0) points_.push_back({centreCell, unit[0].weight});
+        first_[i + 1] = points_.size();
+        if (i < particles_.local()) centreCell_[i] = centreCell;
+        continue;
+      }
+    }
     for (const coupling::FootprintPoint& q : unit) {
       Foam::point x;
       bool image = false;  // beyond a periodic side: the particle's image deposits it
@@ -771,7 +788,12 @@ void ParticleCoupling::checkBalance() {
 void ParticleCoupling::evolve() {
   auto t0 = Clock::now();
   sample();  // straight into the DEM (DemLink::fluid_samples or add_fluid)
-  dem_->end_fluid([this](const std::array<double, 3>& x) { return sampleAt(x); });
+  if (lateSamplerSet_) {
+    dem_->end_fluid();  // the sampler of late arrivals stays sampleAt
+  } else {
+    dem_->end_fluid([this](const std::array<double, 3>& x) { return sampleAt(x); });
+    lateSamplerSet_ = true;
+  }
   couplingSeconds_ += seconds_since(t0);
   t0 = Clock::now();
   try {
