@@ -561,8 +561,7 @@ Foam::volVectorField& ParticleCoupling::viscousLaplacian() {
   // own snGrad on the boundary; fvc::div = surfaceIntegrate, then / V and the
   // extrapolatedCalculated boundary values), the same operations in the same order in one
   // pass, into a field kept from step to step: no face fields made per step.
-  if (!divTau_ || !divTauKept_) {
-    divTauKept_ = true;
+  if (!divTau_) {  // a mesh is orthogonal or not for the whole run: this branch or the other
     divTau_.reset(new volVectorField(
         IOobject("laplacian(nu," + U_.name() + ')', U_.instance(), mesh_, IOobject::NO_READ,
                  IOobject::NO_WRITE, false),
