@@ -295,6 +295,19 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
     Info << "grainFoam coupling: cellPoint weights prepared for "
          << returnReduce(mesh.nCells(), sumOp<label>()) << " cells (" << boxCells
          << " boxes: closed form; the others: their tetrahedra), " << bytes / 1e6 << " MB" << endl;
+    // The point values: all fields in one pass (pointInterpolation.H), bit for bit
+    // volPointInterpolation's, unless the mesh has a patch type that class does not have.
+    pointInterpolation_ = std::make_unique<PointInterpolation>(mesh);
+    if (pointInterpolation_->unsupported().empty()) {
+      Info << "grainFoam coupling: cellPoint point values of all fields in one pass ("
+           << returnReduce(double(pointInterpolation_->bytes()), sumOp<double>()) / 1e6
+           << " MB of weights)" << endl;
+    } else {
+      Info << "grainFoam coupling: cellPoint point values by volPointInterpolation, field by "
+              "field ("
+           << pointInterpolation_->unsupported().c_str() << ")" << endl;
+      pointInterpolation_.reset();
+    }
   }
 
   // --- the viscous term div(tau) = rho nu laplacian(U) at the particles ----------------
@@ -647,50 +660,75 @@ void ParticleCoupling::sample() {
   if (curl) tCurlU = fvc::curl(U_);
   const std::size_t local = particles_.local();
   if (sampling_ == Sampling::cellPoint) {
-    // OpenFOAM's cellPoint interpolation (interpolationCellPoint): the point values by
-    // volPointInterpolation, as its constructor computes them (not copied, as it copies
-    // them), the tetrahedron and its weights by cellPointWeights_, once per particle for all
-    // the fields (cellPointWeights.H: OpenFOAM's weights, to round-off in box cells).
-    const volPointInterpolation& toPoints = volPointInterpolation::New(mesh_);
-    const pointMesh& pMesh = pointMesh::New(mesh_);
-    // interpolate(field) would make a new point field (calculated patches) each call and
-    // fill it with interpolate(field, pointField); the same fields are kept and refilled.
-    const auto points = [&](auto& store, const auto& field) -> const auto& {
-      using PointField = typename std::remove_reference_t<decltype(store)>::element_type;
-      if (!store)
-        store.reset(new PointField(
-            IOobject("volPointInterpolate(" + field.name() + ')', field.instance(), pMesh.thisDb(),
-                     IOobject::NO_READ, IOobject::NO_WRITE, false),
-            pMesh, field.dimensions()));
-      toPoints.interpolate(field, *store);
-      return *store;
-    };
-    const pointVectorField& pU = points(pointU_, U_);
-    const pointVectorField& pG = points(pointGradP_, gradP);
-    const pointVectorField& pT = points(pointDivTau_, divTau);
-    const pointScalarField& pE = points(pointEps_, voidFraction_);
-    const pointVectorField* pC = curl ? &points(pointCurlU_, tCurlU()) : nullptr;
+    // OpenFOAM's cellPoint interpolation (interpolationCellPoint): the point values as
+    // volPointInterpolation makes them (pointInterpolation.H: to the last bit, all fields in
+    // one pass; or volPointInterpolation itself), the tetrahedron and its weights by
+    // cellPointWeights_, once per particle for all the fields (cellPointWeights.H:
+    // OpenFOAM's weights, to round-off in box cells).
     // The fields side by side, one record per cell and per point (U 0-2, grad p 3-5,
     // div tau 6-8, eps 9, curl U 10-12), so that a stencil reads four records.
     const int width = curl ? 13 : 10;
-    const auto pack = [width](std::vector<double>& records, const UList<vector>& U,
-                              const UList<vector>& G, const UList<vector>& T,
-                              const UList<scalar>& E, const UList<vector>* C) {
-      records.resize(static_cast<std::size_t>(width) * U.size());
-      forAll(U, k) {
-        double* r = &records[static_cast<std::size_t>(width) * k];
-        for (int d = 0; d < 3; ++d) {
-          r[d] = U[k][d];
-          r[3 + d] = G[k][d];
-          r[6 + d] = T[k][d];
-          if (C) r[10 + d] = (*C)[k][d];
-        }
-        r[9] = E[k];
+    const UList<vector>* cellCurl = curl ? &tCurlU().primitiveField() : nullptr;
+    const auto pack = [width](double* records, label k, const vector& U, const vector& G,
+                              const vector& T, scalar E, const vector* C) {
+      double* r = records + static_cast<std::size_t>(width) * k;
+      for (int d = 0; d < 3; ++d) {
+        r[d] = U[d];
+        r[3 + d] = G[d];
+        r[6 + d] = T[d];
+        if (C) r[10 + d] = (*C)[d];
       }
+      r[9] = E;
     };
-    pack(cellRecords_, U_.primitiveField(), gradP.primitiveField(), divTau.primitiveField(),
-         voidFraction_.primitiveField(), curl ? &tCurlU().primitiveField() : nullptr);
-    pack(pointRecords_, pU, pG, pT, pE, curl ? &pC->primitiveField() : nullptr);
+    const label nCells = mesh_.nCells();
+    if (pointInterpolation_) {
+      // The cells' records, then those of the boundary faces the point values read.
+      const std::vector<PointInterpolation::Face>& faces = pointInterpolation_->faces();
+      cellRecords_.resize(static_cast<std::size_t>(width) * (nCells + faces.size()));
+      for (label k = 0; k < nCells; ++k)
+        pack(cellRecords_.data(), k, U_[k], gradP[k], divTau[k], voidFraction_[k],
+             curl ? &(*cellCurl)[k] : nullptr);
+      for (std::size_t i = 0; i < faces.size(); ++i) {
+        const label patch = faces[i].patch, f = faces[i].face;
+        pack(cellRecords_.data(), nCells + static_cast<label>(i), U_.boundaryField()[patch][f],
+             gradP.boundaryField()[patch][f], divTau.boundaryField()[patch][f],
+             voidFraction_.boundaryField()[patch][f],
+             curl ? &tCurlU().boundaryField()[patch][f] : nullptr);
+      }
+      pointRecords_.resize(static_cast<std::size_t>(width) * mesh_.nPoints());
+      static const std::vector<int> vectors10 = {0, 3, 6}, vectors13 = {0, 3, 6, 10};
+      if (curl)
+        pointInterpolation_->interpolate<13>(cellRecords_.data(), vectors13, pointRecords_.data());
+      else
+        pointInterpolation_->interpolate<10>(cellRecords_.data(), vectors10, pointRecords_.data());
+    } else {
+      const volPointInterpolation& toPoints = volPointInterpolation::New(mesh_);
+      const pointMesh& pMesh = pointMesh::New(mesh_);
+      // interpolate(field) would make a new point field (calculated patches) each call and
+      // fill it with interpolate(field, pointField); the same fields are kept and refilled.
+      const auto points = [&](auto& store, const auto& field) -> const auto& {
+        using PointField = typename std::remove_reference_t<decltype(store)>::element_type;
+        if (!store)
+          store.reset(new PointField(IOobject("volPointInterpolate(" + field.name() + ')',
+                                              field.instance(), pMesh.thisDb(), IOobject::NO_READ,
+                                              IOobject::NO_WRITE, false),
+                                     pMesh, field.dimensions()));
+        toPoints.interpolate(field, *store);
+        return *store;
+      };
+      const pointVectorField& pU = points(pointU_, U_);
+      const pointVectorField& pG = points(pointGradP_, gradP);
+      const pointVectorField& pT = points(pointDivTau_, divTau);
+      const pointScalarField& pE = points(pointEps_, voidFraction_);
+      const pointVectorField* pC = curl ? &points(pointCurlU_, tCurlU()) : nullptr;
+      cellRecords_.resize(static_cast<std::size_t>(width) * nCells);
+      for (label k = 0; k < nCells; ++k)
+        pack(cellRecords_.data(), k, U_[k], gradP[k], divTau[k], voidFraction_[k],
+             curl ? &(*cellCurl)[k] : nullptr);
+      pointRecords_.resize(static_cast<std::size_t>(width) * mesh_.nPoints());
+      forAll(pU, k)
+        pack(pointRecords_.data(), k, pU[k], pG[k], pT[k], pE[k], curl ? &(*pC)[k] : nullptr);
+    }
     cellPointSamples_ += static_cast<long>(local);
     if (curl)
       sampleCellPoint<13>();

@@ -54,6 +54,33 @@ set_tests_properties(coupling.cellpoint_interpolation PROPERTIES
   LABELS "foam;coupling"
   TIMEOUT 300)
 
+# coupling.point_interpolation: the coupling's point values (coupling/foam/pointInterpolation)
+# against OpenFOAM's volPointInterpolation, bit for bit, on 1 and 2 ranks (pointinterp/
+# pointinterp.cmake, pointinterp/pointInterpolationCheck.C). Under 20 s.
+add_executable(pointInterpolationCheck ${CMAKE_CURRENT_LIST_DIR}/pointinterp/pointInterpolationCheck.C
+                                       ${PROJECT_SOURCE_DIR}/coupling/foam/pointInterpolation.C)
+target_include_directories(pointInterpolationCheck PRIVATE ${PROJECT_SOURCE_DIR})
+target_link_libraries(pointInterpolationCheck PRIVATE OpenFOAM::finiteVolume grainflow_warnings)
+set_target_properties(pointInterpolationCheck PROPERTIES
+  CXX_STANDARD 17
+  CXX_STANDARD_REQUIRED ON
+  CXX_EXTENSIONS OFF
+  RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/bin)
+add_test(NAME coupling.point_interpolation
+         COMMAND ${CMAKE_COMMAND}
+                 -DFOAM_ENV=${PROJECT_SOURCE_DIR}/scripts/foam_env.sh
+                 -DCHECK=$<TARGET_FILE:pointInterpolationCheck>
+                 -DMPIEXEC=${MPIEXEC_EXECUTABLE}
+                 -DCASES=${CMAKE_CURRENT_LIST_DIR}/pointinterp
+                 -DCOMMON=${CMAKE_CURRENT_LIST_DIR}/cellpoint/uniform/system
+                 -DWORK=${CMAKE_CURRENT_BINARY_DIR}/coupling/point_interpolation
+                 -P ${CMAKE_CURRENT_LIST_DIR}/pointinterp/pointinterp.cmake)
+set_tests_properties(coupling.point_interpolation PROPERTIES
+  ENVIRONMENT "GRAINFLOW_FOAM_BASHRC=${OpenFOAM_BASHRC};${GRAINFLOW_MPIEXEC_ENV}"
+  LABELS "foam;coupling;mpi"
+  PROCESSORS 2
+  TIMEOUT 300)
+
 # h5py reads the particle snapshots: Debian's python3-h5py, as in tests/dem/app/tests.cmake.
 find_program(GRAINFLOW_COUPLING_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
 if(GRAINFLOW_COUPLING_PYTHON)
