@@ -13,6 +13,7 @@
 #include "dem/io/output_directory.hpp"
 #include "zeroGradientFvPatchFields.H"
 #include "extrapolatedCalculatedFvPatchField.H"
+#include "coupling/foam/gaussLinearGrad.H"
 #include "volPointInterpolation.H"
 
 namespace grainflow::foam {
@@ -329,6 +330,17 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
     uncorrectedLaplacian_ =
         fv::laplacianScheme<vector, scalar>::New(mesh, IStringStream("Gauss linear uncorrected")());
 
+  // --- grad p at the particles ---------------------------------------------------------
+  // With the scheme Gauss linear (and grad(p) not cached) it is computed by
+  // pressureGradient() in one pass into a kept field, OpenFOAM's operations in their order.
+  {
+    const word gradName("grad(" + p_.name() + ')');
+    const ITstream& scheme = mesh.gradScheme(gradName);
+    gaussLinearGrad_ = scheme.size() == 2 && scheme[0].isWord() &&
+                       scheme[0].wordToken() == "Gauss" && scheme[1].isWord() &&
+                       scheme[1].wordToken() == "linear" && !mesh.cache(gradName);
+  }
+
   Info << "grainFoam coupling: scene " << sceneFile << "\n"
        << "  VANS model " << model_ << ", drag " << dem_->drag_law().c_str() << ", void fraction "
        << coupling::void_fraction_method_name(vf) << " (" << label(footprint_.size())
@@ -340,6 +352,9 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
                       : "the case's laplacian scheme (largest non-orthogonal correction "
                         "vector ")
        << worstCorrection << ")\n"
+       << "  pressure gradient at the particles: "
+       << (gaussLinearGrad_ ? "Gauss linear, in one pass" : "fvc::grad with the case's scheme")
+       << "\n"
        << "  dt_CFD " << dtFluid << " s = " << subSteps_ << " x dt_DEM " << dtDem << " s\n"
        << "  processor grid " << grid.dims[0] << " x " << grid.dims[1] << " x " << grid.dims[2]
        << "; cell location "
@@ -562,6 +577,23 @@ void ParticleCoupling::deposit() {
   stepClampedVolume_ = sums[3];
 }
 
+Foam::volVectorField& ParticleCoupling::pressureGradient() {
+  using namespace Foam;
+  if (!gaussLinearGrad_) {
+    gradPOther_ = fvc::grad(p_);
+    return gradPOther_.ref();
+  }
+  if (!gradP_) {
+    gradP_.reset(new volVectorField(
+        IOobject("grad(" + p_.name() + ')', p_.instance(), mesh_, IOobject::NO_READ,
+                 IOobject::NO_WRITE, false),
+        mesh_, dimensionedVector("zero", p_.dimensions() / dimLength, Zero),
+        extrapolatedCalculatedFvPatchField<vector>::typeName));
+  }
+  gaussLinearGrad(p_, *gradP_);
+  return *gradP_;
+}
+
 Foam::volVectorField& ParticleCoupling::viscousLaplacian() {
   using namespace Foam;
   const dimensionedScalar nu("nu", dimViscosity, nu_);
@@ -650,11 +682,10 @@ void ParticleCoupling::sample() {
   using namespace Foam;
   // rho grad p and rho nu laplacian(U), scaled in place (no second field).
   const dimensionedScalar rho("rho", dimless, rho_);
-  tmp<volVectorField> tGradP(fvc::grad(p_));
-  tGradP.ref() *= rho;
+  volVectorField& gradP = pressureGradient();
+  gradP *= rho;
   volVectorField& divTau = viscousLaplacian();
   divTau *= rho;
-  const volVectorField& gradP = tGradP();
   const bool curl = dem_->needs_vorticity();
   tmp<volVectorField> tCurlU;
   if (curl) tCurlU = fvc::curl(U_);

@@ -62,17 +62,17 @@ void syncShared(const Foam::polyMesh& mesh, double* points, const Combine& combi
 template <int width>
 void pushShared(const Foam::polyMesh& mesh, double* points) {
   using Record = Foam::FixedList<double, width>;
-  const Foam::labelList& meshPoints = mesh.globalData().coupledPatch().meshPoints();
-  Foam::List<Record> records(mesh.nPoints());
-  forAll(meshPoints, i) {
-    const Foam::label p = meshPoints[i];
-    std::copy_n(points + width * p, width, records[p].begin());
+  const Foam::globalMeshData& gmd = mesh.globalData();
+  const Foam::labelList& meshPoints = gmd.coupledPatch().meshPoints();
+  const Foam::mapDistribute& map = gmd.globalCoPointSlavesMap();
+  const Foam::labelListList& slaves = gmd.globalCoPointSlaves();
+  Foam::List<Record> elems(map.constructSize());
+  forAll(meshPoints, i) std::copy_n(points + width * meshPoints[i], width, elems[i].begin());
+  forAll(slaves, i) {
+    for (const Foam::label s : slaves[i]) elems[s] = elems[i];
   }
-  pushMaster(mesh, records);
-  forAll(meshPoints, i) {
-    const Foam::label p = meshPoints[i];
-    std::copy_n(records[p].begin(), width, points + width * p);
-  }
+  map.reverseDistribute(elems.size(), elems, false);
+  forAll(meshPoints, i) std::copy_n(elems[i].begin(), width, points + width * meshPoints[i]);
 }
 
 Foam::vector vectorAt(const double* r) { return Foam::vector(r[0], r[1], r[2]); }

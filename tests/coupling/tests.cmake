@@ -55,8 +55,9 @@ set_tests_properties(coupling.cellpoint_interpolation PROPERTIES
   TIMEOUT 300)
 
 # coupling.point_interpolation: the coupling's point values (coupling/foam/pointInterpolation)
-# against OpenFOAM's volPointInterpolation, bit for bit, on 1 and 2 ranks (pointinterp/
-# pointinterp.cmake, pointinterp/pointInterpolationCheck.C). Under 20 s.
+# against OpenFOAM's volPointInterpolation, and its grad p (coupling/foam/gaussLinearGrad.H)
+# against fvc::grad, bit for bit, on 1 and 2 ranks (pointinterp/pointinterp.cmake,
+# pointinterp/pointInterpolationCheck.C). Under 20 s.
 add_executable(pointInterpolationCheck ${CMAKE_CURRENT_LIST_DIR}/pointinterp/pointInterpolationCheck.C
                                        ${PROJECT_SOURCE_DIR}/coupling/foam/pointInterpolation.C)
 target_include_directories(pointInterpolationCheck PRIVATE ${PROJECT_SOURCE_DIR})

@@ -11,7 +11,13 @@
 //
 // Check: every point value of every field equal, to the last bit, to OpenFOAM's. The class
 // evaluates OpenFOAM's weights with OpenFOAM's formulas and sums in OpenFOAM's order, so no
-// tolerance is needed; a tolerance would hide a changed order of summation. On a mesh with a
+// tolerance is needed; a tolerance would hide a changed order of summation.
+//
+// Also the coupling's grad p (coupling/foam/gaussLinearGrad.H) against fvc::grad with the
+// case's "Gauss linear": every cell and boundary value of the scalar field's gradient, bit for
+// bit (grad=..: the values compared and how many differ).
+//
+// On a mesh with a
 // patch type the class does not reproduce it must say so (unsupported=...), and the test
 // expects that where the case asks for it. The line printed (by the master):
 //
@@ -24,7 +30,9 @@
 
 #include "Time.H"
 #include "argList.H"
+#include "coupling/foam/gaussLinearGrad.H"
 #include "coupling/foam/pointInterpolation.H"
+#include "fvcGrad.H"
 #include "fixedValueFvPatchFields.H"
 #include "fvMesh.H"
 #include "pointFields.H"
@@ -158,12 +166,33 @@ int run(const Foam::argList& args) {
   const tmp<volScalarField> eps =
       makeField<scalar>(mesh, "eps", [L](const point& x) { return scalarField(x, L); });
 
+  // grad: ours against fvc::grad (Gauss linear, from the case's fvSchemes).
+  Tally grad;
+  {
+    volVectorField mine(IOobject("grad(eps)", runTime.timeName(), mesh, IOobject::NO_READ,
+                                 IOobject::NO_WRITE, false),
+                        mesh, dimensionedVector("zero", dimless / dimLength, Zero),
+                        extrapolatedCalculatedFvPatchField<vector>::typeName);
+    grainflow::foam::gaussLinearGrad(eps(), mine);
+    const tmp<volVectorField> foam = fvc::grad(eps());
+    forAll(mine, c)
+      for (int d = 0; d < 3; ++d) grad.add(mine[c][d], foam()[c][d]);
+    forAll(mine.boundaryField(), patch)
+      forAll(mine.boundaryField()[patch], f)
+        for (int d = 0; d < 3; ++d)
+          grad.add(mine.boundaryField()[patch][f][d], foam().boundaryField()[patch][f][d]);
+  }
+  const long gradValues = returnReduce(grad.values, sumOp<long>());
+  const long gradDiffering = returnReduce(grad.differing, sumOp<long>());
+
   const PointInterpolation ours(mesh);
   if (!ours.unsupported().empty()) {
     Info << "pointInterpolationCheck: ranks=" << Pstream::nProcs()
-         << " unsupported=" << ours.unsupported() << " status=unsupported" << endl;
-    return 0;
+         << " unsupported=" << ours.unsupported().c_str() << " grad=" << gradDiffering << '/'
+         << gradValues << (gradDiffering == 0 ? " status=unsupported" : " status=FAIL") << endl;
+    return gradDiffering == 0 ? 0 : 1;
   }
+
   Tally tally;
   check<10>(mesh, ours, {&fields[0](), &fields[1](), &fields[2]()}, eps(), tally);
   check<13>(mesh, ours, {&fields[0](), &fields[1](), &fields[2](), &fields[3]()}, eps(), tally);
@@ -171,12 +200,13 @@ int run(const Foam::argList& args) {
   const long values = returnReduce(tally.values, sumOp<long>());
   const long differing = returnReduce(tally.differing, sumOp<long>());
   const double maxDiff = returnReduce(tally.maxDiff, maxOp<double>());
-  const bool ok = differing == 0 && values > 0;
-  char line[256];
+  const bool ok = differing == 0 && values > 0 && gradDiffering == 0 && gradValues > 0;
+  char line[320];
   std::snprintf(line, sizeof line,
                 "pointInterpolationCheck: ranks=%d points=%ld values=%ld differing=%ld "
-                "maxDiff=%.3g status=%s",
-                Pstream::nProcs(), points, values, differing, maxDiff, ok ? "ok" : "FAIL");
+                "maxDiff=%.3g grad=%ld/%ld status=%s",
+                Pstream::nProcs(), points, values, differing, maxDiff, gradDiffering, gradValues,
+                ok ? "ok" : "FAIL");
   Info << line << endl;
   return ok ? 0 : 1;
 }

@@ -1,13 +1,16 @@
 # coupling.point_interpolation: grainflow's point interpolation of records (coupling/foam/
 # pointInterpolation) against OpenFOAM's volPointInterpolation, bit for bit, by
-# pointInterpolationCheck, on meshes made by blockMesh in fresh copies of the cases here:
+# pointInterpolationCheck, and the coupling's grad p (coupling/foam/gaussLinearGrad.H)
+# against fvc::grad (Gauss linear), on meshes made by blockMesh in fresh copies of the cases
+# here:
 #   thin     2 x 10 x 24 box cells between symmetry patches (the Goldschmidt benchmark's
 #            shape), walls, an inlet and an outlet patch; 1 rank and 2 (cut across z);
 #   twisted  9 x 6 x 7 skewed cells, a symmetry patch on curved faces (point normals vary),
 #            a symmetryPlane, walls; 1 rank and 2 (cut across x);
 #   slab     12 x 1 x 16, empty front and back (two-dimensional); 1 rank;
 #   cyclic   ../cellpoint/graded (cyclic along x): the class must say it does not reproduce
-#            it (the coupling then uses volPointInterpolation itself).
+#            it (the coupling then uses volPointInterpolation itself); its grad p is checked
+#            (the cyclic patch is coupled: the interpolation across it).
 # Each must print status=ok (cyclic: status=unsupported).
 #
 #   cmake -DFOAM_ENV=scripts/foam_env.sh -DCHECK=bin/pointInterpolationCheck -DMPIEXEC=mpiexec
