@@ -203,52 +203,75 @@ coeffs { n (2 1 1); delta 0.001; }
 """
 
 
+CYCLIC_Y = [
+    ("system/blockMeshDict",
+     "walls { type wall; faces ( (0 3 2 1) (4 5 6 7) (0 1 5 4) (2 3 7 6) (1 2 6 5) (3 0 4 7) ); }",
+     "walls { type wall; faces ( (0 3 2 1) (4 5 6 7) (1 2 6 5) (3 0 4 7) ); }\n"
+     "    front { type cyclic; neighbourPatch back;  faces ( (0 1 5 4) ); }\n"
+     "    back  { type cyclic; neighbourPatch front; faces ( (3 7 6 2) ); }"),
+    ("0/U", "boundaryField { walls { type noSlip; } }",
+     "boundaryField { walls { type noSlip; } front { type cyclic; } back { type cyclic; } }"),
+    ("0/p", "boundaryField { walls { type zeroGradient; } }",
+     "boundaryField { walls { type zeroGradient; } front { type cyclic; } back { type cyclic; } }"),
+    ("particle.yaml", "  max: [0.01, 0.01, 0.01]\n", "  max: [0.01, 0.01, 0.01]\n  periodic: [false, true, false]\n"),
+]
+
+
 def cellpoint_ranks(runner, checks):
     """cellPoint sampling on 1 and 2 ranks: the same beads must come out at the same place.
     The sinking beads stir the water (two-way coupling), so U, grad p, the viscous term and
     eps at their centres are not zero, and two of their cells touch the processor patch:
     the point values there are the two ranks' partial sums added (coupling/foam/
     pointInterpolation), and grad p is interpolated across the patch (gaussLinearGrad.H).
+    Twice: in the closed box (the point values in one pass), and with the box periodic along
+    y (cyclic patches, which pointInterpolation does not reproduce: volPointInterpolation
+    field by field, the fallback).
     Reference: the 1-rank run of the same case (no processor patch). The solvers converge
     to 1e-14 here (the case's 1e-8 with relTol 0.01 leaves 5e-9 m between the decompositions,
     GAMG agglomerating per rank), so the two runs must agree to round-off: positions to
     1e-12 m and velocities to 1e-10 m/s, of beads that sink 1.5 mm and reach 22 mm/s
-    (measured: 1.2e-16 m and 1.5e-14 m/s). Without the processor sums of the point values
-    they differ by 1.3e-5 m and 6.0e-4 m/s."""
+    (measured in the closed box: 1.2e-16 m and 1.5e-14 m/s). Without the processor sums of
+    the point values they differ by 1.3e-5 m and 6.0e-4 m/s."""
     edits = [("constant/couplingProperties", "sampling        cell;", "sampling        cellPoint;"),
              ("particle.yaml", "poisson_ratio: 0.3, density: 1000", "poisson_ratio: 0.3, density: 1100"),
              ("system/blockMeshDict", "(5 5 5)", "(6 5 5)"),
              ("system/fvSolution", "tolerance 1e-8; relTol 0.01;", "tolerance 1e-14; relTol 0;"),
              ("system/fvSolution", "tolerance 1e-9; relTol 0;", "tolerance 1e-14; relTol 0;")]
-    final = {}
-    for ranks in (1, 2):
-        case = runner.fresh_case("neutral_particle", f"cellpoint_np{ranks}", edits)
-        with open(os.path.join(case, "particle.csv"), "w") as f:
-            f.write(CELLPOINT_BEADS)
-        with open(os.path.join(case, "system", "decomposeParDict"), "w") as f:
-            f.write(DECOMPOSE_X)
-        log = runner.solve(case, ranks)
-        checks.expect("sampling cellPoint" in log, f"np {ranks}: the solver samples with cellPoint")
-        checks.expect("cellPoint point values of all fields in one pass" in log,
-                      f"np {ranks}: the point values come from pointInterpolation")
-        checks.expect("pressure gradient at the particles: Gauss linear, in one pass" in log,
-                      f"np {ranks}: grad p comes from gaussLinearGrad")
-        snaps = snapshots(case)
-        if not snaps or len(snaps[-1][1]["id"]) != 4 or abs(snaps[-1][0] - 0.1) > 1e-9:
-            checks.expect(False, f"np {ranks}: a snapshot of the 4 beads at t = 0.1 s")
-            return
-        final[ranks] = snaps[-1][1]
-    a, b = final[1], final[2]
-    checks.expect(np.array_equal(a["id"], b["id"]), "the same bead ids on 1 and 2 ranks")
-    sunk = float(np.min(0.0079 - a["position"][:, 2]))
-    speed = float(np.min(-a["velocity"][:, 2]))
-    checks.expect(sunk > 1e-3 and speed > 5e-3,
-                  f"the beads sank (at least {sunk:.3g} m, {speed:.3g} m/s downwards; > 1 mm, > 5 mm/s)")
-    dx = float(np.max(np.abs(a["position"] - b["position"])))
-    dv = float(np.max(np.abs(a["velocity"] - b["velocity"])))
-    print(f"  1 vs 2 ranks: largest position difference {dx:.3g} m, velocity {dv:.3g} m/s")
-    checks.expect(dx < 1e-12, f"positions on 2 ranks = on 1 rank: {dx:.3g} m < 1e-12 m")
-    checks.expect(dv < 1e-10, f"velocities on 2 ranks = on 1 rank: {dv:.3g} m/s < 1e-10 m/s")
+    variants = {"closed": ([], "cellPoint point values of all fields in one pass"),
+                "cyclic": (CYCLIC_Y, "cellPoint point values by volPointInterpolation, field by "
+                                     "field (patch front is of type cyclic)")}
+    for variant, (extra, expected) in variants.items():
+        final = {}
+        for ranks in (1, 2):
+            case = runner.fresh_case("neutral_particle", f"cellpoint_{variant}_np{ranks}",
+                                     edits + extra)
+            with open(os.path.join(case, "particle.csv"), "w") as f:
+                f.write(CELLPOINT_BEADS)
+            with open(os.path.join(case, "system", "decomposeParDict"), "w") as f:
+                f.write(DECOMPOSE_X)
+            log = runner.solve(case, ranks)
+            tag = f"{variant}, np {ranks}"
+            checks.expect("sampling cellPoint" in log, f"{tag}: the solver samples with cellPoint")
+            checks.expect(expected in log, f"{tag}: the log says '{expected}'")
+            checks.expect("pressure gradient at the particles: Gauss linear, in one pass" in log,
+                          f"{tag}: grad p comes from gaussLinearGrad")
+            snaps = snapshots(case)
+            if not snaps or len(snaps[-1][1]["id"]) != 4 or abs(snaps[-1][0] - 0.1) > 1e-9:
+                checks.expect(False, f"{tag}: a snapshot of the 4 beads at t = 0.1 s")
+                return
+            final[ranks] = snaps[-1][1]
+        a, b = final[1], final[2]
+        checks.expect(np.array_equal(a["id"], b["id"]), f"{variant}: the same bead ids on 1 and 2 ranks")
+        sunk = float(np.min(0.0079 - a["position"][:, 2]))
+        speed = float(np.min(-a["velocity"][:, 2]))
+        checks.expect(sunk > 1e-3 and speed > 5e-3,
+                      f"{variant}: the beads sank (at least {sunk:.3g} m, {speed:.3g} m/s downwards; "
+                      "> 1 mm, > 5 mm/s)")
+        dx = float(np.max(np.abs(a["position"] - b["position"])))
+        dv = float(np.max(np.abs(a["velocity"] - b["velocity"])))
+        print(f"  {variant}, 1 vs 2 ranks: largest position difference {dx:.3g} m, velocity {dv:.3g} m/s")
+        checks.expect(dx < 1e-12, f"{variant}: positions on 2 ranks = on 1 rank: {dx:.3g} m < 1e-12 m")
+        checks.expect(dv < 1e-10, f"{variant}: velocities on 2 ranks = on 1 rank: {dv:.3g} m/s < 1e-10 m/s")
 
 
 # --- coupling.refuses_bad_setup ---------------------------------------------------------
