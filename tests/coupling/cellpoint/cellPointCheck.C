@@ -34,7 +34,7 @@
 #include "Time.H"
 #include "argList.H"
 #include "coupling/foam/cellPointWeights.H"
-#include "fixedValueFvPatchFields.H"
+#include "tests/coupling/foamTestFields.H"
 #include "fvMesh.H"
 #include "interpolationCellPoint.H"
 #include "polyMeshTetDecomposition.H"
@@ -56,39 +56,7 @@ double scalarField(const Foam::point& x, double L) {
   return 0.5 + 0.3 * std::sin(2 * a) * std::cos(3 * b) * (1 + c * c);
 }
 
-// Patch types: constraint patches keep their type, the others are fixedValue.
-Foam::wordList patchTypes(const Foam::fvMesh& mesh) {
-  const Foam::polyBoundaryMesh& patches = mesh.boundaryMesh();
-  Foam::wordList types(patches.size());
-  forAll(patches, i) {
-    types[i] = Foam::polyPatch::constraintType(patches[i].type())
-                   ? patches[i].type()
-                   : Foam::word(Foam::fixedValueFvPatchScalarField::typeName);
-  }
-  return types;
-}
-
-template <class Type, class Function>
-Foam::GeometricField<Type, Foam::fvPatchField, Foam::volMesh> makeField(const Foam::fvMesh& mesh,
-                                                                        const Foam::word& name,
-                                                                        Function f) {
-  using Field = Foam::GeometricField<Type, Foam::fvPatchField, Foam::volMesh>;
-  Field field(Foam::IOobject(name, mesh.time().timeName(), mesh, Foam::IOobject::NO_READ,
-                             Foam::IOobject::NO_WRITE),
-              mesh, Foam::dimensioned<Type>("zero", Foam::dimless, Foam::Zero), patchTypes(mesh));
-  const Foam::vectorField& C = mesh.cellCentres();
-  forAll(C, c) field.primitiveFieldRef()[c] = f(C[c]);
-  forAll(field.boundaryField(), patch) {
-    auto& pf = field.boundaryFieldRef()[patch];
-    if (!Foam::isA<Foam::fixedValueFvPatchField<Type>>(pf)) continue;
-    const Foam::vectorField& Cf = mesh.boundary()[patch].Cf();
-    Foam::Field<Type> values(Cf.size());
-    forAll(Cf, k) values[k] = f(Cf[k]);
-    pf == values;
-  }
-  field.correctBoundaryConditions();
-  return field;
-}
+using grainflow::foam::test::makeField;
 
 double magnitude(const Foam::vector& v) { return Foam::mag(v); }
 double magnitude(double s) { return std::abs(s); }
@@ -200,8 +168,8 @@ int run(const Foam::argList& args) {
   const long expectedBoxes = std::count(box.begin(), box.end(), true);
 
   Result r;
-  compare(mesh, U, ours, points, box, r);
-  compare(mesh, eps, ours, points, box, r);
+  compare(mesh, U(), ours, points, box, r);
+  compare(mesh, eps(), ours, points, box, r);
 
   // The bound and its reason: see the header.
   constexpr double kTolerance = 1e-12;

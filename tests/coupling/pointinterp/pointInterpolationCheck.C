@@ -32,8 +32,8 @@
 #include "argList.H"
 #include "coupling/foam/gaussLinearGrad.H"
 #include "coupling/foam/pointInterpolation.H"
+#include "tests/coupling/foamTestFields.H"
 #include "fvcGrad.H"
-#include "fixedValueFvPatchFields.H"
 #include "fvMesh.H"
 #include "pointFields.H"
 #include "volFields.H"
@@ -53,39 +53,7 @@ double scalarField(const Foam::point& x, double L) {
   return 0.5 + 0.3 * std::sin(2 * a) * std::cos(3 * b) * (1 + c * c);
 }
 
-Foam::wordList patchTypes(const Foam::fvMesh& mesh) {
-  const Foam::polyBoundaryMesh& patches = mesh.boundaryMesh();
-  Foam::wordList types(patches.size());
-  forAll(patches, i) {
-    types[i] = Foam::polyPatch::constraintType(patches[i].type())
-                   ? patches[i].type()
-                   : Foam::word(Foam::fixedValueFvPatchScalarField::typeName);
-  }
-  return types;
-}
-
-template <class Type, class Function>
-Foam::tmp<Foam::GeometricField<Type, Foam::fvPatchField, Foam::volMesh>> makeField(
-    const Foam::fvMesh& mesh, const Foam::word& name, Function f) {
-  using Field = Foam::GeometricField<Type, Foam::fvPatchField, Foam::volMesh>;
-  Foam::tmp<Field> tfield(new Field(
-      Foam::IOobject(name, mesh.time().timeName(), mesh, Foam::IOobject::NO_READ,
-                     Foam::IOobject::NO_WRITE),
-      mesh, Foam::dimensioned<Type>("zero", Foam::dimless, Foam::Zero), patchTypes(mesh)));
-  Field& field = tfield.ref();
-  const Foam::vectorField& C = mesh.cellCentres();
-  forAll(C, c) field.primitiveFieldRef()[c] = f(C[c]);
-  forAll(field.boundaryField(), patch) {
-    auto& pf = field.boundaryFieldRef()[patch];
-    if (!Foam::isA<Foam::fixedValueFvPatchField<Type>>(pf)) continue;
-    const Foam::vectorField& Cf = mesh.boundary()[patch].Cf();
-    Foam::Field<Type> values(Cf.size());
-    forAll(Cf, k) values[k] = f(Cf[k]);
-    pf == values;
-  }
-  field.correctBoundaryConditions();
-  return tfield;
-}
+using grainflow::foam::test::makeField;
 
 // OpenFOAM's point values, as the coupling's fallback computes them (particleCoupling.C).
 template <class Type>
