@@ -19,16 +19,26 @@ run_case() {
   [ -x "$GRAINFOAM" ] || { echo "Allrun: $GRAINFOAM not found; build first (scripts/build.sh)" >&2; return 1; }
   export LD_LIBRARY_PATH="$build/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
   local foam="$root/scripts/foam_env.sh"
-  rm -rf processor* particles postProcessing log.* [1-9]* 0.[0-9]* constant/polyMesh
+  # Only what this script and grainFoam write: the user's own files (say, a log.Allrun that
+  # is being written while Allrun runs) stay, and so do the tracked inputs.
+  rm -rf processor* particles postProcessing log.blockMesh log.decomposePar log.grainFoam \
+    [1-9]* 0.[0-9]* constant/polyMesh system/decomposeParDict.np*
   "$foam" blockMesh > log.blockMesh 2>&1 || { tail -20 log.blockMesh; return 1; }
   if [ "$np" -gt 1 ]; then
-    # N slabs along x for method simple (each case's file is set up for 2).
-    sed -i -e "s/^numberOfSubdomains .*/numberOfSubdomains $np;/" \
-           -e "s/n ([0-9]* 1 1);/n ($np 1 1);/" system/decomposeParDict
-    "$foam" decomposePar -force > log.decomposePar 2>&1 || { tail -20 log.decomposePar; return 1; }
+    # N slabs along x for method simple. The case's own file is set up for 2 ranks; another
+    # count gets a copy (system/decomposeParDict.npN, not tracked), so that no tracked file
+    # changes.
+    local dict=()
+    if ! grep -q "^numberOfSubdomains $np;" system/decomposeParDict; then
+      sed -e "s/^numberOfSubdomains .*/numberOfSubdomains $np;/" \
+          -e "s/n ([0-9]* 1 1);/n ($np 1 1);/" system/decomposeParDict > "system/decomposeParDict.np$np"
+      dict=(-decomposeParDict "system/decomposeParDict.np$np")
+    fi
+    "$foam" decomposePar -force "${dict[@]}" > log.decomposePar 2>&1 ||
+      { tail -20 log.decomposePar; return 1; }
     echo "Allrun: grainFoam on $np ranks (log.grainFoam)"
     OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 \
-      "$foam" mpirun --oversubscribe -np "$np" "$GRAINFOAM" -parallel > log.grainFoam 2>&1 ||
+      "$foam" mpirun --oversubscribe -np "$np" "$GRAINFOAM" -parallel "${dict[@]}" > log.grainFoam 2>&1 ||
       { tail -30 log.grainFoam; return 1; }
   else
     echo "Allrun: grainFoam (log.grainFoam)"
