@@ -131,6 +131,18 @@ else()
                    ${MPIEXEC_EXECUTABLE})
   set_tests_properties(grain.disk_full PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}"
                        TIMEOUT 300 PROCESSORS 2 SKIP_RETURN_CODE 77)
+  # The "continue with:" line after SIGTERM, run as printed, continues in the --output folder
+  # with the snapshot numbering going on (1 and 2 ranks).
+  add_test(NAME grain.continue_command
+           COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/continue_command.sh ${_grain}
+                   ${_scenes}/continue_command.yaml ${_work}/continue_command ${GRAINFLOW_PYTHON3})
+  add_test(NAME grain.continue_command_two_ranks
+           COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/continue_command.sh ${_grain}
+                   ${_scenes}/continue_command.yaml ${_work}/continue_command_2
+                   ${GRAINFLOW_PYTHON3} ${MPIEXEC_EXECUTABLE} 2)
+  set_tests_properties(grain.continue_command grain.continue_command_two_ranks
+                       PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}" TIMEOUT 120)
+  set_tests_properties(grain.continue_command_two_ranks PROPERTIES PROCESSORS 2)
   # Hostile checkpoints and snapshots (docs/reliability.md, "What is checked on read"): a real
   # file with one value changed (or one bit flipped) is refused with exit code 1, naming the
   # file, the dataset, the index and the rule, and nothing in the output directory changes.
