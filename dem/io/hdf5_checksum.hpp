@@ -12,8 +12,8 @@ namespace grainflow {
 // A new dataset-creation property list (close it with H5Pclose; -1 on failure) for a dataset
 // of `rank` (1 or 2) dimensions `dims` and `element_bytes` per element: chunked, with the
 // Fletcher32 filter. Chunks hold whole rows, at most 1 MiB, all of about equal size (HDF5
-// allocates whole chunks), so a 30 000-particle position array is one chunk. An empty dataset keeps the contiguous layout (no data to check; a chunk
-// may not exceed a fixed dimension of 0).
+// allocates whole chunks), so a 30 000-particle position array is one chunk. An empty dataset keeps
+// the contiguous layout (no data to check; a chunk may not exceed a fixed dimension of 0).
 hid_t checksummed_layout(int rank, const hsize_t* dims, std::size_t element_bytes);
 // The same settings added to an existing dataset-creation property list; false on failure.
 bool add_checksum(hid_t dcpl, int rank, const hsize_t* dims, std::size_t element_bytes);
