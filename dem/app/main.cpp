@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "dem/engine/restored_state.hpp"
 #include "dem/engine/run.hpp"
 #include "dem/engine/simulation.hpp"
 #include "dem/insert/insertion.hpp"
@@ -39,7 +40,7 @@ int usage_error(const std::string& what) {
   return 2;
 }
 
-int dispatch(const std::vector<std::string>& args, int rank) {
+int dispatch(const std::string& program, const std::vector<std::string>& args, int rank) {
   using namespace grainflow;
   if (args.empty()) return usage_error("no command given");
   const std::string& cmd = args[0];
@@ -56,6 +57,7 @@ int dispatch(const std::vector<std::string>& args, int rank) {
   if (args.size() < 2) return usage_error("'" + cmd + "' needs a scene file");
 
   RunOptions options;
+  options.program = program;
   for (std::size_t k = 2; k < args.size(); ++k) {
     if (cmd == "run" && args[k] == "--output" && k + 1 < args.size())
       options.output_directory = args[++k];
@@ -79,6 +81,9 @@ int dispatch(const std::vector<std::string>& args, int rank) {
   } catch (const InsertionError& e) {
     if (rank == 0) std::cerr << e.what() << "\n";
     return 2;
+  } catch (const StateError& e) {  // a checkpoint or snapshot that breaks a rule
+    if (rank == 0) std::cerr << e.what() << "\n";
+    return 1;
   } catch (const SetupError& e) {
     if (rank == 0) std::cerr << e.what() << "\n";
     return 1;
@@ -102,7 +107,7 @@ int main(int argc, char** argv) {
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   const std::vector<std::string> args(argv + 1, argv + argc);
-  const int code = dispatch(args, rank);
+  const int code = dispatch(argc > 0 ? argv[0] : "grain", args, rank);
   MPI_Finalize();
   return code;
 }

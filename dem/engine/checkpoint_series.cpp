@@ -83,10 +83,10 @@ std::string CheckpointSeries::write(Simulation& sim) {
   return path;
 }
 
-std::string CheckpointSeries::resume_hint(const std::string& run_command) const {
+std::string CheckpointSeries::resume_hint(const std::string& command) const {
   if (newest_.empty()) return "No complete checkpoint of this run exists yet.";
   return "The newest complete checkpoint is '" + newest_ + "' (untouched); free space and " +
-         "continue with: " + run_command + " --restart " + newest_;
+         "continue with: " + command;
 }
 
 }  // namespace grainflow

@@ -33,8 +33,9 @@ class CheckpointSeries {
   // The newest complete checkpoint of the series ("" when none), on every rank.
   const std::string& newest() const { return newest_; }
   // For a failed output write: how to continue ("The newest complete checkpoint is ...; ...
-  // continue with: <run_command> --restart <it>").
-  std::string resume_hint(const std::string& run_command) const;
+  // continue with: <command>", the command continuing from newest(), see continue_command in
+  // run.hpp).
+  std::string resume_hint(const std::string& command) const;
 
  private:
   MPI_Comm comm_;

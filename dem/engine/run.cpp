@@ -52,7 +52,29 @@ void print_report(const Simulation& sim, MPI_Comm comm, std::ostream& out) {
   for (const std::string& note : sim.walls().notes()) o << note << "\n";  // meshes read
 }
 
+// `word` as one word of a POSIX shell command: as it is when it holds only characters no
+// shell treats specially, otherwise in single quotes.
+std::string shell_word(const std::string& word) {
+  const bool plain = !word.empty() && word.find_first_not_of(
+                                          "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                          "0123456789_-+=.,:/@%") == std::string::npos;
+  if (plain) return word;
+  std::string out = "'";
+  for (char c : word) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
 }  // namespace
+
+std::string continue_command(const std::string& scene_file, const RunOptions& options, int ranks,
+                             const std::string& checkpoint) {
+  std::string cmd = ranks > 1 ? "mpirun -np " + std::to_string(ranks) + " " : std::string();
+  cmd += shell_word(options.program) + " run " + shell_word(scene_file);
+  if (options.output_directory) cmd += " --output " + shell_word(*options.output_directory);
+  if (!options.progress) cmd += " --no-progress";
+  if (options.allow_large_time_step) cmd += " --allow-large-dt";
+  return cmd + " --restart " + shell_word(checkpoint);
+}
 
 int check_scene(const Scene& scene, std::ostream& out) {
   Simulation sim(scene);
@@ -124,13 +146,17 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   };
   long removed_reported = 0;
   // A failed output write (full disk, lost mount) stops the run on every rank; the message
-  // names the checkpoint to continue from.
-  const std::string rerun =
-      "grain run " + scene.file + (options.output_directory ? " --output " + dir : std::string());
+  // names the checkpoint to continue from and the command that does.
+  int ranks = 1;
+  MPI_Comm_size(comm, &ranks);
   auto resumable = [&](const OutputError& e) {
     std::string message = e.what();
     if (!message.ends_with('.')) message += '.';
-    return OutputError(message + " " + checkpoints.resume_hint(rerun));
+    const std::string& newest = checkpoints.newest();
+    return OutputError(message + " " +
+                       (newest.empty() ? checkpoints.resume_hint("")
+                                       : checkpoints.resume_hint(continue_command(
+                                             scene.file, options, ranks, newest))));
   };
   auto write_log = [&] {
     const GlobalState g = sim.global_state();
@@ -217,11 +243,10 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
       if (signal != 0) {
         if (log_step != k) write_log();
         sum.stop_checkpoint = write_checkpoint();
-        stop_message << "grain: received " << StopSignals::name(signal)
-                     << "; stopped after step " << k << " (t = " << t
-                     << " s) and wrote the checkpoint " << sum.stop_checkpoint
-                     << "; continue with: grain run " << scene.file << " --restart "
-                     << sum.stop_checkpoint << "\n";
+        stop_message << "grain: received " << StopSignals::name(signal) << "; stopped after step "
+                     << k << " (t = " << t << " s) and wrote the checkpoint " << sum.stop_checkpoint
+                     << "; continue with: "
+                     << continue_command(scene.file, options, ranks, sum.stop_checkpoint) << "\n";
         break;
       }
     }

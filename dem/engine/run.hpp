@@ -18,7 +18,16 @@ struct RunOptions {
   bool allow_large_time_step = false;           // run even when the check refuses dt
   std::optional<std::string> restart;           // checkpoint to continue from (--restart)
   bool handle_stop_signals = true;              // SIGTERM/SIGINT: checkpoint and stop
+  std::string program = "grain";                // as invoked (argv[0]), for "continue with"
 };
+
+// The command that continues this run from `checkpoint`, for "continue with:" messages: run
+// literally from the same working directory, it writes into the same output directory and
+// continues its snapshot numbering. It repeats the program as invoked, `mpirun -np N` when
+// the run has N > 1 ranks, the scene and every option given except --restart (--output,
+// --allow-large-dt, --no-progress), each quoted for a POSIX shell when needed.
+std::string continue_command(const std::string& scene_file, const RunOptions& options, int ranks,
+                             const std::string& checkpoint);
 
 struct RunSummary {
   long steps = 0;

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "dem/engine/restored_state.hpp"
 #include "dem/insert/insertion.hpp"
 #include "dem/walls/stl_reader.hpp"
 
@@ -354,6 +355,29 @@ void Simulation::set_cut_planes(int axis, const std::vector<double>& planes) {
 }
 
 void Simulation::restore(const CheckpointData& checkpoint) {
+  // Stream insertions continue where they were: delivered totals, radii drawn but not yet
+  // placed and the generators, so the restart inserts what the uninterrupted run would.
+  const std::string where = "checkpoint '" + checkpoint.file + "'";
+  if (!checkpoint.streams && !streams_.empty())
+    throw SetupError(scene_.file + ": error: the scene has " + std::to_string(streams_.size()) +
+                     " stream insertion(s), but " + where +
+                     " holds no stream state (group 'streams'; it was written by a grain "
+                     "before format grainflow-checkpoint-2), so the streams' delivered "
+                     "totals and random sequences cannot be continued. Run the scene from "
+                     "the start, or restart from a checkpoint written by this version");
+  if (checkpoint.streams) {
+    try {
+      streams_.restore_state(*checkpoint.streams);
+    } catch (const std::invalid_argument& e) {
+      throw SetupError(scene_.file + ": error: " + where + ": " + e.what() +
+                       "; restart with the scene the checkpoint was written with");
+    }
+  }
+  // Before anything else uses the state (a material index indexes tables, a position bins).
+  std::vector<long> delivered;
+  for (std::size_t k = 0; k < streams_.size(); ++k) delivered.push_back(streams_.count_inserted(k));
+  check_checkpoint(checkpoint, scene_, walls_.history_columns(), streams_.max_radius(), delivered);
+
   p_ = checkpoint.particles;
   restored_drag_.clear();
   for (std::size_t i = 0; i < checkpoint.drag_coefficient.size(); ++i)
@@ -365,25 +389,6 @@ void Simulation::restore(const CheckpointData& checkpoint) {
   next_id_ = checkpoint.next_id;
   restored_springs_ = checkpoint.springs;
   restored_ = true;
-  // Stream insertions continue where they were: delivered totals, radii drawn but not yet
-  // placed and the generators, so the restart inserts what the uninterrupted run would.
-  const std::string where = "checkpoint '" + checkpoint.file + "'";
-  if (!checkpoint.streams) {
-    if (!streams_.empty())
-      throw SetupError(scene_.file + ": error: the scene has " + std::to_string(streams_.size()) +
-                       " stream insertion(s), but " + where +
-                       " holds no stream state (group 'streams'; it was written by a grain "
-                       "before format grainflow-checkpoint-2), so the streams' delivered "
-                       "totals and random sequences cannot be continued. Run the scene from "
-                       "the start, or restart from a checkpoint written by this version");
-    return;
-  }
-  try {
-    streams_.restore_state(*checkpoint.streams);
-  } catch (const std::invalid_argument& e) {
-    throw SetupError(scene_.file + ": error: " + where + ": " + e.what() +
-                     "; restart with the scene the checkpoint was written with");
-  }
 }
 
 void Simulation::write_checkpoint(const std::string& path) {

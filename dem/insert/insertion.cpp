@@ -8,6 +8,7 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "dem/engine/restored_state.hpp"
 #include "dem/io/snapshot_reader.hpp"
 #include "dem/walls/wall_contact.hpp"
 
@@ -353,13 +354,42 @@ void read_csv(const Scene& scene, const Insertion& ins, Particles& p, GlobalId& 
                       "or remove the insertion");
 }
 
+// The rules of a state file (dem/engine/restored_state.hpp) for a snapshot's particles, before
+// they are used: finite positions, radii > 0, material indices of this scene, masses rho V of
+// their material, unique ids. Throws StateError naming the file, dataset, index and rule.
+void check_snapshot_records(const Scene& scene, const Insertion& ins, const Particles& q) {
+  check_particle_records(
+      q, scene,
+      {ins.snapshot_file, "/",
+       "the snapshot (insertion at " + ins.source +
+           ") was changed or damaged after it was written, or belongs to a scene with other "
+           "materials; list the materials in the order of the scene that wrote it, or insert "
+           "from another snapshot"},
+      false);
+}
+
+// The snapshot's particle i is not inside the domain: a StateError naming the dataset.
+[[noreturn]] void snapshot_outside_domain(const Scene& scene, const Insertion& ins,
+                                          const Particles& q, std::size_t i) {
+  throw StateError(
+      ins.snapshot_file + ": error: dataset '/position', index " + std::to_string(i) +
+      " (particle id " + std::to_string(q.id[i]) + "): the particle lies outside the domain: " +
+      outside_domain_reason(scene.domain, q.x[i], q.radius[i]) +
+      " (a bounded side may be crossed by up to time.max_overlap of the radius, a "
+      "periodic range left by up to the larger of the radius and half the skin); "
+      "the snapshot (insertion at " +
+      ins.source + ") belongs to another domain, or was changed or damaged after it was written");
+}
+
 // `grid_needed`: whether a later entry checks overlaps against this one's particles.
 void read_snapshot_entry(const Scene& scene, const Insertion& ins, Particles& p,
                          GlobalId& next_id, OverlapGrid& grid, bool grid_needed) {
   Snapshot snap;
   try {
     snap = read_snapshot(ins.snapshot_file);
-  } catch (const SnapshotReadError& e) {
+  } catch (const SnapshotDamagedError& e) {  // e.g. a checksum that does not match
+    throw StateError(std::string(e.what()) + " (snapshot insertion at " + ins.source + ")");
+  } catch (const SnapshotReadError& e) {  // not a grainflow snapshot
     throw InsertionError(std::string(e.what()) + " (snapshot insertion at " + ins.source + ")");
   }
   // Between neighbour-list rebuilds a periodic run lets centres drift past a periodic side
@@ -367,6 +397,7 @@ void read_snapshot_entry(const Scene& scene, const Insertion& ins, Particles& p,
   // up to half a skin outside that range: such a centre is the same sphere as its image
   // inside, and is moved there. Farther out (a snapshot of another domain) is an error.
   Particles& q = snap.particles;
+  check_snapshot_records(scene, ins, q);
   const Domain& dom = scene.domain;
   const double drift = scene.neighbour.skin ? 0.5 * *scene.neighbour.skin : 0.0;
   for (std::size_t i = 0; i < q.size(); ++i)
@@ -387,16 +418,10 @@ void read_snapshot_entry(const Scene& scene, const Insertion& ins, Particles& p,
       throw InsertionError(ins.source + ": error: particle id " + std::to_string(q.id[i]) +
                            " of snapshot '" + ins.snapshot_file + "' " + what);
     };
-    if (q.material[i] < 0 || q.material[i] >= static_cast<int>(scene.materials.size()))
-      fail("has material index " + std::to_string(q.material[i]) + " but the scene has " +
-           std::to_string(scene.materials.size()) +
-           " materials; list the materials in the same order as in the scene that wrote it");
     // A snapshot of a settled bed has particles overlapping walls on the domain's sides by
     // up to the overlap the run allowed.
     if (!inside_domain(scene.domain, q.x[i], q.radius[i], scene.time.max_overlap * q.radius[i]))
-      fail("lies outside the domain: " + outside_domain_reason(dom, q.x[i], q.radius[i]) +
-           " (a bounded side may be crossed by up to time.max_overlap of the radius, a periodic "
-           "range left by up to the larger of the radius and half the skin)");
+      snapshot_outside_domain(scene, ins, q, i);
     // Touching neighbours of a settled bed overlap slightly: only particles of
     // earlier entries are checked (the grid holds this snapshot's only afterwards).
     if (overlaps_with_images(grid, scene.domain, q.x[i], q.radius[i]))

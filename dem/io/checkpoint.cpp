@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "dem/io/hdf5_checksum.hpp"
 #include "dem/io/hdf5_errors.hpp"
 
 namespace grainflow {
@@ -38,6 +39,16 @@ std::vector<double> pack(const CheckpointData& d) {
     b.insert(b.end(), s.rolling.data(), s.rolling.data() + 3);
   }
   return b;
+}
+
+// The file's size: the data plus HDF5's metadata, about 3 kB per checksummed dataset
+// (measured: 4000 particles without springs take 658 758 bytes, 624 000 of them data).
+std::uintmax_t expected_bytes(const CheckpointData& d) {
+  const std::uintmax_t n = d.particles.size(), per_particle = 8 + 5 * 24 + 3 * 8 + 4;
+  const std::uintmax_t drag = d.drag_coefficient.empty() ? 0 : 32;
+  const std::uintmax_t streams = d.streams ? d.streams->size() : 0;
+  return n * (per_particle + drag) + d.springs.size() * (2 * 8 + 2 * 24) + streams + 17 * 3072 +
+         8192;
 }
 
 // Appends the records of one rank's buffer to `out`.
@@ -117,11 +128,15 @@ class FirstFailure {
 bool write_array(FirstFailure& fail, hid_t loc, const char* name, hid_t type, std::size_t rows,
                  std::size_t cols, const void* data) {
   const hsize_t dims[2] = {rows, cols};
-  const hid_t space = H5Screate_simple(cols > 1 ? 2 : 1, dims, nullptr);
-  const hid_t set = H5Dcreate2(loc, name, type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  const int rank = cols > 1 ? 2 : 1;
+  const hid_t space = H5Screate_simple(rank, dims, nullptr);
+  const hid_t dcpl = checksummed_layout(rank, dims, H5Tget_size(type));
+  const hid_t set =
+      dcpl < 0 ? -1 : H5Dcreate2(loc, name, type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
   bool ok = set >= 0 && (rows == 0 || H5Dwrite(set, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) >= 0);
   if (!ok) fail.capture();
   if (set >= 0) H5Dclose(set);
+  if (dcpl >= 0) H5Pclose(dcpl);
   H5Sclose(space);
   return ok;
 }
@@ -226,12 +241,13 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
   return fail.error();
 }
 
+// `name` is the dataset's full path (/particles/velocity), for messages.
 template <class T>
-std::vector<T> read_array(hid_t loc, const char* name, hid_t type, std::size_t cols,
+std::vector<T> read_array(hid_t file, const char* name, hid_t type, std::size_t cols,
                           std::size_t& rows, std::string& error) {
   std::vector<T> out;
   if (!error.empty()) return out;
-  const hid_t set = H5Dopen2(loc, name, H5P_DEFAULT);
+  const hid_t set = H5Dopen2(file, name, H5P_DEFAULT);
   if (set < 0) {
     error = std::string("dataset '") + name + "' is missing";
     return out;
@@ -248,7 +264,7 @@ std::vector<T> read_array(hid_t loc, const char* name, hid_t type, std::size_t c
     rows = dims[0];
     out.resize(rows * cols);
     if (rows > 0 && H5Dread(set, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()) < 0)
-      error = std::string("dataset '") + name + "' cannot be read";
+      error = std::string("dataset '") + name + "' cannot be read: " + read_failure_reason();
   }
   H5Sclose(space);
   H5Dclose(set);
@@ -286,7 +302,12 @@ void write_checkpoint(MPI_Comm comm, const std::string& path, const CheckpointDa
     d.streams = local.streams;
     for (int r = 0; r < size; ++r) unpack(all.data() + displs[r], counts[r], d);
     const std::string part = path + ".part";
-    {
+    // A foreseeable full disk is refused before HDF5 starts: a checksummed (chunked) file
+    // whose final flush fails leaves HDF5 unable to close it, and the library's clean-up at
+    // exit then crashed (measured: exit 139 after the message).
+    const std::string parent = std::filesystem::path(path).parent_path().string();
+    error = no_space_note(parent.empty() ? "." : parent, expected_bytes(d));
+    if (error.empty()) {
       const QuietHdf5Errors quiet;
       error = write_file(part, d);
     }
@@ -330,38 +351,39 @@ CheckpointData read_checkpoint(const std::string& path) {
     d.next_id = next;
     if (error.empty() && H5Aexists(f, "format") <= 0) error = "it is not a grainflow checkpoint";
     std::size_t n = static_cast<std::size_t>(-1), m = static_cast<std::size_t>(-1);
-    const hid_t g = error.empty() ? H5Gopen2(f, "particles", H5P_DEFAULT) : -1;
-    if (error.empty() && g < 0) error = "group 'particles' is missing";
-    const auto ids = read_array<long long>(g, "id", H5T_NATIVE_LLONG, 1, n, error);
-    const auto x = read_array<double>(g, "position", H5T_NATIVE_DOUBLE, 3, n, error);
-    const auto v = read_array<double>(g, "velocity", H5T_NATIVE_DOUBLE, 3, n, error);
-    const auto w = read_array<double>(g, "angular_velocity", H5T_NATIVE_DOUBLE, 3, n, error);
-    const auto force = read_array<double>(g, "force", H5T_NATIVE_DOUBLE, 3, n, error);
-    const auto torque = read_array<double>(g, "torque", H5T_NATIVE_DOUBLE, 3, n, error);
-    const auto r = read_array<double>(g, "radius", H5T_NATIVE_DOUBLE, 1, n, error);
-    const auto mass = read_array<double>(g, "mass", H5T_NATIVE_DOUBLE, 1, n, error);
-    const auto inertia = read_array<double>(g, "inertia", H5T_NATIVE_DOUBLE, 1, n, error);
-    const auto mat = read_array<int>(g, "material", H5T_NATIVE_INT, 1, n, error);
+    if (error.empty() && H5Lexists(f, "particles", H5P_DEFAULT) <= 0)
+      error = "group 'particles' is missing";
+    const auto ids = read_array<long long>(f, "/particles/id", H5T_NATIVE_LLONG, 1, n, error);
+    const auto x = read_array<double>(f, "/particles/position", H5T_NATIVE_DOUBLE, 3, n, error);
+    const auto v = read_array<double>(f, "/particles/velocity", H5T_NATIVE_DOUBLE, 3, n, error);
+    const auto w =
+        read_array<double>(f, "/particles/angular_velocity", H5T_NATIVE_DOUBLE, 3, n, error);
+    const auto force = read_array<double>(f, "/particles/force", H5T_NATIVE_DOUBLE, 3, n, error);
+    const auto torque = read_array<double>(f, "/particles/torque", H5T_NATIVE_DOUBLE, 3, n, error);
+    const auto r = read_array<double>(f, "/particles/radius", H5T_NATIVE_DOUBLE, 1, n, error);
+    const auto mass = read_array<double>(f, "/particles/mass", H5T_NATIVE_DOUBLE, 1, n, error);
+    const auto inertia =
+        read_array<double>(f, "/particles/inertia", H5T_NATIVE_DOUBLE, 1, n, error);
+    const auto mat = read_array<int>(f, "/particles/material", H5T_NATIVE_INT, 1, n, error);
     // Optional: present when the run had fluid forces.
-    const bool has_drag = error.empty() && H5Lexists(g, "drag_coefficient", H5P_DEFAULT) > 0;
+    const bool has_drag =
+        error.empty() && H5Lexists(f, "/particles/drag_coefficient", H5P_DEFAULT) > 0;
     std::vector<double> drag_k, drag_u;
     if (has_drag) {
-      drag_k = read_array<double>(g, "drag_coefficient", H5T_NATIVE_DOUBLE, 1, n, error);
-      drag_u = read_array<double>(g, "drag_fluid_velocity", H5T_NATIVE_DOUBLE, 3, n, error);
+      drag_k = read_array<double>(f, "/particles/drag_coefficient", H5T_NATIVE_DOUBLE, 1, n, error);
+      drag_u =
+          read_array<double>(f, "/particles/drag_fluid_velocity", H5T_NATIVE_DOUBLE, 3, n, error);
     }
-    if (g >= 0) H5Gclose(g);
-    const hid_t s = error.empty() ? H5Gopen2(f, "springs", H5P_DEFAULT) : -1;
-    if (error.empty() && s < 0) error = "group 'springs' is missing";
-    const auto a = read_array<long long>(s, "particle", H5T_NATIVE_LLONG, 1, m, error);
-    const auto b = read_array<long long>(s, "partner", H5T_NATIVE_LLONG, 1, m, error);
-    const auto t = read_array<double>(s, "tangential", H5T_NATIVE_DOUBLE, 3, m, error);
-    const auto ro = read_array<double>(s, "rolling", H5T_NATIVE_DOUBLE, 3, m, error);
-    if (s >= 0) H5Gclose(s);
+    if (error.empty() && H5Lexists(f, "springs", H5P_DEFAULT) <= 0)
+      error = "group 'springs' is missing";
+    const auto a = read_array<long long>(f, "/springs/particle", H5T_NATIVE_LLONG, 1, m, error);
+    const auto b = read_array<long long>(f, "/springs/partner", H5T_NATIVE_LLONG, 1, m, error);
+    const auto t = read_array<double>(f, "/springs/tangential", H5T_NATIVE_DOUBLE, 3, m, error);
+    const auto ro = read_array<double>(f, "/springs/rolling", H5T_NATIVE_DOUBLE, 3, m, error);
     if (error.empty() && H5Lexists(f, "streams", H5P_DEFAULT) > 0) {
-      const hid_t st = H5Gopen2(f, "streams", H5P_DEFAULT);
       std::size_t length = static_cast<std::size_t>(-1);
-      const auto text = read_array<unsigned char>(st, "state", H5T_NATIVE_UCHAR, 1, length, error);
-      if (st >= 0) H5Gclose(st);
+      const auto text =
+          read_array<unsigned char>(f, "/streams/state", H5T_NATIVE_UCHAR, 1, length, error);
       if (error.empty()) d.streams = std::string(text.begin(), text.end());
     }
     H5Fclose(f);

@@ -7,6 +7,10 @@
 // leaves a truncated checkpoint under the final name. read_checkpoint lets every
 // rank read the whole file; the engine then keeps what each rank owns.
 //
+// Every dataset is chunked with a Fletcher32 checksum (hdf5_checksum.hpp), which HDF5
+// verifies on reading: read_checkpoint names the dataset whose checksum fails. What the
+// values must satisfy is checked by check_checkpoint (dem/engine/restored_state.hpp).
+//
 // Layout: attributes format ("grainflow-checkpoint-2"), time, dt, step, next_id;
 // /particles/{id, position, velocity, angular_velocity, force, torque, radius, mass,
 // inertia, material} — force and torque are those of the step's end, which the next

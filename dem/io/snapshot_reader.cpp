@@ -7,6 +7,8 @@
 #include <type_traits>
 #include <vector>
 
+#include "dem/io/hdf5_checksum.hpp"
+
 namespace grainflow {
 namespace {
 
@@ -57,8 +59,10 @@ std::size_t read(hid_t file, const std::string& path, const char* name, int comp
   out.resize(dims[0] * static_cast<std::size_t>(comps / per_element));
   const herr_t status =
       out.empty() ? 0 : H5Dread(d, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data());
+  const std::string reason = status < 0 ? read_failure_reason() : std::string();
   H5Dclose(d);
-  if (status < 0) throw SnapshotReadError(path + ": error: cannot read dataset '" + name + "'");
+  if (status < 0)
+    throw SnapshotDamagedError(path + ": error: cannot read dataset '" + name + "': " + reason);
   return dims[0];
 }
 
@@ -90,10 +94,6 @@ Snapshot read_snapshot(const std::string& path) {
     H5Aread(a, H5T_NATIVE_DOUBLE, &s.time);
     H5Aclose(a);
   }
-  for (std::size_t i = 0; i < n; ++i)
-    if (!p.x[i].allFinite() || !(p.radius[i] > 0) || !(p.mass[i] > 0))
-      throw SnapshotReadError(path + ": error: particle id " + std::to_string(p.id[i]) +
-                              " has a non-finite position or a non-positive radius or mass");
   p.inertia.resize(n);
   for (std::size_t i = 0; i < n; ++i) p.inertia[i] = 0.4 * p.mass[i] * p.radius[i] * p.radius[i];
   p.force.assign(n, Vec3::Zero());

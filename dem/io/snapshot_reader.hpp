@@ -13,7 +13,13 @@ namespace grainflow {
 class SnapshotReadError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+// A grainflow snapshot whose data cannot be read back as written (a Fletcher32 checksum
+// that does not match, a damaged chunk).
+class SnapshotDamagedError : public SnapshotReadError {
+  using SnapshotReadError::SnapshotReadError;
+};
 
+// The values are not checked here: insert_particles checks them (restored_state.hpp).
 struct Snapshot {
   Particles particles;  // id, x, v, omega, radius, mass, material; inertia = 2/5 m r^2
   double time = 0;

@@ -6,7 +6,8 @@
 // File layout (see snapshot_fields in xdmf_index.hpp), N = global particle count:
 //   /id (int64, N)  /position, /velocity, /angular_velocity (double, N x 3)
 //   /radius, /diameter, /mass (double, N)  /material (int32, N)
-//   each dataset has a string attribute "units"; the root group has the attributes
+//   each dataset is chunked with a Fletcher32 checksum (hdf5_checksum.hpp) and has a string
+//   attribute "units"; the root group has the attributes
 //   time (double, s), step (int64), count (int64, = N) and grainflow_version (string).
 #include <mpi.h>
 

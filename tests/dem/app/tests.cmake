@@ -131,6 +131,42 @@ else()
                    ${MPIEXEC_EXECUTABLE})
   set_tests_properties(grain.disk_full PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}"
                        TIMEOUT 300 PROCESSORS 2 SKIP_RETURN_CODE 77)
+  # The "continue with:" line after SIGTERM, run as printed, continues in the --output folder
+  # with the snapshot numbering going on (1 and 2 ranks).
+  add_test(NAME grain.continue_command
+           COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/continue_command.sh ${_grain}
+                   ${_scenes}/continue_command.yaml ${_work}/continue_command ${GRAINFLOW_PYTHON3})
+  add_test(NAME grain.continue_command_two_ranks
+           COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/continue_command.sh ${_grain}
+                   ${_scenes}/continue_command.yaml ${_work}/continue_command_2
+                   ${GRAINFLOW_PYTHON3} ${MPIEXEC_EXECUTABLE} 2)
+  set_tests_properties(grain.continue_command grain.continue_command_two_ranks
+                       PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}" TIMEOUT 120)
+  set_tests_properties(grain.continue_command_two_ranks PROPERTIES PROCESSORS 2)
+  # Hostile checkpoints and snapshots (docs/reliability.md, "What is checked on read"): a real
+  # file with one value changed (or one bit flipped) is refused with exit code 1, naming the
+  # file, the dataset, the index and the rule, and nothing in the output directory changes.
+  set(_state_work ${_work}/state_file_checks)
+  add_test(NAME grain.state_file_checks.setup
+           COMMAND ${GRAINFLOW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/state_file_checks.py ${_grain}
+                   ${_scenes}/checkpointed_bed.yaml ${_state_work} setup)
+  set_tests_properties(grain.state_file_checks.setup PROPERTIES FIXTURES_SETUP grain_state_files)
+  set(_state_cases material_max material_past position_bounded position_periodic negative_radius
+                   equal_ids zero_mass mass_not_rho_v velocity_bit)
+  foreach(_kind checkpoint snapshot)
+    set(_cases ${_state_cases})
+    if(_kind STREQUAL "checkpoint")
+      list(APPEND _cases spring_partner spring_wall next_id)
+    endif()
+    foreach(_case ${_cases})
+      add_test(NAME grain.state_file_checks.${_kind}.${_case}
+               COMMAND ${GRAINFLOW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/state_file_checks.py
+                       ${_grain} ${_scenes}/checkpointed_bed.yaml ${_state_work} ${_kind} ${_case})
+      set_tests_properties(grain.state_file_checks.${_kind}.${_case} PROPERTIES
+                           FIXTURES_REQUIRED grain_state_files TIMEOUT 60
+                           ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}")
+    endforeach()
+  endforeach()
 endif()
 grain_cli_test(restart_missing_checkpoint 1 "no_such_checkpoint.h5"
                CMD ${_grain} run ${_scenes}/periodic_bed.yaml --output out --no-progress

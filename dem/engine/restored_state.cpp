@@ -1,0 +1,170 @@
+#include "dem/engine/restored_state.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <utility>
+
+namespace grainflow {
+namespace {
+
+// The shortest text that reads back as the same double (1e+300, 0.015).
+std::string number(double v) {
+  char buf[32];
+  const auto end = std::to_chars(buf, buf + sizeof buf, v).ptr;
+  return std::string(buf, end);
+}
+
+std::string vec(const Vec3& v) {
+  std::string out = "(";
+  for (int a = 0; a < 3; ++a) out.append(number(v[a])).append(a < 2 ? ", " : ")");
+  return out;
+}
+
+[[noreturn]] void fail(const StateSource& src, const std::string& dataset, std::size_t index,
+                       const std::string& who, const std::string& rule) {
+  throw StateError(src.file + ": error: dataset '" + src.group + dataset + "', index " +
+                   std::to_string(index) + (who.empty() ? "" : " (" + who + ")") + ": " + rule +
+                   "; " + src.advice);
+}
+
+std::string particle(GlobalId id) { return "particle id " + std::to_string(id); }
+
+bool near(double value, double reference) {
+  return std::abs(value - reference) <= kMassTolerance * std::abs(reference);
+}
+
+}  // namespace
+
+void check_particle_records(const Particles& p, const Scene& scene, const StateSource& src,
+                            bool inertia) {
+  const int materials = static_cast<int>(scene.materials.size());
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const std::string who = particle(p.id[i]);
+    if (!p.x[i].allFinite())
+      fail(src, "position", i, who, "the position " + vec(p.x[i]) + " is not finite");
+    if (!std::isfinite(p.radius[i]) || !(p.radius[i] > 0))
+      fail(src, "radius", i, who,
+           "the radius " + number(p.radius[i]) + " m is not a finite number > 0");
+    if (p.material[i] < 0 || p.material[i] >= materials)
+      fail(src, "material", i, who,
+           "the material index " + std::to_string(p.material[i]) + " is not one of the scene's " +
+               std::to_string(materials) + " material(s) (allowed: 0 to " +
+               std::to_string(materials - 1) + ", in the order of `materials`)");
+    const Material& mat = scene.materials[static_cast<std::size_t>(p.material[i])];
+    const double m = mat.density * sphere_volume(p.radius[i]);
+    if (!near(p.mass[i], m))
+      fail(src, "mass", i, who,
+           "the mass " + number(p.mass[i]) + " kg is not rho (4/3) pi r^3 = " + number(m) +
+               " kg of material '" + mat.name + "' (density " + number(mat.density) +
+               " kg/m^3, radius " + number(p.radius[i]) + " m; relative tolerance " +
+               number(kMassTolerance) + ")");
+    if (inertia && !near(p.inertia[i], 0.4 * m * p.radius[i] * p.radius[i]))
+      fail(src, "inertia", i, who,
+           "the moment of inertia " + number(p.inertia[i]) +
+               " kg m^2 is not 2/5 m r^2 = " + number(0.4 * m * p.radius[i] * p.radius[i]) +
+               " kg m^2 (relative tolerance " + number(kMassTolerance) + ")");
+    if (p.id[i] <= 0)
+      fail(src, "id", i, "", "the particle id " + std::to_string(p.id[i]) + " is not > 0");
+  }
+  std::vector<std::pair<GlobalId, std::size_t>> ids(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) ids[i] = {p.id[i], i};
+  std::sort(ids.begin(), ids.end());
+  for (std::size_t k = 1; k < ids.size(); ++k)
+    if (ids[k].first == ids[k - 1].first)
+      fail(src, "id", ids[k].second, "",
+           "the particle id " + std::to_string(ids[k].first) + " is also at index " +
+               std::to_string(ids[k - 1].second) + "; ids must be unique");
+}
+
+void check_checkpoint(const CheckpointData& d, const Scene& scene, std::size_t wall_columns,
+                      double stream_max_radius, const std::vector<long>& stream_counts) {
+  const StateSource src{d.file, "/particles/",
+                        "the checkpoint was changed or damaged after it was written, or belongs "
+                        "to another scene: restart from an earlier checkpoint of this run (no "
+                        "file was changed or deleted)"};
+  auto attribute = [&](const std::string& name, const std::string& rule) {
+    throw StateError(d.file + ": error: attribute '" + name + "' of the root group: " + rule +
+                     "; " + src.advice);
+  };
+  if (!std::isfinite(d.time) || d.time < 0)
+    attribute("time", "the time " + number(d.time) + " s is not a finite number >= 0");
+  if (!std::isfinite(d.dt) || !(d.dt > 0))
+    attribute("dt", "the time step " + number(d.dt) + " s is not a finite number > 0");
+  if (d.step < 0) attribute("step", "the step " + std::to_string(d.step) + " is negative");
+
+  const Particles& p = d.particles;
+  check_particle_records(p, scene, src, true);
+
+  // The skin Simulation::initialise will choose, from the same radii.
+  double r_max = stream_max_radius;
+  for (double r : p.radius) r_max = std::max(r_max, r);
+  const double drift = 0.5 * scene.neighbour.skin.value_or(0.4 * r_max);
+  const Domain& dom = scene.domain;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double slack = std::max(p.radius[i], drift);
+    for (int a = 0; a < 3; ++a)
+      if (p.x[i][a] < dom.lo[a] - slack || p.x[i][a] > dom.hi[a] + slack)
+        fail(src, "position", i, particle(p.id[i]),
+             std::string("the position ") + vec(p.x[i]) + " is outside the domain along " +
+                 "xyz"[a] + " (" + (dom.periodic[a] ? "periodic" : "bounded") + ", [" +
+                 number(dom.lo[a]) + ", " + number(dom.hi[a]) + "] m) by more than " +
+                 number(slack) +
+                 " m, the larger of the radius and half the neighbour skin that a centre can "
+                 "drift between two neighbour-list rebuilds");
+  }
+
+  GlobalId largest = 0;
+  for (GlobalId id : p.id) largest = std::max(largest, id);
+  if (d.next_id <= largest)
+    attribute("next_id", "next_id = " + std::to_string(d.next_id) +
+                             " is not above the largest particle id " + std::to_string(largest) +
+                             " (a new particle would get an id already taken)");
+  for (std::size_t k = 0; k < stream_counts.size(); ++k)
+    if (stream_counts[k] < 0 || stream_counts[k] >= d.next_id)
+      throw StateError(d.file + ": error: dataset '/streams/state', stream " + std::to_string(k) +
+                       ": " + std::to_string(stream_counts[k]) +
+                       " particles delivered, but every delivered particle took an id and "
+                       "next_id = " +
+                       std::to_string(d.next_id) + " (the count must lie in [0, next_id - 1]); " +
+                       src.advice);
+
+  for (std::size_t i = 0; i < d.drag_coefficient.size(); ++i) {
+    if (!std::isfinite(d.drag_coefficient[i]) || d.drag_coefficient[i] < 0)
+      fail(src, "drag_coefficient", i, particle(p.id[i]),
+           "the implicit drag coefficient " + number(d.drag_coefficient[i]) +
+               " kg/s is not a finite number >= 0");
+    if (!d.drag_fluid_velocity[i].allFinite())
+      fail(src, "drag_fluid_velocity", i, particle(p.id[i]),
+           "the fluid velocity " + vec(d.drag_fluid_velocity[i]) + " is not finite");
+  }
+
+  std::vector<GlobalId> ids = p.id;
+  std::sort(ids.begin(), ids.end());
+  const auto exists = [&](GlobalId id) { return std::binary_search(ids.begin(), ids.end(), id); };
+  const StateSource springs{d.file, "/springs/", src.advice};
+  for (std::size_t k = 0; k < d.springs.size(); ++k) {
+    const CheckpointSpring& s = d.springs[k];
+    if (!exists(s.particle))
+      fail(springs, "particle", k, "",
+           "the spring's particle id " + std::to_string(s.particle) +
+               " is not a particle of the file");
+    if (s.partner >= 0 && !exists(s.partner))
+      fail(springs, "partner", k, particle(s.particle),
+           "the spring's partner id " + std::to_string(s.partner) +
+               " is not a particle of the file");
+    if (s.partner < 0 && static_cast<std::size_t>(-1 - s.partner) >= wall_columns)
+      fail(springs, "partner", k, particle(s.particle),
+           "the spring's partner " + std::to_string(s.partner) + " names wall history column " +
+               std::to_string(-1 - s.partner) + ", but the scene's walls have " +
+               std::to_string(wall_columns) + " (partner = -1 - column)");
+    if (!s.tangential.allFinite())
+      fail(springs, "tangential", k, particle(s.particle),
+           "the tangential spring " + vec(s.tangential) + " is not finite");
+    if (!s.rolling.allFinite())
+      fail(springs, "rolling", k, particle(s.particle),
+           "the rolling spring " + vec(s.rolling) + " is not finite");
+  }
+}
+
+}  // namespace grainflow

@@ -1,0 +1,193 @@
+#!/usr/bin/env python3
+"""Hostile checkpoints and snapshots (docs/reliability.md, "What is checked on read").
+
+    state_file_checks.py GRAIN SCENE WORKDIR setup
+    state_file_checks.py GRAIN SCENE WORKDIR checkpoint|snapshot CASE
+
+`setup` runs SCENE (periodic along x and y, bounded along z, one material) into
+WORKDIR/base: its checkpoint and first snapshot are the real files every case copies.
+A case copies one of them, changes one value with h5py (which writes the chunk anew with a
+correct checksum, so only the rules can see the change) or flips one bit in the file's bytes
+(which only the Fletcher32 checksum can see), and starts from it: `grain run SCENE --restart
+COPY` for a checkpoint, a scene inserting `{type: snapshot, file: COPY}` for a snapshot.
+Each case must exit with code 1 and a message naming the file, the dataset, the index and
+the rule broken, and must leave every file of the output directory as it was.
+"""
+import glob
+import hashlib
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+
+grain, scene, work, kind = sys.argv[1:5]
+case = sys.argv[5] if len(sys.argv) > 5 else ""
+base = os.path.join(work, "base")
+
+
+def fail(message):
+    print("FAIL: " + message)
+    sys.exit(1)
+
+
+if kind == "setup":
+    shutil.rmtree(base, ignore_errors=True)
+    os.makedirs(base)
+    r = subprocess.run([grain, "run", scene, "--output", "out", "--no-progress"], cwd=base,
+                       capture_output=True, text=True)
+    print(r.stdout + r.stderr)
+    if r.returncode != 0 or not glob.glob(os.path.join(base, "out", "checkpoint_*.h5")):
+        fail("the run that makes the real files failed")
+    print("PASS")
+    sys.exit(0)
+
+source = sorted(glob.glob(os.path.join(base, "out", "checkpoint_*.h5")))[0] \
+    if kind == "checkpoint" else os.path.join(base, "out", "particles_000000.h5")
+here = os.path.join(work, kind + "_" + case)
+shutil.rmtree(here, ignore_errors=True)
+os.makedirs(os.path.join(here, "out"))
+# The damaged file lies in the output directory beside an intact checkpoint of the same run,
+# which the refused start must leave alone.
+name = os.path.basename(source) if kind == "checkpoint" else "snapshot.h5"
+target = os.path.join(here, "out", name)
+shutil.copy(source, target)
+shutil.copy(source, os.path.join(here, "out", "checkpoint_000000001.h5"))
+g = "particles/" if kind == "checkpoint" else ""
+relative = os.path.join("out", name)
+
+
+def edit(change):
+    with h5py.File(target, "r+") as f:
+        return change(f)
+
+
+def flip_low_bit(dataset, row, col):
+    """Flips the lowest mantissa bit of dataset[row, col] in the file's bytes (little-endian
+    doubles in one Fletcher32-checked chunk), as a damaged disk sector would."""
+    with h5py.File(target, "r") as f:
+        d = f[dataset]
+        assert d.fletcher32, "the file was written without checksums"
+        info = d.id.get_chunk_info(0)
+        offset = info.byte_offset + (row * d.shape[1] + col) * 8
+        assert d.chunks[0] > row
+        before = d[row, col]
+    with open(target, "r+b") as raw:
+        raw.seek(offset)
+        byte = raw.read(1)[0]
+        raw.seek(offset)
+        raw.write(bytes([byte ^ 1]))
+    return before
+
+
+def set_spring(f, particle, partner):
+    """Replaces the springs with one (particle, partner) spring, as grain writes them."""
+    for k in ("particle", "partner", "tangential", "rolling"):
+        del f["springs/" + k]
+    f.create_dataset("springs/particle", data=np.array([particle], "<i8"), chunks=(1,),
+                     fletcher32=True)
+    f.create_dataset("springs/partner", data=np.array([partner], "<i8"), chunks=(1,),
+                     fletcher32=True)
+    for k in ("tangential", "rolling"):
+        f.create_dataset("springs/" + k, data=np.zeros((1, 3)), chunks=(1, 3), fletcher32=True)
+
+
+def setitem(path, index, value):
+    def change(f):
+        d = f[path]
+        old = d[index]
+        d[index] = value
+        return old
+    return change
+
+
+ids = edit(lambda f: f[g + "id"][...])
+# The regex the message must match: file, dataset, index, rule.
+# A snapshot's path is as the scene resolves it (relative to the scene's folder).
+f_ = re.escape(relative) if kind == "checkpoint" else r"\S*" + re.escape(relative)
+particle = lambda i: r"index %d \(particle id %d\)" % (i, ids[i])
+if case == "material_max":  # 2^31-1: a segmentation fault before these checks
+    edit(setitem(g + "material", 0, 2**31 - 1))
+    expect = f_ + r": error: dataset '/%smaterial', %s: the material index 2147483647 is not " \
+        r"one of the scene's 1 material\(s\) \(allowed: 0 to 0" % (g, particle(0))
+elif case == "material_past":
+    edit(setitem(g + "material", 3, 1))
+    expect = f_ + r": error: dataset '/%smaterial', %s: the material index 1 is not one of" % (
+        g, particle(3))
+elif case == "position_bounded":  # z is bounded
+    edit(setitem(g + "position", (5, 2), 1e300))
+    expect = (f_ + r": error: dataset '/%sposition', %s: the position \(.*, 1e\+300\) is outside "
+              r"the domain along z \(bounded" % (g, particle(5))) if kind == "checkpoint" else \
+        (f_ + r": error: dataset '/position', %s: the particle lies outside the domain: it spans z"
+         % particle(5))
+elif case == "position_periodic":  # x is periodic
+    edit(setitem(g + "position", (5, 0), 1e300))
+    expect = (f_ + r": error: dataset '/%sposition', %s: the position \(1e\+300, .*\) is outside "
+              r"the domain along x \(periodic" % (g, particle(5))) if kind == "checkpoint" else \
+        (f_ + r": error: dataset '/position', %s: the particle lies outside the domain: its "
+         r"centre x = 1e\+300 is outside the periodic range" % particle(5))
+elif case == "negative_radius":
+    edit(setitem(g + "radius", 2, -edit(lambda f: f[g + "radius"][2])))
+    expect = f_ + r": error: dataset '/%sradius', %s: the radius -[0-9.e-]+ m is not a finite " \
+        r"number > 0" % (g, particle(2))
+elif case == "equal_ids":
+    edit(setitem(g + "id", 4, ids[3]))
+    expect = f_ + r": error: dataset '/%sid', index 4: the particle id %d is also at index 3; " \
+        r"ids must be unique" % (g, ids[3])
+elif case == "zero_mass":
+    edit(setitem(g + "mass", 6, 0.0))
+    expect = f_ + r": error: dataset '/%smass', %s: the mass 0 kg is not rho \(4/3\) pi r\^3 = " \
+        r"[0-9.e-]+ kg of material 'glass' \(density 2500 kg/m\^3, radius [0-9.e-]+ m; relative " \
+        r"tolerance 1e-06\)" % (g, particle(6))
+elif case == "mass_not_rho_v":  # issue 17 item 8: twice rho V
+    edit(setitem(g + "mass", 6, 2 * edit(lambda f: f[g + "mass"][6])))
+    expect = f_ + r": error: dataset '/%smass', %s: the mass [0-9.e-]+ kg is not rho \(4/3\) pi " \
+        r"r\^3" % (g, particle(6))
+elif case == "velocity_bit":  # only the checksum sees it
+    flip_low_bit(g + "velocity", 7, 0)
+    expect = (r"cannot read checkpoint '%s': dataset '/particles/velocity' cannot be read: its "
+              r"Fletcher32 checksum does not match the data" % f_) if kind == "checkpoint" else \
+        (f_ + r": error: cannot read dataset '/velocity': its Fletcher32 checksum does not "
+         r"match the data")
+elif case == "spring_partner":
+    edit(lambda f: set_spring(f, ids[0], 10**9))
+    expect = f_ + r": error: dataset '/springs/partner', index 0 \(particle id %d\): the spring's " \
+        r"partner id 1000000000 is not a particle of the file" % ids[0]
+elif case == "spring_wall":  # the scene has one plane: wall history column 0 only
+    edit(lambda f: set_spring(f, ids[0], -1 - 7))
+    expect = f_ + r": error: dataset '/springs/partner', index 0 \(particle id %d\): the spring's " \
+        r"partner -8 names wall history column 7, but the scene's walls have 1" % ids[0]
+elif case == "next_id":
+    edit(lambda f: f.attrs.__setitem__("next_id", np.int64(ids.max())))
+    expect = f_ + r": error: attribute 'next_id' of the root group: next_id = %d is not above " \
+        r"the largest particle id %d" % (ids.max(), ids.max())
+else:
+    fail("unknown case " + case)
+
+before = {p: hashlib.sha256(open(os.path.join(here, "out", p), "rb").read()).hexdigest()
+          for p in os.listdir(os.path.join(here, "out"))}
+if kind == "checkpoint":
+    cmd = [grain, "run", scene, "--output", "out", "--no-progress", "--restart", relative]
+else:
+    text = open(scene).read()
+    text = re.sub(r"(?ms)^insert:.*?(?=^\S)", "insert:\n  - {type: snapshot, file: %s}\n"
+                  % relative, text)
+    with open(os.path.join(here, "scene.yaml"), "w") as out:
+        out.write(text)
+    cmd = [grain, "run", "scene.yaml", "--output", "out", "--no-progress"]
+r = subprocess.run(cmd, cwd=here, capture_output=True, text=True, timeout=60)
+out = r.stdout + r.stderr
+print(" ".join(cmd))
+print(out)
+if r.returncode != 1:
+    fail("exit code %d, expected 1" % r.returncode)
+if not re.search(expect, out):
+    fail("no message matching: " + expect)
+after = {p: hashlib.sha256(open(os.path.join(here, "out", p), "rb").read()).hexdigest()
+         for p in os.listdir(os.path.join(here, "out"))}
+if after != before:
+    fail("the output directory changed: %s -> %s" % (sorted(before), sorted(after)))
+print("PASS")
