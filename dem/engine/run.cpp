@@ -45,9 +45,18 @@ void print_report(const Simulation& sim, MPI_Comm comm, std::ostream& out) {
   o << "scene: " << sim.scene().file << "\n"
     << "particles: " << g.particles << " (radius " << -range[0] << " .. " << range[1] << " m)\n"
     << "contact law: " << sim.contact_law_name() << "\n";
-  if (d.size() > 1)
+  if (d.size() > 1) {
     o << "MPI ranks: " << d.size() << " as a " << d.dims()[0] << " x " << d.dims()[1] << " x "
-      << d.dims()[2] << " grid\n";
+      << d.dims()[2] << " grid";
+    for (int a = 0; a < 3; ++a) {
+      if (d.dims()[a] == 1) continue;
+      o << "; cuts along "
+        << "xyz"[a] << " at";
+      for (int k = 1; k < d.dims()[a]; ++k) o << (k > 1 ? ", " : " ") << d.cuts(a)[k];
+      o << " m";
+    }
+    o << "\n";
+  }
   for (const std::string& note : sim.time_step_report().notes) o << note << "\n";
   for (const std::string& note : sim.walls().notes()) o << note << "\n";  // meshes read
 }

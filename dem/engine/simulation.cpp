@@ -38,6 +38,7 @@ Simulation::Simulation(const Scene& scene, bool insert, MPI_Comm comm,
                        std::array<int, 3> processor_grid)
     : scene_(scene), comm_(comm), table_(scene) {
   if (processor_grid == std::array<int, 3>{0, 0, 0}) processor_grid = scene.parallel.grid;
+  automatic_grid_ = processor_grid == std::array<int, 3>{0, 0, 0};
   try {
     decomp_ = std::make_unique<Decomposition>(comm, scene.domain, processor_grid);
   } catch (const std::invalid_argument& e) {
@@ -77,6 +78,7 @@ void Simulation::initialise() {
           << " m); enlarge the domain along it or reduce the skin";
       throw SetupError(msg.str());
     }
+  if (automatic_grid_ && !cuts_imposed_ && decomp_->size() > 1) fit_grid_to_particles();
   for (int a = 0; a < 3; ++a)
     if (decomp_->dims()[a] > 1 && decomp_->thinnest_box() < cutoff_) {
       std::ostringstream msg;
@@ -345,7 +347,39 @@ void Simulation::balance_cuts() {
                                     decomp_->hi() + Vec3::Constant(cutoff_), cutoff_);
 }
 
+void Simulation::fit_grid_to_particles() {
+  const Domain& d = scene_.domain;
+  const Vec3 length = d.hi - d.lo;
+  // Particles still to come (streams) land where the scene sends them, not where the
+  // particles of the start are: such a scene, like an empty one, is cut for its domain.
+  const bool by_particles = p_.size() > 0 && streams_.empty();
+  std::optional<Vec3> extent;
+  if (by_particles) {
+    Vec3 lo = p_.x[0], hi = p_.x[0];
+    for (const Vec3& x : p_.x) {
+      lo = lo.cwiseMin(x);
+      hi = hi.cwiseMax(x);
+    }
+    // The cut through the particles plus the ghost layer on either side of it.
+    extent = ((hi - lo) + Vec3::Constant(cutoff_)).cwiseMin(length);
+  }
+  const std::array<int, 3> dims = choose_processor_grid(decomp_->size(), length, cutoff_, extent);
+  if (dims != decomp_->dims()) {
+    exchange_.reset();
+    decomp_ = std::make_unique<Decomposition>(comm_, d, dims);
+    exchange_ = std::make_unique<Exchange>(*decomp_);
+  }
+  if (!by_particles) return;
+  std::vector<double> coordinate(p_.size());
+  for (int a = 0; a < 3; ++a) {
+    if (dims[a] == 1) continue;
+    for (std::size_t i = 0; i < p_.size(); ++i) coordinate[i] = p_.x[i][a];
+    decomp_->set_cuts(a, balanced_cut_planes(coordinate, d.lo[a], d.hi[a], dims[a], cutoff_));
+  }
+}
+
 void Simulation::set_cut_planes(int axis, const std::vector<double>& planes) {
+  cuts_imposed_ = true;
   try {
     decomp_->set_cuts(axis, planes);
   } catch (const std::invalid_argument& e) {

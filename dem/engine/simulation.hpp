@@ -76,7 +76,9 @@ class Simulation {
   // Inserts the scene's particles (every rank inserts the same set; initialise()
   // keeps each on the rank that owns it). `insert = false` starts empty: tests add
   // particles by hand — on every rank alike — before initialise().
-  // processor_grid {0,0,0} takes the scene's `parallel.grid` (itself {0,0,0}: automatic).
+  // processor_grid {0,0,0} takes the scene's `parallel.grid`; when that is {0,0,0} too, the
+  // grid and its cut planes are chosen by initialise() for the particles then present
+  // (docs/parallel.md, "The default grid"), unless set_cut_planes() imposed planes.
   explicit Simulation(const Scene& scene, bool insert = true, MPI_Comm comm = MPI_COMM_WORLD,
                       std::array<int, 3> processor_grid = {0, 0, 0});
 
@@ -156,6 +158,10 @@ class Simulation {
  private:
   void rebuild(bool keep_drag = false);
   void balance_cuts();  // moves cut planes toward equal particle counts (collective)
+  // The default grid (automatic grid, no imposed planes): the grid with the least cut area
+  // through the particles' extent, its planes at the particle-count quantiles. Every rank
+  // holds every particle when it runs, so all choose the same.
+  void fit_grid_to_particles();
   ContactGuards compute_forces();  // gravity, contacts, then the force terms
   void apply_force_terms();  // non-contact terms only
   void restore_implicit_drag();  // initialise() after restore()
@@ -227,6 +233,8 @@ class Simulation {
   bool state_finite_ = true;                        // after the last step(), this rank's particles
   bool finite_everywhere_ = true;                   // the same, every rank's
   bool restored_ = false;                           // initialise() keeps the forces read
+  bool automatic_grid_ = false;  // neither the caller nor the scene gave the grid
+  bool cuts_imposed_ = false;    // set_cut_planes() was called
   bool initialised_ = false;
 };
 

@@ -1,6 +1,7 @@
 #include "dem/neighbour/verlet_list.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 namespace grainflow {
@@ -13,104 +14,136 @@ Box::Box(const Domain& d)
   }
 }
 
-BinGrid::BinGrid(const Vec3& lo, const Vec3& hi, double bin_edge)
-    : lo_(lo), hi_(hi), min_edge_(bin_edge) {
-  resize_for(0);
+namespace {
+
+// Stable LSD radix sort of `order` (indices into `key`) by key[order[k]] - base, all of
+// which are below 2^bits: a few passes over the particles, whatever the keys' range.
+void radix_sort(std::vector<int>& order, const std::vector<std::uint64_t>& key, std::uint64_t base,
+                int bits, std::vector<int>& tmp) {
+  constexpr int kDigit = 11;
+  constexpr std::size_t kBuckets = std::size_t{1} << kDigit;
+  tmp.resize(order.size());
+  for (int shift = 0; shift < bits; shift += kDigit) {
+    std::array<int, kBuckets + 1> start{};
+    for (int k : order) ++start[((key[k] - base) >> shift & (kBuckets - 1)) + 1];
+    for (std::size_t b = 0; b < kBuckets; ++b) start[b + 1] += start[b];
+    for (int k : order) tmp[start[(key[k] - base) >> shift & (kBuckets - 1)]++] = k;
+    order.swap(tmp);
+  }
 }
 
-void BinGrid::resize_for(std::size_t particles) {
-  // Bins no smaller than the interaction range, and no more bins than ~2 per
-  // particle: a large, sparsely filled domain must not cost memory per empty bin.
-  const double limit = std::max(1000.0, 2.0 * static_cast<double>(particles));
-  const Vec3 length = hi_ - lo_;
-  double n[3];
-  for (int a = 0; a < 3; ++a) n[a] = std::max(1.0, std::floor(length[a] / min_edge_));
-  const double total = n[0] * n[1] * n[2];
-  if (total > limit) {
-    const double f = std::cbrt(total / limit);
-    for (int a = 0; a < 3; ++a) n[a] = std::max(1.0, std::floor(n[a] / f));
+// Sorts 0 .. key.size()-1 by key into `order`.
+void sort_by_key(const std::vector<std::uint64_t>& key, std::vector<int>& order,
+                 std::vector<int>& tmp) {
+  order.resize(key.size());
+  if (key.empty()) return;
+  std::uint64_t lo = key[0], hi = key[0];
+  for (std::size_t k = 0; k < key.size(); ++k) {
+    order[k] = static_cast<int>(k);
+    lo = std::min(lo, key[k]);
+    hi = std::max(hi, key[k]);
   }
+  radix_sort(order, key, lo, static_cast<int>(std::bit_width(hi - lo)), tmp);
+}
+
+}  // namespace
+
+BinGrid::BinGrid(const Vec3& lo, const Vec3& hi, double bin_edge) : lo_(lo), hi_(hi) {
+  // Bins no smaller than the interaction range. No bin is stored for empty space, so the
+  // lattice may be as fine as that over any domain.
+  constexpr double kMaxPerAxis = 1 << 20;
+  const Vec3 length = hi_ - lo_;
   for (int a = 0; a < 3; ++a) {
-    n_[a] = static_cast<int>(n[a]);
+    n_[a] = static_cast<int>(std::clamp(std::floor(length[a] / bin_edge), 1.0, kMaxPerAxis));
     inv_edge_[a] = n_[a] / length[a];
   }
 }
 
-int BinGrid::bin_of(const Vec3& x) const {
-  int c[3];
+std::uint64_t BinGrid::key_of(const Vec3& x) const {
+  std::uint64_t c[3];
   for (int a = 0; a < 3; ++a) {
-    const int k = static_cast<int>(std::floor((x[a] - lo_[a]) * inv_edge_[a]));
-    c[a] = std::clamp(k, 0, n_[a] - 1);
+    const double k = std::floor((x[a] - lo_[a]) * inv_edge_[a]);
+    c[a] = static_cast<std::uint64_t>(std::clamp(k, 0.0, n_[a] - 1.0));
   }
-  return (c[2] * n_[1] + c[1]) * n_[0] + c[0];
+  return (c[2] * static_cast<std::uint64_t>(n_[1]) + c[1]) * static_cast<std::uint64_t>(n_[0]) +
+         c[0];
 }
 
 std::vector<std::size_t> BinGrid::sort_permutation(const Particles& p) {
-  resize_for(p.size());
-  const int nbins = n_[0] * n_[1] * n_[2];
-  std::vector<int> bin(p.size());
-  bin_start_.assign(nbins + 1, 0);
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    bin[i] = bin_of(p.x[i]);
-    ++bin_start_[bin[i] + 1];
-  }
-  for (int b = 0; b < nbins; ++b) bin_start_[b + 1] += bin_start_[b];
-  std::vector<int> fill(bin_start_.begin(), bin_start_.end() - 1);
-  std::vector<std::size_t> perm(p.size());
-  for (std::size_t i = 0; i < p.size(); ++i) perm[fill[bin[i]]++] = i;
+  const std::size_t n = p.size();
+  key_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) key_[i] = key_of(p.x[i]);
+  sort_by_key(key_, order_, order_tmp_);
   // Within a bin, order by global id: the order (and so the order in which each
   // particle's contact forces are summed) then depends on positions and ids only,
   // not on the order particles arrived in — a restart or another rank count
   // rebuilds the same lists.
-  for (int b = 0; b < nbins; ++b)
-    if (bin_start_[b + 1] - bin_start_[b] > 1)
-      std::sort(perm.begin() + bin_start_[b], perm.begin() + bin_start_[b + 1],
-                [&p](std::size_t a, std::size_t c) { return p.id[a] < p.id[c]; });
-  return perm;
+  for (std::size_t s = 0; s < n;) {
+    std::size_t e = s + 1;
+    while (e < n && key_[order_[e]] == key_[order_[s]]) ++e;
+    if (e - s > 1)
+      std::sort(order_.begin() + static_cast<std::ptrdiff_t>(s),
+                order_.begin() + static_cast<std::ptrdiff_t>(e),
+                [&p](int a, int c) { return p.id[a] < p.id[c]; });
+    s = e;
+  }
+  return std::vector<std::size_t>(order_.begin(), order_.end());
 }
 
 void BinGrid::build(const Particles& p, const Ghosts& g, double skin, NeighbourList& local,
-                    NeighbourList& ghost) const {
-  const std::size_t n = p.size();
-  const int nbins = n_[0] * n_[1] * n_[2];
-  // Ghosts by bin (CSR), in their exchange order within a bin.
-  std::vector<int> gstart(nbins + 1, 0), gbin(g.size()), gsorted(g.size());
-  for (std::size_t k = 0; k < g.size(); ++k) {
-    gbin[k] = bin_of(g.position(k));
-    ++gstart[gbin[k] + 1];
-  }
-  for (int b = 0; b < nbins; ++b) gstart[b + 1] += gstart[b];
-  {
-    std::vector<int> fill(gstart.begin(), gstart.end() - 1);
-    for (std::size_t k = 0; k < g.size(); ++k) gsorted[fill[gbin[k]]++] = static_cast<int>(k);
-  }
+                    NeighbourList& ghost) {
+  const std::size_t n = p.size(), ng = g.size();
+  key_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) key_[i] = key_of(p.x[i]);  // sorted: see above
+  // Ghosts by key, in their exchange order within a bin (the sort is stable).
+  key_tmp_.resize(ng);
+  for (std::size_t k = 0; k < ng; ++k) key_tmp_[k] = key_of(g.position(k));
+  sort_by_key(key_tmp_, ghost_order_, order_tmp_);
+  ghost_key_.resize(ng);
+  for (std::size_t s = 0; s < ng; ++s) ghost_key_[s] = key_tmp_[ghost_order_[s]];
+
   local.offsets.assign(n + 1, 0);
   local.j.clear();
   ghost.offsets.assign(n + 1, 0);
   ghost.j.clear();
+  const std::uint64_t nx = n_[0], ny = n_[1], nz = n_[2];
+  // For each of the nine rows (dz, dy) of the 27 bins, the range of sorted locals and of
+  // sorted ghosts in the row's three bins. The particles come in key order, so each
+  // range's ends only move forward: all rows of all particles cost O(N + ghosts).
+  std::array<std::size_t, 9> lb{}, le{}, gb{}, ge{};
   for (std::size_t i = 0; i < n; ++i) {
-    const int b = bin_of(p.x[i]);
-    const int c[3] = {b % n_[0], (b / n_[0]) % n_[1], b / (n_[0] * n_[1])};
-    int lo[3], hi[3];
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::max(0, c[a] - 1);
-      hi[a] = std::min(n_[a] - 1, c[a] + 1);
-    }
-    for (int z = lo[2]; z <= hi[2]; ++z)
-      for (int y = lo[1]; y <= hi[1]; ++y)
-        for (int x = lo[0]; x <= hi[0]; ++x) {
-          const int nb = (z * n_[1] + y) * n_[0] + x;
-          for (int j = std::max(bin_start_[nb], static_cast<int>(i) + 1); j < bin_start_[nb + 1];
-               ++j) {
-            const double cut = p.radius[i] + p.radius[j] + skin;
-            if ((p.x[i] - p.x[j]).squaredNorm() < cut * cut) local.j.push_back(j);
-          }
-          for (int s = gstart[nb]; s < gstart[nb + 1]; ++s) {
-            const int k = gsorted[s];
-            const double cut = p.radius[i] + g.radius[k] + skin;
-            if ((p.x[i] - g.position(k)).squaredNorm() < cut * cut) ghost.j.push_back(k);
-          }
+    const std::uint64_t k = key_[i];
+    const std::uint64_t cx = k % nx, cy = k / nx % ny, cz = k / (nx * ny);
+    const std::uint64_t x0 = cx > 0 ? cx - 1 : 0, x1 = std::min(cx + 1, nx - 1);
+    // Rows (z, y) = (cz + dz - 1, cy + dy - 1) in the lattice, z then y ascending.
+    for (std::uint64_t dz = 0; dz < 3; ++dz) {
+      if (cz + dz < 1 || cz + dz - 1 >= nz) continue;
+      for (std::uint64_t dy = 0; dy < 3; ++dy) {
+        if (cy + dy < 1 || cy + dy - 1 >= ny) continue;
+        const std::uint64_t row = ((cz + dz - 1) * ny + cy + dy - 1) * nx;
+        const std::uint64_t first = row + x0, last = row + x1;
+        const std::size_t r = 3 * dz + dy;
+        std::size_t& b = lb[r];
+        std::size_t& e = le[r];
+        while (b < n && key_[b] < first) ++b;
+        e = std::max(e, b);
+        while (e < n && key_[e] <= last) ++e;
+        for (std::size_t j = std::max(b, i + 1); j < e; ++j) {
+          const double cut = p.radius[i] + p.radius[j] + skin;
+          if ((p.x[i] - p.x[j]).squaredNorm() < cut * cut) local.j.push_back(static_cast<int>(j));
         }
+        std::size_t& c = gb[r];
+        std::size_t& f = ge[r];
+        while (c < ng && ghost_key_[c] < first) ++c;
+        f = std::max(f, c);
+        while (f < ng && ghost_key_[f] <= last) ++f;
+        for (std::size_t s = c; s < f; ++s) {
+          const int q = ghost_order_[s];
+          const double cut = p.radius[i] + g.radius[q] + skin;
+          if ((p.x[i] - g.position(q)).squaredNorm() < cut * cut) ghost.j.push_back(q);
+        }
+      }
+    }
     local.offsets[i + 1] = static_cast<int>(local.j.size());
     ghost.offsets[i + 1] = static_cast<int>(ghost.j.size());
   }
@@ -121,6 +154,11 @@ void BinGrid::build(const Particles& p, const Ghosts& g, double skin, NeighbourL
       for (int k = list->offsets[i]; k < list->offsets[i + 1]; ++k)
         list->owner[k] = static_cast<int>(i);
   }
+}
+
+std::size_t BinGrid::memory_bytes() const {
+  return (key_.capacity() + key_tmp_.capacity() + ghost_key_.capacity()) * sizeof(std::uint64_t) +
+         (order_.capacity() + order_tmp_.capacity() + ghost_order_.capacity()) * sizeof(int);
 }
 
 std::vector<std::pair<GlobalId, GlobalId>> brute_force_pairs(const Particles& p, const Box& box,

@@ -1,19 +1,28 @@
 #pragma once
 // Binned Verlet neighbour lists with skin.
 //
-// Build: local particles and ghosts are binned on a regular grid over the rank's box
-// widened by the interaction range, with bins no smaller than that range
-// (2 r_max + skin). The caller first re-sorts local particles by bin
-// (sort_permutation) so that a bin's particles are contiguous in memory. build()
-// then scans each local particle's 27 neighbouring bins and lists a pair when its
-// surface gap is below the skin, |x_i - x_j| < r_i + r_j + skin:
+// Bins: a regular lattice over the rank's box widened by the interaction range, with bins
+// no smaller than that range (2 r_max + skin). Only the bins that hold particles exist:
+// each local particle and ghost carries the integer key of its bin, and the particles are
+// sorted by key, so memory and time are O(N) whatever the size of the domain — a heap of
+// particles in a 20 m domain costs what it costs in an 8 cm one (docs/performance.md,
+// benchmarks/neighbour_search/).
+//
+// Build: the caller first re-sorts local particles by bin (sort_permutation, ordered by
+// bin, then by global id within a bin) so that a bin's particles are contiguous in
+// memory. build() then scans each local particle's 27 neighbouring bins — nine rows of
+// three bins along x, each row a contiguous range of keys and so of sorted particles —
+// and lists a pair when its surface gap is below the skin, |x_i - x_j| < r_i + r_j + skin:
 //   - `local`: local-local pairs, each once (j > i), a half list;
 //   - `ghost`: local-ghost pairs, each once per local particle (the rank that owns
 //     the ghost lists the same pair from its side: forces are computed twice, once
 //     per owner, bit-identically — see dem/parallel/ghosts.hpp).
+// A particle's partners are listed bin by bin in key order (z, then y, then x), within a
+// bin in sorted order (locals) or exchange order (ghosts).
 // Periodicity is handled by ghosts (images), not here.
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "dem/core/particles.hpp"
@@ -48,25 +57,29 @@ struct NeighbourList {
 
 class BinGrid {
  public:
-  // Bins covering [lo, hi] with edges no smaller than bin_edge.
+  // The lattice of bins covering [lo, hi] with edges no smaller than bin_edge (at most
+  // 2^20 bins per axis, so that a key fits in 60 bits; larger bins are still correct).
   BinGrid(const Vec3& lo, const Vec3& hi, double bin_edge);
-  int bin_of(const Vec3& x) const;
-  // Permutation that orders local particles by bin (counting sort, stable); also
-  // sizes the grid for the current particle count.
+  // Key of the bin holding x: (k_z n_y + k_y) n_x + k_x, each k clamped to the lattice.
+  std::uint64_t key_of(const Vec3& x) const;
+  // Permutation that orders local particles by bin key, then by global id.
   std::vector<std::size_t> sort_permutation(const Particles& p);
   // Requires local particles sorted by bin (after applying sort_permutation).
   void build(const Particles& p, const Ghosts& g, double skin, NeighbourList& local,
-             NeighbourList& ghost) const;
-  const std::array<int, 3>& bins() const { return n_; }
+             NeighbourList& ghost);
+  const std::array<int, 3>& bins() const { return n_; }  // the lattice, per axis
+  // Bytes held by the grid between builds (its work arrays): O(particles + ghosts).
+  std::size_t memory_bytes() const;
 
  private:
-  void resize_for(std::size_t particles);
-
   Vec3 lo_, hi_;
-  double min_edge_;
   std::array<int, 3> n_{};
   Vec3 inv_edge_;
-  std::vector<int> bin_start_;  // size nbins+1, valid after sort_permutation
+  // Work arrays, kept between builds so that a rebuild does not allocate.
+  std::vector<std::uint64_t> key_, key_tmp_;
+  std::vector<int> order_, order_tmp_;
+  std::vector<std::uint64_t> ghost_key_;  // sorted
+  std::vector<int> ghost_order_;          // ghost indices by key, exchange order within a key
 };
 
 // Reference O(N^2) search with the same criterion (minimum image on periodic axes).

@@ -7,23 +7,62 @@
 
 namespace grainflow {
 
-std::array<int, 3> choose_processor_grid(int ranks, const Vec3& length) {
+std::array<int, 3> choose_processor_grid(int ranks, const Vec3& length, double min_box,
+                                         const std::optional<Vec3>& extent) {
+  const Vec3 e = extent.value_or(length);
   std::array<int, 3> best{ranks, 1, 1};
-  double best_area = std::numeric_limits<double>::infinity();
-  for (int nx = 1; nx <= ranks; ++nx) {
+  double best_area = 0;
+  bool found = false, best_fits = false;
+  // From the most ranks along x down: on equal areas the first grid met is kept.
+  for (int nx = ranks; nx >= 1; --nx) {
     if (ranks % nx) continue;
-    for (int ny = 1; ny <= ranks / nx; ++ny) {
+    for (int ny = ranks / nx; ny >= 1; --ny) {
       if ((ranks / nx) % ny) continue;
       const int nz = ranks / nx / ny;
-      const double area = (nx - 1) * length[1] * length[2] + (ny - 1) * length[0] * length[2] +
-                          (nz - 1) * length[0] * length[1];
-      if (area < best_area - 1e-12 * best_area) {
+      const std::array<int, 3> n{nx, ny, nz};
+      bool fits = true;
+      for (int a = 0; a < 3; ++a) fits = fits && (n[a] == 1 || length[a] / n[a] >= min_box);
+      const double area = (nx - 1) * e[1] * e[2] + (ny - 1) * e[0] * e[2] + (nz - 1) * e[0] * e[1];
+      // A grid whose boxes are thick enough beats any that is not; then the least area.
+      const bool better = !found || (fits && !best_fits) ||
+                          (fits == best_fits && area < best_area - 1e-12 * best_area);
+      if (better) {
+        found = true;
+        best_fits = fits;
         best_area = area;
-        best = {nx, ny, nz};
+        best = n;
       }
     }
   }
   return best;
+}
+
+std::vector<double> balanced_cut_planes(std::vector<double> x, double lo, double hi, int n,
+                                        double min_box) {
+  std::vector<double> cuts(n + 1);
+  for (int k = 0; k <= n; ++k) cuts[k] = lo + (hi - lo) * k / n;
+  cuts[n] = hi;
+  const std::size_t count = x.size();
+  if (count > 0) {
+    std::sort(x.begin(), x.end());
+    for (int k = 1; k < n; ++k) {
+      // Boxes 0 .. k-1 get the first count*k/n coordinates.
+      const std::size_t m = count * static_cast<std::size_t>(k) / static_cast<std::size_t>(n);
+      if (m == 0)
+        cuts[k] = lo;
+      else if (m == count)
+        cuts[k] = hi;
+      else
+        cuts[k] = 0.5 * (x[m - 1] + x[m]);
+      cuts[k] = std::clamp(cuts[k], lo, hi);
+    }
+  }
+  // No box thinner than min_box (a hair more, so that the thickness computed back from
+  // the planes is not below it by round-off): forward from lo, then back from hi.
+  const double t = min_box * (1 + 1e-9);
+  for (int k = 1; k < n; ++k) cuts[k] = std::max(cuts[k], cuts[k - 1] + t);
+  for (int k = n - 1; k >= 1; --k) cuts[k] = std::min(cuts[k], cuts[k + 1] - t);
+  return cuts;
 }
 
 Decomposition::Decomposition(MPI_Comm world, const Domain& domain, std::array<int, 3> dims)

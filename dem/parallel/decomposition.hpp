@@ -15,7 +15,7 @@ namespace grainflow {
 
 class Decomposition {
  public:
-  // dims: ranks per axis; {0,0,0} picks the grid with the least cut area.
+  // dims: ranks per axis; {0,0,0} picks choose_processor_grid's grid for the domain alone.
   Decomposition(MPI_Comm world, const Domain& domain, std::array<int, 3> dims = {0, 0, 0});
   ~Decomposition();
   Decomposition(const Decomposition&) = delete;
@@ -58,7 +58,20 @@ class Decomposition {
   Vec3 lo_, hi_;
 };
 
-// The processor grid nx*ny*nz = ranks with the least total cut area for this domain.
-std::array<int, 3> choose_processor_grid(int ranks, const Vec3& length);
+// The processor grid nx × ny × nz = ranks for a domain of size `length` (docs/parallel.md):
+// among the grids whose uniform boxes are at least `min_box` thick along every axis with
+// more than one rank (all grids when none is), the one with the least total cut area
+// through a region of size `extent` (where the particles are; the domain when absent):
+// (nx−1) E_y E_z + (ny−1) E_x E_z + (nz−1) E_x E_y. Equal areas (to 1e-12 relative) go
+// to the grid with more ranks along x, then along y.
+std::array<int, 3> choose_processor_grid(int ranks, const Vec3& length, double min_box = 0,
+                                         const std::optional<Vec3>& extent = std::nullopt);
+
+// The n+1 cut planes of one axis over [lo, hi] that put equal numbers of the coordinates
+// `x` into the n boxes (each plane midway between the two coordinates it separates), then
+// moved as little as needed so that no box is thinner than min_box (possible when
+// hi − lo ≥ n min_box). Without coordinates: uniform planes.
+std::vector<double> balanced_cut_planes(std::vector<double> x, double lo, double hi, int n,
+                                        double min_box);
 
 }  // namespace grainflow

@@ -89,6 +89,8 @@ struct MeshWall {
   double rotate_angle = 0;               // [rad] (degrees in the scene file)
   Vec3 translate = Vec3::Zero();
   Vec3 surface_velocity = Vec3::Zero();  // conveyor: tangential surface speed [m/s]
+  // Vertices closer than this times the bounding box's diagonal are one (stl_reader.hpp).
+  double weld_tolerance = 1e-5;
 };
 
 // Prescribed rigid motion of a wall (dem/walls/wall_motion.hpp): a point x0 of the

@@ -305,7 +305,7 @@ Wall parse_wall(const Field& item, const std::unordered_set<std::string>& names,
   if (const auto motion = m.find("motion")) w.motion = parse_wall_motion(*motion);
   if (w.kind == Wall::Kind::mesh) {
     m.allow_only({"type", "name", "file", "scale", "rotate", "translate", "surface_velocity",
-                  "material", "motion"},
+                  "weld_tolerance", "material", "motion"},
                  " (a mesh wall)");
     w.mesh.file = existing_file(m.get("file", "add `file: <mesh.stl>`"), "STL file");
     w.mesh.scale = m.number_or("scale", 1.0, kPositive);
@@ -316,6 +316,8 @@ Wall parse_wall(const Field& item, const std::unordered_set<std::string>& names,
     }
     w.mesh.translate = m.vec3_or("translate", Vec3::Zero());
     w.mesh.surface_velocity = m.vec3_or("surface_velocity", Vec3::Zero());
+    w.mesh.weld_tolerance =
+        m.number_or("weld_tolerance", w.mesh.weld_tolerance, Range{0, 0.01, true, true});
   } else if (w.kind == Wall::Kind::plane) {
     m.allow_only({"type", "name", "point", "normal", "material", "motion"}, " (a plane wall)");
     w.plane.point = m.vec3("point");

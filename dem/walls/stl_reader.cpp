@@ -160,6 +160,111 @@ struct BitsHash {
   }
 };
 
+// Points in cells of edge h (a hashed grid: only occupied cells are stored).
+class PointCells {
+ public:
+  explicit PointCells(double h) : inv_(1 / h) {}
+  std::array<std::int64_t, 3> cell(const Vec3& x) const {
+    return {static_cast<std::int64_t>(std::floor(x[0] * inv_)),
+            static_cast<std::int64_t>(std::floor(x[1] * inv_)),
+            static_cast<std::int64_t>(std::floor(x[2] * inv_))};
+  }
+  void add(const Vec3& x, int k) { cells_[key(cell(x))].push_back(k); }
+  // Calls f(k) for every point stored in the 27 cells around x.
+  template <class F>
+  void around(const Vec3& x, F&& f) const {
+    const auto c = cell(x);
+    for (std::int64_t dz = -1; dz <= 1; ++dz)
+      for (std::int64_t dy = -1; dy <= 1; ++dy)
+        for (std::int64_t dx = -1; dx <= 1; ++dx) {
+          const auto it = cells_.find(key({c[0] + dx, c[1] + dy, c[2] + dz}));
+          if (it != cells_.end())
+            for (int k : it->second) f(k);
+        }
+  }
+
+ private:
+  static std::array<std::uint64_t, 3> key(const std::array<std::int64_t, 3>& c) {
+    return {static_cast<std::uint64_t>(c[0]), static_cast<std::uint64_t>(c[1]),
+            static_cast<std::uint64_t>(c[2])};
+  }
+  double inv_;
+  std::unordered_map<std::array<std::uint64_t, 3>, std::vector<int>, BitsHash> cells_;
+};
+
+double diagonal_of(const std::vector<Vec3>& x) {
+  if (x.empty()) return 0;
+  Vec3 lo = x[0], hi = x[0];
+  for (const Vec3& v : x) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  return (hi - lo).norm();
+}
+
+// For each vertex, the kept vertex it joins (itself if kept): the first kept vertex, in
+// order, within `tol`. Counts the joined ones in `welded`.
+std::vector<int> weld(const std::vector<Vec3>& x, double tol, long& welded) {
+  std::vector<int> to(x.size());
+  for (std::size_t k = 0; k < x.size(); ++k) to[k] = static_cast<int>(k);
+  if (!(tol > 0)) return to;
+  PointCells cells(tol);
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    int into = -1;
+    cells.around(x[k], [&](int q) {
+      if ((into < 0 || q < into) && (x[q] - x[k]).norm() <= tol) into = q;
+    });
+    if (into >= 0) {
+      to[k] = into;
+      ++welded;
+    } else {
+      cells.add(x[k], static_cast<int>(k));
+    }
+  }
+  return to;
+}
+
+// Counts the edges of one triangle, and finds the closest two vertices on such edges that
+// share no triangle, if closer than 1e-3 of the diagonal (a seam the welding left open).
+void find_open_edges(const std::vector<Vec3>& x, const std::vector<std::array<int, 3>>& tris,
+                     StlReport& rep) {
+  std::unordered_map<std::uint64_t, int> uses;
+  auto edge = [](int a, int b) {
+    return static_cast<std::uint64_t>(std::min(a, b)) << 32 |
+           static_cast<std::uint32_t>(std::max(a, b));
+  };
+  for (const auto& t : tris)
+    for (int e = 0; e < 3; ++e) ++uses[edge(t[e], t[(e + 1) % 3])];
+  std::vector<char> on_rim(x.size(), 0);
+  for (const auto& [key, n] : uses)
+    if (n == 1) {
+      ++rep.open_edges;
+      on_rim[key >> 32] = on_rim[key & 0xffffffffu] = 1;
+    }
+  const double reach = 1e-3 * diagonal_of(x);
+  if (rep.open_edges == 0 || !(reach > 0)) return;
+  // Triangles around each rim vertex, to skip pairs of one triangle (a rim's own edges).
+  std::unordered_map<int, std::vector<int>> around;
+  for (std::size_t t = 0; t < tris.size(); ++t)
+    for (int v : tris[t])
+      if (on_rim[v]) around[v].push_back(static_cast<int>(t));
+  PointCells cells(reach);
+  double best = reach;
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    if (!on_rim[k]) continue;
+    cells.around(x[k], [&](int q) {
+      const double d = (x[q] - x[k]).norm();
+      if (d >= best) return;
+      for (int t : around[q])
+        if (std::find(around[k].begin(), around[k].end(), t) != around[k].end()) return;
+      best = d;
+      rep.seam_gap = d;
+      rep.seam_at = x[k];
+    });
+    cells.add(x[k], static_cast<int>(k));
+  }
+}
+
 }  // namespace
 
 Vec3 MeshTransform::apply(const Vec3& x) const {
@@ -167,7 +272,7 @@ Vec3 MeshTransform::apply(const Vec3& x) const {
 }
 
 TriangleMesh parse_stl(const std::string& bytes, const std::string& label,
-                       const MeshTransform& transform, StlReport* report) {
+                       const MeshTransform& transform, StlReport* report, double weld_tolerance) {
   std::uint32_t count = 0;
   const std::size_t first = bytes.find_first_not_of(" \t\r\n");
   std::vector<RawTriangle> raw;
@@ -197,23 +302,38 @@ TriangleMesh parse_stl(const std::string& bytes, const std::string& label,
   }
   rep.facets_read = static_cast<long>(raw.size());
 
-  // Weld vertices that are bit-identical in the file, then place them.
+  // Vertices that are bit-identical in the file are one vertex; then the welding of
+  // near-coincident ones (stl_reader.hpp), then the placement.
   std::unordered_map<std::array<std::uint64_t, 3>, int, BitsHash> index;
-  std::vector<Vec3> verts;
-  std::vector<std::array<int, 3>> tris;
-  for (const RawTriangle& t : raw) {
-    std::array<int, 3> ids;
+  std::vector<Vec3> unique;
+  std::vector<std::array<int, 3>> raw_ids(raw.size());
+  for (std::size_t t = 0; t < raw.size(); ++t)
     for (int k = 0; k < 3; ++k) {
       std::array<std::uint64_t, 3> key;
       for (int a = 0; a < 3; ++a) {
-        const double c = t.v[k][a] == 0 ? 0.0 : t.v[k][a];  // -0 welds with +0
+        const double c = raw[t].v[k][a] == 0 ? 0.0 : raw[t].v[k][a];  // -0 welds with +0
         std::memcpy(&key[a], &c, 8);
       }
-      const auto [it, fresh] = index.emplace(key, static_cast<int>(verts.size()));
-      if (fresh) verts.push_back(t.v[k]);
-      ids[k] = it->second;
+      const auto [it, fresh] = index.emplace(key, static_cast<int>(unique.size()));
+      if (fresh) unique.push_back(raw[t].v[k]);
+      raw_ids[t][k] = it->second;
     }
-    const Vec3 ab = t.v[1] - t.v[0], ac = t.v[2] - t.v[0], bc = t.v[2] - t.v[1];
+  decltype(index)().swap(index);
+  const double diagonal = diagonal_of(unique);
+  const std::vector<int> into = weld(unique, weld_tolerance * diagonal, rep.welded);
+  std::vector<int> number(unique.size(), -1);  // kept vertices, numbered in order
+  std::vector<Vec3> verts;
+  for (std::size_t k = 0; k < unique.size(); ++k)
+    if (into[k] == static_cast<int>(k)) {
+      number[k] = static_cast<int>(verts.size());
+      verts.push_back(unique[k]);
+    }
+  std::vector<std::array<int, 3>> tris;
+  for (std::size_t t = 0; t < raw.size(); ++t) {
+    std::array<int, 3> ids;
+    for (int k = 0; k < 3; ++k) ids[k] = number[into[raw_ids[t][k]]];
+    const Vec3 a = verts[ids[0]], b = verts[ids[1]], c = verts[ids[2]];
+    const Vec3 ab = b - a, ac = c - a, bc = c - b;
     const double longest2 = std::max({ab.squaredNorm(), ac.squaredNorm(), bc.squaredNorm()});
     if (ids[0] == ids[1] || ids[1] == ids[2] || ids[0] == ids[2] ||
         ab.cross(ac).norm() <= 1e-12 * longest2) {
@@ -235,18 +355,21 @@ TriangleMesh parse_stl(const std::string& bytes, const std::string& label,
                           ") moves a vertex to a non-finite position; use a smaller scale");
     }
   }
+  rep.diagonal = diagonal * transform.scale;
+  rep.weld_distance = weld_tolerance * rep.diagonal;
+  find_open_edges(verts, tris, rep);
   rep.vertices = static_cast<long>(verts.size());
   if (report) *report = rep;
   return TriangleMesh(std::move(verts), std::move(tris));
 }
 
-TriangleMesh read_stl(const std::string& path, const MeshTransform& transform,
-                      StlReport* report) {
+TriangleMesh read_stl(const std::string& path, const MeshTransform& transform, StlReport* report,
+                      double weld_tolerance) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw GeometryError(path + ": error: cannot open the STL file");
   std::ostringstream s;
   s << in.rdbuf();
-  return parse_stl(s.str(), path, transform, report);
+  return parse_stl(s.str(), path, transform, report, weld_tolerance);
 }
 
 void write_ascii_stl(const std::string& path, const std::vector<Vec3>& vertices,

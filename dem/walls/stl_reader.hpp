@@ -19,8 +19,16 @@
 // collinear to round-off) are dropped. Facet normals in the file are ignored: a
 // mesh wall is two-sided and normals are recomputed from the vertices.
 //
-// Vertices with bit-identical coordinates in the file are welded into one, which
-// is what lets the contact rule see shared edges and vertices.
+// Welding: vertices closer than a tolerance relative to the mesh's size
+// (`weld_tolerance` times the diagonal of the file's bounding box; default 1e-5) are one
+// vertex, which is what lets the contact rule see shared edges and vertices (two
+// triangles whose common edge is 1e-7 m apart in a CAD export are otherwise two contacts
+// for a sphere on that edge). Each vertex, in file order, joins the first kept vertex
+// within the tolerance, else is kept; triangles that welding collapses are dropped as
+// degenerate. Bit-identical vertices are one vertex whatever the tolerance. After welding,
+// edges of exactly one triangle are counted as open: the rim of an open surface, or a seam
+// wider than the tolerance; two open-edge vertices of no common triangle closer than 1e-3
+// of the diagonal are reported as a likely seam, with the tolerance that would weld them.
 #include <stdexcept>
 #include <string>
 
@@ -44,19 +52,33 @@ struct MeshTransform {
   Vec3 apply(const Vec3& x) const;
 };
 
+// Default weld tolerance, relative to the diagonal of the mesh's bounding box.
+constexpr double kDefaultWeldTolerance = 1e-5;
+
 struct StlReport {
   bool binary = false;
   long facets_read = 0;
   long degenerate_removed = 0;  // counted repairs
   long vertices = 0;            // after welding
+  long welded = 0;              // vertices joined to another that was not bit-identical
+  double weld_distance = 0;     // the tolerance in metres, after the placement's scale
+  long open_edges = 0;          // edges of one triangle only, after welding
+  // The closest two open-edge vertices that share no triangle, if closer than 1e-3 of the
+  // diagonal (a likely seam): their distance in metres (placed), and a point (placed); -1
+  // when there is none.
+  double seam_gap = -1;
+  Vec3 seam_at = Vec3::Zero();
+  double diagonal = 0;  // of the placed mesh's bounding box, m
 };
 
+// weld_tolerance: relative to the bounding box's diagonal (0: bit-identical vertices only).
 TriangleMesh read_stl(const std::string& path, const MeshTransform& transform = {},
-                      StlReport* report = nullptr);
+                      StlReport* report = nullptr, double weld_tolerance = kDefaultWeldTolerance);
 
 // The same from the file's bytes; `label` names it in messages.
 TriangleMesh parse_stl(const std::string& bytes, const std::string& label,
-                       const MeshTransform& transform = {}, StlReport* report = nullptr);
+                       const MeshTransform& transform = {}, StlReport* report = nullptr,
+                       double weld_tolerance = kDefaultWeldTolerance);
 
 // Writes an ASCII STL (for tests, benchmarks and tutorials that generate meshes).
 void write_ascii_stl(const std::string& path, const std::vector<Vec3>& vertices,

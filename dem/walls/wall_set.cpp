@@ -31,7 +31,7 @@ WallSet::WallSet(const Scene& scene) {
       t.rotation_angle = w.mesh.rotate_angle;
       t.translation = w.mesh.translate;
       StlReport rep;
-      TriangleMesh m = read_stl(w.mesh.file, t, &rep);
+      TriangleMesh m = read_stl(w.mesh.file, t, &rep, w.mesh.weld_tolerance);
       // Cells of one particle diameter: a query visits at most 8 small cells, each
       // holding only the few triangles that pass near it. Without a known radius
       // (CSV or snapshot particles only), cells of the mean triangle edge.
@@ -42,7 +42,22 @@ WallSet::WallSet(const Scene& scene) {
            << " STL " << w.mesh.file;
       if (rep.degenerate_removed > 0)
         note << " (" << rep.degenerate_removed << " degenerate triangles removed)";
+      note << "; " << rep.welded << " vertices welded (closer than " << rep.weld_distance
+           << " m = " << w.mesh.weld_tolerance << " of the diagonal)";
+      if (rep.open_edges > 0)
+        note << "; " << rep.open_edges
+             << " open edges (of one triangle: the rim of an open surface, or seams)";
       notes_.push_back(note.str());
+      if (rep.seam_gap >= 0) {
+        std::ostringstream warn;
+        warn << "warning: wall '" << w.name << "' (" << w.mesh.file
+             << "): two open-edge vertices of no common triangle are " << rep.seam_gap
+             << " m apart near (" << rep.seam_at[0] << ", " << rep.seam_at[1] << ", "
+             << rep.seam_at[2] << "): a seam that welding left open (a sphere on it feels two "
+             << "contacts). If they are one point, set `weld_tolerance` above "
+             << rep.seam_gap / rep.diagonal << " (now " << w.mesh.weld_tolerance << ")";
+        notes_.push_back(warn.str());
+      }
       e.mesh = static_cast<int>(meshes_.size());
       e.surface_velocity = w.mesh.surface_velocity;
       meshes_.push_back(std::move(m));

@@ -51,6 +51,26 @@ inline MeshData box(const Vec3& lo, const Vec3& hi) {
   return m;
 }
 
+// `m` with the triangles right of the line x = x_seam given their own copies of the
+// vertices on that line, moved by `offset`: the near-miss seam of a CAD export.
+inline MeshData split_at(const MeshData& m, double x_seam, const Vec3& offset) {
+  MeshData out = m;
+  std::vector<int> copy(m.v.size(), -1);
+  for (auto& t : out.t) {
+    const double xc = (m.v[t[0]][0] + m.v[t[1]][0] + m.v[t[2]][0]) / 3;
+    if (xc <= x_seam) continue;
+    for (int& k : t) {
+      if (m.v[k][0] != x_seam) continue;
+      if (copy[k] < 0) {
+        copy[k] = static_cast<int>(out.v.size());
+        out.v.push_back(m.v[k] + offset);
+      }
+      k = copy[k];
+    }
+  }
+  return out;
+}
+
 inline std::string write_mesh(const MeshData& m, const std::string& name) {
   const std::filesystem::path dir =
       std::filesystem::path(GRAINFLOW_BINARY_DIR) / "test_output" / "walls";

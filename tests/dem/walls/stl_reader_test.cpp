@@ -14,6 +14,7 @@
 #include "dem/scene/scene_parser.hpp"
 #include "dem/walls/stl_reader.hpp"
 #include "dem/walls/wall_set.hpp"
+#include "tests/dem/walls/mesh_support.hpp"
 
 namespace grainflow {
 namespace {
@@ -245,6 +246,72 @@ walls: [{type: mesh, name: floor, file: d.stl, material: glass}]
   ASSERT_EQ(walls.notes().size(), 1u);
   EXPECT_THAT(walls.notes()[0], HasSubstr("wall 'floor': 2 triangles, 4 vertices from binary STL"));
   EXPECT_THAT(walls.notes()[0], HasSubstr("(1 degenerate triangles removed)"));
+}
+
+// The near-miss seam of issue 18: a 4 x 4 flat grid (16 mm, 32 triangles, 25 vertices)
+// whose right half has its own 5 vertices on the line x = 0, 1e-7 m off. Welded with the
+// default tolerance (1e-5 of the 22.6 mm diagonal = 2.3e-7 m): 5 vertices welded, 25 left,
+// and the 16 rim edges are the only open ones. With weld_tolerance 0: 30 vertices, the 4 + 4
+// seam edges open too, and the seam is reported 1e-7 m wide. Reference: counted by hand.
+TEST(StlReader, NearMissVerticesAreWeldedAndCounted) {
+  const test::MeshData seam =
+      test::split_at(test::flat_grid(4, 0.004, -0.008, -0.008, 0), 0.0, Vec3(0.6e-7, 0, 0.8e-7));
+  const std::string path = test::write_mesh(seam, "seam_report.stl");
+  StlReport rep;
+  const TriangleMesh welded = read_stl(path, {}, &rep);
+  EXPECT_EQ(welded.vertex_count(), 25u);
+  EXPECT_EQ(welded.triangle_count(), 32u);
+  EXPECT_EQ(rep.welded, 5);
+  EXPECT_EQ(rep.open_edges, 16);
+  EXPECT_EQ(rep.seam_gap, -1);
+  EXPECT_NEAR(rep.weld_distance, 1e-5 * std::sqrt(2.0) * 0.016, 1e-12);
+  // Placement scales the stated distance with the mesh.
+  MeshTransform mm;
+  mm.scale = 1000;
+  StlReport scaled;
+  read_stl(path, mm, &scaled);
+  EXPECT_EQ(scaled.welded, 5);
+  EXPECT_NEAR(scaled.weld_distance, 1000 * rep.weld_distance, 1e-9);
+
+  StlReport open;
+  const TriangleMesh apart = read_stl(path, {}, &open, 0.0);
+  EXPECT_EQ(apart.vertex_count(), 30u);
+  EXPECT_EQ(open.welded, 0);
+  EXPECT_EQ(open.open_edges, 24);
+  EXPECT_NEAR(open.seam_gap, 1e-7, 1e-12);
+  EXPECT_NEAR(open.seam_at[0], 0, 1e-6);
+}
+
+// The wall's start-up note states the tolerance and the count, and a seam left open is a
+// warning that names the tolerance that would close it.
+TEST(StlReader, WeldingIsReportedForTheWall) {
+  const test::MeshData seam =
+      test::split_at(test::flat_grid(4, 0.004, -0.008, -0.008, 0), 0.0, Vec3(0.6e-7, 0, 0.8e-7));
+  const std::string path = test::write_mesh(seam, "seam_note.stl");
+  auto notes = [&](const std::string& extra) {
+    const Scene scene = parse_scene(R"(domain: {min: [-1, -1, -1], max: [2, 2, 2]}
+time: {step: 1.0e-5, end: 0.01}
+materials: [{name: glass, youngs_modulus: 1.0e7, poisson_ratio: 0.3, density: 2500}]
+interaction_defaults: {restitution: 0.5}
+contact: {normal: hertz}
+walls: [{type: mesh, name: plate, file: ')" +
+                                        path + "', material: glass" + extra + R"(}]
+)",
+                                    "scene.yaml");
+    return WallSet(scene).notes();
+  };
+  const auto welded = notes("");
+  ASSERT_EQ(welded.size(), 1u);
+  EXPECT_THAT(welded[0], HasSubstr("32 triangles, 25 vertices"));
+  EXPECT_THAT(welded[0], HasSubstr("5 vertices welded (closer than 2.26274e-07 m = 1e-05 of "
+                                   "the diagonal)"));
+  EXPECT_THAT(welded[0], HasSubstr("16 open edges"));
+  const auto open = notes(", weld_tolerance: 0");
+  ASSERT_EQ(open.size(), 2u);
+  EXPECT_THAT(open[0], HasSubstr("0 vertices welded"));
+  EXPECT_THAT(open[1], HasSubstr("warning: wall 'plate'"));
+  EXPECT_THAT(open[1], HasSubstr("1e-07 m apart"));
+  EXPECT_THAT(open[1], HasSubstr("set `weld_tolerance` above 4.41942e-06"));
 }
 
 // A mesh whose triangles each span the whole bounding box (100 slanted triangles across
