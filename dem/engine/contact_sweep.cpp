@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "dem/engine/canonical_sum.hpp"
 #include "dem/engine/wall_sweep.hpp"
 
 namespace grainflow {
@@ -153,7 +154,16 @@ inline void keep_or_zero(bool keep, Vec3& h) {
     h[a] = std::bit_cast<double>(std::bit_cast<std::uint64_t>(h[a]) & mask);
 }
 
-template <class Law>
+// With Canonical (parallel.reproducible), the pair sweeps put each touching contact's two
+// shares in s.canonical (canonical_sum.hpp) instead of adding them to the particles: entry e
+// of this sweep's touching contacts gets record `t` (its rank among them, counted over the
+// local list, then the ghost list), the others the record of zeros.
+inline void put_shares(CanonicalSum& sum, int t, const ContactResult& r) {
+  sum.shares[2 * t] = {r.force, r.torque_i};
+  sum.shares[2 * t + 1] = {-r.force, r.torque_j};
+}
+
+template <class Law, bool Canonical>
 void local_pair_sweep(ContactSweep& s) {
   Particles& p = s.p;
   const int n = static_cast<int>(p.size());
@@ -186,12 +196,19 @@ void local_pair_sweep(ContactSweep& s) {
   };
   const auto body = [&](int q) { return Body<double>{v[q], w[q], radius[q], mass[q], inertia[q]}; };
   // The contact's forces and torques on both bodies, its count and the overlap guard.
-  const auto apply = [&](const Pair& c, const ContactResult& r, double overlap) {
-    force[c.a] += r.force;
-    force[c.b] -= r.force;
-    if constexpr (Law::needs_spin) {
-      torque[c.a] += r.torque_i;
-      torque[c.b] += r.torque_j;
+  [[maybe_unused]] int* slot = Canonical ? s.canonical->slot.data() : nullptr;
+  [[maybe_unused]] int touched = 0;  // touching entries before this batch (Canonical)
+  const auto apply = [&](const Pair& c, const ContactResult& r, double overlap,
+                         [[maybe_unused]] int t) {
+    if constexpr (Canonical) {
+      put_shares(*s.canonical, touched + t, r);
+    } else {
+      force[c.a] += r.force;
+      force[c.b] -= r.force;
+      if constexpr (Law::needs_spin) {
+        torque[c.a] += r.torque_i;
+        torque[c.b] += r.torque_j;
+      }
     }
     ++s.contacts;
     // The guard's details are gathered only for a new largest overlap (rare).
@@ -259,7 +276,7 @@ void local_pair_sweep(ContactSweep& s) {
         if (c + l == m) break;
         if constexpr (Law::keeps_tangential) springs_t[group[l].k] = lane(ht, l);
         apply(group[l], ContactResult{lane(r.force, l), lane(r.torque_i, l), lane(r.torque_j, l)},
-              overlap[l]);
+              overlap[l], c + l);
       }
     }
   };
@@ -280,7 +297,7 @@ void local_pair_sweep(ContactSweep& s) {
         const ContactResult r = pair_force<Law>(
             s, Vec3(x[p0.a] - x[p0.b]), a, b, reduced_radius(a, b), reduced_mass(a, b),
             s.table(material[p0.a], material[p0.b]), ht, hr, overlap);
-        apply(p0, r, overlap);
+        apply(p0, r, overlap, c);
       }
     }
   };
@@ -295,15 +312,18 @@ void local_pair_sweep(ContactSweep& s) {
       const int i = owner[k], j = partner[k];
       const bool touching = !apart(x[i] - x[j], radius[i] + radius[j]);
       batch[m] = {i, k};
+      if constexpr (Canonical) slot[k] = touching ? touched + m : s.canonical->none;
       m += touching;
       if constexpr (Law::keeps_tangential) keep_or_zero(touching, springs_t[k]);
       if constexpr (Law::keeps_rolling) keep_or_zero(touching, springs_r[k]);
     }
     evaluate(m);
+    if constexpr (Canonical) touched += m;
   }
+  if constexpr (Canonical) s.canonical_touching = touched;
 }
 
-template <class Law>
+template <class Law, bool Canonical>
 void ghost_pair_sweep(ContactSweep& s) {
   Particles& p = s.p;
   const Ghosts& g = s.ghosts;
@@ -355,10 +375,19 @@ void ghost_pair_sweep(ContactSweep& s) {
     return c.local_first ? s.table(material[c.i], g_material[c.q])
                          : s.table(g_material[c.q], material[c.i]);
   };
-  const auto apply = [&](const Pair& c, const ContactResult& r, double overlap) {
+  // Canonical: the ghost list's entries and records follow the local list's.
+  [[maybe_unused]] int* slot =
+      Canonical ? s.canonical->slot.data() + s.canonical->ghost_base : nullptr;
+  [[maybe_unused]] int touched = Canonical ? s.canonical_touching : 0;
+  const auto apply = [&](const Pair& c, const ContactResult& r, double overlap,
+                         [[maybe_unused]] int t) {
     const int i = c.i, q = c.q;
-    force[i] += c.local_first ? r.force : Vec3(-r.force);
-    if constexpr (Law::needs_spin) torque[i] += c.local_first ? r.torque_i : r.torque_j;
+    if constexpr (Canonical) {
+      put_shares(*s.canonical, touched + t, r);
+    } else {
+      force[i] += c.local_first ? r.force : Vec3(-r.force);
+      if constexpr (Law::needs_spin) torque[i] += c.local_first ? r.torque_i : r.torque_j;
+    }
     // Both owners see this contact; the owner of the lower id counts it.
     if (c.local_first) ++s.contacts;
     const double min_r = std::min(radius[i], g_radius[q]);
@@ -403,7 +432,7 @@ void ghost_pair_sweep(ContactSweep& s) {
           if (c + l == m) break;
           if constexpr (Law::keeps_tangential) springs_t[group[l].k] = lane(ht, l);
           apply(group[l], ContactResult{lane(r.force, l), lane(r.torque_i, l), lane(r.torque_j, l)},
-                overlap[l]);
+                overlap[l], c + l);
         }
       }
     } else {
@@ -416,7 +445,7 @@ void ghost_pair_sweep(ContactSweep& s) {
         const ContactResult r =
             pair_force<Law>(s, p0.d, p0.first, p0.second, reduced_radius(p0.first, p0.second),
                             reduced_mass(p0.first, p0.second), table(p0), ht, hr, overlap);
-        apply(p0, r, overlap);
+        apply(p0, r, overlap, c);
       }
     }
   };
@@ -428,24 +457,29 @@ void ghost_pair_sweep(ContactSweep& s) {
       const int i = owner[k], q = partner[k];
       const bool touching = !apart((x[i] - g_x[q]) + (zero - g_shift[q]), radius[i] + g_radius[q]);
       batch[m] = {i, k};
+      if constexpr (Canonical) slot[k] = touching ? touched + m : s.canonical->none;
       m += touching;
       if constexpr (Law::keeps_tangential) keep_or_zero(touching, springs_t[k]);
       if constexpr (Law::keeps_rolling) keep_or_zero(touching, springs_r[k]);
     }
     evaluate(m);
+    if constexpr (Canonical) touched += m;
   }
 }
 
-template <class Law>
+// Pairs, then walls. With Canonical the pairs' shares are added in canonical order before
+// the walls (in wall order) add theirs.
+template <class Law, bool Canonical>
 void sweep(ContactSweep& s) {
-  local_pair_sweep<Law>(s);
-  ghost_pair_sweep<Law>(s);
+  local_pair_sweep<Law, Canonical>(s);
+  ghost_pair_sweep<Law, Canonical>(s);
+  if constexpr (Canonical) s.canonical->add_to(s.p, Law::needs_spin);
   wall_sweep<Law>(s);
 }
 
 template <class Law>
-SweepChoice choice() {
-  return {&sweep<Law>,
+SweepChoice choice(bool canonical) {
+  return {canonical ? &sweep<Law, true> : &sweep<Law, false>,
           Law::has_history,
           Law::keeps_tangential,
           Law::keeps_rolling,
@@ -456,30 +490,33 @@ SweepChoice choice() {
 
 // Expands the run-time slot choice into one compile-time combination, one slot at a time.
 template <class N, class T, class R>
-SweepChoice pick_cohesion(const ContactSettings& c) {
-  if (c.cohesion == CohesionModel::sjkr) return choice<ContactLaw<N, T, R, SjkrCohesion>>();
-  return choice<ContactLaw<N, T, R, NoCohesion>>();
+SweepChoice pick_cohesion(const ContactSettings& c, bool canonical) {
+  if (c.cohesion == CohesionModel::sjkr)
+    return choice<ContactLaw<N, T, R, SjkrCohesion>>(canonical);
+  return choice<ContactLaw<N, T, R, NoCohesion>>(canonical);
 }
 template <class N, class T>
-SweepChoice pick_rolling(const ContactSettings& c) {
+SweepChoice pick_rolling(const ContactSettings& c, bool canonical) {
   switch (c.rolling) {
-    case RollingModel::cdt: return pick_cohesion<N, T, CdtRolling>(c);
-    case RollingModel::epsd: return pick_cohesion<N, T, EpsdRolling>(c);
+    case RollingModel::cdt: return pick_cohesion<N, T, CdtRolling>(c, canonical);
+    case RollingModel::epsd: return pick_cohesion<N, T, EpsdRolling>(c, canonical);
     case RollingModel::none: break;
   }
-  return pick_cohesion<N, T, NoRolling>(c);
+  return pick_cohesion<N, T, NoRolling>(c, canonical);
 }
 template <class N>
-SweepChoice pick_tangential(const ContactSettings& c) {
-  if (c.tangential == TangentialModel::history) return pick_rolling<N, HistoryTangential>(c);
-  return pick_rolling<N, NoTangential>(c);
+SweepChoice pick_tangential(const ContactSettings& c, bool canonical) {
+  if (c.tangential == TangentialModel::history)
+    return pick_rolling<N, HistoryTangential>(c, canonical);
+  return pick_rolling<N, NoTangential>(c, canonical);
 }
 
 }  // namespace
 
-SweepChoice select_sweep(const ContactSettings& settings) {
-  if (settings.normal == NormalModel::hooke) return pick_tangential<HookeNormal>(settings);
-  return pick_tangential<HertzNormal>(settings);
+SweepChoice select_sweep(const ContactSettings& settings, bool canonical) {
+  if (settings.normal == NormalModel::hooke)
+    return pick_tangential<HookeNormal>(settings, canonical);
+  return pick_tangential<HertzNormal>(settings, canonical);
 }
 
 void steps_per_contact_sweep(ContactSweep& s) {
