@@ -11,9 +11,23 @@ void CanonicalSum::build(const Particles& p, const Ghosts& g, const NeighbourLis
   const int local_entries = static_cast<int>(local.pairs());
   const int entries = local_entries + static_cast<int>(ghost.pairs());
   ghost_base = local_entries;
-  none = entries;
+  // The ring: the t-th touching contact of a sweep is read, at the latest, when the chunk
+  // of its partner ends; until then fewer touching contacts than list entries of the chunks
+  // from the owner's to the partner's follow it.
+  const auto chunk_start = [&](int i) { return i / kChunk * kChunk; };
+  const auto chunk_end = [&](int i) { return std::min<int>(n, (i / kChunk + 1) * kChunk); };
+  const auto before = [&](int i) { return (n > 0 ? local.offsets[i] + ghost.offsets[i] : 0); };
+  int window = 1;
+  for (int k = 0; k < local_entries; ++k)
+    window = std::max(window, before(chunk_end(local.j[k])) - before(chunk_start(local.owner[k])));
+  for (int a = 0; a < static_cast<int>(n); a += kChunk)
+    window = std::max(window, before(chunk_end(a)) - before(a));
+  int ring = 1;
+  while (ring < window) ring *= 2;
+  mask = ring - 1;
+  none = ring;
   slot.assign(entries, none);
-  shares.assign(2 * static_cast<std::size_t>(entries) + 2, Share{Vec3::Zero(), Vec3::Zero()});
+  shares.assign(2 * static_cast<std::size_t>(ring) + 2, Share{Vec3::Zero(), Vec3::Zero()});
   // Each local entry is referenced by both its particles, each ghost entry by its local one.
   offsets_.assign(n + 1, 0);
   for (int k = 0; k < local_entries; ++k) {
@@ -44,18 +58,17 @@ void CanonicalSum::build(const Particles& p, const Ghosts& g, const NeighbourLis
     const int e = local_entries + static_cast<int>(k);
     keyed[fill[i]++] = {g.id[q], s[0], s[1], s[2], 2 * e + (p.id[i] < g.id[q] ? 0 : 1)};
   }
-  const auto before = [](const Keyed& a, const Keyed& b) {
+  const auto by_key = [](const Keyed& a, const Keyed& b) {
     return std::tie(a.partner, a.sx, a.sy, a.sz) < std::tie(b.partner, b.sx, b.sy, b.sz);
   };
   refs_.resize(keyed.size());
   for (std::size_t i = 0; i < n; ++i) {
-    std::sort(keyed.begin() + offsets_[i], keyed.begin() + offsets_[i + 1], before);
+    std::sort(keyed.begin() + offsets_[i], keyed.begin() + offsets_[i + 1], by_key);
     for (int r = offsets_[i]; r < offsets_[i + 1]; ++r) refs_[r] = keyed[r].ref;
   }
 }
 
-void CanonicalSum::add_to(Particles& p, bool spin) const {
-  const std::size_t n = p.size();
+void CanonicalSum::add_to(Particles& p, bool spin, int a, int b) const {
   const int* offsets = offsets_.data();
   const int* refs = refs_.data();
   const int* slots = slot.data();
@@ -65,7 +78,7 @@ void CanonicalSum::add_to(Particles& p, bool spin) const {
   // An entry that does not touch adds the zero share: x + 0 = x exactly (and a sum that
   // starts from a non-negative-zero value never becomes -0), so it changes no bit.
   const auto pass = [&]<bool Spin>() {
-    for (std::size_t i = 0; i < n; ++i) {
+    for (int i = a; i < b; ++i) {
       Vec3 f = force[i], t = torque[i];
       for (int r = offsets[i]; r < offsets[i + 1]; ++r) {
         const Share& c = s[2 * slots[refs[r] >> 1] + (refs[r] & 1)];

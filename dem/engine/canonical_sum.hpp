@@ -35,15 +35,21 @@ struct CanonicalSum {
   void build(const Particles& p, const Ghosts& g, const NeighbourList& local,
              const NeighbourList& ghost);
 
-  // Adds each local particle's shares of this sweep, in canonical order, to its force (and
-  // torque when `spin`).
-  void add_to(Particles& p, bool spin) const;
+  // Adds the shares of the local particles [a, b) of this sweep, in canonical order, to
+  // their force (and torque when `spin`).
+  void add_to(Particles& p, bool spin, int a, int b) const;
 
+  // The sweep runs over the owners kChunk at a time, and adds the chunk's sums right after
+  // it (contact_sweep.cpp). The shares then live in a ring of records that holds every
+  // touching contact between the first owner of a pair's chunk and the end of its partner's
+  // chunk (its size is set in build()), small enough to stay in cache.
+  static constexpr int kChunk = 256;
   // Filled by the pair sweeps: the record of entry e, slot[e] (shares 2 slot[e] and
   // 2 slot[e] + 1), or `none` (two zero shares) when the entry does not touch.
   std::vector<int> slot;
   std::vector<Share> shares;
-  int none = 0;        // the record of zeros: the number of entries
+  int mask = 0;        // ring size - 1 (a power of two minus 1)
+  int none = 0;        // the record of zeros: the ring size
   int ghost_base = 0;  // number of the first ghost-list entry (the local list's length)
 
  private:

@@ -155,16 +155,16 @@ inline void keep_or_zero(bool keep, Vec3& h) {
 }
 
 // With Canonical (parallel.reproducible), the pair sweeps put each touching contact's two
-// shares in s.canonical (canonical_sum.hpp) instead of adding them to the particles: entry e
-// of this sweep's touching contacts gets record `t` (its rank among them, counted over the
-// local list, then the ghost list), the others the record of zeros.
-inline void put_shares(CanonicalSum& sum, int t, const ContactResult& r) {
-  sum.shares[2 * t] = {r.force, r.torque_i};
-  sum.shares[2 * t + 1] = {-r.force, r.torque_j};
+// shares in s.canonical (canonical_sum.hpp) instead of adding them to the particles: the
+// t-th touching contact of the sweep gets record t & mask of the ring, an entry that does
+// not touch the record of zeros. The sweeps then run over the owners [a, b) only.
+inline void put_shares(CanonicalSum::Share* shares, int record, const ContactResult& r) {
+  shares[2 * record] = {r.force, r.torque_i};
+  shares[2 * record + 1] = {-r.force, r.torque_j};
 }
 
 template <class Law, bool Canonical>
-void local_pair_sweep(ContactSweep& s) {
+void local_pair_sweep(ContactSweep& s, int a_first, int a_end) {
   Particles& p = s.p;
   const int n = static_cast<int>(p.size());
   // The arrays' addresses, read once: through the vectors, every store of a force would
@@ -196,12 +196,16 @@ void local_pair_sweep(ContactSweep& s) {
   };
   const auto body = [&](int q) { return Body<double>{v[q], w[q], radius[q], mass[q], inertia[q]}; };
   // The contact's forces and torques on both bodies, its count and the overlap guard.
+  // Canonical: where the shares go (see put_shares).
   [[maybe_unused]] int* slot = Canonical ? s.canonical->slot.data() : nullptr;
-  [[maybe_unused]] int touched = 0;  // touching entries before this batch (Canonical)
+  [[maybe_unused]] CanonicalSum::Share* shares = Canonical ? s.canonical->shares.data() : nullptr;
+  [[maybe_unused]] const int mask = Canonical ? s.canonical->mask : 0;
+  [[maybe_unused]] const int none = Canonical ? s.canonical->none : 0;
+  [[maybe_unused]] int touched = Canonical ? s.canonical_touching : 0;  // before this batch
   const auto apply = [&](const Pair& c, const ContactResult& r, double overlap,
                          [[maybe_unused]] int t) {
     if constexpr (Canonical) {
-      put_shares(*s.canonical, touched + t, r);
+      put_shares(shares, (touched + t) & mask, r);
     } else {
       force[c.a] += r.force;
       force[c.b] -= r.force;
@@ -305,14 +309,14 @@ void local_pair_sweep(ContactSweep& s) {
   // of each group are evaluated before the next group is tested; one call site keeps the
   // kernel inlined.
   const int* owner = s.local_list.owner.data();
-  const int entries = n > 0 ? offsets[n] : 0;
-  for (int k = n > 0 ? offsets[0] : 0; k < entries;) {
+  const int entries = n > 0 ? offsets[a_end] : 0;
+  for (int k = n > 0 ? offsets[a_first] : 0; k < entries;) {
     int m = 0;
     for (const int stop = std::min(entries, k + kBatch); k < stop; ++k) {
       const int i = owner[k], j = partner[k];
       const bool touching = !apart(x[i] - x[j], radius[i] + radius[j]);
       batch[m] = {i, k};
-      if constexpr (Canonical) slot[k] = touching ? touched + m : s.canonical->none;
+      if constexpr (Canonical) slot[k] = touching ? (touched + m) & mask : none;
       m += touching;
       if constexpr (Law::keeps_tangential) keep_or_zero(touching, springs_t[k]);
       if constexpr (Law::keeps_rolling) keep_or_zero(touching, springs_r[k]);
@@ -324,7 +328,7 @@ void local_pair_sweep(ContactSweep& s) {
 }
 
 template <class Law, bool Canonical>
-void ghost_pair_sweep(ContactSweep& s) {
+void ghost_pair_sweep(ContactSweep& s, int a_first, int a_end) {
   Particles& p = s.p;
   const Ghosts& g = s.ghosts;
   const int n = static_cast<int>(p.size());
@@ -378,12 +382,15 @@ void ghost_pair_sweep(ContactSweep& s) {
   // Canonical: the ghost list's entries and records follow the local list's.
   [[maybe_unused]] int* slot =
       Canonical ? s.canonical->slot.data() + s.canonical->ghost_base : nullptr;
+  [[maybe_unused]] CanonicalSum::Share* shares = Canonical ? s.canonical->shares.data() : nullptr;
+  [[maybe_unused]] const int mask = Canonical ? s.canonical->mask : 0;
+  [[maybe_unused]] const int none = Canonical ? s.canonical->none : 0;
   [[maybe_unused]] int touched = Canonical ? s.canonical_touching : 0;
   const auto apply = [&](const Pair& c, const ContactResult& r, double overlap,
                          [[maybe_unused]] int t) {
     const int i = c.i, q = c.q;
     if constexpr (Canonical) {
-      put_shares(*s.canonical, touched + t, r);
+      put_shares(shares, (touched + t) & mask, r);
     } else {
       force[i] += c.local_first ? r.force : Vec3(-r.force);
       if constexpr (Law::needs_spin) torque[i] += c.local_first ? r.torque_i : r.torque_j;
@@ -450,14 +457,14 @@ void ghost_pair_sweep(ContactSweep& s) {
     }
   };
   const int* owner = s.ghost_list.owner.data();
-  const int entries = n > 0 ? offsets[n] : 0;
-  for (int k = n > 0 ? offsets[0] : 0; k < entries;) {
+  const int entries = n > 0 ? offsets[a_end] : 0;
+  for (int k = n > 0 ? offsets[a_first] : 0; k < entries;) {
     int m = 0;
     for (const int stop = std::min(entries, k + kBatch); k < stop; ++k) {
       const int i = owner[k], q = partner[k];
       const bool touching = !apart((x[i] - g_x[q]) + (zero - g_shift[q]), radius[i] + g_radius[q]);
       batch[m] = {i, k};
-      if constexpr (Canonical) slot[k] = touching ? touched + m : s.canonical->none;
+      if constexpr (Canonical) slot[k] = touching ? (touched + m) & mask : none;
       m += touching;
       if constexpr (Law::keeps_tangential) keep_or_zero(touching, springs_t[k]);
       if constexpr (Law::keeps_rolling) keep_or_zero(touching, springs_r[k]);
@@ -465,15 +472,29 @@ void ghost_pair_sweep(ContactSweep& s) {
     evaluate(m);
     if constexpr (Canonical) touched += m;
   }
+  if constexpr (Canonical) s.canonical_touching = touched;
 }
 
 // Pairs, then walls. With Canonical the pairs' shares are added in canonical order before
 // the walls (in wall order) add theirs.
+// The canonical sweep goes over the owners a chunk at a time: a particle's local-list shares
+// come from owners up to itself (a half list, j > i) and its ghost-list shares from itself,
+// so its sum is complete after its chunk, while the shares are still in cache.
 template <class Law, bool Canonical>
 void sweep(ContactSweep& s) {
-  local_pair_sweep<Law, Canonical>(s);
-  ghost_pair_sweep<Law, Canonical>(s);
-  if constexpr (Canonical) s.canonical->add_to(s.p, Law::needs_spin);
+  const int n = static_cast<int>(s.p.size());
+  if constexpr (Canonical) {
+    s.canonical_touching = 0;
+    for (int a = 0; a < n; a += CanonicalSum::kChunk) {
+      const int b = std::min(n, a + CanonicalSum::kChunk);
+      local_pair_sweep<Law, true>(s, a, b);
+      ghost_pair_sweep<Law, true>(s, a, b);
+      s.canonical->add_to(s.p, Law::needs_spin, a, b);
+    }
+  } else {
+    local_pair_sweep<Law, false>(s, 0, n);
+    ghost_pair_sweep<Law, false>(s, 0, n);
+  }
   wall_sweep<Law>(s);
 }
 
