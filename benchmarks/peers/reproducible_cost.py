@@ -6,8 +6,9 @@
 grain alone (no peer): the bed of compare_liggghts.py (30 720 spheres, settled once and cached
 in --work) runs its timed steps with the mode off and on, side by side in each round (off, on,
 off, on, ...). Prints each run's particle-steps/s (grain's own loop timer) and, per rank count,
-the median over the rounds of the ratio on/off within a round, and checks that the two modes
-end with the same bed (they differ only in summation order: round-off).
+the median over the rounds of the ratio on/off within a round (of the loop's wall time, and of
+the process's CPU time, less sensitive to other jobs on the machine), and the two modes' final
+beds (they differ only in summation order: round-off).
 """
 import argparse
 import os
@@ -60,8 +61,10 @@ def main():
     for n in args.ranks:
         off, on = results[("off", n)], results[("on", n)]
         ratios = [b["loop"] / a["loop"] for a, b in zip(off, on)]
+        cpu = [b["cpu"] / a["cpu"] for a, b in zip(off, on)]
         print(f"{n} rank(s): loop time on/off per round " + ", ".join(f"{x:.3f}" for x in ratios)
               + f"; median {statistics.median(ratios):.3f} (+{100 * (statistics.median(ratios) - 1):.1f} %); "
+              f"CPU time of the process (start-up included) on/off: median {statistics.median(cpu):.3f}; "
               f"peak RSS on/off {statistics.median(b['rss_kb'] for b in on) / statistics.median(a['rss_kb'] for a in off):.3f}")
         dh = abs(on[0]["height"] / off[0]["height"] - 1)
         print(f"  same bed: height differs by {dh:.1e} (relative), kinetic energy "

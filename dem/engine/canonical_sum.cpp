@@ -27,7 +27,8 @@ void CanonicalSum::build(const Particles& p, const Ghosts& g, const NeighbourLis
   mask = ring - 1;
   none = ring;
   slot.assign(entries, none);
-  shares.assign(2 * static_cast<std::size_t>(ring) + 2, Share{Vec3::Zero(), Vec3::Zero()});
+  shares.assign(static_cast<std::size_t>(ring) + 1,
+                Share{Vec3::Zero(), {Vec3::Zero(), Vec3::Zero()}});
   // Each local entry is referenced by both its particles, each ghost entry by its local one.
   offsets_.assign(n + 1, 0);
   for (int k = 0; k < local_entries; ++k) {
@@ -81,9 +82,10 @@ void CanonicalSum::add_to(Particles& p, bool spin, int a, int b) const {
     for (int i = a; i < b; ++i) {
       Vec3 f = force[i], t = torque[i];
       for (int r = offsets[i]; r < offsets[i + 1]; ++r) {
-        const Share& c = s[2 * slots[refs[r] >> 1] + (refs[r] & 1)];
-        f += c.force;
-        if constexpr (Spin) t += c.torque;
+        const int side = refs[r] & 1;
+        const Share& c = s[slots[refs[r] >> 1]];
+        f += static_cast<double>(1 - 2 * side) * c.force;  // -F exactly on side 1
+        if constexpr (Spin) t += c.torque[side];
       }
       force[i] = f;
       if constexpr (Spin) torque[i] = t;

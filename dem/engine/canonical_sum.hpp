@@ -23,9 +23,11 @@
 namespace grainflow {
 
 struct CanonicalSum {
-  // One contact's force and torque on one of its particles.
+  // One contact's force on its first particle (the second gets -force) and its torques on
+  // both.
   struct Share {
-    Vec3 force, torque;
+    Vec3 force;
+    Vec3 torque[2];
   };
 
   // Sets the order of every local particle's list entries, after a neighbour rebuild:
@@ -44,8 +46,8 @@ struct CanonicalSum {
   // touching contact between the first owner of a pair's chunk and the end of its partner's
   // chunk (its size is set in build()), small enough to stay in cache.
   static constexpr int kChunk = 256;
-  // Filled by the pair sweeps: the record of entry e, slot[e] (shares 2 slot[e] and
-  // 2 slot[e] + 1), or `none` (two zero shares) when the entry does not touch.
+  // Filled by the pair sweeps: the record of entry e, slot[e], or `none` (zeros) when the
+  // entry does not touch.
   std::vector<int> slot;
   std::vector<Share> shares;
   int mask = 0;        // ring size - 1 (a power of two minus 1)

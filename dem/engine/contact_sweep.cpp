@@ -159,8 +159,7 @@ inline void keep_or_zero(bool keep, Vec3& h) {
 // t-th touching contact of the sweep gets record t & mask of the ring, an entry that does
 // not touch the record of zeros. The sweeps then run over the owners [a, b) only.
 inline void put_shares(CanonicalSum::Share* shares, int record, const ContactResult& r) {
-  shares[2 * record] = {r.force, r.torque_i};
-  shares[2 * record + 1] = {-r.force, r.torque_j};
+  shares[record] = {r.force, {r.torque_i, r.torque_j}};
 }
 
 template <class Law, bool Canonical>

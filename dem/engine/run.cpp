@@ -48,6 +48,9 @@ void print_report(const Simulation& sim, MPI_Comm comm, std::ostream& out) {
   if (d.size() > 1)
     o << "MPI ranks: " << d.size() << " as a " << d.dims()[0] << " x " << d.dims()[1] << " x "
       << d.dims()[2] << " grid\n";
+  if (sim.scene().parallel.reproducible)
+    o << "force sums: canonical order (parallel.reproducible): results bit-identical on any "
+         "number of ranks\n";
   for (const std::string& note : sim.time_step_report().notes) o << note << "\n";
   for (const std::string& note : sim.walls().notes()) o << note << "\n";  // meshes read
 }
