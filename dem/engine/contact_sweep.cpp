@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "dem/engine/canonical_sum.hpp"
 #include "dem/engine/wall_sweep.hpp"
 
 namespace grainflow {
@@ -153,8 +154,16 @@ inline void keep_or_zero(bool keep, Vec3& h) {
     h[a] = std::bit_cast<double>(std::bit_cast<std::uint64_t>(h[a]) & mask);
 }
 
-template <class Law>
-void local_pair_sweep(ContactSweep& s) {
+// With Canonical (parallel.reproducible), the pair sweeps put each touching contact's two
+// shares in s.canonical (canonical_sum.hpp) instead of adding them to the particles: the
+// t-th touching contact of the sweep gets record t & mask of the ring, an entry that does
+// not touch the record of zeros. The sweeps then run over the owners [a, b) only.
+inline void put_shares(CanonicalSum::Share* shares, int record, const ContactResult& r) {
+  shares[record] = {r.force, {r.torque_i, r.torque_j}};
+}
+
+template <class Law, bool Canonical>
+void local_pair_sweep(ContactSweep& s, int a_first, int a_end) {
   Particles& p = s.p;
   const int n = static_cast<int>(p.size());
   // The arrays' addresses, read once: through the vectors, every store of a force would
@@ -186,12 +195,23 @@ void local_pair_sweep(ContactSweep& s) {
   };
   const auto body = [&](int q) { return Body<double>{v[q], w[q], radius[q], mass[q], inertia[q]}; };
   // The contact's forces and torques on both bodies, its count and the overlap guard.
-  const auto apply = [&](const Pair& c, const ContactResult& r, double overlap) {
-    force[c.a] += r.force;
-    force[c.b] -= r.force;
-    if constexpr (Law::needs_spin) {
-      torque[c.a] += r.torque_i;
-      torque[c.b] += r.torque_j;
+  // Canonical: where the shares go (see put_shares).
+  [[maybe_unused]] int* slot = Canonical ? s.canonical->slot.data() : nullptr;
+  [[maybe_unused]] CanonicalSum::Share* shares = Canonical ? s.canonical->shares.data() : nullptr;
+  [[maybe_unused]] const int mask = Canonical ? s.canonical->mask : 0;
+  [[maybe_unused]] const int none = Canonical ? s.canonical->none : 0;
+  [[maybe_unused]] int touched = Canonical ? s.canonical_touching : 0;  // before this batch
+  const auto apply = [&](const Pair& c, const ContactResult& r, double overlap,
+                         [[maybe_unused]] int t) {
+    if constexpr (Canonical) {
+      put_shares(shares, (touched + t) & mask, r);
+    } else {
+      force[c.a] += r.force;
+      force[c.b] -= r.force;
+      if constexpr (Law::needs_spin) {
+        torque[c.a] += r.torque_i;
+        torque[c.b] += r.torque_j;
+      }
     }
     ++s.contacts;
     // The guard's details are gathered only for a new largest overlap (rare).
@@ -259,7 +279,7 @@ void local_pair_sweep(ContactSweep& s) {
         if (c + l == m) break;
         if constexpr (Law::keeps_tangential) springs_t[group[l].k] = lane(ht, l);
         apply(group[l], ContactResult{lane(r.force, l), lane(r.torque_i, l), lane(r.torque_j, l)},
-              overlap[l]);
+              overlap[l], c + l);
       }
     }
   };
@@ -280,7 +300,7 @@ void local_pair_sweep(ContactSweep& s) {
         const ContactResult r = pair_force<Law>(
             s, Vec3(x[p0.a] - x[p0.b]), a, b, reduced_radius(a, b), reduced_mass(a, b),
             s.table(material[p0.a], material[p0.b]), ht, hr, overlap);
-        apply(p0, r, overlap);
+        apply(p0, r, overlap, c);
       }
     }
   };
@@ -288,23 +308,26 @@ void local_pair_sweep(ContactSweep& s) {
   // of each group are evaluated before the next group is tested; one call site keeps the
   // kernel inlined.
   const int* owner = s.local_list.owner.data();
-  const int entries = n > 0 ? offsets[n] : 0;
-  for (int k = n > 0 ? offsets[0] : 0; k < entries;) {
+  const int entries = n > 0 ? offsets[a_end] : 0;
+  for (int k = n > 0 ? offsets[a_first] : 0; k < entries;) {
     int m = 0;
     for (const int stop = std::min(entries, k + kBatch); k < stop; ++k) {
       const int i = owner[k], j = partner[k];
       const bool touching = !apart(x[i] - x[j], radius[i] + radius[j]);
       batch[m] = {i, k};
+      if constexpr (Canonical) slot[k] = touching ? (touched + m) & mask : none;
       m += touching;
       if constexpr (Law::keeps_tangential) keep_or_zero(touching, springs_t[k]);
       if constexpr (Law::keeps_rolling) keep_or_zero(touching, springs_r[k]);
     }
     evaluate(m);
+    if constexpr (Canonical) touched += m;
   }
+  if constexpr (Canonical) s.canonical_touching = touched;
 }
 
-template <class Law>
-void ghost_pair_sweep(ContactSweep& s) {
+template <class Law, bool Canonical>
+void ghost_pair_sweep(ContactSweep& s, int a_first, int a_end) {
   Particles& p = s.p;
   const Ghosts& g = s.ghosts;
   const int n = static_cast<int>(p.size());
@@ -355,10 +378,22 @@ void ghost_pair_sweep(ContactSweep& s) {
     return c.local_first ? s.table(material[c.i], g_material[c.q])
                          : s.table(g_material[c.q], material[c.i]);
   };
-  const auto apply = [&](const Pair& c, const ContactResult& r, double overlap) {
+  // Canonical: the ghost list's entries and records follow the local list's.
+  [[maybe_unused]] int* slot =
+      Canonical ? s.canonical->slot.data() + s.canonical->ghost_base : nullptr;
+  [[maybe_unused]] CanonicalSum::Share* shares = Canonical ? s.canonical->shares.data() : nullptr;
+  [[maybe_unused]] const int mask = Canonical ? s.canonical->mask : 0;
+  [[maybe_unused]] const int none = Canonical ? s.canonical->none : 0;
+  [[maybe_unused]] int touched = Canonical ? s.canonical_touching : 0;
+  const auto apply = [&](const Pair& c, const ContactResult& r, double overlap,
+                         [[maybe_unused]] int t) {
     const int i = c.i, q = c.q;
-    force[i] += c.local_first ? r.force : Vec3(-r.force);
-    if constexpr (Law::needs_spin) torque[i] += c.local_first ? r.torque_i : r.torque_j;
+    if constexpr (Canonical) {
+      put_shares(shares, (touched + t) & mask, r);
+    } else {
+      force[i] += c.local_first ? r.force : Vec3(-r.force);
+      if constexpr (Law::needs_spin) torque[i] += c.local_first ? r.torque_i : r.torque_j;
+    }
     // Both owners see this contact; the owner of the lower id counts it.
     if (c.local_first) ++s.contacts;
     const double min_r = std::min(radius[i], g_radius[q]);
@@ -403,7 +438,7 @@ void ghost_pair_sweep(ContactSweep& s) {
           if (c + l == m) break;
           if constexpr (Law::keeps_tangential) springs_t[group[l].k] = lane(ht, l);
           apply(group[l], ContactResult{lane(r.force, l), lane(r.torque_i, l), lane(r.torque_j, l)},
-                overlap[l]);
+                overlap[l], c + l);
         }
       }
     } else {
@@ -416,36 +451,55 @@ void ghost_pair_sweep(ContactSweep& s) {
         const ContactResult r =
             pair_force<Law>(s, p0.d, p0.first, p0.second, reduced_radius(p0.first, p0.second),
                             reduced_mass(p0.first, p0.second), table(p0), ht, hr, overlap);
-        apply(p0, r, overlap);
+        apply(p0, r, overlap, c);
       }
     }
   };
   const int* owner = s.ghost_list.owner.data();
-  const int entries = n > 0 ? offsets[n] : 0;
-  for (int k = n > 0 ? offsets[0] : 0; k < entries;) {
+  const int entries = n > 0 ? offsets[a_end] : 0;
+  for (int k = n > 0 ? offsets[a_first] : 0; k < entries;) {
     int m = 0;
     for (const int stop = std::min(entries, k + kBatch); k < stop; ++k) {
       const int i = owner[k], q = partner[k];
       const bool touching = !apart((x[i] - g_x[q]) + (zero - g_shift[q]), radius[i] + g_radius[q]);
       batch[m] = {i, k};
+      if constexpr (Canonical) slot[k] = touching ? (touched + m) & mask : none;
       m += touching;
       if constexpr (Law::keeps_tangential) keep_or_zero(touching, springs_t[k]);
       if constexpr (Law::keeps_rolling) keep_or_zero(touching, springs_r[k]);
     }
     evaluate(m);
+    if constexpr (Canonical) touched += m;
   }
+  if constexpr (Canonical) s.canonical_touching = touched;
 }
 
-template <class Law>
+// Pairs, then walls. With Canonical the pairs' shares are added in canonical order before
+// the walls (in wall order) add theirs.
+// The canonical sweep goes over the owners a chunk at a time: a particle's local-list shares
+// come from owners up to itself (a half list, j > i) and its ghost-list shares from itself,
+// so its sum is complete after its chunk, while the shares are still in cache.
+template <class Law, bool Canonical>
 void sweep(ContactSweep& s) {
-  local_pair_sweep<Law>(s);
-  ghost_pair_sweep<Law>(s);
+  const int n = static_cast<int>(s.p.size());
+  if constexpr (Canonical) {
+    s.canonical_touching = 0;
+    for (int a = 0; a < n; a += CanonicalSum::kChunk) {
+      const int b = std::min(n, a + CanonicalSum::kChunk);
+      local_pair_sweep<Law, true>(s, a, b);
+      ghost_pair_sweep<Law, true>(s, a, b);
+      s.canonical->add_to(s.p, Law::needs_spin, a, b);
+    }
+  } else {
+    local_pair_sweep<Law, false>(s, 0, n);
+    ghost_pair_sweep<Law, false>(s, 0, n);
+  }
   wall_sweep<Law>(s);
 }
 
 template <class Law>
-SweepChoice choice() {
-  return {&sweep<Law>,
+SweepChoice choice(bool canonical) {
+  return {canonical ? &sweep<Law, true> : &sweep<Law, false>,
           Law::has_history,
           Law::keeps_tangential,
           Law::keeps_rolling,
@@ -456,30 +510,33 @@ SweepChoice choice() {
 
 // Expands the run-time slot choice into one compile-time combination, one slot at a time.
 template <class N, class T, class R>
-SweepChoice pick_cohesion(const ContactSettings& c) {
-  if (c.cohesion == CohesionModel::sjkr) return choice<ContactLaw<N, T, R, SjkrCohesion>>();
-  return choice<ContactLaw<N, T, R, NoCohesion>>();
+SweepChoice pick_cohesion(const ContactSettings& c, bool canonical) {
+  if (c.cohesion == CohesionModel::sjkr)
+    return choice<ContactLaw<N, T, R, SjkrCohesion>>(canonical);
+  return choice<ContactLaw<N, T, R, NoCohesion>>(canonical);
 }
 template <class N, class T>
-SweepChoice pick_rolling(const ContactSettings& c) {
+SweepChoice pick_rolling(const ContactSettings& c, bool canonical) {
   switch (c.rolling) {
-    case RollingModel::cdt: return pick_cohesion<N, T, CdtRolling>(c);
-    case RollingModel::epsd: return pick_cohesion<N, T, EpsdRolling>(c);
+    case RollingModel::cdt: return pick_cohesion<N, T, CdtRolling>(c, canonical);
+    case RollingModel::epsd: return pick_cohesion<N, T, EpsdRolling>(c, canonical);
     case RollingModel::none: break;
   }
-  return pick_cohesion<N, T, NoRolling>(c);
+  return pick_cohesion<N, T, NoRolling>(c, canonical);
 }
 template <class N>
-SweepChoice pick_tangential(const ContactSettings& c) {
-  if (c.tangential == TangentialModel::history) return pick_rolling<N, HistoryTangential>(c);
-  return pick_rolling<N, NoTangential>(c);
+SweepChoice pick_tangential(const ContactSettings& c, bool canonical) {
+  if (c.tangential == TangentialModel::history)
+    return pick_rolling<N, HistoryTangential>(c, canonical);
+  return pick_rolling<N, NoTangential>(c, canonical);
 }
 
 }  // namespace
 
-SweepChoice select_sweep(const ContactSettings& settings) {
-  if (settings.normal == NormalModel::hooke) return pick_tangential<HookeNormal>(settings);
-  return pick_tangential<HertzNormal>(settings);
+SweepChoice select_sweep(const ContactSettings& settings, bool canonical) {
+  if (settings.normal == NormalModel::hooke)
+    return pick_tangential<HookeNormal>(settings, canonical);
+  return pick_tangential<HertzNormal>(settings, canonical);
 }
 
 void steps_per_contact_sweep(ContactSweep& s) {

@@ -16,6 +16,7 @@
 #include "dem/contact/contact_geometry.hpp"
 #include "dem/contact/pair_coefficients.hpp"
 #include "dem/core/particles.hpp"
+#include "dem/engine/canonical_sum.hpp"
 #include "dem/neighbour/verlet_list.hpp"
 #include "dem/neighbour/wall_neighbours.hpp"
 #include "dem/parallel/ghosts.hpp"
@@ -98,6 +99,10 @@ struct ContactSweep {
   double max_overlap_ratio = 0;  // overlap / smaller radius
   WorstContact worst;            // the contact with that overlap
   UnresolvedContact unresolved;  // filled by steps_per_contact_sweep
+  // parallel.reproducible: the canonical order of the sums (set at each neighbour rebuild),
+  // for a sweep of select_sweep(..., true); unused otherwise.
+  CanonicalSum* canonical = nullptr;
+  int canonical_touching = 0;  // touching local-list entries (set by the local pair sweep)
 };
 
 using SweepFunction = void (*)(ContactSweep&);
@@ -111,7 +116,9 @@ struct SweepChoice {
   std::string name;       // e.g. "hertz + history + none + none"
 };
 
-SweepChoice select_sweep(const ContactSettings& settings);
+// `canonical`: the sweep for parallel.reproducible, which adds each particle's pair
+// contributions in canonical order (ContactSweep::canonical, canonical_sum.hpp).
+SweepChoice select_sweep(const ContactSettings& settings, bool canonical = false);
 
 // The steps-per-contact test (UnresolvedContact) over every touching contact of the
 // sweep's lists and walls, as the force sweep finds them, into s.unresolved. A pass of its

@@ -57,6 +57,9 @@ void print_report(const Simulation& sim, MPI_Comm comm, std::ostream& out) {
     }
     o << "\n";
   }
+  if (sim.scene().parallel.reproducible)
+    o << "force sums: canonical order (parallel.reproducible): results bit-identical on any "
+         "number of ranks\n";
   for (const std::string& note : sim.time_step_report().notes) o << note << "\n";
   for (const std::string& note : sim.walls().notes()) o << note << "\n";  // meshes read
 }

@@ -51,7 +51,7 @@ Simulation::Simulation(const Scene& scene, bool insert, MPI_Comm comm,
   constants_.hooke_kn = scene.contact.hooke_kn.value_or(0.0);
   constants_.hooke_kt = scene.contact.hooke_kt.value_or(constants_.hooke_kn);
   constants_.epsd_damping_ratio = scene.contact.epsd_damping_ratio;
-  sweep_ = select_sweep(scene.contact);
+  sweep_ = select_sweep(scene.contact, scene.parallel.reproducible);
   try {
     walls_ = WallSet(scene_);  // reads STL meshes
   } catch (const GeometryError& e) {
@@ -493,6 +493,7 @@ void Simulation::rebuild(bool keep_drag) {
   grid_->build(p_, ghosts_, skin_, local_list_, ghost_list_);
   wall_neighbours_.build(p_, walls_, skin_);
   restore_histories(carried);
+  if (scene_.parallel.reproducible) canonical_.build(p_, ghosts_, local_list_, ghost_list_);
   if (carried.carries_drag) {
     drag_.coefficient.resize(p_.size());
     drag_.fluid_velocity.resize(p_.size());
@@ -541,6 +542,7 @@ ContactGuards Simulation::compute_forces() {
       walls_,   wall_history_, wall_neighbours_, table_,      constants_,     dt_,
       uniform_, 0,             0.0,              WorstContact{}, UnresolvedContact{}};
   // clang-format on
+  s.canonical = &canonical_;
   sweep_.run(s);
   // The fastest local particle bounds both the steps-per-contact gate and the travel guard;
   // kick_and_drift() has found it (in the same order) unless a rebuild came since.

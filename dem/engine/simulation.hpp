@@ -215,6 +215,7 @@ class Simulation {
   std::vector<std::vector<ContactHistory>> wall_history_;
   WallNeighbours wall_neighbours_;  // rebuilt with the Verlet lists
   UniformPairs uniform_;            // found with the Verlet lists
+  CanonicalSum canonical_;          // parallel.reproducible: built with the Verlet lists
   WallSet walls_;
   StreamInsertion streams_;
   std::vector<Vec3> x_at_build_;

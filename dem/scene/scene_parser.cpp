@@ -260,7 +260,7 @@ std::string existing_file(const Field& file, const std::string& what) {
 }
 
 ParallelSettings parse_parallel(const Field& f) {
-  const Map m = f.map({"grid", "balance"});
+  const Map m = f.map({"grid", "balance", "reproducible"});
   ParallelSettings par;
   if (const auto g = m.find("grid")) {
     const std::vector<Field> items = g->items();
@@ -271,6 +271,7 @@ ParallelSettings parse_parallel(const Field& f) {
       par.grid[a] = static_cast<int>(items[a].integer(Range{1, 1e6, true, true}));
   }
   if (const auto b = m.find("balance")) par.balance = b->boolean();
+  if (const auto r = m.find("reproducible")) par.reproducible = r->boolean();
   return par;
 }
 

@@ -172,3 +172,14 @@ grain_cli_test(restart_missing_checkpoint 1 "no_such_checkpoint.h5"
                CMD ${_grain} run ${_scenes}/periodic_bed.yaml --output out --no-progress
                    --restart no_such_checkpoint.h5
                WORKDIR ${_work}/restart_missing)
+
+# parallel.reproducible through the command line (docs/parallel.md): snapshots on 1, 2 and 3
+# ranks and a restart on 3 ranks equal bit for bit (about 15 s of CPU).
+if(GRAINFLOW_PYTHON3)
+  add_test(NAME grain.reproducible_snapshots
+           COMMAND ${GRAINFLOW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/reproducible_snapshots.py
+                   ${_grain} ${_scenes}/periodic_bed_reproducible.yaml
+                   ${_work}/reproducible_snapshots ${MPIEXEC_EXECUTABLE})
+  set_tests_properties(grain.reproducible_snapshots
+                       PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}" TIMEOUT 300 PROCESSORS 2)
+endif()

@@ -719,5 +719,16 @@ TEST(SceneParser, CheckpointSettings) {
               HasSubstr("checkpoint_interval, checkpoint_keep"));
 }
 
+// parallel.reproducible: off by default, `true` selects canonical summation, and a value
+// that is not a boolean names the key and what it accepts.
+TEST(SceneParser, ParallelReproducible) {
+  EXPECT_FALSE(parse_scene(kBase, kLabel).parallel.reproducible);
+  const Scene on = parse_scene(kBase + "parallel: {reproducible: true}\n", kLabel);
+  EXPECT_TRUE(on.parallel.reproducible);
+  const std::string msg =
+      expect_at(error_of(kBase + "parallel: {reproducible: sometimes}\n"), 17, 26);
+  EXPECT_THAT(msg, HasSubstr("parallel.reproducible: expected true or false, got 'sometimes'"));
+}
+
 }  // namespace
 }  // namespace grainflow
