@@ -23,6 +23,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <string>
 
@@ -166,6 +167,9 @@ TEST_P(WallTravel, RefusedWithSpeedLimitAndStepsThatWork) {
   EXPECT_GE(resolved.contacts, 1);
   EXPECT_FALSE(resolved.passed);
   EXPECT_NEAR(resolved.v_out, -(1 + kE) * c.speed, 0.03 * (1 + kE) * c.speed);
+  std::printf("%s at %g m/s: fit %g s: %ld contacts, stop: %.80s; impact %g s: out at %.5g U\n",
+              c.name, c.speed, fit, at_fit.contacts, at_fit.stop.c_str(), impact,
+              -resolved.v_out / c.speed);
 }
 
 INSTANTIATE_TEST_SUITE_P(Reproductions, WallTravel, ::testing::Values(kPlate, kRod),
