@@ -1,6 +1,7 @@
 #include "coupling/footprint.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
@@ -127,11 +128,15 @@ Footprint::Footprint(VoidFractionMethod method, int divided_resolution, double s
                                 std::to_string(divided_resolution) + " is outside [2, " +
                                 std::to_string(kMaxDividedResolution) +
                                 "]; it counts the lattice cubes across the particle diameter");
-  if (!(smoothing_factor >= 1.0 && smoothing_factor <= 2.0))
+  if (!(smoothing_factor >= 1.0 && smoothing_factor <= 2.0)) {
+    // Every digit that reads back (to_string would show 2.0000001 as 2.000000, inside [1, 2]).
+    char value[32];
+    char* end = std::to_chars(value, value + sizeof value, smoothing_factor).ptr;
     throw std::invalid_argument("void fraction: smoothing_factor " +
-                                std::to_string(smoothing_factor) +
+                                std::string(value, static_cast<std::size_t>(end - value)) +
                                 " is outside [1, 2]; it is the smoothed kernel's support "
                                 "radius in particle radii");
+  }
   switch (method) {
     case VoidFractionMethod::centre:
       unit_.push_back(FootprintPoint{{0, 0, 0}, 1});

@@ -14,6 +14,7 @@
 #include "dem/engine/simulation.hpp"
 #include "dem/engine/stop_signals.hpp"
 #include "dem/fluid/fluid_forces.hpp"
+#include "dem/fluid/void_fraction_grid.hpp"
 #include "dem/io/log_table.hpp"
 #include "dem/io/output_directory.hpp"
 #include "dem/io/progress_line.hpp"
@@ -43,8 +44,14 @@ void print_report(const Simulation& sim, MPI_Comm comm, std::ostream& out) {
   const Decomposition& d = sim.decomposition();
   std::ostream& o = speaker(comm, out);
   o << "scene: " << sim.scene().file << "\n"
-    << "particles: " << g.particles << " (radius " << -range[0] << " .. " << range[1] << " m)\n"
-    << "contact law: " << sim.contact_law_name() << "\n";
+    << "particles: " << g.particles;
+  if (g.particles > 0)
+    o << " (radius " << -range[0] << " .. " << range[1] << " m)\n";
+  else if (sim.streams().size() > 0)
+    o << " (none at the start; the stream insertions add them during the run)\n";
+  else
+    o << " (the scene has no particles: no insertion entry placed any)\n";
+  o << "contact law: " << sim.contact_law_name() << "\n";
   if (d.size() > 1) {
     o << "MPI ranks: " << d.size() << " as a " << d.dims()[0] << " x " << d.dims()[1] << " x "
       << d.dims()[2] << " grid";
@@ -76,6 +83,17 @@ std::string shell_word(const std::string& word) {
   return out + "'";
 }
 
+// Grids sized from the scene, checked against their memory limit before anything is
+// allocated. The neighbour bins and the mesh search grids bound themselves (by the count of
+// particles and of triangles); the one-way void-fraction grid covers the whole domain.
+void check_grids(const Scene& scene) {
+  if (scene.fluid && scene.fluid->computed_void_fraction)
+    if (const std::string why =
+            void_fraction_grid_too_large(scene.domain, *scene.fluid->computed_void_fraction);
+        !why.empty())
+      throw SetupError(scene.fluid->source + ": error: fluid.void_fraction: " + why);
+}
+
 }  // namespace
 
 std::string continue_command(const std::string& scene_file, const RunOptions& options, int ranks,
@@ -89,6 +107,7 @@ std::string continue_command(const std::string& scene_file, const RunOptions& op
 }
 
 int check_scene(const Scene& scene, std::ostream& out) {
+  check_grids(scene);
   Simulation sim(scene);
   sim.initialise();  // lists and first forces only: no time step is taken
   print_report(sim, MPI_COMM_WORLD, out);
@@ -102,6 +121,7 @@ int check_scene(const Scene& scene, std::ostream& out) {
 
 RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm comm,
                      std::ostream& out) {
+  check_grids(scene);
   const std::string dir = options.output_directory.value_or(scene.output.directory);
   prepare_output_directory(dir);  // before any work: an unwritable directory fails now
   std::ostream& say = speaker(comm, out);

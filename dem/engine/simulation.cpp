@@ -9,6 +9,7 @@
 #include "dem/engine/restored_state.hpp"
 #include "dem/insert/insertion.hpp"
 #include "dem/walls/stl_reader.hpp"
+#include "dem/walls/wall_travel.hpp"
 
 namespace grainflow {
 namespace {
@@ -96,6 +97,7 @@ void Simulation::initialise() {
     throw SetupError(scene_.file +
                      ": error: time.rayleigh_fraction needs particles to size the time step; "
                      "give time.step instead");
+  check_walls_travel();
 
   std::vector<char> foreign(p_.size());
   for (std::size_t i = 0; i < p_.size(); ++i) foreign[i] = !decomp_->owns(p_.x[i]);
@@ -134,6 +136,27 @@ void Simulation::initialise() {
   else
     check_contacts(compute_forces(), true);
   initialised_ = true;
+}
+
+void Simulation::check_walls_travel() {
+  // The smallest particle present or still to come, the one a wall passes most easily:
+  // (radius, material), the lowest material index among equals, agreed by every rank.
+  struct {
+    double radius;
+    int material;
+  } smallest{std::numeric_limits<double>::infinity(), -1};
+  auto take = [&](double r, int m) {
+    if (r < smallest.radius || (r == smallest.radius && m < smallest.material)) smallest = {r, m};
+  };
+  for (std::size_t i = 0; i < p_.size(); ++i) take(p_.radius[i], p_.material[i]);
+  for (const Insertion& ins : scene_.insertions)
+    if (ins.kind == Insertion::Kind::stream) take(min_radius(ins.radius), ins.material);
+  MPI_Allreduce(MPI_IN_PLACE, &smallest, 1, MPI_DOUBLE_INT, MPI_MINLOC, comm_);
+  const WallTravelReport walls =
+      check_wall_travel(scene_, walls_, dt_, std::isfinite(smallest.radius) ? smallest.radius : 0.0,
+                        smallest.material, table_);
+  for (const std::string& note : walls.notes) report_.notes.push_back(note);
+  if (!walls.error.empty()) throw SetupError(walls.error);
 }
 
 void Simulation::mark_leaving() {

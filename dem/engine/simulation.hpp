@@ -177,7 +177,10 @@ class Simulation {
   // sweep skips it): a bound from the fastest local (v2_local: its |v|^2) or ghost particle.
   bool contact_may_be_unresolved(double v2_local) const;
   bool needs_rebuild() const;  // collective
-  void mark_leaving();         // particles beyond a bounded side of the domain
+  // The walls' travel guard (dem/walls/wall_travel.hpp): notes into the report, SetupError
+  // when a wall moves too far per step.
+  void check_walls_travel();
+  void mark_leaving();  // particles beyond a bounded side of the domain
   // The first half kick and x += dt v in one pass, with mark_leaving()'s test, the skin test
   // and the largest local |v|^2 (for contact_may_be_unresolved()); forces and torques set to
   // gravity and zero for the next evaluation.

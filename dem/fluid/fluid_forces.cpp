@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "dem/core/number_format.hpp"
 #include "dem/fluid/beetstra.hpp"
 #include "dem/fluid/di_felice.hpp"
 #include "dem/fluid/drag_law.hpp"
@@ -45,7 +46,7 @@ class FluidForcesWith final : public ForceTerm {
     return "void fraction: " + std::to_string(grid_->cells()[0]) + " x " +
            std::to_string(grid_->cells()[1]) + " x " + std::to_string(grid_->cells()[2]) +
            " cells; clamped to the minimum " + std::to_string(grid_->clamped_cells_total()) +
-           " times (cell-steps), removing " + std::to_string(grid_->clamped_volume_total()) +
+           " times (cell-steps), removing " + significant(grid_->clamped_volume_total()) +
            " m^3 of solid volume in total";
   }
 

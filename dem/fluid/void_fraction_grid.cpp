@@ -2,15 +2,55 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
+#include <stdexcept>
 
 namespace grainflow {
 
+std::array<double, 3> void_fraction_grid_cells(const Domain& domain,
+                                               const VoidFractionGridSettings& s) {
+  std::array<double, 3> n{};
+  for (int a = 0; a < 3; ++a)
+    n[a] = std::max(1.0, std::round((domain.hi[a] - domain.lo[a]) / s.cell_size));
+  return n;
+}
+
+std::string void_fraction_grid_too_large(const Domain& domain, const VoidFractionGridSettings& s) {
+  const std::array<double, 3> n = void_fraction_grid_cells(domain, s);
+  const double cells = n[0] * n[1] * n[2];
+  if (cells <= kMaxVoidFractionCells) return {};
+  // The smallest cell size (three significant digits, rounded up) whose grid fits.
+  const Vec3 length = domain.hi - domain.lo;
+  VoidFractionGridSettings fit = s;
+  fit.cell_size = std::cbrt(length.prod() / kMaxVoidFractionCells);
+  const double scale = std::pow(10.0, std::floor(std::log10(fit.cell_size)) - 2);
+  fit.cell_size = std::ceil(fit.cell_size / scale) * scale;
+  for (;;) {
+    const std::array<double, 3> m = void_fraction_grid_cells(domain, fit);
+    if (m[0] * m[1] * m[2] <= kMaxVoidFractionCells) break;
+    fit.cell_size += scale;
+  }
+  std::ostringstream o;
+  o.precision(4);
+  o << "cell_size " << s.cell_size << " m over the domain's " << length[0] << " x " << length[1]
+    << " x " << length[2] << " m gives " << n[0] << " x " << n[1] << " x " << n[2] << " = " << cells
+    << " cells, " << cells * kVoidFractionBytesPerCell / 1e9 << " GB on every rank; the limit is "
+    << static_cast<long>(kMaxVoidFractionCells) << " cells ("
+    << kMaxVoidFractionCells * kVoidFractionBytesPerCell / 1e9
+    << " GB). Use cell_size >= " << fit.cell_size
+    << " m (the grid covers the whole domain), or a smaller domain";
+  return o.str();
+}
+
 VoidFractionGrid::VoidFractionGrid(const Domain& domain, const VoidFractionGridSettings& s)
     : domain_(domain), minimum_(s.minimum) {
+  if (const std::string why = void_fraction_grid_too_large(domain, s); !why.empty())
+    throw std::length_error("void fraction grid: " + why);
+  const std::array<double, 3> counts = void_fraction_grid_cells(domain, s);
   cell_volume_ = 1;
   for (int a = 0; a < 3; ++a) {
     const double length = domain.hi[a] - domain.lo[a];
-    n_[a] = std::max(1, static_cast<int>(std::lround(length / s.cell_size)));
+    n_[a] = static_cast<int>(counts[a]);
     edge_[a] = length / n_[a];
     cell_volume_ *= edge_[a];
   }

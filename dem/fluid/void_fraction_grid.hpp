@@ -11,6 +11,7 @@
 #include <mpi.h>
 
 #include <array>
+#include <string>
 #include <vector>
 
 #include "dem/core/particles.hpp"
@@ -19,8 +20,25 @@
 
 namespace grainflow {
 
+// The most cells a void-fraction grid may have: 2^26 = 67 108 864. Each cell holds two
+// doubles (solid volume, eps): 1 GiB on every rank, summed over the ranks by one reduction
+// of that size per step. Finer grids are refused before allocation (docs/stability.md).
+constexpr double kMaxVoidFractionCells = 67108864;
+constexpr double kVoidFractionBytesPerCell = 2 * sizeof(double);
+
+// The cells along each axis the grid takes for a domain (cell_size rounded to fit it).
+std::array<double, 3> void_fraction_grid_cells(const Domain& domain,
+                                               const VoidFractionGridSettings& settings);
+
+// Why the grid would be too large, for a message that names the scene's key (cells and bytes,
+// the limit, the smallest cell_size that fits); "" when it fits.
+std::string void_fraction_grid_too_large(const Domain& domain,
+                                         const VoidFractionGridSettings& settings);
+
 class VoidFractionGrid {
  public:
+  // std::length_error when void_fraction_grid_too_large() has a reason (checked earlier,
+  // with the scene's key, by grain check and run: dem/engine/run.cpp).
   VoidFractionGrid(const Domain& domain, const VoidFractionGridSettings& settings);
   // Recomputes eps from this rank's particles and the other ranks' (collective).
   void update(const Particles& p, MPI_Comm comm);

@@ -3,12 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
-#include <iomanip>
+#include <limits>
 #include <numbers>
 #include <sstream>
 #include <unordered_map>
 
 #include "dem/engine/restored_state.hpp"
+#include "dem/core/number_format.hpp"
 #include "dem/io/snapshot_reader.hpp"
 #include "dem/walls/wall_contact.hpp"
 
@@ -48,6 +49,9 @@ double max_radius(const SizeDistribution& d) {
 
 namespace {
 
+// Overlap below this many units in the last place of the coordinates is round-off.
+constexpr double kTouchUlps = 8;
+
 // Hash grid over existing spheres for the no-overlap test.
 class OverlapGrid {
  public:
@@ -60,9 +64,14 @@ class OverlapGrid {
   }
   // The index of a stored sphere that overlaps the sphere (x, r), or -1.
   int overlapping(const Vec3& x, double r) const {
+    // Spheres that touch, written with every digit (17), may overlap by the round-off of
+    // their coordinates: kTouchUlps units in the last place of the largest coordinate (or
+    // of the radii's sum) are no overlap (docs/scene-reference.md, `csv`).
     auto overlap = [&](int k) {
       const double s = r + rs_[k];
-      return (x - xs_[k]).squaredNorm() < s * s;
+      const double scale = std::max({x.cwiseAbs().maxCoeff(), xs_[k].cwiseAbs().maxCoeff(), s});
+      const double reach = s - kTouchUlps * std::numeric_limits<double>::epsilon() * scale;
+      return (x - xs_[k]).squaredNorm() < reach * reach;
     };
     // A sphere much larger than the cells (a hostile CSV radius) would visit more
     // cells than there are spheres: then checking every sphere is cheaper.
@@ -176,6 +185,37 @@ bool touches_a_wall(const Scene& s, const WallSet* walls, const Vec3& x, double 
   return false;
 }
 
+// Why a particle given by a file (x, r) may not start where it is, or "" if it may: it
+// overlaps a wall by more than time.max_overlap of its radius (more than a run allows; a
+// settled bed touches its walls by less), or its centre is on the wall's far side (an
+// overlap above r). Planes and cylinders at t = 0 when `walls` is not given.
+std::string inside_a_wall(const Scene& s, const WallSet* walls, const Vec3& x, double r) {
+  int wall = -1;
+  double overlap = 0;
+  if (walls) {
+    const WallSet::Overlap o = walls->deepest_overlap(x, r);
+    wall = o.wall;
+    overlap = o.overlap;
+  } else {
+    WallTouch t;
+    for (std::size_t k = 0; k < s.walls.size(); ++k)
+      if (touch_wall(s.walls[k], x, r, t) && t.overlap > overlap) {
+        wall = static_cast<int>(k);
+        overlap = t.overlap;
+      }
+  }
+  if (wall < 0 || overlap <= s.time.max_overlap * r) return {};
+  std::ostringstream o;
+  o.precision(4);
+  o << "lies inside wall '" << s.walls[wall].name << "': it overlaps it by " << overlap << " m, "
+    << 100 * overlap / r << " % of its radius";
+  if (overlap > r) o << " (its centre is on the wall's far side)";
+  o << "; at insertion a particle may overlap a wall by at most time.max_overlap = "
+    << 100 * s.time.max_overlap
+    << " % of its radius (the most a run allows); move the particle out of the wall";
+  return o.str();
+}
+
 void fill_region(const Scene& scene, const WallSet* walls, const Insertion& ins, Particles& p,
                  GlobalId& next_id, OverlapGrid& grid) {
   std::mt19937_64 rng(ins.seed);
@@ -225,34 +265,31 @@ std::vector<std::string> split_csv(const std::string& line) {
   return out;
 }
 
-std::string format_number(double x) {
-  std::ostringstream s;
-  s << std::setprecision(9) << x;
-  return s.str();
-}
+// Every digit of a value read from a file (dem/core/number_format.hpp): a message that
+// compares it with a limit must show how it differs.
+std::string format_number(double x) { return exact_number(x); }
 
 std::string format_vec(const Vec3& x) {
-  std::ostringstream s;
-  s << std::setprecision(9) << '(' << x[0] << ", " << x[1] << ", " << x[2] << ')';
-  return s.str();
+  return '(' + exact_number(x[0]) + ", " + exact_number(x[1]) + ", " + exact_number(x[2]) + ')';
 }
 
 // Why a particle (x, r) is not inside the domain (inside_domain() is false), for messages.
 std::string outside_domain_reason(const Domain& d, const Vec3& x, double r) {
   const char* axis = "xyz";
   std::ostringstream s;
-  s << std::setprecision(9);
+  auto num = [](double v) { return exact_number(v); };
   for (int a = 0; a < 3; ++a) {
     if (d.periodic[a]) {
       if (x[a] < d.lo[a] || x[a] >= d.hi[a]) {
-        s << "its centre " << axis[a] << " = " << x[a] << " is outside the periodic range ["
-          << d.lo[a] << ", " << d.hi[a] << ")";
+        s << "its centre " << axis[a] << " = " << num(x[a]) << " is outside the periodic range ["
+          << num(d.lo[a]) << ", " << num(d.hi[a]) << ")";
         return s.str();
       }
     } else if (x[a] - r < d.lo[a] || x[a] + r > d.hi[a]) {
-      s << "it spans " << axis[a] << " from " << x[a] - r << " to " << x[a] + r
-        << ", beyond the domain's " << d.lo[a] << " to " << d.hi[a]
-        << " (a sphere must lie wholly inside a bounded side)";
+      const double beyond = std::max(d.lo[a] - (x[a] - r), x[a] + r - d.hi[a]);
+      s << "it spans " << axis[a] << " from " << num(x[a] - r) << " to " << num(x[a] + r)
+        << ", beyond the domain's " << num(d.lo[a]) << " to " << num(d.hi[a]) << " by "
+        << significant(beyond) << " m (a sphere must lie wholly inside a bounded side)";
       return s.str();
     }
   }
@@ -263,8 +300,8 @@ std::string outside_domain_reason(const Domain& d, const Vec3& x, double r) {
 // come together.
 const std::vector<std::string> kCsvColumns = {"x", "y", "z", "radius", "vx", "vy", "vz", "material"};
 
-void read_csv(const Scene& scene, const Insertion& ins, Particles& p, GlobalId& next_id,
-              OverlapGrid& grid) {
+void read_csv(const Scene& scene, const WallSet* walls, const Insertion& ins, Particles& p,
+              GlobalId& next_id, OverlapGrid& grid) {
   std::ifstream in(ins.csv_file);
   if (!in)
     throw InsertionError(ins.source + ": error: cannot open particle file '" + ins.csv_file + "'");
@@ -340,6 +377,9 @@ void read_csv(const Scene& scene, const Insertion& ins, Particles& p, GlobalId& 
     if (!inside_domain(scene.domain, x, r))
       fail(lineno, "the particle at " + format_vec(x) + " with radius " + format_number(r) +
                        " is outside the domain: " + outside_domain_reason(scene.domain, x, r));
+    if (const std::string why = inside_a_wall(scene, walls, x, r); !why.empty())
+      fail(lineno,
+           "the particle at " + format_vec(x) + " with radius " + format_number(r) + " " + why);
     if (const int k = overlapping_with_images(grid, scene.domain, x, r); k >= 0)
       fail(lineno, "the particle at " + format_vec(x) + " with radius " + format_number(r) +
                        " overlaps an earlier particle at " + format_vec(grid.position(k)) +
@@ -382,8 +422,8 @@ void check_snapshot_records(const Scene& scene, const Insertion& ins, const Part
 }
 
 // `grid_needed`: whether a later entry checks overlaps against this one's particles.
-void read_snapshot_entry(const Scene& scene, const Insertion& ins, Particles& p,
-                         GlobalId& next_id, OverlapGrid& grid, bool grid_needed) {
+void read_snapshot_entry(const Scene& scene, const WallSet* walls, const Insertion& ins,
+                         Particles& p, GlobalId& next_id, OverlapGrid& grid, bool grid_needed) {
   Snapshot snap;
   try {
     snap = read_snapshot(ins.snapshot_file);
@@ -422,6 +462,8 @@ void read_snapshot_entry(const Scene& scene, const Insertion& ins, Particles& p,
     // up to the overlap the run allowed.
     if (!inside_domain(scene.domain, q.x[i], q.radius[i], scene.time.max_overlap * q.radius[i]))
       snapshot_outside_domain(scene, ins, q, i);
+    if (const std::string why = inside_a_wall(scene, walls, q.x[i], q.radius[i]); !why.empty())
+      fail(why);
     // Touching neighbours of a settled bed overlap slightly: only particles of
     // earlier entries are checked (the grid holds this snapshot's only afterwards).
     if (overlaps_with_images(grid, scene.domain, q.x[i], q.radius[i]))
@@ -468,9 +510,9 @@ void insert_particles(const Scene& scene, Particles& p, GlobalId& next_id, const
         [](const Insertion& later) { return later.kind != Insertion::Kind::stream; });
     switch (ins.kind) {
       case Insertion::Kind::fill: fill_region(scene, walls, ins, p, next_id, grid); break;
-      case Insertion::Kind::csv: read_csv(scene, ins, p, next_id, grid); break;
+      case Insertion::Kind::csv: read_csv(scene, walls, ins, p, next_id, grid); break;
       case Insertion::Kind::snapshot:
-        read_snapshot_entry(scene, ins, p, next_id, grid, later_checks);
+        read_snapshot_entry(scene, walls, ins, p, next_id, grid, later_checks);
         break;
       case Insertion::Kind::stream: break;  // during the run: StreamInsertion
     }

@@ -26,13 +26,20 @@ inline bool touch_plane(const PlaneWall& w, const Vec3& x, double r, WallTouch& 
   return true;
 }
 
+// A unit vector normal to the unit vector a, a function of a alone.
+inline Vec3 axis_normal(const Vec3& a) {
+  return (std::abs(a[0]) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(a).normalized();
+}
+
 inline bool touch_cylinder(const CylinderWall& w, const Vec3& x, double r, WallTouch& t) {
   const Vec3 rel = x - w.axis_point;
   const Vec3 radial = rel - rel.dot(w.axis) * w.axis;
   const double rho = radial.norm();
   const double overlap = w.inside ? r - (w.radius - rho) : r - (rho - w.radius);
-  if (overlap <= 0 || rho == 0) return false;
-  const Vec3 out = radial / rho;
+  if (overlap <= 0) return false;
+  // On the axis every radial direction is as near: take one fixed by the axis alone, so a
+  // sphere there (the deepest overlap of an `outside` cylinder) is pushed off, not ignored.
+  const Vec3 out = rho > 0 ? Vec3(radial / rho) : axis_normal(w.axis);
   t.n = w.inside ? Vec3(-out) : out;
   t.overlap = overlap;
   // Contact point on the cylinder surface; the surface turns about the axis.

@@ -106,4 +106,30 @@ bool WallSet::touches_any(const Vec3& x, double r) const {
   return false;
 }
 
+WallSet::Overlap WallSet::deepest_overlap(const Vec3& x, double r) const {
+  Overlap deepest;
+  auto take = [&](std::size_t k, double overlap) {
+    if (overlap > deepest.overlap) deepest = {static_cast<int>(k), overlap};
+  };
+  WallTouch t;
+  MeshTouch m[TriangleMesh::kMaxTouches];
+  for (std::size_t k = 0; k < walls_.size(); ++k) {
+    const Entry& e = walls_[k];
+    switch (e.kind) {
+      case Wall::Kind::plane:
+        if (touch_plane(e.plane, x, r, t)) take(k, t.overlap);
+        break;
+      case Wall::Kind::cylinder:
+        if (touch_cylinder(e.cylinder, x, r, t)) take(k, t.overlap);
+        break;
+      case Wall::Kind::mesh: {
+        const int n = meshes_[e.mesh].touches(e.pose.to_body(x), r, m);
+        for (int c = 0; c < n; ++c) take(k, m[c].overlap);
+        break;
+      }
+    }
+  }
+  return deepest;
+}
+
 }  // namespace grainflow

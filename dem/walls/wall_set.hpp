@@ -63,6 +63,15 @@ class WallSet {
   // True if a sphere at x with radius r touches any wall (insertion).
   bool touches_any(const Vec3& x, double r) const;
 
+  // The wall a sphere at x with radius r overlaps most (index into walls(); -1: none) and
+  // by how much; an overlap above r means its centre is on the wall's far side (planes and
+  // cylinders; a mesh has no far side: its overlap is at most r).
+  struct Overlap {
+    int wall = -1;
+    double overlap = 0;
+  };
+  Overlap deepest_overlap(const Vec3& x, double r) const;
+
   // One line per mesh: triangles, vertices, repairs (for the run report).
   const std::vector<std::string>& notes() const { return notes_; }
 
