@@ -155,6 +155,7 @@ void Simulation::initialise() {
 
 void Simulation::check_force_limits() {
   force_limits_.clear();
+  force_limit_notes_.clear();
   for (const auto& term : terms_)
     for (TermLimit& l : term->limits(p_, time_)) force_limits_.push_back(std::move(l));
   // The smallest time scale and limit over the ranks, with the particle of the time scale
@@ -191,6 +192,7 @@ void Simulation::check_force_limits() {
       if (std::isfinite(l.dt_max)) o << "; dt <= " << l.dt_max << " s";
     }
     report_.notes.push_back(o.str());
+    force_limit_notes_.push_back(o.str());
     if (dt_ > l.dt_max) {
       o.str("");
       o << "error: dt = " << dt_ << " s is beyond the stability limit of the fluid force '"
@@ -198,6 +200,7 @@ void Simulation::check_force_limits() {
         << "); use dt <= " << 0.9 * l.dt_max << " s, or remove '" << l.term
         << "' from fluid.forces";
       report_.notes.push_back(o.str());
+      force_limit_notes_.push_back(o.str());
       report_.verdict = TimeStepReport::Verdict::refuse;
     }
   }

@@ -90,6 +90,9 @@ class Simulation {
   // rank, and the same as one line: each term with dt / its time scale, for messages.
   const std::vector<TermLimit>& force_limits() const { return force_limits_; }
   std::string force_limits_summary() const;
+  // The lines check_force_limits() added to the time-step report (also for runs that do not
+  // print the report, the coupled DEM).
+  const std::vector<std::string>& force_limit_notes() const { return force_limit_notes_; }
   std::vector<std::string> force_term_reports() const {
     std::vector<std::string> out;
     for (const auto& t : terms_) out.push_back(t->report());
@@ -231,6 +234,7 @@ class Simulation {
   std::vector<std::unique_ptr<ForceTerm>> terms_;
   ImplicitDrag drag_;
   std::vector<TermLimit> force_limits_;
+  std::vector<std::string> force_limit_notes_;
   Counters counters_;
   TimeStepReport report_;
   std::vector<CheckpointSpring> restored_springs_;  // from restore(), until initialise()

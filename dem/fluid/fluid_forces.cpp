@@ -1,5 +1,6 @@
 #include "dem/fluid/fluid_forces.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -79,7 +80,7 @@ class FluidForcesWith final : public ForceTerm {
     TermLimit magnus{
         "magnus", "m/K_M, K_M = (pi/8) d^3 rho_f |Omega| (Re_p/Re_r) C_LR", inf, -1, false, inf,
         ""};
-    // The drag time scale of the particle that sets each lift's limit.
+    // The drag time scale of the particle with each lift's shortest time scale.
     double saffman_drag = inf, magnus_drag = inf;
     CoupledFluid::View samples;
     if (coupled_) samples = coupled_->at_particles(p);
@@ -106,11 +107,13 @@ class FluidForcesWith final : public ForceTerm {
         const double re_s = f.density * d * d * w / f.viscosity;
         const double kl = 1.615 * d * d * std::sqrt(f.density * f.viscosity * w) *
                           saffman_mei_correction(re_p, re_s);
-        if (const double tau = p.mass[i] / kl; tau < saffman.tau) {
+        const double tau = p.mass[i] / kl;
+        if (tau < saffman.tau) {
           saffman.tau = tau;
           saffman.particle = p.id[i];
           saffman_drag = tau_d;
         }
+        saffman.dt_max = std::min(saffman.dt_max, explicit_lift_limit(tau, tau_d));
       }
       const double wr = relative_rotation.norm();
       if (on_.magnus && wr > 0) {
@@ -118,11 +121,13 @@ class FluidForcesWith final : public ForceTerm {
         const double re_r = f.density * d * d * wr / f.viscosity;
         const double km =
             std::numbers::pi / 8 * d * d * d * f.density * wr * magnus_factor(re_p, re_r);
-        if (const double tau = p.mass[i] / km; tau < magnus.tau) {
+        const double tau = p.mass[i] / km;
+        if (tau < magnus.tau) {
           magnus.tau = tau;
           magnus.particle = p.id[i];
           magnus_drag = tau_d;
         }
+        magnus.dt_max = std::min(magnus.dt_max, explicit_lift_limit(tau, tau_d));
       }
     }
     if (on_.drag) out.push_back(drag);
@@ -130,7 +135,7 @@ class FluidForcesWith final : public ForceTerm {
     for (auto [lift, tau_d] :
          {std::pair{&saffman, saffman_drag}, std::pair{&magnus, magnus_drag}}) {
       if (lift == &saffman ? !on_.saffman : !on_.magnus) continue;
-      lift->dt_max = explicit_lift_limit(lift->tau, tau_d);
+      // dt_max: the least over the particles, each with its own drag time scale.
       if (!(lift->tau < inf))
         lift->rule = "no shear or rotation at the particles now: no limit yet";
       else if (lift->dt_max == inf)
