@@ -499,4 +499,8 @@ std::string DemLink::write_checkpoint(const std::string& directory, int keep) {
 
 std::vector<std::string> DemLink::reports() const { return impl_->simulation().force_term_reports(); }
 
+std::vector<std::string> DemLink::force_limit_notes() const {
+  return impl_->simulation().force_limit_notes();
+}
+
 }  // namespace grainflow::coupling

@@ -185,6 +185,10 @@ class DemLink {
   // Collective; throws std::runtime_error if the write fails.
   std::string write_checkpoint(const std::string& directory, int keep);
   std::vector<std::string> reports() const;  // the force terms' closing remarks
+  // Each fluid force's stability time scale and limit at initialise() (before the first
+  // fluid sample: fluid at rest), one line each, and an "error: ..." line for a step beyond
+  // an explicit force's limit (docs/models/fluid-forces.md).
+  std::vector<std::string> force_limit_notes() const;
 
  private:
   struct Impl;

@@ -214,6 +214,12 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
   } catch (const std::exception& e) {
     FatalErrorInFunction << "\n" << e.what() << exit(FatalError);
   }
+  // Each fluid force's stability limit, as grain check prints it (fluid at rest: the DEM
+  // starts before the first fluid sample); a step beyond an explicit force's limit stops here.
+  for (const std::string& note : dem_->force_limit_notes()) {
+    if (note.rfind("error:", 0) == 0) FatalErrorInFunction << "\n" << note << exit(FatalError);
+    Info << "grainFoam coupling: " << note.c_str() << endl;
+  }
 
   // --- the time-step ratio ----------------------------------------------------------
   const Time& time = mesh.time();

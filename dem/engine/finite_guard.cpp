@@ -43,7 +43,8 @@ bool non_finite_anywhere(const Particles& p, MPI_Comm comm) {
   return non_finite_anywhere(has_non_finite(p), comm);
 }
 
-std::string describe_first_non_finite(const Particles& p, long step, double time, int rank) {
+std::string describe_first_non_finite(const Particles& p, long step, double time, int rank,
+                                      const std::string& force_terms) {
   const std::size_t i = first_bad(p);
   if (i == p.size()) return {};
   const char* what = !finite(p.x[i])   ? "position"
@@ -54,10 +55,13 @@ std::string describe_first_non_finite(const Particles& p, long step, double time
   s << "error: step " << step << " (t = " << time << " s): particle " << p.id[i] << " (rank "
     << rank << ") has a non-finite " << what << "; position " << text(p.x[i]) << " m, velocity "
     << text(p.v[i]) << " m/s, angular velocity " << text(p.omega[i]) << " rad/s, force "
-    << text(p.force[i]) << " N, torque " << text(p.torque[i])
-    << " N m. The run stops here. Usual causes: a time step too large for the contact "
-       "stiffness (see `grain check`), particles inserted deeply overlapping, or a NaN in an "
-       "input file";
+    << text(p.force[i]) << " N, torque " << text(p.torque[i]) << " N m. The run stops here. ";
+  if (!force_terms.empty())
+    s << force_terms
+      << ". A ratio dt/limit above 1 is a force term beyond its stability limit; implicit terms "
+         "are stable at any dt. ";
+  s << "Other causes: a time step too large for the contact stiffness (see `grain check`), "
+       "particles inserted deeply overlapping, or a NaN in an input file";
   return s.str();
 }
 
@@ -75,8 +79,8 @@ void guard_finite(const Simulation& sim, bool local_bad, const std::string& dire
   }
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
-  const std::string mine =
-      describe_first_non_finite(sim.particles(), sim.counters().steps, sim.time(), rank);
+  const std::string mine = describe_first_non_finite(sim.particles(), sim.counters().steps,
+                                                     sim.time(), rank, sim.force_limits_summary());
   agree_on_error(comm, mine.empty() ? mine : mine + where);
 }
 

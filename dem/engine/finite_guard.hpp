@@ -20,7 +20,10 @@ bool has_non_finite(const Particles& p);
 
 // This rank's first such particle described for the user (id, rank, step, time, position,
 // velocity, angular velocity, force and torque), or "" when this rank has none. Local.
-std::string describe_first_non_finite(const Particles& p, long step, double time, int rank);
+// `force_terms`: the force terms enabled with their dt / time-scale ratios
+// (Simulation::force_limits_summary), or "" when the run has none.
+std::string describe_first_non_finite(const Particles& p, long step, double time, int rank,
+                                      const std::string& force_terms = "");
 
 class Simulation;
 

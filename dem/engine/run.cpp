@@ -109,6 +109,10 @@ std::string continue_command(const std::string& scene_file, const RunOptions& op
 int check_scene(const Scene& scene, std::ostream& out) {
   check_grids(scene);
   Simulation sim(scene);
+  // The fluid forces too, so that their stability limits are checked as at start-up.
+  if (scene.fluid)
+    sim.add_force_term(
+        make_fluid_forces(*scene.fluid, scene.gravity, scene.domain, MPI_COMM_WORLD));
   sim.initialise();  // lists and first forces only: no time step is taken
   print_report(sim, MPI_COMM_WORLD, out);
   const TimeStepReport& rep = sim.time_step_report();

@@ -2,17 +2,36 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <sstream>
 #include <unordered_map>
 
+#include "dem/contact/normal_hooke.hpp"
 #include "dem/engine/restored_state.hpp"
 #include "dem/insert/insertion.hpp"
 #include "dem/walls/stl_reader.hpp"
+#include "dem/walls/wall_contact.hpp"
 #include "dem/walls/wall_travel.hpp"
 
 namespace grainflow {
 namespace {
+// How a half kick treats the spin: not at all (no torques), w += h/I T, or implicit in w
+// where a force term sets a spin drag (ImplicitDrag::spin_coefficient).
+enum SpinKick { kNoSpin, kSpin, kImplicitSpin };
+
+// w after a half kick h of the torque T and, implicitly, K_r (W - w'):
+// w' = (w + h/I (T + K_r W)) / (1 + h K_r / I).
+inline Vec3 implicit_spin(const Vec3& w, double h_over_i, const Vec3& torque, double kr,
+                          const Vec3& fluid_spin) {
+  return (w + h_over_i * (torque + kr * fluid_spin)) / (1 + h_over_i * kr);
+}
+
+SpinKick spin_kick(const ImplicitDrag& drag, bool needs_spin) {
+  if (!drag.spin_coefficient.empty()) return kImplicitSpin;
+  return needs_spin ? kSpin : kNoSpin;
+}
+
 bool is_set(const ContactHistory& h) { return !h.tangential.isZero(0) || !h.rolling.isZero(0); }
 
 template <class T>
@@ -135,6 +154,7 @@ void Simulation::initialise() {
     restore_implicit_drag();
   else
     check_contacts(compute_forces(), true);
+  check_force_limits();
   initialised_ = true;
 }
 
@@ -157,6 +177,86 @@ void Simulation::check_walls_travel() {
                         smallest.material, table_);
   for (const std::string& note : walls.notes) report_.notes.push_back(note);
   if (!walls.error.empty()) throw SetupError(walls.error);
+}
+
+void Simulation::check_force_limits() {
+  force_limits_.clear();
+  force_limit_notes_.clear();
+  for (const auto& term : terms_)
+    for (TermLimit& l : term->limits(p_, time_)) force_limits_.push_back(std::move(l));
+  // The smallest time scale and limit over the ranks, with the particle of the time scale
+  // (the same list of terms on every rank).
+  const std::size_t n = force_limits_.size();
+  if (n > 0 && decomp_->size() > 1) {
+    std::vector<double> least(2 * n);
+    for (std::size_t k = 0; k < n; ++k) {
+      least[2 * k] = force_limits_[k].tau;
+      least[2 * k + 1] = force_limits_[k].dt_max;
+    }
+    MPI_Allreduce(MPI_IN_PLACE, least.data(), static_cast<int>(2 * n), MPI_DOUBLE, MPI_MIN, comm_);
+    std::vector<std::int64_t> who(n);
+    for (std::size_t k = 0; k < n; ++k)
+      who[k] = force_limits_[k].tau == least[2 * k] ? force_limits_[k].particle
+                                                    : std::numeric_limits<std::int64_t>::max();
+    MPI_Allreduce(MPI_IN_PLACE, who.data(), static_cast<int>(n), MPI_INT64_T, MPI_MIN, comm_);
+    for (std::size_t k = 0; k < n; ++k) {
+      force_limits_[k].tau = least[2 * k];
+      force_limits_[k].dt_max = least[2 * k + 1];
+      force_limits_[k].particle = who[k];
+    }
+  }
+  for (const TermLimit& l : force_limits_) {
+    std::ostringstream o;
+    o.precision(4);
+    o << "fluid force " << l.term << ": ";
+    if (l.time_scale == "none")
+      o << l.rule;
+    else {
+      o << "time scale " << l.time_scale << " = " << l.tau << " s";
+      if (std::isfinite(l.tau)) o << " (particle " << l.particle << "), dt/tau = " << dt_ / l.tau;
+      o << "; " << l.rule;
+      if (std::isfinite(l.dt_max)) o << "; dt <= " << l.dt_max << " s";
+    }
+    report_.notes.push_back(o.str());
+    force_limit_notes_.push_back(o.str());
+    if (dt_ > l.dt_max) {
+      o.str("");
+      o << "error: dt = " << dt_ << " s is beyond the stability limit of the fluid force '"
+        << l.term << "' (dt <= " << l.dt_max << " s; " << l.rule
+        << "); use dt <= " << 0.9 * l.dt_max << " s, or remove '" << l.term
+        << "' from fluid.forces";
+      report_.notes.push_back(o.str());
+      force_limit_notes_.push_back(o.str());
+      report_.verdict = TimeStepReport::Verdict::refuse;
+    }
+  }
+}
+
+std::string Simulation::force_limits_summary() const {
+  if (force_limits_.empty()) return {};
+  std::ostringstream o;
+  o.precision(3);
+  o << "fluid force terms enabled (at start-up):";
+  const char* sep = " ";
+  for (const TermLimit& l : force_limits_) {
+    o << sep << l.term;
+    sep = ", ";
+    if (l.time_scale == "none") {
+      o << " (no limit)";
+    } else if (!std::isfinite(l.tau)) {
+      o << " (no time scale yet)";
+    } else {
+      o << " (dt/tau = " << dt_ / l.tau;
+      if (l.implicit)
+        o << ", implicit";
+      else if (std::isfinite(l.dt_max))
+        o << ", dt/limit = " << dt_ / l.dt_max;
+      else
+        o << ", stable at any dt";
+      o << ")";
+    }
+  }
+  return o.str();
 }
 
 void Simulation::mark_leaving() {
@@ -200,7 +300,9 @@ void Simulation::kick_and_drift() {
   const Vec3* fluid_u = drag_.fluid_velocity.data();
   const Vec3* built = x_at_build_.data();
   leaving_.clear();
-  const auto pass = [&]<bool Drag, bool Spin>() {
+  const double* spin_k = drag_.spin_coefficient.data();
+  const Vec3* fluid_w = drag_.fluid_spin.data();
+  const auto pass = [&]<bool Drag, SpinKick Spin>() {
     bool moved_far = false;
     double v2 = 0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -211,7 +313,9 @@ void Simulation::kick_and_drift() {
         const double a = h / mass[i], k = drag_k[i];
         v = (v + a * (force[i] + k * fluid_u[i])) / (1 + a * k);
       }
-      if constexpr (Spin) ws[i] += (h / inertia[i]) * torque[i];
+      if constexpr (Spin == kSpin) ws[i] += (h / inertia[i]) * torque[i];
+      if constexpr (Spin == kImplicitSpin)
+        ws[i] = implicit_spin(ws[i], h / inertia[i], torque[i], spin_k[i], fluid_w[i]);
       force[i] = mass[i] * g;
       torque[i].setZero();
       Vec3& x = xs[i];
@@ -228,11 +332,16 @@ void Simulation::kick_and_drift() {
     moved_beyond_half_skin_ = moved_far;
     local_speed2_ = v2;
   };
-  const bool drag = !drag_.coefficient.empty(), spin = sweep_.needs_spin;
-  if (drag)
-    spin ? pass.template operator()<true, true>() : pass.template operator()<true, false>();
+  const bool drag = !drag_.coefficient.empty();
+  const SpinKick spin = spin_kick(drag_, sweep_.needs_spin);
+  if (drag && spin == kImplicitSpin)
+    pass.template operator()<true, kImplicitSpin>();
+  else if (drag)
+    spin == kSpin ? pass.template operator()<true, kSpin>()
+                  : pass.template operator()<true, kNoSpin>();
   else
-    spin ? pass.template operator()<false, true>() : pass.template operator()<false, false>();
+    spin == kSpin ? pass.template operator()<false, kSpin>()
+                  : pass.template operator()<false, kNoSpin>();
   fresh_from_kick_ = true;
 }
 
@@ -484,6 +593,23 @@ void Simulation::write_checkpoint(const std::string& path) {
   grainflow::write_checkpoint(comm_, path, d);
   mark_leaving();
   rebuild(/*keep_drag=*/true);  // the next half kick uses the drag of this step's end
+  refresh_spin_drag();          // in the new order, as a restart from the file finds it
+}
+
+void Simulation::refresh_spin_drag() {
+  // The spin drag is not in the checkpoint: a function of the particles' state, the terms
+  // give it again, without adding their forces a second time or changing the drag.
+  bool spin = false;
+  for (const auto& term : terms_) spin |= term->implicit_spin();
+  if (!spin) return;
+  const std::vector<Vec3> force = p_.force, torque = p_.torque;
+  const std::vector<double> k = drag_.coefficient;
+  const std::vector<Vec3> u = drag_.fluid_velocity;
+  apply_force_terms();
+  p_.force = force;
+  p_.torque = torque;
+  drag_.coefficient = k;
+  drag_.fluid_velocity = u;
 }
 
 void Simulation::rebuild(bool keep_drag) {
@@ -678,38 +804,235 @@ bool Simulation::check_contacts(const ContactGuards& s, bool finite_here) const 
     o << "particles " << w.a << " and " << w.b;
   else
     o << "particle " << w.a << " and a wall";
-  const double tc =
-      hertz_contact_time(w.y_star, w.r_star, w.m_star, std::max(std::abs(w.speed), 1e-12));
-  const char* remedy =
-      " s would (1/20 of the Hertz contact time at that speed); lower time.step or "
-      "time.rayleigh_fraction, or raise time.expected_max_speed so that grain check warns "
-      "about it";
   if (!overlap) {
+    const double tc =
+        hertz_contact_time(w.y_star, w.r_star, w.m_star, std::max(std::abs(w.speed), 1e-12));
     o << " approach at " << w.speed << " m/s, overlapping by " << 100 * s.unresolved.overlap_ratio
       << " % of the smaller radius. At that speed a Hertz contact lasts " << tc << " s: only "
       << s.unresolved.fewest << " steps of dt = " << dt_ << " s (fewer than " << n_min
       << ", key time.min_steps_per_contact). So coarse a step cannot resolve the contact and "
          "can give it back more energy than it took. A step of at most "
-      << tc / 20 << remedy;
+      << tc / 20
+      << " s would (1/20 of the Hertz contact time at that speed); lower time.step or "
+         "time.rayleigh_fraction, or raise time.expected_max_speed so that grain check warns "
+         "about it";
   } else {
     o << " overlap by " << 100 * worst[0] << " % of the smaller radius (limit " << 100 * limit
       << " %, key time.max_overlap)";
-    if (w.speed > 1e-9)
-      o << ", approaching at " << w.speed << " m/s: the time step dt = " << dt_
-        << " s is too large to resolve this impact. A step of at most " << tc / 20 << remedy;
-    else if (w.speed < -1e-9)
-      // Deep and already separating at its first sight: the centre jumped past the other
-      // body's surface (a two-sided mesh, another particle's centre) within one step.
-      o << ", moving apart at " << -w.speed << " m/s: the centre has most likely crossed the "
-        << "other surface within one step of dt = " << dt_ << " s (tunnelled; or the two were "
-        << "placed overlapping). A step of at most " << tc / 20 << remedy;
-    else
-      o << " without approaching each other: the overlap was there at the start, or the load "
-        << "compresses a too-soft material; check the initial positions (insertion, CSV) or "
-        << "raise the Young's modulus";
+    describe_overlap(o, w, worst[0]);
   }
   agree_on_error(comm_, o.str());  // the rank holding the worst contact speaks
   return worst[3] == 0;            // not reached: agree_on_error throws on every rank
+}
+
+namespace {
+// A contact is resolved with at least this many steps per contact time; a proposed step is
+// the contact time over it, and is proposed only when it is smaller than the step that ran.
+constexpr double kResolvingSteps = 20;
+
+// At most 2 significant digits, rounded up (a proposal that must be reached).
+double round_up(double x) {
+  if (!(x > 0) || !std::isfinite(x)) return x;
+  const double unit = std::pow(10.0, std::floor(std::log10(x)) - 1);
+  return std::ceil(x / unit * (1 - 1e-12)) * unit;
+}
+}  // namespace
+
+void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double ratio) const {
+  // The two bodies: particles by id (local first, then ghosts), or the wall the particle
+  // overlaps most (planes and cylinders; a mesh gives no normal here, and no load).
+  struct Body {
+    bool found = false;
+    Vec3 x = Vec3::Zero();
+    double r = 0, m = 0;
+    int material = 0;
+    long local = -1;  // index among this rank's particles (their force is known), or -1
+  };
+  const auto find = [&](GlobalId id) {
+    Body b;
+    for (std::size_t i = 0; i < p_.size() && !b.found; ++i)
+      if (p_.id[i] == id)
+        b = {true, p_.x[i], p_.radius[i], p_.mass[i], p_.material[i], static_cast<long>(i)};
+    for (std::size_t q = 0; q < ghosts_.id.size() && !b.found; ++q)
+      if (ghosts_.id[q] == id)
+        b = {true, ghosts_.position(q), ghosts_.radius[q], ghosts_.mass[q], ghosts_.material[q],
+             -1};
+    return b;
+  };
+  const Body a = find(w.a);
+  const Body b = w.b >= 0 ? find(w.b) : Body{};
+  const Vec3 g = scene_.gravity;
+  ContactLoad c;
+  c.hertz = scene_.contact.normal == NormalModel::hertz;
+  c.speed = w.speed;
+  c.r_star = w.r_star;
+  c.m_star = w.m_star;
+  c.wall = w.b < 0;
+  c.r_i = a.r;
+  c.r_j = b.r;
+  c.r_small = c.wall ? a.r : std::min(a.r, b.r);
+  c.overlap = ratio * c.r_small;
+  int material_b = b.material;
+  std::string wall_name;
+  const WallSet::Entry* wall = nullptr;
+  Vec3 n = Vec3::Zero();  // the contact normal, towards a (zero: not known, a mesh)
+  if (c.wall) {
+    double best = std::numeric_limits<double>::infinity();
+    for (const WallSet::Entry& e : walls_.walls()) {
+      WallTouch t;
+      const bool touches = e.kind == Wall::Kind::plane ? touch_plane(e.plane, a.x, a.r, t)
+                           : e.kind == Wall::Kind::cylinder
+                               ? touch_cylinder(e.cylinder, a.x, a.r, t)
+                               : false;
+      if (touches && std::abs(t.overlap - c.overlap) < best) {
+        best = std::abs(t.overlap - c.overlap);
+        wall = &e;
+        n = t.n;
+      }
+    }
+    if (wall == nullptr)  // a mesh: the first one the particle could touch
+      for (const WallSet::Entry& e : walls_.walls())
+        if (e.kind == Wall::Kind::mesh && wall == nullptr) wall = &e;
+    if (wall != nullptr) {
+      material_b = wall->material;
+      wall_name = wall->name;
+    }
+  } else if (a.found && b.found) {
+    n = (a.x - b.x).normalized();
+  }
+  const PairCoefficients& pc = table_(a.material, material_b);
+  c.y_star = pc.y_star;
+  if (!c.hertz) c.kn = HookeNormal::coefficients(pc, constants_, c.r_star, c.m_star, 0).kn;
+  if (scene_.contact.cohesion == CohesionModel::sjkr) c.cohesion = pc.cohesion_energy_density;
+  // The load pressing the contact: for a partner held here, every force on it but this
+  // contact's (its weight, the particles and walls pressing on it, fluid forces), along n;
+  // this contact's own force is taken as its elastic part less cohesion (its damping, which
+  // resists the approach, is left in, so the load is if anything underestimated). For a
+  // partner on another rank, its weight.
+  std::string load_by;
+  if (n.squaredNorm() > 0) {
+    const double own = elastic_force(c, c.overlap) - cohesion_force(c, c.overlap);
+    const auto pressing = [&](const Body& body, double sign, GlobalId id) {
+      const double load =
+          body.local >= 0 ? own - sign * p_.force[body.local].dot(n) : -sign * body.m * g.dot(n);
+      if (load > c.load) {
+        c.load = load;
+        load_by = "particle " + std::to_string(id);
+      }
+    };
+    pressing(a, 1, w.a);  // a is pushed along +n by the contact
+    if (!c.wall && b.found) pressing(b, -1, w.b);
+  }
+  const double limit = scene_.time.max_overlap, at_limit = limit * c.r_small;
+  const double tc = pair_contact_time(scene_.contact, pc, constants_, c.r_star, c.m_star,
+                                      std::max(std::abs(w.speed), 1e-12));
+  const double steps = tc / dt_;
+  const char* remedy =
+      " s would resolve it (1/20 of the contact time at that speed); lower time.step or "
+      "time.rayleigh_fraction, or raise time.expected_max_speed so that grain check warns "
+      "about it";
+  if (w.speed < -1e-9) {
+    // Deep and already separating at its first sight: the centre jumped past the other
+    // body's surface (a two-sided mesh, another particle's centre) within one step.
+    o << ", moving apart at " << -w.speed << " m/s: the centre has most likely crossed the "
+      << "other surface within one step of dt = " << dt_ << " s (tunnelled; or the two were "
+      << "placed overlapping). A step of at most " << tc / kResolvingSteps << remedy;
+    return;
+  }
+  if (counters_.steps == 0 && w.speed <= 1e-9) {
+    o << " at the start, before any step: check the initial positions (insertion, CSV, "
+         "snapshot)";
+    return;
+  }
+  const double stop = stopping_overlap(c);
+  const auto stop_text = [&] {
+    std::ostringstream t;
+    t.precision(4);
+    if (stop < kNoStop)
+      t << "undamped, it stops at " << 100 * stop / c.r_small << " %";
+    else
+      t << "it does not stop before the overlap reaches the whole smaller radius";
+    return t.str();
+  };
+  if (w.speed > 1e-9)
+    o << ", approaching at " << w.speed << " m/s";
+  else
+    o << ", at rest";
+  if (steps < kResolvingSteps) {
+    o << ": the time step dt = " << dt_ << " s is too large to resolve this contact (it lasts "
+      << tc << " s at that speed, " << steps << " steps; " << kResolvingSteps
+      << " resolve it). A step of at most " << tc / kResolvingSteps << remedy
+      << ". (With that step, by its energy and load now, " << stop_text()
+      << "; if it stops again the contact is overloaded, and the message will say what carries "
+         "it)";
+    return;
+  }
+  std::vector<const WallSet::Entry*> moving;
+  for (const WallSet::Entry& e : walls_.walls())
+    if (e.pose.moving()) moving.push_back(&e);
+  o << ". No time step prevents this: dt = " << dt_ << " s already resolves the contact (it lasts "
+    << tc << " s at that speed, " << steps << " steps; " << kResolvingSteps
+    << " resolve it). The contact is overloaded: the spring carries " << elastic_force(c, at_limit)
+    << " N at the limit";
+  if (w.speed > 1e-9) o << "; the approach brings " << 0.5 * c.m_star * w.speed * w.speed << " J";
+  if (c.load > 0)
+    o << "; the other forces on " << load_by << " (weight, neighbours, walls) press it with "
+      << c.load << " N";
+  if (c.cohesion > 0)
+    o << "; cohesion (cohesion_energy_density " << c.cohesion << " J/m^3) pulls it in with "
+      << cohesion_force(c, at_limit) << " N at the limit";
+  const double r_large = std::max(a.r, b.r);
+  if (!c.wall && r_large > 3 * c.r_small)
+    o << "; a radius ratio of " << r_large / c.r_small << ": the smaller radius, " << c.r_small
+      << " m, sets the limit of " << at_limit << " m";
+  for (const WallSet::Entry* e : moving)
+    o << "; wall '" << e->name << "' moves by its prescribed motion whatever resists it, so "
+      << "particles it presses against others are squeezed by its travel";
+  o << ". By its energy and load now, " << stop_text() << ". What changes it:";
+  const double target = 0.9 * at_limit;
+  if (stop < kNoStop) {
+    const double need = round_up(1.1 * stop / c.r_small);
+    if (need <= 1)
+      o << " set time.max_overlap to at least " << need << " (knowingly: the overlap then "
+        << "stands for that much deformation"
+        << (moving.empty() ? ""
+                           : "; with a moving wall "
+                             "pressing, this only moves the stop later")
+        << ");";
+    else
+      o << " no time.max_overlap (at most 1) carries it;";
+  } else {
+    o << " no time.max_overlap (at most 1) carries it;";
+  }
+  if (moving.empty()) {
+    const ContactLoad touch = at_first_touch(c);
+    const double s = stiffness_factor_for(touch, target);
+    if (s < kNoStop && s > 1) {
+      if (c.hertz) {
+        const Material& m = scene_.materials[a.material];
+        o << " scale the Young's modulus by at least " << round_up(s) << " (material '" << m.name
+          << "': " << round_up(s) * m.youngs_modulus << " Pa"
+          << (material_b != a.material ? ", and the partner's alike" : "") << ");";
+      } else {
+        o << " set contact.hooke.stiffness.normal to at least " << round_up(s) * c.kn << " N/m;";
+      }
+    }
+    if (c.cohesion > 0) {
+      const double f = cohesion_factor_for(touch, target);
+      if (f >= 0 && f < 1)
+        o << " lower cohesion_energy_density to at most " << f * c.cohesion << " J/m^3;";
+      else if (f < 0)
+        o << " (without cohesion it is still overloaded);";
+    }
+    // The load and the impact where they are a tenth of what the spring holds at the limit.
+    const double spring = elastic_force(c, at_limit);
+    if (c.load > 0.1 * spring) o << " a smaller load on the contact;";
+    if (0.5 * c.m_star * w.speed * w.speed > 0.1 * 0.4 * spring * at_limit)
+      o << " a slower impact;";
+  }
+  for (const WallSet::Entry* e : moving)
+    o << " stop or slow wall '" << e->name << "' before it squeezes the particles this far;";
+  o << " (docs/stability.md, the overlap guard)";
 }
 
 void Simulation::restore_implicit_drag() {
@@ -724,6 +1047,7 @@ void Simulation::restore_implicit_drag() {
     p_.torque = torque;
     return;
   }
+  refresh_spin_drag();
   drag_.coefficient.assign(p_.size(), 0.0);
   drag_.fluid_velocity.assign(p_.size(), Vec3::Zero());
   for (std::size_t i = 0; i < p_.size(); ++i) {
@@ -739,20 +1063,26 @@ void Simulation::apply_force_terms() {
   if (!terms_.empty()) {
     drag_.coefficient.assign(p_.size(), 0.0);
     drag_.fluid_velocity.assign(p_.size(), Vec3::Zero());
+    bool spin = false;
+    for (const auto& term : terms_) spin |= term->implicit_spin();
+    if (spin) {
+      drag_.spin_coefficient.assign(p_.size(), 0.0);
+      drag_.fluid_spin.assign(p_.size(), Vec3::Zero());
+    }
     for (auto& term : terms_) term->add(p_, time_, drag_);
   }
 }
 
 namespace {
 // One half kick of velocity Verlet over n particles: v += h/m F (implicit in v where drag
-// is set), and w += h/I T when the law has torques. Written on the arrays' addresses, one
-// loop per case, so that the loops hold no branch and no reload of an address. With Guard,
-// returns whether every x, v and w is finite after it: x - x is 0 for a finite x and NaN
-// for an infinite or NaN one, and NaN stays in a sum.
-template <bool Guard, bool Drag, bool Spin>
+// is set), and w += h/I T when the law has torques (implicit in w with a spin drag). Written
+// on the arrays' addresses, one loop per case, so that the loops hold no branch and no
+// reload of an address. With Guard, returns whether every x, v and w is finite after it:
+// x - x is 0 for a finite x and NaN for an infinite or NaN one, and NaN stays in a sum.
+template <bool Guard, bool Drag, SpinKick Spin>
 bool kick(std::size_t n, double h, const Vec3* x, Vec3* v, Vec3* w, const Vec3* force,
           const Vec3* torque, const double* mass, const double* inertia, const double* drag_k,
-          const Vec3* fluid_u) {
+          const Vec3* fluid_u, const double* spin_k, const Vec3* fluid_w) {
   double nan_if_any = 0;
   for (std::size_t i = 0; i < n; ++i) {
     if constexpr (!Drag) {
@@ -762,7 +1092,9 @@ bool kick(std::size_t n, double h, const Vec3* x, Vec3* v, Vec3* w, const Vec3* 
       const double a = h / mass[i], k = drag_k[i];
       v[i] = (v[i] + a * (force[i] + k * fluid_u[i])) / (1 + a * k);
     }
-    if constexpr (Spin) w[i] += (h / inertia[i]) * torque[i];
+    if constexpr (Spin == kSpin) w[i] += (h / inertia[i]) * torque[i];
+    if constexpr (Spin == kImplicitSpin)
+      w[i] = implicit_spin(w[i], h / inertia[i], torque[i], spin_k[i], fluid_w[i]);
     if constexpr (Guard) nan_if_any += ((x[i] - x[i]) + (v[i] - v[i]) + (w[i] - w[i])).sum();
   }
   return nan_if_any == 0;
@@ -775,15 +1107,22 @@ bool Simulation::half_kick() {
   const std::size_t n = p_.size();
   const double* k = drag_.coefficient.data();
   const Vec3* u = drag_.fluid_velocity.data();
+  const double* kr = drag_.spin_coefficient.data();
+  const Vec3* uw = drag_.fluid_spin.data();
   Particles& p = p_;
-  const auto run = [&]<bool Drag, bool Spin>() {
+  const auto run = [&]<bool Drag, SpinKick Spin>() {
     return kick<Guard, Drag, Spin>(n, h, p.x.data(), p.v.data(), p.omega.data(), p.force.data(),
-                                   p.torque.data(), p.mass.data(), p.inertia.data(), k, u);
+                                   p.torque.data(), p.mass.data(), p.inertia.data(), k, u, kr, uw);
   };
-  const bool drag = !drag_.coefficient.empty(), spin = sweep_.needs_spin;
-  if (drag)
-    return spin ? run.template operator()<true, true>() : run.template operator()<true, false>();
-  return spin ? run.template operator()<false, true>() : run.template operator()<false, false>();
+  const bool drag = !drag_.coefficient.empty();
+  const SpinKick spin = spin_kick(drag_, sweep_.needs_spin);
+  if (drag) {
+    if (spin == kImplicitSpin) return run.template operator()<true, kImplicitSpin>();
+    return spin == kSpin ? run.template operator()<true, kSpin>()
+                         : run.template operator()<true, kNoSpin>();
+  }
+  return spin == kSpin ? run.template operator()<false, kSpin>()
+                       : run.template operator()<false, kNoSpin>();
 }
 
 void Simulation::step() {

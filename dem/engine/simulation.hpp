@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <ostream>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -18,6 +19,7 @@
 #include "dem/core/particles.hpp"
 #include "dem/engine/contact_sweep.hpp"
 #include "dem/engine/force_term.hpp"
+#include "dem/engine/overload.hpp"
 #include "dem/engine/time_step.hpp"
 #include "dem/insert/stream_insertion.hpp"
 #include "dem/io/checkpoint.hpp"
@@ -86,6 +88,13 @@ class Simulation {
   // before initialise().
   void add_force_term(std::unique_ptr<ForceTerm> term) { terms_.push_back(std::move(term)); }
   const ImplicitDrag& implicit_drag() const { return drag_; }
+  // The force terms' stability limits found at initialise() (TermLimit), the same on every
+  // rank, and the same as one line: each term with dt / its time scale, for messages.
+  const std::vector<TermLimit>& force_limits() const { return force_limits_; }
+  std::string force_limits_summary() const;
+  // The lines check_force_limits() added to the time-step report (also for runs that do not
+  // print the report, the coupled DEM).
+  const std::vector<std::string>& force_limit_notes() const { return force_limit_notes_; }
   std::vector<std::string> force_term_reports() const {
     std::vector<std::string> out;
     for (const auto& t : terms_) out.push_back(t->report());
@@ -165,6 +174,12 @@ class Simulation {
   ContactGuards compute_forces();  // gravity, contacts, then the force terms
   void apply_force_terms();  // non-contact terms only
   void restore_implicit_drag();  // initialise() after restore()
+  // The terms' implicit spin drag at the present state, in the present order (after a
+  // checkpoint's rebuild, or a restore); forces, torques and drag unchanged.
+  void refresh_spin_drag();
+  // Each force term's stability limit at the present state, over every rank; notes in the
+  // time-step report, and a refusal there for a step beyond an explicit term's limit.
+  void check_force_limits();
   // Stops the run (ParallelError on every rank) when a contact overlaps beyond
   // time.max_overlap, or when a Hertz contact gets fewer than time.min_steps_per_contact
   // steps at its own approach speed; the message names the contact and a time step that
@@ -172,6 +187,9 @@ class Simulation {
   // radii in the last drift (`guards.fast`). Returns whether every rank's state is finite
   // (`finite_here`: this rank's). Collective: the step's one reduction.
   bool check_contacts(const ContactGuards& guards, bool finite_here) const;
+  // The overlap guard's diagnosis of the contact `w` at `ratio` of the smaller radius
+  // (overload.hpp): a step that resolves it, or what carries the load (error path only).
+  void describe_overlap(std::ostream& o, const WorstContact& w, double ratio) const;
   FastParticle fastest_particle(double v2_max) const;  // v2_max: largest local |v|^2
   // Whether any contact of this step could fail the steps-per-contact test (else the
   // sweep skips it): a bound from the fastest local (v2_local: its |v|^2) or ghost particle.
@@ -225,6 +243,8 @@ class Simulation {
   std::vector<char> leaving_;
   std::vector<std::unique_ptr<ForceTerm>> terms_;
   ImplicitDrag drag_;
+  std::vector<TermLimit> force_limits_;
+  std::vector<std::string> force_limit_notes_;
   Counters counters_;
   TimeStepReport report_;
   std::vector<CheckpointSpring> restored_springs_;  // from restore(), until initialise()

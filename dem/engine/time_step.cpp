@@ -20,7 +20,6 @@ double hertz_contact_time(double y_star, double r_star, double m_star, double sp
   return 2.868 * std::pow(m_star * m_star / (r_star * y_star * y_star * speed), 0.2);
 }
 
-namespace {
 double pair_contact_time(const ContactSettings& cs, const PairCoefficients& pc,
                          const ContactConstants& cc, double r_star, double m_star, double v) {
   if (cs.normal == NormalModel::hertz) return hertz_contact_time(pc.y_star, r_star, m_star, v);
@@ -28,6 +27,8 @@ double pair_contact_time(const ContactSettings& cs, const PairCoefficients& pc,
   const double w2 = s.kn / m_star - std::pow(s.gn / (2 * m_star), 2);
   return w2 > 0 ? std::numbers::pi / std::sqrt(w2) : std::numeric_limits<double>::infinity();
 }
+
+namespace {
 
 struct PairImpact {
   std::string pair;

@@ -38,6 +38,10 @@ constexpr double kRefuseStepsPerContact = 5;
 
 double rayleigh_time(const Material& m, double radius);
 double hertz_contact_time(double y_star, double r_star, double m_star, double speed);
+// The contact time of a pair under the scene's normal law (Hertz at approach speed v; Hooke,
+// damped, independent of v; infinity for an overdamped Hooke contact).
+double pair_contact_time(const ContactSettings& cs, const PairCoefficients& pc,
+                         const ContactConstants& cc, double r_star, double m_star, double v);
 
 TimeStepReport check_time_step(const Scene& scene, const Particles& p, const PairTable& table,
                                const ContactConstants& constants);

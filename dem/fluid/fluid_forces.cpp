@@ -1,9 +1,14 @@
 #include "dem/fluid/fluid_forces.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <numbers>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "dem/core/number_format.hpp"
 #include "dem/fluid/beetstra.hpp"
@@ -12,18 +17,25 @@
 #include "dem/fluid/ergun.hpp"
 #include "dem/fluid/gidaspow.hpp"
 #include "dem/fluid/koch_hill.hpp"
-#include "dem/fluid/rong.hpp"
-#include "dem/fluid/schiller_naumann.hpp"
-#include "dem/fluid/tenneti_garg_subramaniam.hpp"
-#include "dem/fluid/wen_yu.hpp"
 #include "dem/fluid/magnus_lift.hpp"
+#include "dem/fluid/rong.hpp"
 #include "dem/fluid/rotational_drag.hpp"
 #include "dem/fluid/saffman_mei_lift.hpp"
+#include "dem/fluid/schiller_naumann.hpp"
+#include "dem/fluid/tenneti_garg_subramaniam.hpp"
 #include "dem/fluid/void_fraction_grid.hpp"
 #include "dem/fluid/volume_forces.hpp"
+#include "dem/fluid/wen_yu.hpp"
 
 namespace grainflow {
 namespace {
+
+std::string significant(double x) {
+  std::ostringstream o;
+  o.precision(4);
+  o << x;
+  return o.str();
+}
 
 struct Enabled {
   bool drag = false, pressure = false, viscous = false, buoyancy = false, virtual_mass = false,
@@ -48,6 +60,103 @@ class FluidForcesWith final : public ForceTerm {
            " cells; clamped to the minimum " + std::to_string(grid_->clamped_cells_total()) +
            " times (cell-steps), removing " + significant(grid_->clamped_volume_total()) +
            " m^3 of solid volume in total";
+  }
+
+  bool implicit_spin() const override { return on_.rotation; }
+
+  std::vector<TermLimit> limits(const Particles& p, double /*time*/) const override {
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    std::vector<TermLimit> out;
+    TermLimit drag{"drag", "m/K (Stokes: rho_p d^2/(18 mu f))",         inf, -1, true,
+                   inf,    "implicit in the velocity: stable at any dt"};
+    TermLimit spin{"rotational_drag",
+                   "I/K_r (Stokes: rho_p d^2/(60 mu))",
+                   inf,
+                   -1,
+                   true,
+                   inf,
+                   "implicit in the spin: stable at any dt"};
+    TermLimit saffman{
+        "saffman_mei", "m/K_L, K_L = 1.615 d^2 sqrt(rho_f mu |curl u|) f", inf, -1, false, inf, ""};
+    TermLimit magnus{
+        "magnus", "m/K_M, K_M = (pi/8) d^3 rho_f |Omega| (Re_p/Re_r) C_LR", inf, -1, false, inf,
+        ""};
+    // The drag time scale of the particle with each lift's shortest time scale.
+    double saffman_drag = inf, magnus_drag = inf;
+    CoupledFluid::View samples;
+    if (coupled_) samples = coupled_->at_particles(p);
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      FluidSample f = coupled_ ? coupled_->sample(samples, i) : s_.field.sample(p.x[i], gravity_);
+      if (grid_) f.void_fraction = grid_->at(p.x[i]);
+      const double d = 2 * p.radius[i];
+      const Vec3 slip = f.velocity - p.v[i];
+      const double u = slip.norm();
+      const double k = Law({d, u, f.void_fraction, f.density, f.viscosity});
+      const double tau_d = k > 0 ? p.mass[i] / k : inf;
+      if (tau_d < drag.tau)
+        drag = {drag.term, drag.time_scale, tau_d, p.id[i], true, inf, drag.rule};
+      const Vec3 relative_rotation = 0.5 * f.vorticity - p.omega[i];
+      if (on_.rotation) {
+        const double kr =
+            rotational_drag_coefficient(d, f.density, f.viscosity, relative_rotation.norm());
+        const double tau = kr > 0 ? p.inertia[i] / kr : inf;
+        if (tau < spin.tau) spin = {spin.term, spin.time_scale, tau, p.id[i], true, inf, spin.rule};
+      }
+      const double w = f.vorticity.norm();
+      if (on_.saffman && w > 0) {
+        const double re_p = f.density * d * u / f.viscosity;
+        const double re_s = f.density * d * d * w / f.viscosity;
+        const double kl = 1.615 * d * d * std::sqrt(f.density * f.viscosity * w) *
+                          saffman_mei_correction(re_p, re_s);
+        const double tau = p.mass[i] / kl;
+        if (tau < saffman.tau) {
+          saffman.tau = tau;
+          saffman.particle = p.id[i];
+          saffman_drag = tau_d;
+        }
+        saffman.dt_max = std::min(saffman.dt_max, explicit_lift_limit(tau, tau_d));
+      }
+      const double wr = relative_rotation.norm();
+      if (on_.magnus && wr > 0) {
+        const double re_p = f.density * d * u / f.viscosity;
+        const double re_r = f.density * d * d * wr / f.viscosity;
+        const double km =
+            std::numbers::pi / 8 * d * d * d * f.density * wr * magnus_factor(re_p, re_r);
+        const double tau = p.mass[i] / km;
+        if (tau < magnus.tau) {
+          magnus.tau = tau;
+          magnus.particle = p.id[i];
+          magnus_drag = tau_d;
+        }
+        magnus.dt_max = std::min(magnus.dt_max, explicit_lift_limit(tau, tau_d));
+      }
+    }
+    if (on_.drag) out.push_back(drag);
+    if (on_.rotation) out.push_back(spin);
+    for (auto [lift, tau_d] :
+         {std::pair{&saffman, saffman_drag}, std::pair{&magnus, magnus_drag}}) {
+      if (lift == &saffman ? !on_.saffman : !on_.magnus) continue;
+      // dt_max: the least over the particles, each with its own drag time scale.
+      if (!(lift->tau < inf))
+        lift->rule = "no shear or rotation at the particles now: no limit yet";
+      else if (lift->dt_max == inf)
+        lift->rule =
+            "explicit; weaker than the implicit drag (tau_L >= tau_d = " + significant(tau_d) +
+            " s): stable at any dt";
+      else
+        lift->rule = "explicit; stable while sqrt(1 + (dt/tau_L)^2) <= 1 + dt/tau_d, tau_d = " +
+                     significant(tau_d) + " s";
+      out.push_back(*lift);
+    }
+    const auto no_limit = [&](bool on, const char* name, const char* why) {
+      if (on) out.push_back({name, "none", inf, -1, true, inf, why});
+    };
+    no_limit(on_.pressure, "pressure_gradient", "independent of the particle's velocity: no limit");
+    no_limit(on_.viscous, "viscous", "independent of the particle's velocity: no limit");
+    no_limit(on_.buoyancy, "buoyancy", "constant: no limit");
+    no_limit(on_.virtual_mass, "virtual_mass",
+             "solved within the particle's equation (added mass): no limit");
+    return out;
   }
 
   void add(Particles& p, double /*time*/, ImplicitDrag& drag) override {
@@ -94,8 +203,16 @@ class FluidForcesWith final : public ForceTerm {
           force += lift;
           carried += lift;
         }
-        if (on_.rotation)
-          p.torque[i] += rotational_drag_torque(d, f.density, f.viscosity, relative_rotation);
+        if (on_.rotation) {
+          // Implicit in the spin (ImplicitDrag): K_r at this step's relative rotation.
+          const double kr =
+              rotational_drag_coefficient(d, f.density, f.viscosity, relative_rotation.norm());
+          const double kr_sum = drag.spin_coefficient[i] + kr;
+          if (kr_sum > 0)
+            drag.fluid_spin[i] =
+                (drag.spin_coefficient[i] * drag.fluid_spin[i] + kr * 0.5 * f.vorticity) / kr_sum;
+          drag.spin_coefficient[i] = kr_sum;
+        }
       }
       p.force[i] += force;
       if (coupled_) coupled_->exchange_force[i] = carried;

@@ -5,6 +5,7 @@
 // compiled into the particle loop.
 #include <mpi.h>
 
+#include <limits>
 #include <memory>
 
 #include "dem/engine/force_term.hpp"
@@ -13,6 +14,15 @@
 #include "dem/scene/scene.hpp"
 
 namespace grainflow {
+
+// The largest time step at which an explicit lift (a force across the slip, growing it at
+// the rate 1/tau_l) together with the implicit drag (damping it at 1/tau_d) does not amplify
+// the slip in one step: sqrt(1 + (dt/tau_l)^2) <= 1 + dt/tau_d, i.e.
+// dt (1/tau_l^2 - 1/tau_d^2) <= 2/tau_d. Infinity when tau_l >= tau_d (any dt is stable).
+inline double explicit_lift_limit(double tau_l, double tau_d) {
+  if (!(tau_l < tau_d)) return std::numeric_limits<double>::infinity();
+  return 2 / (tau_d * (1 / (tau_l * tau_l) - 1 / (tau_d * tau_d)));
+}
 
 // `gravity` is the scene's (for Archimedes buoyancy). Throws UnknownDragLaw or
 // std::invalid_argument for settings the parser would have refused.

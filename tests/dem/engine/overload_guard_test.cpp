@@ -1,0 +1,283 @@
+// The overlap guard tells an overloaded contact from a time step too coarse for it
+// (docs/stability.md, "The overlap guard"; issue 17 item 3). Four scenes that no time step
+// can save: a sphere dropped on a soft Hooke spring, a sphere pulled into a floor by strong
+// SJKR cohesion, a 2 mm sphere resting on a 0.1 mm one (radius ratio 20), and a piston
+// crushing a bed. Each must stop with "No time step prevents this" (its step already
+// resolves the contact: t_c(v)/dt >= 20, t_c by the same rule as the steps check) and no
+// proposed step; then every proposal the message makes (time.max_overlap, stiffness,
+// cohesion) is rerun and must get further: run to the end, or stop later.
+//
+// References: the Hooke contact time pi/sqrt(k/m* - (gamma/2m*)^2) and the undamped peak
+// overlap v sqrt(m*/k) (linear oscillator); the Hertz force (4/3) Y* sqrt(R*) delta^{3/2}
+// and SJKR force k_c pi (2 r delta - delta^2) on a wall (DESIGN.md §3).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <numbers>
+#include <string>
+
+#include "dem/engine/overload.hpp"
+#include "dem/engine/simulation.hpp"
+#include "tests/dem/support/test_scene.hpp"
+
+namespace grainflow {
+namespace {
+
+constexpr double kRho = 2500, kNu = 0.3, kG = 9.81;
+
+double number_after(const std::string& m, const std::string& key) {
+  const auto at = m.find(key);
+  if (at == std::string::npos) return std::nan("");
+  return std::stod(m.substr(at + key.size()));
+}
+
+struct Outcome {
+  std::string stop;  // the guard's message, or "" when it ran to the end
+  double time = 0;   // when it stopped (or the end)
+};
+
+// Runs `scene` with the particles `place` adds, for `t_end`, at dt.
+Outcome run(const Scene& scene, const std::function<void(Particles&)>& place, double dt,
+            double t_end) {
+  Simulation sim(scene, false);
+  place(sim.particles());
+  sim.set_dt(dt);
+  Outcome out;
+  try {
+    sim.initialise();
+    while (sim.time() < t_end - 0.5 * dt) sim.step();
+  } catch (const ParallelError& e) {
+    out.stop = e.what();
+  }
+  out.time = sim.time();
+  return out;
+}
+
+// The diagnosis every overload scene must get.
+void expect_overload(const Outcome& o) {
+  ASSERT_FALSE(o.stop.empty()) << "expected the overlap guard to stop the run";
+  std::printf("[ message  ] %s\n", o.stop.c_str());
+  EXPECT_NE(o.stop.find("key time.max_overlap"), std::string::npos) << o.stop;
+  EXPECT_NE(o.stop.find("No time step prevents this"), std::string::npos) << o.stop;
+  EXPECT_NE(o.stop.find("overloaded"), std::string::npos) << o.stop;
+  EXPECT_EQ(o.stop.find("A step of at most"), std::string::npos) << o.stop;
+  // The steps it counts are t_c/dt >= 20, the rule a proposed step would come from.
+  EXPECT_GE(number_after(o.stop, " s at that speed, "), 20.0) << o.stop;
+}
+
+// A proposal rerun: it passes, or stops later.
+void expect_further(const Outcome& first, const Outcome& again, const char* what) {
+  std::printf("[ measured ] %s: first stop at t = %.4g s; rerun %s at t = %.4g s\n", what,
+              first.time, again.stop.empty() ? "ran to the end" : "stopped", again.time);
+  if (!again.stop.empty()) {
+    EXPECT_GT(again.time, first.time) << what << ": " << again.stop;
+  }
+}
+
+Scene base_scene(double youngs, double restitution) {
+  Scene s = test::one_material_scene(youngs, kNu, kRho, restitution);
+  s.gravity = Vec3(0, 0, -kG);
+  s.walls.push_back(test::plane(Vec3::Zero(), Vec3::UnitZ()));
+  s.walls.back().name = "floor";
+  return s;
+}
+
+// One 1 mm sphere at 1.2 m/s onto a floor on a Hooke spring k_n = 100 N/m, e = 0.9: the
+// contact lasts ~1 ms, 1000 steps of 1e-6 s; its undamped peak v sqrt(m/k) = 0.39 r passes
+// 0.25 r (damped, about 0.33 r).
+TEST(OverloadGuard, SoftHookeSpring) {
+  const double r = 1e-3, k = 100, dt = 1e-6, e = 0.9;
+  Scene s = base_scene(1e7, e);
+  s.contact.normal = NormalModel::hooke;
+  s.contact.hooke_kn = k;
+  s.contact.hooke_kt = k;
+  const auto place = [&](Particles& p) {
+    p.add(1, Vec3(0, 0, r * (1 + 1e-6)), Vec3(0, 0, -1.2), Vec3::Zero(), r, 0, kRho);
+  };
+  const double m = kRho * sphere_volume(r);
+  const Outcome first = run(s, place, dt, 5e-3);
+  expect_overload(first);
+  // Closed form of the damped linear oscillator: gamma = sqrt(4 m k)/sqrt(1 + (pi/ln e)^2);
+  // t_c = pi / sqrt(k/m - (gamma/2m)^2); the message prints 4 digits.
+  const double gamma =
+      std::sqrt(4 * m * k) / std::sqrt(1 + std::pow(std::numbers::pi / std::log(e), 2));
+  const double tc = std::numbers::pi / std::sqrt(k / m - std::pow(gamma / (2 * m), 2));
+  EXPECT_NEAR(number_after(first.stop, " s at that speed, ") / (tc / dt), 1.0, 1e-3) << first.stop;
+  // The undamped peak overlap: at speed v and overlap d now, k x^2 = k d^2 + m v^2 (+ the
+  // weight's work, under 1e-3 of it here): within 1 %.
+  const double v = number_after(first.stop, "approaching at ");
+  const double d = number_after(first.stop, "overlap by ") / 100 * r;
+  const double peak = std::sqrt(d * d + m * v * v / k);
+  EXPECT_NEAR(number_after(first.stop, "undamped, it stops at ") / (100 * peak / r), 1.0, 0.01)
+      << first.stop;
+
+  Scene a = s;
+  a.time.max_overlap = number_after(first.stop, "set time.max_overlap to at least ");
+  ASSERT_TRUE(a.time.max_overlap > 0.25 && a.time.max_overlap <= 1) << first.stop;
+  expect_further(first, run(a, place, dt, 5e-3), "Hooke, proposed max_overlap");
+  Scene b = s;
+  b.contact.hooke_kn = number_after(first.stop, "contact.hooke.stiffness.normal to at least ");
+  b.contact.hooke_kt = b.contact.hooke_kn;
+  ASSERT_GT(*b.contact.hooke_kn, k) << first.stop;
+  const Outcome stiff = run(b, place, dt, 5e-3);
+  EXPECT_TRUE(stiff.stop.empty()) << stiff.stop;
+  expect_further(first, stiff, "Hooke, proposed stiffness");
+}
+
+// A 1 mm sphere touching a floor, Y = 1e7 Pa, SJKR k_c = 1e6 J/m^3: at 0.25 r the cohesion
+// pulls with k_c pi (2 r d - d^2) = 1.37 N, the Hertz spring pushes with 0.92 N.
+TEST(OverloadGuard, StrongCohesion) {
+  const double r = 1e-3, dt = 1e-6;
+  Scene s = base_scene(1e7, 0.5);
+  s.contact.cohesion = CohesionModel::sjkr;
+  s.pairs[0].cohesion_energy_density = 1e6;
+  const auto place = [&](Particles& p) {
+    p.add(1, Vec3(0, 0, r * (1 - 1e-6)), Vec3::Zero(), Vec3::Zero(), r, 0, kRho);
+  };
+  const Outcome first = run(s, place, dt, 0.01);
+  expect_overload(first);
+  const double d = 0.25 * r, y_star = 1e7 / (2 * (1 - kNu * kNu));
+  EXPECT_NEAR(number_after(first.stop, "pulls it in with ") /
+                  (1e6 * std::numbers::pi * (2 * r * d - d * d)),
+              1.0, 1e-3)
+      << first.stop;
+  EXPECT_NEAR(number_after(first.stop, "the spring carries ") /
+                  (4.0 / 3 * y_star * std::sqrt(r) * std::pow(d, 1.5)),
+              1.0, 1e-3)
+      << first.stop;
+
+  Scene a = s;
+  const double y_factor = number_after(first.stop, "scale the Young's modulus by at least ");
+  ASSERT_GT(y_factor, 1) << first.stop;
+  a.materials[0].youngs_modulus *= y_factor;
+  const Outcome stiff = run(a, place, dt, 0.01);
+  EXPECT_TRUE(stiff.stop.empty()) << stiff.stop;
+  expect_further(first, stiff, "cohesion, proposed Young's modulus");
+  Scene b = s;
+  b.pairs[0].cohesion_energy_density =
+      number_after(first.stop, "lower cohesion_energy_density to at most ");
+  ASSERT_LT(b.pairs[0].cohesion_energy_density, 1e6) << first.stop;
+  const Outcome weak = run(b, place, dt, 0.01);
+  EXPECT_TRUE(weak.stop.empty()) << weak.stop;
+  expect_further(first, weak, "cohesion, proposed cohesion_energy_density");
+  if (const double mo = number_after(first.stop, "set time.max_overlap to at least "); mo > 0) {
+    Scene c = s;
+    c.time.max_overlap = mo;
+    expect_further(first, run(c, place, dt, 0.01), "cohesion, proposed max_overlap");
+  } else {
+    EXPECT_NE(first.stop.find("no time.max_overlap (at most 1) carries it"), std::string::npos)
+        << first.stop;
+  }
+}
+
+// A 2 mm sphere set on a 0.1 mm one on the floor, exactly above it, Y = 2e5 Pa: its weight,
+// 8.2e-4 N, is 4.5 times what the small sphere's contacts carry at 0.25 of 0.1 mm.
+// The same stop at 4x and 10x smaller steps: the step is not the cause.
+TEST(OverloadGuard, RadiusRatioTwenty) {
+  const double big = 2e-3, small = 1e-4;
+  Scene s = base_scene(2e5, 0.5);
+  const auto place = [&](Particles& p) {
+    p.add(1, Vec3(0, 0, small * (1 - 1e-6)), Vec3::Zero(), Vec3::Zero(), small, 0, kRho);
+    p.add(2, Vec3(0, 0, 2 * small + big - 1e-9), Vec3::Zero(), Vec3::Zero(), big, 0, kRho);
+  };
+  const double end = 0.02;
+  Outcome first;
+  for (const double dt : {1e-6, 2.5e-7, 1e-7}) {
+    first = run(s, place, dt, end);
+    SCOPED_TRACE(dt);
+    expect_overload(first);
+    EXPECT_NE(first.stop.find("radius ratio of 20"), std::string::npos) << first.stop;
+  }
+  const double dt = 1e-6;
+  first = run(s, place, dt, end);
+  Scene a = s;
+  const double y_factor = number_after(first.stop, "scale the Young's modulus by at least ");
+  ASSERT_GT(y_factor, 1) << first.stop;
+  a.materials[0].youngs_modulus *= y_factor;
+  const Outcome stiff = run(a, place, dt, end);
+  expect_further(first, stiff, "radius ratio 20, proposed Young's modulus");
+  if (const double mo = number_after(first.stop, "set time.max_overlap to at least "); mo > 0) {
+    Scene c = s;
+    c.time.max_overlap = mo;
+    expect_further(first, run(c, place, dt, end), "radius ratio 20, proposed max_overlap");
+  } else {
+    EXPECT_NE(first.stop.find("no time.max_overlap (at most 1) carries it"), std::string::npos)
+        << first.stop;
+  }
+}
+
+// A piston (a plane moving down at 0.1 m/s) crushing a bed of 3 x 3 x 2 spheres in a box
+// that fits it exactly: the bed cannot give way, so its overlaps grow with the piston's
+// travel whatever the step or the stiffness.
+TEST(OverloadGuard, PistonCrushingABed) {
+  const double r = 1e-3, dt = 2e-6, v = 0.1;
+  Scene s = base_scene(1e7, 0.5);
+  const auto wall = [&](const Vec3& point, const Vec3& normal, const char* name) {
+    s.walls.push_back(test::plane(point, normal));
+    s.walls.back().name = name;
+  };
+  wall(Vec3::Zero(), Vec3::UnitX(), "x0");
+  wall(Vec3(6 * r, 0, 0), -Vec3::UnitX(), "x1");
+  wall(Vec3::Zero(), Vec3::UnitY(), "y0");
+  wall(Vec3(0, 6 * r, 0), -Vec3::UnitY(), "y1");
+  wall(Vec3(0, 0, 4 * r), -Vec3::UnitZ(), "piston");
+  s.walls.back().motion.velocity = Vec3(0, 0, -v);
+  const auto place = [&](Particles& p) {
+    GlobalId id = 1;
+    for (int k = 0; k < 2; ++k)
+      for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i)
+          p.add(id++, Vec3((2 * i + 1) * r, (2 * j + 1) * r, (2 * k + 1) * r), Vec3::Zero(),
+                Vec3::Zero(), r, 0, kRho);
+  };
+  const double end = 0.02;  // 2 mm of travel: far beyond what the bed can take
+  const Outcome first = run(s, place, dt, end);
+  expect_overload(first);
+  EXPECT_NE(first.stop.find("wall 'piston' moves by its prescribed motion"), std::string::npos)
+      << first.stop;
+  EXPECT_NE(first.stop.find("stop or slow wall 'piston'"), std::string::npos) << first.stop;
+  // No stiffness proposal: a prescribed motion squeezes a stiffer bed just as far.
+  EXPECT_EQ(first.stop.find("scale the Young's modulus"), std::string::npos) << first.stop;
+  const double mo = number_after(first.stop, "set time.max_overlap to at least ");
+  ASSERT_TRUE(mo > 0.25 && mo <= 1) << first.stop;
+  Scene a = s;
+  a.time.max_overlap = mo;
+  const Outcome again = run(a, place, dt, end);
+  expect_further(first, again, "piston, proposed max_overlap");
+  // It only moves the stop later: the piston keeps coming.
+  EXPECT_FALSE(again.stop.empty());
+}
+
+// The energy balance of overload.hpp against closed forms: a Hooke contact at speed v from
+// first touch stops at v sqrt(m/k); a Hertz contact under a constant load W from rest at
+// (15 W / (8 Y* sqrt(R*)))^{2/3} (W x = (8/15) Y* sqrt(R*) x^{5/2}).
+TEST(OverloadGuard, StoppingOverlapClosedForms) {
+  ContactLoad h;
+  h.hertz = false;
+  h.kn = 100;
+  h.m_star = 1e-5;
+  h.r_small = 1e-3;
+  h.speed = 1;
+  EXPECT_NEAR(stopping_overlap(h) / std::sqrt(1e-5 / 100), 1.0, 1e-4);
+  ContactLoad z;
+  z.y_star = 5e6;
+  z.r_star = 1e-3;
+  z.r_small = 1e-3;
+  z.m_star = 1e-5;
+  z.load = 0.5;
+  const double x = std::pow(15 * 0.5 / (8 * 5e6 * std::sqrt(1e-3)), 2.0 / 3.0);
+  EXPECT_NEAR(stopping_overlap(z) / x, 1.0, 1e-4);
+  // From half way with the speed the balance gives there: the same peak.
+  ContactLoad mid = h;
+  mid.overlap = 0.5 * std::sqrt(1e-5 / 100);
+  mid.speed = std::sqrt(1 - 100 * mid.overlap * mid.overlap / 1e-5);
+  EXPECT_NEAR(at_first_touch(mid).speed, 1.0, 1e-9);
+  // The stiffness that stops it at x: k x^2 = m v^2.
+  const double target = 0.2e-3;
+  EXPECT_NEAR(stiffness_factor_for(h, target) * 100 / (1e-5 / (target * target)), 1.0, 1e-4);
+}
+
+}  // namespace
+}  // namespace grainflow

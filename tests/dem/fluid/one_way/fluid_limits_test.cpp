@@ -1,0 +1,200 @@
+// Every fluid force term declares its stability limit (DESIGN.md §9; issue 17 item 4).
+//
+// 1. Rotational drag is implicit in the spin. A 10 µm glass sphere in a water shear flow
+//    u = G z x̂ spins up to half the vorticity, Ω_f = G/2 about y. Reference: the Stokes
+//    torque 8πμ(d/2)³(Ω_f − ω) gives ω(t) = Ω_f (1 − exp(−t/τ_r)), τ_r = ρ_p d²/(60 μ).
+//    At dt = τ_r/100 the run follows it to a/(2e) of Ω_f (a = dt/(2τ_r): two implicit half
+//    kicks per step give (1 + a)^{−2n} for exp(−2na), which differ by at most a/(2e)).
+// 2. The reproduction: the same sphere at dt = 2.7e-4 s, 65 τ_r (it diverged to 9e111
+//    rad/s when the torque was explicit): ω = Ω_f to round-off after 5 steps, for 1000.
+// 3. Each term's time scale against its closed form: drag m/K = ρ_p d²/(18 μ) at zero
+//    slip (Stokes), spin ρ_p d²/(60 μ), Saffman m/(1.615 d² √(ρ_f μ G)) (Mei's f = 1 at
+//    zero slip), Magnus m/((π/8) d³ ρ_f G/2) (the factor is 1 at zero slip).
+// 4. An explicit lift beyond its limit is refused at start-up with its name; the limit is
+//    where the slip's amplification per step, √(1 + (dt/τ_L)²)/(1 + dt/τ_d), reaches 1.
+// 5. The NaN guard's message names the terms enabled and their dt / time-scale ratios.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include "dem/engine/finite_guard.hpp"
+#include "dem/engine/simulation.hpp"
+#include "dem/fluid/fluid_forces.hpp"
+#include "tests/dem/support/test_scene.hpp"
+
+namespace grainflow {
+namespace {
+
+constexpr double kRhoP = 2500, kRhoF = 1000, kMu = 1e-3;
+
+FluidSettings shear_flow(double g, std::vector<FluidForce> extra) {
+  FluidSettings f;
+  f.field.density = kRhoF;
+  f.field.viscosity = kMu;
+  f.field.shear_rate = g;  // u = G z x̂: curl u = G ŷ
+  f.forces = {FluidForce::drag, FluidForce::pressure_gradient, FluidForce::viscous};
+  for (FluidForce e : extra) f.forces.push_back(e);
+  return f;
+}
+
+Scene scene_with(double dt) {
+  Scene s = test::one_material_scene(5e6, 0.3, kRhoP, 0.5);
+  s.gravity = Vec3::Zero();
+  s.time.step = dt;
+  return s;
+}
+
+double spin_time(double d) { return kRhoP * d * d / (60 * kMu); }
+
+TEST(FluidLimits, ImplicitSpinFollowsTheExponentialRelaxation) {
+  const double d = 10e-6, g = 100, tau = spin_time(d), dt = tau / 100;
+  Simulation sim(scene_with(dt), false);
+  sim.particles().add(1, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), d / 2, 0, kRhoP);
+  sim.add_force_term(make_fluid_forces(shear_flow(g, {FluidForce::rotational_drag}), Vec3::Zero()));
+  sim.initialise();
+  const double target = g / 2, a = dt / (2 * tau);
+  double worst = 0;
+  for (int n = 1; n <= 1000; ++n) {  // 10 tau
+    sim.step();
+    const Vec3 w = sim.particles().omega[0];
+    const double exact = target * (1 - std::exp(-n * dt / tau));
+    worst = std::max(worst, std::abs(w.y() - exact));
+    ASSERT_EQ(w.x(), 0);
+    ASSERT_EQ(w.z(), 0);
+  }
+  std::printf("[ measured ] spin-up at dt = tau/100: largest gap %.3e of Omega_f (bound %.3e)\n",
+              worst / target, a / (2 * std::numbers::e));
+  EXPECT_LE(worst, 1.01 * a / (2 * std::numbers::e) * target);
+}
+
+TEST(FluidLimits, RotationalDragAtSixtyFiveSpinTimesIsStable) {
+  const double d = 10e-6, g = 100, dt = 2.7e-4, tau = spin_time(d);
+  EXPECT_NEAR(tau, 4.1667e-6, 1e-10);  // the issue's 4.2e-6 s
+  Simulation sim(scene_with(dt), false);
+  sim.particles().add(1, Vec3::Zero(), Vec3::Zero(), Vec3(0, 1e3, 0), d / 2, 0, kRhoP);
+  sim.add_force_term(make_fluid_forces(shear_flow(g, {FluidForce::rotational_drag}), Vec3::Zero()));
+  sim.initialise();
+  // No fluid force refuses it (a lone particle: the contact checks of the report do not
+  // concern it).
+  for (const std::string& note : sim.time_step_report().notes)
+    EXPECT_EQ(note.find("fluid force '"), std::string::npos) << note;
+  for (int n = 1; n <= 1000; ++n) {
+    sim.step();
+    // Each step multiplies the gap to Omega_f by (1 + dt/(2 tau))^-2 = 9.0e-4: from 950
+    // rad/s, under 1e-12 rad/s by step 5 (then round-off).
+    if (n >= 5) {
+      ASSERT_NEAR(sim.particles().omega[0].y(), g / 2, 1e-12) << "step " << n;
+    }
+  }
+  const auto& limits = sim.force_limits();
+  const auto spin = std::find_if(limits.begin(), limits.end(),
+                                 [](const TermLimit& l) { return l.term == "rotational_drag"; });
+  ASSERT_NE(spin, limits.end());
+  EXPECT_TRUE(spin->implicit);
+  EXPECT_NEAR(dt / spin->tau, 64.8, 0.05);
+}
+
+TEST(FluidLimits, TimeScalesMatchTheClosedForms) {
+  // G = 20/s: Re_r = rho_f d^2 G/(2 mu) = 10, the Stokes branch of the rotational drag.
+  const double d = 1e-3, g = 20, m = kRhoP * std::numbers::pi * d * d * d / 6;
+  Simulation sim(scene_with(1e-4), false);
+  sim.particles().add(7, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), d / 2, 0, kRhoP);
+  sim.add_force_term(make_fluid_forces(
+      shear_flow(g, {FluidForce::rotational_drag, FluidForce::saffman_mei, FluidForce::magnus}),
+      Vec3::Zero()));
+  sim.initialise();
+  const auto find = [&](const char* name) {
+    for (const TermLimit& l : sim.force_limits())
+      if (l.term == name) return l;
+    ADD_FAILURE() << "no limit for " << name;
+    return TermLimit{};
+  };
+  const TermLimit drag = find("drag"), spin = find("rotational_drag"),
+                  saffman = find("saffman_mei"), magnus = find("magnus");
+  const double tau_d = kRhoP * d * d / (18 * kMu);
+  EXPECT_NEAR(drag.tau / tau_d, 1, 1e-12);
+  EXPECT_TRUE(drag.implicit);
+  EXPECT_EQ(drag.particle, 7);
+  EXPECT_NEAR(spin.tau / spin_time(d), 1, 1e-12);
+  EXPECT_NEAR(saffman.tau / (m / (1.615 * d * d * std::sqrt(kRhoF * kMu * g))), 1, 1e-12);
+  EXPECT_NEAR(magnus.tau / (m / (std::numbers::pi / 8 * d * d * d * kRhoF * g / 2)), 1, 1e-12);
+  EXPECT_FALSE(saffman.implicit);
+  EXPECT_FALSE(magnus.implicit);
+  // Both lifts are weaker than the drag here (tau_L > tau_d): stable at any dt.
+  EXPECT_GT(saffman.tau, tau_d);
+  EXPECT_GT(magnus.tau, tau_d);
+  EXPECT_TRUE(std::isinf(saffman.dt_max));
+  EXPECT_TRUE(std::isinf(magnus.dt_max));
+  // Pressure gradient and viscous force do not depend on the particle's velocity.
+  EXPECT_TRUE(std::isinf(find("pressure_gradient").dt_max));
+  EXPECT_TRUE(std::isinf(find("viscous").dt_max));
+}
+
+TEST(FluidLimits, ExplicitLiftBeyondItsLimitIsRefused) {
+  // 1 mm in water at G = 1000/s: Saffman's m/K_L = 0.026 s is shorter than the drag's
+  // 0.139 s, so the lift limits dt, to 9.9e-3 s.
+  const double d = 1e-3, g = 1000;
+  for (const double dt : {5e-3, 2e-2}) {
+    Simulation sim(scene_with(dt), false);
+    sim.particles().add(1, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), d / 2, 0, kRhoP);
+    sim.add_force_term(make_fluid_forces(shear_flow(g, {FluidForce::saffman_mei}), Vec3::Zero()));
+    sim.initialise();
+    const TimeStepReport& rep = sim.time_step_report();
+    std::string all;
+    for (const std::string& note : rep.notes) all += note + "\n";
+    SCOPED_TRACE(all);
+    // (The verdict also holds the contact checks, which refuse these steps for a lone
+    // sphere of this soft material; the fluid force's refusal is its own note.)
+    const bool beyond = dt > 1e-2 * 0.99;
+    const std::string refusal = "beyond the stability limit of the fluid force 'saffman_mei'";
+    EXPECT_EQ(all.find(refusal) != std::string::npos, beyond);
+    if (beyond) {
+      EXPECT_EQ(rep.verdict, TimeStepReport::Verdict::refuse);
+    }
+    EXPECT_NE(all.find("fluid force saffman_mei: time scale"), std::string::npos);
+    // The limit: at dt_max the slip's amplification per step is exactly 1.
+    for (const TermLimit& l : sim.force_limits())
+      if (l.term == "saffman_mei") {
+        const double tau_d = kRhoP * d * d / (18 * kMu);
+        const double x = l.dt_max / l.tau, y = l.dt_max / tau_d;
+        EXPECT_NEAR(std::sqrt(1 + x * x) / (1 + y), 1, 1e-12);
+        EXPECT_NEAR(l.dt_max, 9.794e-3, 1e-6);
+      }
+    if (beyond) {
+      EXPECT_NE(all.find("beyond the stability limit of the fluid force 'saffman_mei'"),
+                std::string::npos);
+      // The step it proposes, 0.9 dt_max, is accepted.
+      const double proposed = std::stod(all.substr(all.find("; use dt <= ") + 12));
+      ASSERT_LT(proposed, dt);
+      Simulation again(scene_with(proposed), false);
+      again.particles().add(1, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), d / 2, 0, kRhoP);
+      again.add_force_term(
+          make_fluid_forces(shear_flow(g, {FluidForce::saffman_mei}), Vec3::Zero()));
+      again.initialise();
+      for (const std::string& note : again.time_step_report().notes)
+        EXPECT_EQ(note.find(refusal), std::string::npos) << note;
+    }
+  }
+}
+
+TEST(FluidLimits, NanGuardNamesTheTermsAndTheirRatios) {
+  const double d = 10e-6, g = 100, dt = 2.7e-4;
+  Simulation sim(scene_with(dt), false);
+  sim.particles().add(1, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), d / 2, 0, kRhoP);
+  sim.add_force_term(make_fluid_forces(shear_flow(g, {FluidForce::rotational_drag}), Vec3::Zero()));
+  sim.initialise();
+  sim.particles().omega[0].y() = std::nan("");
+  const std::string m =
+      describe_first_non_finite(sim.particles(), 3, sim.time(), 0, sim.force_limits_summary());
+  // dt / (rho d^2/(18 mu)) = 19.44, dt / (rho d^2/(60 mu)) = 64.8 (3 digits printed).
+  EXPECT_NE(m.find("drag (dt/tau = 19.4, implicit)"), std::string::npos) << m;
+  EXPECT_NE(m.find("rotational_drag (dt/tau = 64.8, implicit)"), std::string::npos) << m;
+  EXPECT_NE(m.find("pressure_gradient (no limit)"), std::string::npos) << m;
+  EXPECT_NE(m.find("angular velocity"), std::string::npos) << m;
+}
+
+}  // namespace
+}  // namespace grainflow
