@@ -25,7 +25,9 @@ A scene passes when either
   * or it exits 1 with a message of the form "error: <cause>" that names a key or a remedy;
     a step the message proposes ("a step of at most X s", "use dt <= X s") must be smaller
     than the step that ran, and the scene rerun with it must get further (finish, or stop
-    later in simulated time).
+    later in simulated time); a CSV row that is valid input (touching spheres written with
+    17 digits) must not be refused; the NaN guard of a scene with fluid forces must name
+    each enabled force term (issue 17, item 4). Exit 2 (input refused) is judged as exit 1.
 A signal, std::bad_alloc, an abort, exit codes other than 0 and 1, or a run longer than
 --timeout fail the scene. A failing scene's YAML is printed and kept under --work.
 
@@ -589,12 +591,15 @@ class Draw:
                   "material": rng.choice(mats)}]
         rows = []
         valid = []  # per row: True when the row is valid input and must be accepted
+        # Half the scenes test touching and overlapping pairs; the other half walls, so that
+        # a refusal of the first kind does not hide what the second would show.
+        touching = rng.random() < 0.5
         # A chain of touching spheres along a random direction: centres r1 + r2 apart, written
         # with 17 significant digits.
         d = np.array([rng.gauss(0, 1) for _ in range(3)])
         d /= np.linalg.norm(d)
         x = np.array([L / 2, L / 2, L / 2])
-        k = rng.randint(2, 6)
+        k = rng.randint(2, 6) if touching else 0
         radii = [r * logu(rng, 0.3, 1) for _ in range(k)]
         span = sum(2 * q for q in radii)
         x = x - d * span / 2
@@ -612,28 +617,27 @@ class Draw:
         q = r * rng.uniform(0.5, 1)
         rows.append((L * 0.2, L * 0.2, q, q))
         valid.append(True)
-        u = rng.random()
-        if u < 0.4:  # a rod with a sphere exactly on (or just off) its axis
+        u = rng.random() if not touching else 1
+        if u < 0.55:  # a rod with a sphere exactly on (or just off) its axis
             R = r * logu(rng, 0.2, 2)
             off = rng.choice([0.0, 0.0, 0.3 * R])
+            yz = float(f"{L * 0.8:.12g}")  # as the YAML holds it: the centre exactly on the axis
             walls.append({"type": "cylinder", "name": "rod", "side": "outside",
-                          "axis_point": [0, L * 0.8, L * 0.8], "axis": [1, 0, 0], "radius": R,
+                          "axis_point": [0, yz, yz], "axis": [1, 0, 0], "radius": R,
                           "material": rng.choice(mats)})
-            self.meta["rods"].append({"name": "rod", "point": [0, L * 0.8, L * 0.8],
+            self.meta["rods"].append({"name": "rod", "point": [0, yz, yz],
                                       "axis": [1, 0, 0], "radius": R, "velocity": [0, 0, 0]})
-            rows.append((L * 0.5, L * 0.8 + off, L * 0.8, r * 0.5))
+            rows.append((L * 0.5, yz + off, yz, r * 0.5))
             valid.append(False)  # inside the rod: must be refused with the rod's name
-        elif u < 0.7:  # a wall crossing a sphere by a given fraction of its radius
+        elif u < 1:  # a wall crossing a sphere by a given fraction of its radius
             frac = rng.choice([0.01, 0.1, 0.24, 0.26, 0.5, 0.99])
             q = r * 0.8
             walls.append({"type": "plane", "name": "shelf", "point": [0, 0, L * 0.85],
                           "normal": [0, 0, -1], "material": rng.choice(mats)})
             rows.append((L * 0.7, L * 0.7, L * 0.85 - q * (1 - frac), q))
             valid.append(None)  # accepted or refused, depending on the overlap limit
-        else:  # a soft spring under load, or strong cohesion: overload at rest
-            pass
-        # A slightly overlapping or slightly separated pair.
-        gap = rng.choice([-1e-3, -1e-9, 0.0, 1e-12, 1e-6]) * r
+        # A touching, slightly overlapping or slightly separated pair.
+        gap = (rng.choice([-1e-3, -1e-9, 0.0, 1e-12]) if touching else 1e-6) * r
         a = np.array([L * 0.25, L * 0.75, L * 0.3])
         rows.append((a[0], a[1], a[2], r))
         rows.append((a[0] + 2 * r + gap, a[1], a[2], r))
@@ -1031,7 +1035,8 @@ def check_scene(args, seed, d, scene, workdir, depth=0):
     d.dt_run = scene["time"].get("step") or startup_dt(out) or d.dt_estimate
     for pat, cls in FATAL_PATTERNS:
         if re.search(pat, out):
-            raise Failure(cls, error_line(out) or out[-300:])
+            hit = [ln.strip() for ln in out.splitlines() if re.search(pat, ln)]
+            raise Failure(cls, hit[0] if hit else out[-300:])
     if rc is None:
         raise Failure("timeout", f"no end after {args.timeout} s; last output: {out[-200:]!r}")
     if rc < 0:
@@ -1050,6 +1055,13 @@ def check_scene(args, seed, d, scene, workdir, depth=0):
     if not ADVICE_WORDS.search(msg.split("error", 1)[1]):
         raise Failure("message without a remedy", msg)
     d.message = msg
+    if "non-finite" in msg and "fluid" in scene:
+        # Issue 17: the NaN guard names the enabled force terms (and their dt / limit ratios).
+        silent = [f for f in scene["fluid"]["forces"] if f not in msg]
+        if silent:
+            raise Failure("NaN guard silent on the force terms",
+                          f"enabled {', '.join(scene['fluid']['forces'])}, not named: "
+                          f"{', '.join(silent)}: {msg}")
     proposals = [float(v) for v in STEP_PROPOSAL.findall(msg)]
     if not proposals or depth >= 2:
         return ("refused" if rc == 2 else "stopped"), seconds
@@ -1087,9 +1099,53 @@ def check_scene(args, seed, d, scene, workdir, depth=0):
     return f"stopped, proposal {how}", seconds + s2
 
 
+STOP_CAUSES = [
+    ("key time.min_steps_per_contact", "steps-per-contact guard"),
+    ("key time.max_step_travel", "travel guard"),
+    ("key time.max_overlap", "overlap guard"),
+    ("dt is too large", "start-up step refusal"),
+    ("non-finite", "NaN guard"),
+    ("overlaps an earlier particle", "CSV overlap refused"),
+    ("wall", "insertion against a wall"),
+]
+
+
+def summarise(path):
+    """Counts of a --report file: outcomes, failure classes with seeds, what stopped runs."""
+    rows = [json.loads(line) for line in open(path) if line.strip()]
+    print(f"{len(rows)} scenes")
+    by = {}
+    for r in rows:
+        key = r["result"] if r["result"] == "FAIL" else r["result"].split(",")[0].split(" (")[0]
+        by[key] = by.get(key, 0) + 1
+    print("outcomes: " + ", ".join(f"{k} {v}" for k, v in sorted(by.items())))
+    fam = {}
+    for r in rows:
+        f = fam.setdefault(r["family"], [0, 0])
+        f[0] += 1
+        f[1] += r["result"] == "FAIL"
+    print("families (scenes, failed): " + ", ".join(f"{k} {v[0]}/{v[1]}" for k, v in fam.items()))
+    stops = {}
+    for r in rows:
+        msg = r.get("message") or ""
+        if r["result"] != "FAIL" and msg:
+            cause = next((c for pat, c in STOP_CAUSES if pat in msg), "other")
+            stops.setdefault(cause, []).append(r["seed"])
+    for c, ss in sorted(stops.items(), key=lambda kv: -len(kv[1])):
+        print(f"  stopped by {c}: {len(ss)}")
+    classes = {}
+    for r in rows:
+        if r["result"] == "FAIL":
+            classes.setdefault(r["class"], []).append(r)
+    for c, rs in sorted(classes.items(), key=lambda kv: -len(kv[1])):
+        print(f"  FAIL {len(rs):4d} {c}: seeds {' '.join(str(r['seed']) for r in rs)}")
+        print(f"       e.g. seed {rs[0]['seed']}: {rs[0]['detail'][:400]}")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--grain", required=True)
+    ap.add_argument("--grain")
+    ap.add_argument("--summarise", metavar="REPORT", help="summarise a --report file and exit")
     ap.add_argument("--mpiexec", default="mpiexec")
     ap.add_argument("--seed", type=int, help="one scene")
     ap.add_argument("--seeds", help="a range A:B (B excluded)")
@@ -1106,6 +1162,11 @@ def main():
     ap.add_argument("--family", choices=FAMILIES, help="run only the seeds of this family")
     ap.add_argument("--verbose", action="store_true", help="print the message of each stop")
     args = ap.parse_args()
+    if args.summarise:
+        summarise(args.summarise)
+        return 0
+    if not args.grain:
+        ap.error("--grain is required")
     if os.sep in args.grain:
         args.grain = os.path.abspath(args.grain)
     if args.seed is not None:
