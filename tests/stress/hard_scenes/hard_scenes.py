@@ -518,8 +518,8 @@ class Draw:
     def fluid(self):
         rng = self.rng
         # Soft materials: steps long against the fluid's time scales (drag, spin relaxation).
-        scene = self.base(y_max=1e8)
         small = rng.random() < 0.4
+        scene = self.base(y_max=1e7 if small else 1e8)
         r0 = logu(rng, 5e-6, 5e-5) if small else logu(rng, 1e-4, 2e-3)
         ratio = logu(rng, 1, 10)
         r_max = r0 * ratio
@@ -539,16 +539,19 @@ class Draw:
         scene["walls"] = walls
         hydro = rng.random() < 0.5
         forces = ["drag", "pressure_gradient", "viscous"]
-        forces += [f for f in OPTIONAL_FORCES if rng.random() < 0.5]
+        # Small beads mostly get a shear and rotational drag with a viscous fluid: their spin
+        # relaxation time rho_p d^2 / (60 mu) is then far below the contact step (issue 17).
+        forces += [f for f in OPTIONAL_FORCES
+                   if rng.random() < (0.8 if small and f == "rotational_drag" else 0.5)]
         if gravity and not hydro:
             forces.append("buoyancy")
         rng.shuffle(forces)
         fl = {"density": float(f"{logu(rng, 1, 2000):.4g}"),
-              "viscosity": float(f"{logu(rng, 1e-5, 1):.3g}"),
+              "viscosity": float(f"{logu(rng, 1e-2 if small else 1e-5, 1):.3g}"),
               "velocity": [round(rng.uniform(-2, 2), 4) for _ in range(3)],
               "drag": rng.choice(DRAG_LAWS), "model": rng.choice(["A", "B"]), "forces": forces,
               "pressure": {"hydrostatic": hydro}}
-        if rng.random() < 0.5:
+        if rng.random() < (0.8 if small else 0.5):
             fl["shear"] = {"rate": round(logu(rng, 0.1, 1e4), 4), "flow_direction": [1, 0, 0],
                            "gradient_direction": [0, 0, 1], "origin": [0, 0, 0]}
         if rng.random() < 0.3:
