@@ -1,0 +1,1240 @@
+#!/usr/bin/env python3
+"""Random hard scenes for `grain run`, each checked against invariants (docs/stability.md).
+
+    hard_scenes.py --grain build/bin/grain [--mpiexec mpiexec] --seeds 0:40
+    hard_scenes.py --grain build/bin/grain --seed 17          # one scene, reproducibly
+    hard_scenes.py --grain build/bin/grain --first 1000 --count 400 --budget 1200
+
+Each seed draws one valid scene (numbers from Python's seeded `random.Random(seed)`, so a
+seed is the same scene on every machine): sizes over a ratio up to 100 and densities up to
+1000 within a scene, Young's modulus over 1e5..1e11 Pa (Hooke stiffness 1e1..1e7 N/m), all 24
+contact-slot combinations (normal x tangential x rolling x cohesion; seeds 0..23 hold each once),
+planes, cylinders inside and outside, STL meshes written next to the scene, moving walls,
+periodic axes, 1 or 2 ranks, one-way fluid with every drag law and force term, streams, CSV
+particles placed at the limits (touching, on a cylinder's axis, on a wall). The family of a
+scene is seed % 8 (see FAMILIES).
+
+A scene passes when either
+  * `grain run` exits 0 and the run's output holds the invariants: finite state in every
+    snapshot; every particle on the allowed side of every wall it cannot pass (planes,
+    cylinders, mesh plates that span the domain, at the snapshot's time for moving walls);
+    no resting particle in the path of a moving rod left untouched; particles at the end +
+    removed = particles at the start + streamed; in an isolated system (no gravity, fluid,
+    cohesion or moving wall) the energy, kinetic + elastic, does not rise; in a fully
+    periodic box without walls, gravity or fluid the momentum is conserved;
+  * or it exits 1 with a message of the form "error: <cause>" that names a key or a remedy;
+    a step the message proposes ("a step of at most X s", "use dt <= X s") must be smaller
+    than the step that ran, and the scene rerun with it must get further (finish, or stop
+    later in simulated time); a CSV row that is valid input (touching spheres written with
+    17 digits) must not be refused; the NaN guard of a scene with fluid forces must name
+    each enabled force term (issue 17, item 4). Exit 2 (input refused) is judged as exit 1.
+A signal, std::bad_alloc, an abort, exit codes other than 0 and 1, or a run longer than
+--timeout fail the scene. A failing scene's YAML is printed and kept under --work.
+
+Needs Debian's python3-numpy, python3-h5py and python3-yaml (/usr/bin/python3).
+"""
+import argparse
+import json
+import math
+import os
+import random
+import re
+import resource
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+try:
+    import h5py
+    import numpy as np
+    import yaml
+except ImportError as e:  # pragma: no cover - environment problem
+    sys.exit(f"hard_scenes.py needs numpy, h5py and yaml ({e}); on Debian: apt install "
+             "python3-numpy python3-h5py python3-yaml, and run it with /usr/bin/python3")
+
+FAMILIES = ["pour", "drum", "rod", "mesh", "periodic_gas", "closed_gas", "fluid", "limits"]
+NORMAL = ["hertz", "hooke"]
+TANGENTIAL = ["none", "history"]
+ROLLING = ["none", "cdt", "epsd"]
+COHESION = ["none", "sjkr"]
+DRAG_LAWS = ["schiller_naumann", "di_felice", "rong", "wen_yu", "ergun", "gidaspow",
+             "koch_hill", "beetstra", "tenneti_garg_subramaniam"]
+OPTIONAL_FORCES = ["virtual_mass", "saffman_mei", "magnus", "rotational_drag"]
+MAX_OVERLAP_DEFAULT = 0.25
+# A child may not take more address space than this (per rank): an unbounded grid must end
+# in a clear error or std::bad_alloc here, never in the kernel's OOM killer on a shared box.
+MEMORY_LIMIT = 3 << 30
+
+
+def logu(rng, lo, hi):
+    return math.exp(rng.uniform(math.log(lo), math.log(hi)))
+
+
+def combo_of(seed):
+    # 7 is prime to 24: seeds 0..23 hold every combination once; the s // 24 term shifts the
+    # cycle so that every family (seed % 8) meets every combination over 192 seeds.
+    i = (7 * seed + seed // 24) % 24
+    return (NORMAL[i // 12], TANGENTIAL[(i // 6) % 2], ROLLING[(i // 2) % 3], COHESION[i % 2])
+
+
+def rayleigh_time(r, rho, y, nu):
+    g = y / (2 * (1 + nu))
+    return math.pi * r * math.sqrt(rho / g) / (0.1631 * nu + 0.8766)
+
+
+# ---------------------------------------------------------------------------------------
+# Drawing a scene
+# ---------------------------------------------------------------------------------------
+class Draw:
+    """One scene: the YAML dict plus what the checks need to know about it."""
+
+    def __init__(self, seed):
+        self.seed = seed
+        self.rng = random.Random(seed)
+        self.family = FAMILIES[seed % len(FAMILIES)]
+        self.ranks = 2 if seed % 3 == 2 else 1
+        self.files = {}  # extra files: name -> text
+        self.meta = {"moving_walls": False, "gravity": False, "fluid": False, "cohesion": False,
+                     "streams": False, "expected_start": None, "plates": [], "rods": [],
+                     "isolated": False, "momentum": False}
+
+    # -- pieces shared by the families ------------------------------------------------------
+    def materials(self, n, y_max=1e11):
+        rng = self.rng
+        mats = []
+        rho0 = logu(rng, 100, 20000)
+        for k in range(n):
+            rho = rho0 if k == 0 else rho0 * logu(rng, 1e-3, 1) if rng.random() < 0.5 else \
+                min(rho0 * logu(rng, 1, 1000), 1e6)
+            mats.append({"name": f"m{k}", "youngs_modulus": float(f"{logu(rng, 1e5, y_max):.4g}"),
+                         "poisson_ratio": round(rng.uniform(-0.2, 0.49), 3),
+                         "density": float(f"{rho:.4g}")})
+        return mats
+
+    def contact(self, scene):
+        rng = self.rng
+        normal, tangential, rolling, cohesion = combo_of(self.seed)
+        c = {"normal": normal, "tangential": tangential, "rolling": rolling, "cohesion": cohesion}
+        if normal == "hooke":
+            if rng.random() < 0.5:
+                c["hooke"] = {"characteristic_velocity": float(f"{logu(rng, 0.01, 20):.3g}")}
+            else:
+                kn = logu(rng, 1e1, 1e7)
+                c["hooke"] = {"stiffness": {"normal": float(f"{kn:.4g}")}}
+                if rng.random() < 0.5:
+                    c["hooke"]["stiffness"]["tangential"] = float(f"{kn * rng.uniform(0.2, 1):.4g}")
+        if rolling == "epsd" and rng.random() < 0.5:
+            c["epsd"] = {"damping_ratio": round(rng.uniform(0, 1), 3)}
+        scene["contact"] = c
+        self.meta["cohesion"] = cohesion == "sjkr"
+        d = {"restitution": round(rng.uniform(0.05, 1.0), 3),
+             "friction": round(rng.choice([0, rng.uniform(0, 1.2)]), 3)}
+        if rolling != "none":
+            d["rolling_friction"] = round(rng.uniform(0, 0.3), 3)
+        if cohesion == "sjkr":
+            d["cohesion_energy_density"] = float(f"{logu(rng, 1e2, 1e6):.3g}")
+        scene["interaction_defaults"] = d
+        names = [m["name"] for m in scene["materials"]]
+        if len(names) > 1 and rng.random() < 0.5:
+            e = {"materials": [names[0], names[-1]], "restitution": round(rng.uniform(0.1, 1), 3)}
+            scene["interactions"] = [e]
+
+    def radii(self, r0, ratio):
+        rng = self.rng
+        kind = rng.choice(["constant", "uniform", "normal", "discrete"]) if ratio > 1.01 else \
+            "constant"
+        if kind == "constant":
+            return {"distribution": "constant", "value": r0}
+        if kind == "uniform":
+            return {"distribution": "uniform", "min": r0, "max": r0 * ratio}
+        if kind == "normal":
+            mean = r0 * math.sqrt(ratio)
+            return {"distribution": "normal", "mean": mean, "stddev": mean * rng.uniform(0.05, 0.3),
+                    "min": max(r0, mean / 10), "max": r0 * ratio}
+        return {"distribution": "discrete", "values": [r0, r0 * ratio],
+                "weights": [round(logu(rng, 1, 100), 2), 1]}
+
+    def time(self, scene, r_min, steps):
+        """Time step from the smallest particle's Rayleigh time, as the code computes it."""
+        rng = self.rng
+        tr = min(rayleigh_time(r_min, m["density"], m["youngs_modulus"], m["poisson_ratio"])
+                 for m in scene["materials"])
+        u = rng.random()
+        t = {}
+        if u < 0.7:
+            frac = logu(rng, 0.02, 0.5)
+            t["rayleigh_fraction"] = float(f"{frac:.3g}")
+            dt = frac * tr
+        else:  # a given step, sometimes beyond what the contacts resolve
+            dt = tr * logu(rng, 0.02, 3)
+            t["step"] = float(f"{dt:.4g}")
+        t["end"] = float(f"{dt * steps:.4g}")
+        if rng.random() < 0.3:
+            t["expected_max_speed"] = float(f"{logu(rng, 0.1, 50):.3g}")
+        if rng.random() < 0.2:
+            t["max_overlap"] = round(rng.uniform(0.05, 0.6), 3)
+        scene["time"] = t
+        self.dt_estimate = dt
+        return dt
+
+    def output(self, scene):
+        end = scene["time"]["end"]
+        scene["output"] = {"directory": "out", "snapshot_interval": end / 8, "progress": False}
+
+    def parallel(self, scene, axis_choices):
+        if self.ranks == 2 and self.rng.random() < 0.5:
+            a = self.rng.choice(axis_choices)
+            grid = [1, 1, 1]
+            grid[a] = 2
+            scene["parallel"] = {"grid": grid}
+            if self.rng.random() < 0.5:
+                scene["parallel"]["balance"] = True
+
+    def count_fill(self, region_volume, r_mean, fraction):
+        return max(1, int(fraction * region_volume / (4 / 3 * math.pi * r_mean ** 3)))
+
+    def velocity(self, scale):
+        rng = self.rng
+        return [round(rng.gauss(0, scale), 6) for _ in range(3)]
+
+    # -- families ----------------------------------------------------------------------------
+    def base(self, nmat=None, y_max=1e11):
+        rng = self.rng
+        scene = {"materials": self.materials(nmat or rng.choice([1, 2, 2, 3]), y_max)}
+        self.contact(scene)
+        return scene
+
+    def pour(self):
+        rng = self.rng
+        scene = self.base()
+        r0 = logu(rng, 5e-5, 3e-3)
+        ratio = logu(rng, 1, 100) if rng.random() < 0.7 else 1
+        r_max = r0 * ratio
+        per = [rng.random() < 0.4, rng.random() < 0.4, False]
+        lx, ly = (r_max * rng.uniform(6, 16) for _ in range(2))
+        lz = r_max * rng.uniform(10, 30)
+        scene["domain"] = {"min": [0, 0, 0], "max": [lx, ly, lz], "periodic": per}
+        g = -logu(rng, 0.5, 50)
+        scene["gravity"] = [0, 0, round(g, 4)]
+        self.meta["gravity"] = True
+        mats = [m["name"] for m in scene["materials"]]
+        walls = [{"type": "plane", "name": "floor", "point": [0, 0, 0], "normal": [0, 0, 1],
+                  "material": rng.choice(mats)}]
+        for a, (lo, hi) in enumerate([(0, lx), (0, ly)]):
+            if not per[a] and rng.random() < 0.7:
+                n = [0, 0, 0]
+                n[a] = 1
+                walls.append({"type": "plane", "name": f"side{a}lo", "point": [0, 0, 0],
+                              "normal": list(n), "material": rng.choice(mats)})
+                n[a] = -1
+                p = [0, 0, 0]
+                p[a] = hi
+                walls.append({"type": "plane", "name": f"side{a}hi", "point": p, "normal": n,
+                              "material": rng.choice(mats)})
+        fill_top = lz * 0.6
+        if rng.random() < 0.3:  # a piston coming down, sometimes fast
+            v = -logu(rng, 0.01, 200)
+            walls.append({"type": "plane", "name": "piston", "point": [0, 0, lz * 0.95],
+                          "normal": [0, 0, -1], "material": rng.choice(mats),
+                          "motion": {"velocity": [0, 0, round(v, 5)]}})
+            self.meta["moving_walls"] = True
+            fill_top = lz * 0.6
+        elif not per[0] and rng.random() < 0.2:  # a tilting floor (rotation about y)
+            walls[0]["motion"] = {"angular_velocity": round(rng.uniform(-20, 20), 3),
+                                  "axis": [0, 1, 0], "axis_point": [lx / 2, 0, 0]}
+            walls[0]["point"] = [lx / 2, 0, 0]
+            self.meta["moving_walls"] = True
+        scene["walls"] = walls
+        fill = {"type": "fill",
+                "region": {"box": {"min": [0, 0, lz * 0.05], "max": [lx, ly, fill_top]}},
+                "material": rng.choice(mats), "radius": self.radii(r0, ratio),
+                "seed": rng.randrange(1 << 32)}
+        vol = lx * ly * (fill_top - lz * 0.05)
+        r_mean = r0 * (1 + ratio) / 2 if ratio > 1 else r0
+        n = min(300, self.count_fill(vol, r_mean, rng.uniform(0.02, 0.2)))
+        fill["count"] = n
+        if rng.random() < 0.3:
+            fill["velocity"] = self.velocity(logu(rng, 0.01, 5))
+        scene["insert"] = [fill]
+        self.meta["expected_start"] = n
+        if rng.random() < 0.3:
+            rs = r_max * 0.5
+            scene["insert"].append({
+                "type": "stream", "material": rng.choice(mats),
+                "face": {"rectangle": {"centre": [lx / 2, ly / 2, lz * 0.9], "normal": [0, 0, -1],
+                                       "u": [1, 0, 0], "size": [lx * 0.6, ly * 0.6]}},
+                "count_rate": 1.0, "radius": {"distribution": "constant", "value": rs},
+                "velocity": [0, 0, round(-logu(rng, 0.01, 3), 4)], "seed": rng.randrange(1000)})
+            self.meta["streams"] = True
+        self.time(scene, r0, rng.randint(300, 1500))
+        # A stream delivers a few particles in the run.
+        for ins in scene["insert"]:
+            if ins["type"] == "stream":
+                ins["count_rate"] = float(f"{rng.randint(3, 30) / scene['time']['end']:.4g}")
+        self.parallel(scene, [0, 1, 2])
+        return scene
+
+    def drum(self):
+        rng = self.rng
+        scene = self.base()
+        r0 = logu(rng, 1e-4, 2e-3)
+        ratio = logu(rng, 1, 20)
+        r_max = r0 * ratio
+        R = r_max * rng.uniform(6, 15)
+        L = r_max * rng.uniform(6, 12)
+        m = R * 1.05
+        periodic_x = rng.random() < 0.6
+        scene["domain"] = {"min": [0, -m, -m], "max": [L, m, m],
+                           "periodic": [periodic_x, False, False]}
+        g = rng.choice([0, -9.81, -logu(rng, 0.1, 100)])
+        scene["gravity"] = [0, 0, round(g, 4)]
+        self.meta["gravity"] = g != 0
+        mats = [x["name"] for x in scene["materials"]]
+        drum = {"type": "cylinder", "name": "drum", "axis_point": [0, 0, 0], "axis": [1, 0, 0],
+                "radius": R, "side": "inside", "material": rng.choice(mats)}
+        u = rng.random()
+        if u < 0.35:
+            drum["angular_velocity"] = round(rng.uniform(-50, 50), 3)
+            self.meta["moving_walls"] = True
+        elif u < 0.7:
+            drum["motion"] = {"angular_velocity": round(logu(rng, 0.1, 3000) *
+                                                        rng.choice([-1, 1]), 3),
+                              "axis": [1, 0, 0], "axis_point": [0, 0, 0]}
+            self.meta["moving_walls"] = True
+        walls = [drum]
+        if not periodic_x:
+            walls.append({"type": "plane", "name": "cap0", "point": [0, 0, 0], "normal": [1, 0, 0],
+                          "material": rng.choice(mats)})
+            walls.append({"type": "plane", "name": "cap1", "point": [L, 0, 0],
+                          "normal": [-1, 0, 0], "material": rng.choice(mats)})
+        scene["walls"] = walls
+        n = min(250, self.count_fill(math.pi * R * R * L, r0 * (1 + ratio) / 2,
+                                     rng.uniform(0.02, 0.25)))
+        scene["insert"] = [{"type": "fill",
+                            "region": {"cylinder": {"base": [0, 0, 0], "axis": [1, 0, 0],
+                                                    "radius": R * 0.98, "height": L}},
+                            "count": n, "material": rng.choice(mats),
+                            "radius": self.radii(r0, ratio), "seed": rng.randrange(1 << 32)}]
+        self.meta["expected_start"] = n
+        self.time(scene, r0, rng.randint(300, 1500))
+        self.parallel(scene, [0, 1, 2])
+        return scene
+
+    def rod(self):
+        rng = self.rng
+        scene = self.base()
+        r0 = logu(rng, 2e-4, 2e-3)
+        ratio = logu(rng, 1, 10)
+        r_max = r0 * ratio
+        R = logu(rng, 0.2, 5) * r0
+        L = r_max * rng.uniform(8, 16)
+        periodic_x = rng.random() < 0.5
+        scene["domain"] = {"min": [0, -L / 2, -L / 2], "max": [L, L / 2, L / 2],
+                           "periodic": [periodic_x, False, False]}
+        gravity = rng.random() < 0.4
+        scene["gravity"] = [0, 0, -9.81] if gravity else [0, 0, 0]
+        self.meta["gravity"] = gravity
+        mats = [x["name"] for x in scene["materials"]]
+        rod = {"type": "cylinder", "name": "rod", "axis_point": [0, 0, -L / 4], "axis": [1, 0, 0],
+               "radius": R, "side": "outside", "material": rng.choice(mats)}
+        speed = 0.0
+        if rng.random() < 0.7:  # the rod sweeps up through the particles
+            speed = logu(rng, 0.01, 5) if rng.random() < 0.5 else logu(rng, 5, 300)
+            rod["motion"] = {"velocity": [0, 0, round(speed, 5)]}
+            self.meta["moving_walls"] = True
+        elif rng.random() < 0.5:
+            rod["angular_velocity"] = round(rng.uniform(-100, 100), 3)
+            self.meta["moving_walls"] = True
+        scene["walls"] = [rod]
+        vol = L * L * L / 2
+        n = min(250, self.count_fill(vol, r0 * (1 + ratio) / 2, rng.uniform(0.02, 0.15)))
+        scene["insert"] = [{"type": "fill",
+                            "region": {"box": {"min": [0, -L / 2, -L / 8],
+                                               "max": [L, L / 2, L / 2 * 0.95]}},
+                            "count": n, "material": rng.choice(mats),
+                            "radius": self.radii(r0, ratio), "seed": rng.randrange(1 << 32)}]
+        self.meta["expected_start"] = n
+        dt = self.time(scene, r0, rng.randint(300, 1500))
+        if speed > 0:
+            # Long enough for the rod to cross the particles when it is fast; capped in steps.
+            end = min(max(scene["time"]["end"], 0.6 * L / speed), dt * 4000)
+            scene["time"]["end"] = float(f"{end:.4g}")
+        self.meta["rods"].append({"name": "rod", "point": [0, 0, -L / 4], "axis": [1, 0, 0],
+                                  "radius": R, "velocity": [0, 0, speed]})
+        self.parallel(scene, [0, 1, 2])
+        return scene
+
+    def stl_plate(self, name, x0, x1, y0, y1, n):
+        lines = [f"solid {name}"]
+        xs = np.linspace(x0, x1, n + 1)
+        ys = np.linspace(y0, y1, n + 1)
+        for i in range(n):
+            for j in range(n):
+                a = (xs[i], ys[j], 0.0)
+                b = (xs[i + 1], ys[j], 0.0)
+                c = (xs[i + 1], ys[j + 1], 0.0)
+                d = (xs[i], ys[j + 1], 0.0)
+                for tri in ((a, b, c), (a, c, d)):
+                    lines.append("  facet normal 0 0 1\n    outer loop")
+                    for v in tri:
+                        lines.append(f"      vertex {v[0]!r} {v[1]!r} {v[2]!r}")
+                    lines.append("    endloop\n  endfacet")
+        lines.append(f"endsolid {name}")
+        self.files[f"{name}.stl"] = "\n".join(lines) + "\n"
+
+    def mesh(self):
+        rng = self.rng
+        scene = self.base()
+        r0 = logu(rng, 1e-4, 3e-3)
+        ratio = logu(rng, 1, 30) if rng.random() < 0.6 else 1
+        r_max = r0 * ratio
+        lx, ly = (r_max * rng.uniform(6, 14) for _ in range(2))
+        lz = r_max * rng.uniform(10, 25)
+        per = [rng.random() < 0.5, rng.random() < 0.5, False]
+        scene["domain"] = {"min": [0, 0, 0], "max": [lx, ly, lz], "periodic": per}
+        gravity = rng.random() < 0.7
+        scene["gravity"] = [0, 0, round(-logu(rng, 1, 30), 4)] if gravity else [0, 0, 0]
+        self.meta["gravity"] = gravity
+        mats = [x["name"] for x in scene["materials"]]
+        # A plate that spans the domain's cross-section (and beyond), so nothing goes round it.
+        n = rng.randint(1, 5)
+        self.stl_plate("plate", -0.25 * lx, 1.25 * lx, -0.25 * ly, 1.25 * ly, n)
+        zp = lz * rng.uniform(0.05, 0.3)
+        plate = {"type": "mesh", "name": "plate", "file": "plate.stl", "translate": [0, 0, zp],
+                 "material": rng.choice(mats)}
+        if rng.random() < 0.3:  # an in-plane turn about z keeps the plane and the cover
+            plate["rotate"] = {"axis": [0, 0, 1], "angle": round(rng.uniform(-10, 10), 3)}
+            plate["translate"] = [0, 0, zp]
+        velocity = [0, 0, 0]
+        u = rng.random()
+        if u < 0.3:
+            # Rises into the particles; half the time fast (issue 17: 120 m/s crossed a sphere).
+            speed = logu(rng, 0.01, 5) if rng.random() < 0.5 else logu(rng, 5, 300)
+            velocity = [0, 0, round(speed, 5)]
+            plate["motion"] = {"velocity": velocity}
+            self.meta["moving_walls"] = True
+        elif u < 0.5:
+            plate["surface_velocity"] = [round(rng.uniform(-2, 2), 4), 0, 0]
+            self.meta["moving_walls"] = True
+        scene["walls"] = [plate]
+        top = lz * 0.9
+        bottom = zp + r_max * 0.5
+        n_p = min(250, self.count_fill(lx * ly * (top - bottom), r0 * (1 + ratio) / 2,
+                                       rng.uniform(0.02, 0.15)))
+        fill = {"type": "fill", "region": {"box": {"min": [0, 0, bottom], "max": [lx, ly, top]}},
+                "count": n_p, "material": rng.choice(mats), "radius": self.radii(r0, ratio),
+                "seed": rng.randrange(1 << 32)}
+        if rng.random() < 0.4:
+            fill["velocity"] = [0, 0, round(-logu(rng, 0.01, 30), 4)]
+        scene["insert"] = [fill]
+        self.meta["expected_start"] = n_p
+        dt = self.time(scene, r0, rng.randint(300, 1500))
+        if velocity[2] > 0:
+            end = min(max(scene["time"]["end"], 0.8 * (top - zp) / velocity[2]), dt * 4000)
+            scene["time"]["end"] = float(f"{end:.4g}")
+        self.meta["plates"].append({"name": "plate", "point": [0, 0, zp], "normal": [0, 0, 1],
+                                    "velocity": velocity, "side": 1})
+        self.parallel(scene, [0, 1, 2])
+        return scene
+
+    def gas(self, periodic):
+        rng = self.rng
+        scene = self.base()
+        r0 = logu(rng, 1e-4, 3e-3)
+        ratio = logu(rng, 1, 100) if rng.random() < 0.6 else 1
+        r_max = r0 * ratio
+        L = [r_max * rng.uniform(5, 12) for _ in range(3)]
+        scene["domain"] = {"min": [0, 0, 0], "max": L, "periodic": [periodic] * 3}
+        scene["gravity"] = [0, 0, 0]
+        mats = [x["name"] for x in scene["materials"]]
+        if not periodic:
+            walls = []
+            for a in range(3):
+                for side in (0, 1):
+                    nvec = [0, 0, 0]
+                    nvec[a] = 1 if side == 0 else -1
+                    p = [0, 0, 0]
+                    p[a] = 0 if side == 0 else L[a]
+                    walls.append({"type": "plane", "name": f"box{a}{side}", "point": p,
+                                  "normal": nvec, "material": rng.choice(mats)})
+            if rng.random() < 0.4:  # a static rod through the box
+                R = r_max * rng.uniform(0.3, 1.5)
+                walls.append({"type": "cylinder", "name": "post", "side": "outside",
+                              "axis_point": [L[0] / 2, L[1] / 2, 0], "axis": [0, 0, 1],
+                              "radius": R, "material": rng.choice(mats)})
+                self.meta["rods"].append({"name": "post", "point": [L[0] / 2, L[1] / 2, 0],
+                                          "axis": [0, 0, 1], "radius": R,
+                                          "velocity": [0, 0, 0]})
+            scene["walls"] = walls
+        vol = L[0] * L[1] * L[2]
+        n = min(300, self.count_fill(vol, r0 * (1 + ratio) / 2, rng.uniform(0.02, 0.2)))
+        speed = logu(rng, 0.01, 10)
+        if rng.random() < 0.5:
+            # Groups of particles, each with its own velocity (a fill gives one to all).
+            scene["insert"] = []
+            groups = rng.randint(2, 4)
+            for k in range(groups):
+                scene["insert"].append({
+                    "type": "fill", "region": {"box": {"min": [0, 0, 0], "max": L}},
+                    "count": max(1, n // groups), "material": mats[k % len(mats)],
+                    "radius": self.radii(r0, ratio), "velocity": self.velocity(speed),
+                    "seed": rng.randrange(1 << 32)})
+            self.meta["expected_start"] = sum(i["count"] for i in scene["insert"])
+        else:
+            # A gas with a random velocity per particle, from a CSV file (non-overlapping by
+            # rejection; centres kept a radius inside the walls).
+            rows = []
+            placed = []
+            for _ in range(20 * n):
+                if len(rows) >= n:
+                    break
+                q = r0 if rng.random() < 0.7 else r0 * ratio
+                c = np.array([rng.uniform(q, L[a] - q) for a in range(3)])
+                span = np.asarray(L) * (1.0 if periodic else 0.0)
+                if any(np.linalg.norm(c - c2 - span * np.round((c - c2) / np.asarray(L))) <
+                       q + q2 for c2, q2 in placed):
+                    continue
+                if any(np.linalg.norm((c - rod["point"])[:2]) < rod["radius"] + q
+                       for rod in self.meta["rods"]):  # the post stands along z
+                    continue
+                placed.append((c, q))
+                v = self.velocity(speed)
+                rows.append((*c, q, *v, rng.choice(mats)))
+            text = "x,y,z,radius,vx,vy,vz,material\n"
+            for row in rows:
+                text += ",".join(f"{v:.17g}" for v in row[:7]) + f",{row[7]}\n"
+            self.files["gas.csv"] = text
+            scene["insert"] = [{"type": "csv", "file": "gas.csv", "material": mats[0]}]
+            self.meta["expected_start"] = len(rows)
+            self.meta["csv_valid_lines"] = set(range(2, len(rows) + 2))
+        self.meta["isolated"] = not self.meta["cohesion"]
+        self.meta["momentum"] = periodic
+        self.time(scene, r0, rng.randint(300, 1500))
+        self.parallel(scene, [0, 1, 2])
+        return scene
+
+    def fluid(self):
+        rng = self.rng
+        # Soft materials: steps long against the fluid's time scales (drag, spin relaxation).
+        small = rng.random() < 0.4
+        scene = self.base(y_max=1e7 if small else 1e8)
+        r0 = logu(rng, 5e-6, 5e-5) if small else logu(rng, 1e-4, 2e-3)
+        ratio = logu(rng, 1, 10)
+        r_max = r0 * ratio
+        L = [r_max * rng.uniform(8, 20) for _ in range(3)]
+        per = [rng.random() < 0.5, rng.random() < 0.5, rng.random() < 0.3]
+        big = rng.random() < 0.08  # a large domain with a fine void-fraction grid
+        if big:
+            L = [logu(rng, 0.5, 3)] * 3
+        scene["domain"] = {"min": [0, 0, 0], "max": L, "periodic": per}
+        gravity = rng.random() < 0.7
+        scene["gravity"] = [0, 0, -9.81] if gravity else [0, 0, 0]
+        mats = [x["name"] for x in scene["materials"]]
+        walls = []
+        if not per[2]:
+            walls.append({"type": "plane", "name": "floor", "point": [0, 0, 0],
+                          "normal": [0, 0, 1], "material": rng.choice(mats)})
+        scene["walls"] = walls
+        hydro = rng.random() < 0.5
+        forces = ["drag", "pressure_gradient", "viscous"]
+        # Small beads mostly get a shear and rotational drag with a viscous fluid: their spin
+        # relaxation time rho_p d^2 / (60 mu) is then far below the contact step (issue 17).
+        forces += [f for f in OPTIONAL_FORCES
+                   if rng.random() < (0.8 if small and f == "rotational_drag" else 0.5)]
+        if gravity and not hydro:
+            forces.append("buoyancy")
+        rng.shuffle(forces)
+        fl = {"density": float(f"{logu(rng, 1, 2000):.4g}"),
+              "viscosity": float(f"{logu(rng, 1e-2 if small else 1e-5, 1):.3g}"),
+              "velocity": [round(rng.uniform(-2, 2), 4) for _ in range(3)],
+              "drag": rng.choice(DRAG_LAWS), "model": rng.choice(["A", "B"]), "forces": forces,
+              "pressure": {"hydrostatic": hydro}}
+        if rng.random() < (0.8 if small else 0.5):
+            fl["shear"] = {"rate": round(logu(rng, 0.1, 1e4), 4), "flow_direction": [1, 0, 0],
+                           "gradient_direction": [0, 0, 1], "origin": [0, 0, 0]}
+        if rng.random() < 0.3:
+            fl["pressure"]["gradient"] = [round(rng.uniform(-1e3, 1e3), 3), 0, 0]
+        if "virtual_mass" in forces and rng.random() < 0.5:
+            fl["virtual_mass_coefficient"] = round(rng.uniform(0, 1), 3)
+        if big or rng.random() < 0.4:
+            cell = L[0] / logu(rng, 50, 3000) if big else r_max * logu(rng, 1.5, 8)
+            fl["void_fraction"] = {"cell_size": float(f"{cell:.4g}"),
+                                   "minimum": round(rng.uniform(0.2, 0.6), 3)}
+        else:
+            fl["void_fraction"] = round(rng.uniform(0.2, 1), 3)
+        scene["fluid"] = fl
+        self.meta["fluid"] = True
+        self.meta["gravity"] = gravity
+        box_max = [L[0], L[1], L[2] * 0.8] if not big else [r_max * 20] * 3
+        vol = box_max[0] * box_max[1] * box_max[2]
+        n = min(200, self.count_fill(vol, r0 * (1 + ratio) / 2, rng.uniform(0.01, 0.15)))
+        scene["insert"] = [{"type": "fill",
+                            "region": {"box": {"min": [0, 0, 0], "max": box_max}},
+                            "count": n, "material": rng.choice(mats),
+                            "radius": self.radii(r0, ratio), "seed": rng.randrange(1 << 32)}]
+        self.meta["expected_start"] = n
+        self.time(scene, r0, rng.randint(200, 1000))
+        self.parallel(scene, [0, 1, 2])
+        return scene
+
+    def limits(self):
+        """CSV particles at the limits of insertion: touching (17 digits), on walls, on axes."""
+        rng = self.rng
+        scene = self.base()
+        r = logu(rng, 1e-4, 3e-3)
+        L = r * rng.uniform(12, 30)
+        scene["domain"] = {"min": [0, 0, 0], "max": [L, L, L], "periodic": [False] * 3}
+        gravity = rng.random() < 0.6
+        scene["gravity"] = [0, 0, -9.81] if gravity else [0, 0, 0]
+        self.meta["gravity"] = gravity
+        mats = [x["name"] for x in scene["materials"]]
+        walls = [{"type": "plane", "name": "floor", "point": [0, 0, 0], "normal": [0, 0, 1],
+                  "material": rng.choice(mats)}]
+        rows = []
+        valid = []  # per row: True when the row is valid input and must be accepted
+        # Half the scenes test touching and overlapping pairs; the other half walls, so that
+        # a refusal of the first kind does not hide what the second would show.
+        touching = rng.random() < 0.5
+        # A chain of touching spheres along a random direction: centres r1 + r2 apart, written
+        # with 17 significant digits.
+        d = np.array([rng.gauss(0, 1) for _ in range(3)])
+        d /= np.linalg.norm(d)
+        x = np.array([L / 2, L / 2, L / 2])
+        k = rng.randint(2, 6) if touching else 0
+        radii = [r * logu(rng, 0.3, 1) for _ in range(k)]
+        span = sum(2 * q for q in radii)
+        x = x - d * span / 2
+        pos = []
+        for i, q in enumerate(radii):
+            if i == 0:
+                c = x + d * q
+            else:
+                c = pos[-1][0] + d * (radii[i - 1] + q)
+            pos.append((c, q))
+        for c, q in pos:
+            rows.append((c[0], c[1], c[2], q))
+            valid.append(True)
+        # A sphere resting exactly on the floor (centre r above it).
+        q = r * rng.uniform(0.5, 1)
+        rows.append((L * 0.2, L * 0.2, q, q))
+        valid.append(True)
+        u = rng.random() if not touching else 1
+        if u < 0.55:  # a rod with a sphere exactly on (or just off) its axis
+            R = r * logu(rng, 0.2, 2)
+            off = rng.choice([0.0, 0.0, 0.3 * R])
+            yz = float(f"{L * 0.8:.12g}")  # as the YAML holds it: the centre exactly on the axis
+            walls.append({"type": "cylinder", "name": "rod", "side": "outside",
+                          "axis_point": [0, yz, yz], "axis": [1, 0, 0], "radius": R,
+                          "material": rng.choice(mats)})
+            self.meta["rods"].append({"name": "rod", "point": [0, yz, yz],
+                                      "axis": [1, 0, 0], "radius": R, "velocity": [0, 0, 0]})
+            rows.append((L * 0.5, yz + off, yz, r * 0.5))
+            valid.append(False)  # inside the rod: must be refused with the rod's name
+        elif u < 1:  # a wall crossing a sphere by a given fraction of its radius
+            frac = rng.choice([0.01, 0.1, 0.24, 0.26, 0.5, 0.99])
+            q = r * 0.8
+            walls.append({"type": "plane", "name": "shelf", "point": [0, 0, L * 0.85],
+                          "normal": [0, 0, -1], "material": rng.choice(mats)})
+            rows.append((L * 0.7, L * 0.7, L * 0.85 - q * (1 - frac), q))
+            valid.append(None)  # accepted or refused, depending on the overlap limit
+        # A touching, slightly overlapping or slightly separated pair.
+        gap = (rng.choice([-1e-3, -1e-9, 0.0, 1e-12]) if touching else 1e-6) * r
+        a = np.array([L * 0.25, L * 0.75, L * 0.3])
+        rows.append((a[0], a[1], a[2], r))
+        rows.append((a[0] + 2 * r + gap, a[1], a[2], r))
+        valid += [True, gap >= 0]
+        # An unequal pair: a large sphere resting on a small one (ratio up to 20).
+        ratio = logu(rng, 1, 20)
+        small = r / ratio
+        b = np.array([L * 0.75, L * 0.25, small])
+        rows.append((b[0], b[1], b[2], small))
+        rows.append((b[0], b[1], b[2] + small + r * 1.0000001, r))
+        valid += [True, True]
+        text = "x,y,z,radius,vx,vy,vz\n"
+        for row in rows:
+            text += ",".join(f"{v:.17g}" for v in row) + ",0,0,0\n"
+        self.files["particles.csv"] = text
+        scene["walls"] = walls
+        scene["insert"] = [{"type": "csv", "file": "particles.csv", "material": rng.choice(mats)}]
+        self.meta["expected_start"] = len(rows)
+        # Line numbers in the file (the header is line 1) of rows that must be accepted.
+        self.meta["csv_valid_lines"] = {k + 2 for k, ok in enumerate(valid) if ok}
+        self.time(scene, min(row[3] for row in rows), rng.randint(300, 1500))
+        self.parallel(scene, [0, 1, 2])
+        return scene
+
+    def scene(self):
+        f = self.family
+        s = {"pour": self.pour, "drum": self.drum, "rod": self.rod, "mesh": self.mesh,
+             "periodic_gas": lambda: self.gas(True), "closed_gas": lambda: self.gas(False),
+             "fluid": self.fluid, "limits": self.limits}[f]()
+        self.output(s)
+        order = ["domain", "gravity", "time", "materials", "interactions", "interaction_defaults",
+                 "contact", "walls", "insert", "fluid", "parallel", "output"]
+        return {k: s[k] for k in order if k in s}
+
+
+def draw(seed):
+    d = Draw(seed)
+    s = d.scene()
+    return d, clean(s)
+
+
+def clean(x):
+    """Plain Python numbers (no numpy scalars) with 12 significant digits for YAML."""
+    if isinstance(x, dict):
+        return {k: clean(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [clean(v) for v in x]
+    if isinstance(x, bool):
+        return x
+    if isinstance(x, (int, np.integer)):
+        return int(x)
+    if isinstance(x, (float, np.floating)):
+        return float(f"{float(x):.12g}")
+    return x
+
+
+def scene_yaml(seed, scene, draw_obj):
+    head = (f"# hard_scenes.py seed {seed}: family {draw_obj.family}, {draw_obj.ranks} rank(s), "
+            f"contact {'+'.join(combo_of(seed))}\n")
+    return head + yaml.safe_dump(scene, default_flow_style=None, sort_keys=False, width=100)
+
+
+# ---------------------------------------------------------------------------------------
+# Running and checking
+# ---------------------------------------------------------------------------------------
+def limit_memory():
+    resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT, MEMORY_LIMIT))
+
+
+def run_grain(args, ranks, scene_path, cwd, timeout, extra=()):
+    cmd = [args.grain, "run", scene_path, "--output", "out", "--no-progress", *extra]
+    if ranks > 1:
+        cmd = [args.mpiexec, "-np", str(ranks), "--oversubscribe", *cmd]
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+               OMPI_MCA_rmaps_base_oversubscribe="1")
+    start = time.monotonic()
+    try:
+        p = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, timeout=timeout,
+                           env=env, preexec_fn=limit_memory, start_new_session=True)
+        return p.returncode, p.stdout + p.stderr, time.monotonic() - start
+    except subprocess.TimeoutExpired as e:
+        out = (e.stdout or b"").decode(errors="replace") if isinstance(e.stdout, bytes) else \
+            (e.stdout or "")
+        return None, out, time.monotonic() - start
+
+
+FATAL_PATTERNS = [
+    (r"bad_alloc", "std::bad_alloc"),
+    (r"Segmentation fault|SIGSEGV|signal 11\b", "segmentation fault"),
+    (r"SIGABRT|signal 6\b|Aborted \(core|terminate called", "abort"),
+    (r"exited on signal \d+|SIGBUS|SIGFPE|SIGKILL|Floating point exception", "signal"),
+    (r"MPI_ABORT was invoked", "MPI_Abort"),
+]
+
+STEP_PROPOSAL = re.compile(
+    r"(?:[Ss]tep of at most|dt\s*<=|dt\s*≤|step of|time step of)\s*([0-9]+(?:\.[0-9]*)?"
+    r"(?:[eE][-+]?[0-9]+)?)\s*s\b")
+FAIL_TIME = re.compile(r"\bt = ([0-9.eE+-]+) s")
+ADVICE_WORDS = re.compile(
+    r"key |lower |raise |reduce |increase |decrease |use |set |give |add |remove |check |"
+    r"enlarge |make |move |choose |at most|at least|should|must|would|instead|;", re.I)
+
+
+class Failure(Exception):
+    def __init__(self, cls, detail):
+        super().__init__(f"{cls}: {detail}")
+        self.cls = cls
+        self.detail = detail
+
+
+def error_line(out):
+    for line in out.splitlines():
+        if re.search(r"\berror: ", line):
+            return line.strip()
+    lines = [ln for ln in out.splitlines() if ln.strip()]
+    return lines[-1].strip() if lines else ""
+
+
+def read_snapshots(outdir):
+    snaps = []
+    for name in sorted(os.listdir(outdir)):
+        if name.startswith("particles_") and name.endswith(".h5"):
+            with h5py.File(os.path.join(outdir, name), "r") as f:
+                d = {k: f[k][...] for k in ("id", "position", "velocity", "angular_velocity",
+                                            "radius", "mass", "material") if k in f}
+                d["time"] = float(f.attrs["time"])
+                d["count"] = int(f.attrs["count"])
+                snaps.append(d)
+    return snaps
+
+
+def rotation(axis, angle):
+    a = np.asarray(axis, float)
+    a /= np.linalg.norm(a)
+    k = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+    return np.eye(3) + math.sin(angle) * k + (1 - math.cos(angle)) * (k @ k)
+
+
+def plane_at(w, t):
+    """Point and unit normal of a plane wall at time t (DESIGN motion: P + V t + R (x0 - P))."""
+    p = np.asarray(w["point"], float)
+    n = np.asarray(w["normal"], float)
+    n = n / np.linalg.norm(n)
+    m = w.get("motion", {})
+    v = np.asarray(m.get("velocity", [0, 0, 0]), float)
+    om = m.get("angular_velocity", 0)
+    if om:
+        P = np.asarray(m.get("axis_point", [0, 0, 0]), float)
+        R = rotation(m["axis"], om * t)
+        p = P + R @ (p - P)
+        n = R @ n
+    return p + v * t, n
+
+
+def cylinder_at(w, t):
+    p = np.asarray(w["axis_point"], float)
+    a = np.asarray(w["axis"], float)
+    a = a / np.linalg.norm(a)
+    m = w.get("motion", {})
+    v = np.asarray(m.get("velocity", [0, 0, 0]), float)
+    om = m.get("angular_velocity", 0)
+    if om:
+        P = np.asarray(m.get("axis_point", [0, 0, 0]), float)
+        R = rotation(m["axis"], om * t)
+        p = P + R @ (p - P)
+        a = R @ a
+    return p + v * t, a
+
+
+def wall_speed(w, extent):
+    m = w.get("motion", {})
+    v = np.linalg.norm(np.asarray(m.get("velocity", [0, 0, 0]), float))
+    return v + abs(m.get("angular_velocity", 0)) * extent
+
+
+def material_table(scene):
+    return {i: m for i, m in enumerate(scene["materials"])}, \
+        {m["name"]: i for i, m in enumerate(scene["materials"])}
+
+
+def y_star(ma, mb):
+    return 1 / ((1 - ma["poisson_ratio"] ** 2) / ma["youngs_modulus"] +
+                (1 - mb["poisson_ratio"] ** 2) / mb["youngs_modulus"])
+
+
+def elastic_energy(scene, s):
+    """Normal elastic energy of every pair and plane contact, by brute force (DESIGN.md §3):
+    Hertz (8/15) Y* sqrt(R*) d^(5/2); Hooke k_n d^2 / 2."""
+    mats, index = material_table(scene)
+    c = scene["contact"]
+    hooke = c["normal"] == "hooke"
+    x, r, m, mat = s["position"], s["radius"], s["mass"], s["material"]
+    n = len(r)
+    if n == 0:
+        return 0.0
+    lo = np.asarray(scene["domain"]["min"], float)
+    L = np.asarray(scene["domain"]["max"], float) - lo
+    per = scene["domain"].get("periodic", [False] * 3)
+
+    def law(delta, ys, rs, ms):
+        if not hooke:
+            return (8 / 15) * ys * np.sqrt(rs) * delta ** 2.5
+        h = c["hooke"]
+        if "stiffness" in h:
+            kn = h["stiffness"]["normal"]
+        else:
+            v = h["characteristic_velocity"]
+            kn = (16 / 15) * np.sqrt(rs) * ys * (15 * ms * v * v / (16 * np.sqrt(rs) * ys)) ** 0.2
+        return 0.5 * kn * delta ** 2
+
+    e = 0.0
+    for i in range(n - 1):
+        d = x[i + 1:] - x[i]
+        for a in range(3):
+            if per[a]:
+                d[:, a] -= L[a] * np.round(d[:, a] / L[a])
+        dist = np.linalg.norm(d, axis=1)
+        rr = r[i] + r[i + 1:]
+        ov = rr - dist
+        k = np.nonzero(ov > 0)[0]
+        for j in k:
+            jj = i + 1 + j
+            ys = y_star(mats[int(mat[i])], mats[int(mat[jj])])
+            rs = r[i] * r[jj] / (r[i] + r[jj])
+            ms = m[i] * m[jj] / (m[i] + m[jj])
+            e += law(ov[j], ys, rs, ms)
+    for w in scene.get("walls", []):
+        wm = mats[index[w["material"]]]
+        if w["type"] == "plane":
+            p, nn = plane_at(w, s["time"])
+            dist = (x - p) @ nn
+        elif w["type"] == "cylinder":
+            p, a = cylinder_at(w, s["time"])
+            rel = x - p
+            rho = np.linalg.norm(rel - np.outer(rel @ a, a), axis=1)
+            dist = w["radius"] - rho if w.get("side", "inside") == "inside" else rho - w["radius"]
+        else:  # the plates of these scenes are flat at z = translate[2]
+            dist = np.abs(x[:, 2] - w["translate"][2])
+        ov = r - dist
+        for i in np.nonzero(ov > 0)[0]:
+            e += law(ov[i], y_star(mats[int(mat[i])], wm), r[i], m[i])
+    return float(e)
+
+
+def kinetic_energy(s):
+    m, r = s["mass"], s["radius"]
+    return float(0.5 * np.sum(m * np.sum(s["velocity"] ** 2, axis=1)) +
+                 0.5 * np.sum(0.4 * m * r * r * np.sum(s["angular_velocity"] ** 2, axis=1)))
+
+
+def check_output(d, scene, cwd, out):
+    """Invariants of a run that ended with exit 0."""
+    outdir = os.path.join(cwd, "out")
+    snaps = read_snapshots(outdir)
+    if not snaps:
+        raise Failure("no output", "exit 0 but no snapshot in out/")
+    m = re.search(r"done: (\d+) steps, (\d+) particles \((\d+) removed\)", out)
+    if not m:
+        raise Failure("no summary", "exit 0 without the 'done: ... particles (... removed)' line")
+    n_end, removed = int(m.group(2)), int(m.group(3))
+    streamed = sum(int(k) for k in re.findall(r"^stream .*?: (\d+) particles", out, re.M))
+    first = snaps[0]
+    if d.meta["expected_start"] is not None and first["count"] != d.meta["expected_start"]:
+        raise Failure("particle count", f"{first['count']} particles at t = 0, "
+                      f"{d.meta['expected_start']} asked for")
+    if n_end + removed != first["count"] + streamed:
+        raise Failure("particle lost", f"start {first['count']} + streamed {streamed} != end "
+                      f"{n_end} + removed {removed}")
+    if snaps[-1]["count"] != n_end:
+        raise Failure("particle lost", f"last snapshot holds {snaps[-1]['count']}, summary {n_end}")
+    max_ov = scene["time"].get("max_overlap", MAX_OVERLAP_DEFAULT)
+    dt = d.dt_run
+    for s in snaps:
+        for k in ("position", "velocity", "angular_velocity"):
+            if s["count"] and not np.all(np.isfinite(s[k])):
+                raise Failure("non-finite state", f"{k} not finite at t = {s['time']}")
+        if len(s["id"]) != len(set(s["id"].tolist())):
+            raise Failure("duplicate ids", f"at t = {s['time']}")
+        x, r = s["position"], s["radius"]
+        if len(r) == 0:
+            continue
+        # Slack: the guard allows max_overlap of the radius; a moving wall may advance one
+        # step's travel between the guard's check and the snapshot; 1e-9 r for round-off.
+        for w in scene.get("walls", []):
+            if w["type"] == "plane":
+                p, n = plane_at(w, s["time"])
+                dist = (x - p) @ n
+                slack = wall_speed(w, np.max(np.abs(x - p))) * dt + 1e-9 * r
+                bad = np.nonzero(dist < r * (1 - max_ov) - slack)[0]
+            elif w["type"] == "cylinder":
+                p, a = cylinder_at(w, s["time"])
+                rel = x - p
+                rho = np.linalg.norm(rel - np.outer(rel @ a, a), axis=1)
+                slack = wall_speed(w, w["radius"]) * dt + 1e-9 * r
+                if w.get("side", "inside") == "inside":
+                    bad = np.nonzero(w["radius"] - rho < r * (1 - max_ov) - slack)[0]
+                else:
+                    bad = np.nonzero(rho - w["radius"] < r * (1 - max_ov) - slack)[0]
+            else:
+                bad = []
+                for pl in d.meta["plates"]:
+                    if pl["name"] != w["name"]:
+                        continue
+                    pz = pl["point"][2] + pl["velocity"][2] * s["time"]
+                    slack = abs(pl["velocity"][2]) * dt + 1e-9 * r
+                    bad = np.nonzero((x[:, 2] - pz) * pl["side"] < r * (1 - max_ov) - slack)[0]
+            if len(bad):
+                i = bad[0]
+                raise Failure(
+                    "particle inside a wall",
+                    f"wall '{w.get('name')}' ({w['type']}): {len(bad)} particle(s) at t = "
+                    f"{s['time']:.6g} s, e.g. id {int(s['id'][i])} at "
+                    f"({x[i][0]:.6g}, {x[i][1]:.6g}, {x[i][2]:.6g}) m, r = {r[i]:.4g} m "
+                    f"(overlap limit {max_ov})")
+    # A moving rod must touch every resting particle in its path (no gravity, no fluid).
+    last = snaps[-1]
+    if not d.meta["gravity"] and not d.meta["fluid"]:
+        for rod in d.meta["rods"]:
+            v = np.asarray(rod["velocity"], float)
+            if not np.any(v):
+                continue
+            T = last["time"]
+            p0 = np.asarray(rod["point"], float)
+            ids_end = {int(i): k for k, i in enumerate(last["id"])}
+            for k, pid in enumerate(first["id"]):
+                pid = int(pid)
+                if pid not in ids_end or np.any(first["velocity"][k] != 0):
+                    continue
+                rel = first["position"][k] - p0
+                ahead = rel @ v / np.linalg.norm(v)
+                lateral = abs(rel[1])  # the rods sweep along z with axis x: y is lateral
+                travel = np.linalg.norm(v) * T
+                rr = first["radius"][k]
+                # The rod's surface passes through the centre's column in the run.
+                if lateral < rod["radius"] and ahead > rod["radius"] + rr and \
+                        ahead < travel - rod["radius"] - rr:
+                    j = ids_end[pid]
+                    if np.array_equal(last["position"][j], first["position"][k]):
+                        raise Failure(
+                            "wall passed through a particle",
+                            f"rod '{rod['name']}' at {np.linalg.norm(v):.4g} m/s swept over "
+                            f"particle {pid} (r = {rr:.4g} m, {lateral:.3g} m off its path) "
+                            f"without touching it (dt = {dt:.4g} s: "
+                            f"{np.linalg.norm(v) * dt / rr:.3g} radii per step)")
+    if d.meta["isolated"] and not d.meta["moving_walls"]:
+        e = [kinetic_energy(s) + elastic_energy(scene, s) for s in snaps]
+        e0 = e[0]
+        # Tangential and rolling springs store energy that is not counted here, and velocity
+        # Verlet's energy error within a contact at >= 5 steps per contact is a few per cent:
+        # a rise above 5 % of E0 over the lowest earlier value is a gain, not noise (an
+        # under-resolved impact multiplies the energy, docs/stability.md).
+        lowest = e0
+        for s, ek in zip(snaps[1:], e[1:]):
+            if ek > lowest + 0.05 * e0 + 1e-300:
+                raise Failure("energy rises", f"E = {ek:.6g} J at t = {s['time']:.6g} s, above "
+                              f"the earlier lowest {lowest:.6g} J by {100 * (ek - lowest) / e0:.3g}"
+                              f" % of E0 = {e0:.6g} J (isolated, dissipative)")
+            lowest = min(lowest, ek)
+    if d.meta["momentum"] and removed == 0:
+        p = [np.sum(s["mass"][:, None] * s["velocity"], axis=0) for s in snaps]
+        scale = max(float(np.sum(snaps[0]["mass"] * np.linalg.norm(snaps[0]["velocity"],
+                                                                   axis=1))), 1e-300)
+        for s, pk in zip(snaps[1:], p[1:]):
+            # Pair forces are equal and opposite: only round-off of the sums, ~1e-15 per step.
+            if np.max(np.abs(pk - p[0])) > 1e-9 * scale:
+                raise Failure("momentum not conserved",
+                              f"|P - P0| = {np.max(np.abs(pk - p[0])):.3g} kg m/s at t = "
+                              f"{s['time']:.6g} s, sum m|v| = {scale:.3g} (fully periodic, no "
+                              "walls, gravity or fluid)")
+
+
+def run_dt(scene):
+    """The step a scene runs with: given, or from its line in the start-up report."""
+    return scene["time"].get("step")
+
+
+def startup_dt(out):
+    m = re.search(r"\bdt = ([0-9.eE+-]+) s", out)
+    return float(m.group(1)) if m else None
+
+
+def check_scene(args, seed, d, scene, workdir, depth=0):
+    """Runs one scene; returns a note on success, raises Failure otherwise."""
+    os.makedirs(workdir, exist_ok=True)
+    for name, text in d.files.items():
+        with open(os.path.join(workdir, name), "w") as f:
+            f.write(text)
+    path = os.path.join(workdir, "scene.yaml")
+    with open(path, "w") as f:
+        f.write(scene_yaml(seed, scene, d))
+    shutil.rmtree(os.path.join(workdir, "out"), ignore_errors=True)
+    rc, out, seconds = run_grain(args, d.ranks, "scene.yaml", workdir, args.timeout)
+    with open(os.path.join(workdir, "grain.out"), "w") as f:
+        f.write(out)
+    d.dt_run = scene["time"].get("step") or startup_dt(out) or d.dt_estimate
+    for pat, cls in FATAL_PATTERNS:
+        if re.search(pat, out):
+            hit = [ln.strip() for ln in out.splitlines() if re.search(pat, ln)]
+            raise Failure(cls, hit[0] if hit else out[-300:])
+    if rc is None:
+        raise Failure("timeout", f"no end after {args.timeout} s; last output: {out[-200:]!r}")
+    if rc < 0:
+        raise Failure("signal", f"killed by signal {-rc}")
+    if rc == 0:
+        check_output(d, scene, workdir, out)
+        return "ran", seconds
+    if rc not in (1, 2):
+        raise Failure(f"exit {rc}", error_line(out))
+    msg = error_line(out)
+    m = re.search(r"particles\.csv:(\d+):", msg)
+    if m and int(m.group(1)) in d.meta.get("csv_valid_lines", ()):
+        raise Failure("valid CSV row refused", msg)
+    if "error" not in msg:
+        raise Failure("exit 1 without an error message", out[-300:])
+    if not ADVICE_WORDS.search(msg.split("error", 1)[1]):
+        raise Failure("message without a remedy", msg)
+    d.message = msg
+    if "non-finite" in msg and "fluid" in scene:
+        # Issue 17: the NaN guard names the enabled force terms (and their dt / limit ratios).
+        silent = [f for f in scene["fluid"]["forces"] if f not in msg]
+        if silent:
+            raise Failure("NaN guard silent on the force terms",
+                          f"enabled {', '.join(scene['fluid']['forces'])}, not named: "
+                          f"{', '.join(silent)}: {msg}")
+    proposals = [float(v) for v in STEP_PROPOSAL.findall(msg)]
+    if not proposals or depth >= 2:
+        return ("refused" if rc == 2 else "stopped"), seconds
+    dt_ran = d.dt_run
+    step = min(proposals)
+    if dt_ran and step >= dt_ran * (1 - 1e-9):
+        raise Failure("proposed step not smaller",
+                      f"proposes {step:.4g} s after running with dt = {dt_ran:.4g} s: {msg}")
+    m = FAIL_TIME.search(msg)
+    t_fail = float(m.group(1)) if m else 0.0
+    # Rerun with the proposal, far enough to pass the point of failure, at most 2e5 steps.
+    end = min(scene["time"]["end"], t_fail + 20 * (dt_ran or step))
+    if end / step > 2e5:
+        return "stopped (proposal not rerun: over 2e5 steps)", seconds
+    re_scene = json.loads(json.dumps(scene))
+    re_scene["time"].pop("rayleigh_fraction", None)
+    re_scene["time"]["step"] = float(f"{step:.6g}")
+    re_scene["time"]["end"] = float(f"{end:.6g}")
+    re_scene["output"]["snapshot_interval"] = end / 8
+    sub = os.path.join(workdir, f"rerun{depth + 1}")
+    d2 = Draw(seed)
+    d2.files, d2.meta, d2.ranks, d2.family = d.files, d.meta, d.ranks, d.family
+    d2.dt_estimate = step
+    try:
+        how, s2 = check_scene(args, seed, d2, re_scene, sub, depth + 1)
+    except Failure as f:
+        raise Failure("rerun with the proposed step: " + f.cls, f.detail + f" [after: {msg}]")
+    if how.startswith("stopped"):
+        m2 = FAIL_TIME.search(error_line(open(os.path.join(sub, "grain.out")).read()))
+        t2 = float(m2.group(1)) if m2 else 0.0
+        if t2 <= t_fail:
+            raise Failure("proposed step does not get further",
+                          f"stopped at t = {t2:.6g} s after stopping at t = {t_fail:.6g} s with "
+                          f"dt = {dt_ran:.4g} s; proposal {step:.4g} s: {msg}")
+    return f"stopped, proposal {how}", seconds + s2
+
+
+STOP_CAUSES = [
+    ("key time.min_steps_per_contact", "steps-per-contact guard"),
+    ("key time.max_step_travel", "travel guard"),
+    ("key time.max_overlap", "overlap guard"),
+    ("dt is too large", "start-up step refusal"),
+    ("non-finite", "NaN guard"),
+    ("overlaps an earlier particle", "CSV overlap refused"),
+    ("wall", "insertion against a wall"),
+]
+
+
+def summarise(path):
+    """Counts of a --report file: outcomes, failure classes with seeds, what stopped runs."""
+    rows = [json.loads(line) for line in open(path) if line.strip()]
+    print(f"{len(rows)} scenes")
+    by = {}
+    for r in rows:
+        key = r["result"] if r["result"] == "FAIL" else r["result"].split(",")[0].split(" (")[0]
+        by[key] = by.get(key, 0) + 1
+    print("outcomes: " + ", ".join(f"{k} {v}" for k, v in sorted(by.items())))
+    fam = {}
+    for r in rows:
+        f = fam.setdefault(r["family"], [0, 0])
+        f[0] += 1
+        f[1] += r["result"] == "FAIL"
+    print("families (scenes, failed): " + ", ".join(f"{k} {v[0]}/{v[1]}" for k, v in fam.items()))
+    stops = {}
+    for r in rows:
+        msg = r.get("message") or ""
+        if r["result"] != "FAIL" and msg:
+            cause = next((c for pat, c in STOP_CAUSES if pat in msg), "other")
+            stops.setdefault(cause, []).append(r["seed"])
+    for c, ss in sorted(stops.items(), key=lambda kv: -len(kv[1])):
+        print(f"  stopped by {c}: {len(ss)}")
+    classes = {}
+    for r in rows:
+        if r["result"] == "FAIL":
+            classes.setdefault(r["class"], []).append(r)
+    for c, rs in sorted(classes.items(), key=lambda kv: -len(kv[1])):
+        print(f"  FAIL {len(rs):4d} {c}: seeds {' '.join(str(r['seed']) for r in rs)}")
+        print(f"       e.g. seed {rs[0]['seed']}: {rs[0]['detail'][:400]}")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--grain")
+    ap.add_argument("--summarise", metavar="REPORT", help="summarise a --report file and exit")
+    ap.add_argument("--mpiexec", default="mpiexec")
+    ap.add_argument("--seed", type=int, help="one scene")
+    ap.add_argument("--seeds", help="a range A:B (B excluded)")
+    ap.add_argument("--first", type=int, default=0)
+    ap.add_argument("--count", type=int, default=40)
+    ap.add_argument("--budget", type=float, default=0, help="stop after this many seconds")
+    ap.add_argument("--ranks", choices=["mixed", "1", "2"], default="mixed",
+                    help="mixed: every third seed on 2 ranks")
+    ap.add_argument("--timeout", type=float, default=60, help="per run [s]")
+    ap.add_argument("--work", default="hard_scenes_work")
+    ap.add_argument("--keep", action="store_true", help="keep the folders of passing scenes")
+    ap.add_argument("--print-scene", action="store_true", help="print the seed's YAML, no run")
+    ap.add_argument("--report", help="write a JSON line per scene to this file")
+    ap.add_argument("--family", choices=FAMILIES, help="run only the seeds of this family")
+    ap.add_argument("--verbose", action="store_true", help="print the message of each stop")
+    args = ap.parse_args()
+    if args.summarise:
+        summarise(args.summarise)
+        return 0
+    if not args.grain:
+        ap.error("--grain is required")
+    if os.sep in args.grain:
+        args.grain = os.path.abspath(args.grain)
+    if args.seed is not None:
+        seeds = [args.seed]
+    elif args.seeds:
+        a, b = (int(v) for v in args.seeds.split(":"))
+        seeds = list(range(a, b))
+    else:
+        seeds = list(range(args.first, args.first + args.count))
+    os.makedirs(args.work, exist_ok=True)
+    report = open(args.report, "a") if args.report else None
+    start = time.monotonic()
+    failures = []
+    done = 0
+    for seed in seeds:
+        if args.budget and time.monotonic() - start > args.budget:
+            print(f"time budget of {args.budget:g} s used after {done} scenes")
+            break
+        if args.family and FAMILIES[seed % len(FAMILIES)] != args.family:
+            continue
+        d, scene = draw(seed)
+        if args.ranks != "mixed":
+            d.ranks = int(args.ranks)
+        if args.print_scene:
+            print(scene_yaml(seed, scene, d))
+            continue
+        workdir = os.path.abspath(os.path.join(args.work, f"seed_{seed}"))
+        shutil.rmtree(workdir, ignore_errors=True)
+        t0 = time.monotonic()
+        try:
+            how, _ = check_scene(args, seed, d, scene, workdir)
+            msg = getattr(d, "message", "")
+            line = {"seed": seed, "family": d.family, "ranks": d.ranks, "result": how,
+                    "message": msg}
+            print(f"seed {seed:6d} {d.family:13s} {d.ranks}r {'+'.join(combo_of(seed)):28s} "
+                  f"{time.monotonic() - t0:6.2f} s  ok ({how})"
+                  + (f": {msg[:200]}" if args.verbose and msg else ""), flush=True)
+            if not args.keep:
+                shutil.rmtree(workdir, ignore_errors=True)
+        except Failure as f:
+            line = {"seed": seed, "family": d.family, "ranks": d.ranks, "result": "FAIL",
+                    "class": f.cls, "detail": f.detail}
+            failures.append((seed, d, f, workdir))
+            print(f"seed {seed:6d} {d.family:13s} {d.ranks}r {'+'.join(combo_of(seed)):28s} "
+                  f"{time.monotonic() - t0:6.2f} s  FAIL {f.cls}: {f.detail}", flush=True)
+        if report:
+            report.write(json.dumps(line) + "\n")
+            report.flush()
+        done += 1
+    if args.print_scene:
+        return 0
+    elapsed = time.monotonic() - start
+    print(f"\n{done} scenes in {elapsed:.1f} s, {len(failures)} failed")
+    classes = {}
+    for seed, d, f, _ in failures:
+        classes.setdefault(f.cls, []).append(seed)
+    for cls, ss in sorted(classes.items(), key=lambda kv: -len(kv[1])):
+        print(f"  {len(ss):4d}  {cls}: seeds {' '.join(map(str, ss))}")
+    for seed, d, f, workdir in failures:
+        print(f"\n--- seed {seed} failed ({f.cls}); scene {workdir}/scene.yaml; rerun with "
+              f"--seed {seed}:")
+        with open(os.path.join(workdir, "scene.yaml")) as fh:
+            print(fh.read())
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
