@@ -98,7 +98,7 @@ void Simulation::initialise() {
           << " m); enlarge the domain along it or reduce the skin";
       throw SetupError(msg.str());
     }
-  if (automatic_grid_ && !cuts_imposed_ && decomp_->size() > 1) fit_grid_to_particles();
+  if (automatic_grid_ && !cuts_imposed_ && decomp_->size() > 1) fit_grid_to_domain();
   for (int a = 0; a < 3; ++a)
     if (decomp_->dims()[a] > 1 && decomp_->thinnest_box() < cutoff_) {
       std::ostringstream msg;
@@ -479,35 +479,15 @@ void Simulation::balance_cuts() {
                                     decomp_->hi() + Vec3::Constant(cutoff_), cutoff_);
 }
 
-void Simulation::fit_grid_to_particles() {
-  const Domain& d = scene_.domain;
-  const Vec3 length = d.hi - d.lo;
-  // Particles still to come (streams) land where the scene sends them, not where the
-  // particles of the start are: such a scene, like an empty one, is cut for its domain.
-  const bool by_particles = p_.size() > 0 && streams_.empty();
-  std::optional<Vec3> extent;
-  if (by_particles) {
-    Vec3 lo = p_.x[0], hi = p_.x[0];
-    for (const Vec3& x : p_.x) {
-      lo = lo.cwiseMin(x);
-      hi = hi.cwiseMax(x);
-    }
-    // The cut through the particles plus the ghost layer on either side of it.
-    extent = ((hi - lo) + Vec3::Constant(cutoff_)).cwiseMin(length);
-  }
-  const std::array<int, 3> dims = choose_processor_grid(decomp_->size(), length, cutoff_, extent);
-  if (dims != decomp_->dims()) {
-    exchange_.reset();
-    decomp_ = std::make_unique<Decomposition>(comm_, d, dims);
-    exchange_ = std::make_unique<Exchange>(*decomp_);
-  }
-  if (!by_particles) return;
-  std::vector<double> coordinate(p_.size());
-  for (int a = 0; a < 3; ++a) {
-    if (dims[a] == 1) continue;
-    for (std::size_t i = 0; i < p_.size(); ++i) coordinate[i] = p_.x[i][a];
-    decomp_->set_cuts(a, balanced_cut_planes(coordinate, d.lo[a], d.hi[a], dims[a], cutoff_));
-  }
+void Simulation::fit_grid_to_domain() {
+  // The grid is a function of the scene alone (the domain and the interaction range), so a
+  // restart builds the same boxes and continues bit for bit.
+  const std::array<int, 3> dims =
+      choose_processor_grid(decomp_->size(), decomp_->length(), cutoff_);
+  if (dims == decomp_->dims()) return;
+  exchange_.reset();
+  decomp_ = std::make_unique<Decomposition>(comm_, scene_.domain, dims);
+  exchange_ = std::make_unique<Exchange>(*decomp_);
 }
 
 void Simulation::set_cut_planes(int axis, const std::vector<double>& planes) {

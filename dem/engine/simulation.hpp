@@ -79,8 +79,8 @@ class Simulation {
   // keeps each on the rank that owns it). `insert = false` starts empty: tests add
   // particles by hand — on every rank alike — before initialise().
   // processor_grid {0,0,0} takes the scene's `parallel.grid`; when that is {0,0,0} too, the
-  // grid and its cut planes are chosen by initialise() for the particles then present
-  // (docs/parallel.md, "The default grid"), unless set_cut_planes() imposed planes.
+  // grid is chosen by initialise() once the interaction range is known (docs/parallel.md,
+  // "The default grid"), unless set_cut_planes() imposed planes.
   explicit Simulation(const Scene& scene, bool insert = true, MPI_Comm comm = MPI_COMM_WORLD,
                       std::array<int, 3> processor_grid = {0, 0, 0});
 
@@ -167,10 +167,9 @@ class Simulation {
  private:
   void rebuild(bool keep_drag = false);
   void balance_cuts();  // moves cut planes toward equal particle counts (collective)
-  // The default grid (automatic grid, no imposed planes): the grid with the least cut area
-  // through the particles' extent, its planes at the particle-count quantiles. Every rank
-  // holds every particle when it runs, so all choose the same.
-  void fit_grid_to_particles();
+  // The default grid (automatic grid, no imposed planes): the least cut area among the grids
+  // whose boxes are at least as thick as the interaction range, uniform planes.
+  void fit_grid_to_domain();
   ContactGuards compute_forces();  // gravity, contacts, then the force terms
   void apply_force_terms();  // non-contact terms only
   void restore_implicit_drag();  // initialise() after restore()

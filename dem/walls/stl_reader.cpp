@@ -160,14 +160,23 @@ struct BitsHash {
   }
 };
 
-// Points in cells of edge h (a hashed grid: only occupied cells are stored).
+// Points in cells of edge h from `origin` (a hashed grid: only occupied cells are stored).
+// Cell numbers are clamped to +-2^62: a tolerance far below the coordinates' spacing puts
+// distant points into one extreme cell, which costs time but never a wrong answer (the
+// distance is always checked).
 class PointCells {
  public:
-  explicit PointCells(double h) : inv_(1 / h) {}
+  PointCells(double h, const Vec3& origin) : inv_(1 / h), origin_(origin) {}
   std::array<std::int64_t, 3> cell(const Vec3& x) const {
-    return {static_cast<std::int64_t>(std::floor(x[0] * inv_)),
-            static_cast<std::int64_t>(std::floor(x[1] * inv_)),
-            static_cast<std::int64_t>(std::floor(x[2] * inv_))};
+    constexpr double kMax = 4.6e18;  // < 2^62
+    std::array<std::int64_t, 3> c;
+    for (int a = 0; a < 3; ++a) {
+      double v = std::floor((x[a] - origin_[a]) * inv_);
+      if (!(v > -kMax)) v = -kMax;  // also NaN (0 * inf)
+      if (!(v < kMax)) v = kMax;
+      c[a] = static_cast<std::int64_t>(v);
+    }
+    return c;
   }
   void add(const Vec3& x, int k) { cells_[key(cell(x))].push_back(k); }
   // Calls f(k) for every point stored in the 27 cells around x.
@@ -189,6 +198,7 @@ class PointCells {
             static_cast<std::uint64_t>(c[2])};
   }
   double inv_;
+  Vec3 origin_;
   std::unordered_map<std::array<std::uint64_t, 3>, std::vector<int>, BitsHash> cells_;
 };
 
@@ -208,7 +218,7 @@ std::vector<int> weld(const std::vector<Vec3>& x, double tol, long& welded) {
   std::vector<int> to(x.size());
   for (std::size_t k = 0; k < x.size(); ++k) to[k] = static_cast<int>(k);
   if (!(tol > 0)) return to;
-  PointCells cells(tol);
+  PointCells cells(tol, x.empty() ? Vec3::Zero() : x[0]);
   for (std::size_t k = 0; k < x.size(); ++k) {
     int into = -1;
     cells.around(x[k], [&](int q) {
@@ -248,7 +258,7 @@ void find_open_edges(const std::vector<Vec3>& x, const std::vector<std::array<in
   for (std::size_t t = 0; t < tris.size(); ++t)
     for (int v : tris[t])
       if (on_rim[v]) around[v].push_back(static_cast<int>(t));
-  PointCells cells(reach);
+  PointCells cells(reach, x[0]);
   double best = reach;
   for (std::size_t k = 0; k < x.size(); ++k) {
     if (!on_rim[k]) continue;

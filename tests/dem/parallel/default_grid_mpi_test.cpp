@@ -5,10 +5,6 @@
 //    Reference: conservation of the particle count, and the run on one rank (the same
 //    scene on MPI_COMM_SELF) whose settled bed height agrees to round-off amplified by a
 //    short settling (1e-9 m, a millionth of the radius).
-// 2. A bed in the lowest sixth of a tall domain: the default cuts across the bed, with
-//    the plane at the particles' median, so the two ranks start with equal counts
-//    (reference: the even split, imbalance 1); the domain's least-cut-area grid would cut
-//    along z at mid-height and leave the upper rank empty (imbalance 2).
 #include <gtest/gtest.h>
 
 #include "tests/dem/parallel/support.hpp"
@@ -73,36 +69,6 @@ TEST(DefaultGrid, TallColumnIsCutAlongItsHeight) {
   const double one_rank = mean_height(one, MPI_COMM_SELF);
   EXPECT_NEAR(two_ranks, one_rank, 1e-9);
   EXPECT_LT(two_ranks, 0.03);  // the spheres have fallen (from up to 39 mm)
-}
-
-TEST(DefaultGrid, ABedAtTheBottomIsSplitEvenly) {
-  Scene s = test::one_material_scene(1e7, 0.3, 2500, 0.9, 0.3);
-  s.domain.lo = Vec3(0, 0, 0);
-  s.domain.hi = Vec3(0.02, 0.02, 0.08);
-  s.gravity = Vec3(0, 0, -9.81);
-  s.walls.push_back(test::plane(Vec3::Zero(), Vec3::UnitZ()));
-  Insertion fill;
-  fill.kind = Insertion::Kind::fill;
-  fill.region.lo = Vec3(0, 0, 0);
-  fill.region.hi = Vec3(0.02, 0.02, 0.012);
-  fill.count = 600;
-  fill.radius.value = 0.5e-3;
-  fill.seed = 5;
-  fill.source = "test";
-  s.insertions.push_back(fill);
-  ASSERT_EQ(choose_processor_grid(2, s.domain.hi - s.domain.lo), (std::array<int, 3>{1, 1, 2}));
-  Simulation sim(s);
-  sim.initialise();
-  // Across the bed: along x or y, whichever of the bed's (random) widths is the smaller.
-  const std::array<int, 3> dims = sim.decomposition().dims();
-  EXPECT_TRUE(dims == (std::array<int, 3>{2, 1, 1}) || dims == (std::array<int, 3>{1, 2, 1}));
-  EXPECT_DOUBLE_EQ(sim.load_imbalance(), 1.0);
-  // A grid given in the scene keeps uniform planes.
-  s.parallel.grid = {1, 1, 2};
-  Simulation given(s);
-  given.initialise();
-  EXPECT_EQ(given.decomposition().cuts(2)[1], 0.04);
-  EXPECT_DOUBLE_EQ(given.load_imbalance(), 2.0);
 }
 
 }  // namespace
