@@ -102,7 +102,9 @@ ImpactRun impact(const MeshImpact& c, double dt, double max_step_travel = 1,
   s.domain.hi = Vec3(0.012, 0.012, 0.012);
   test::MeshData mesh = test::flat_grid(4, kLeg, -2 * kLeg, -2 * kLeg, 0);
   for (Vec3& v : mesh.v) v = tilted(v, c.tilt);
-  s.walls.push_back(test::mesh_wall(test::write_mesh(mesh, std::string(c.name) + ".stl")));
+  // One file per case: CTest runs the cases at once, and several share a mesh name.
+  s.walls.push_back(test::mesh_wall(test::write_mesh(
+      mesh, std::string(c.name) + "_" + std::to_string(static_cast<int>(c.speed)) + ".stl")));
   const Vec3 normal = tilted(Vec3::UnitZ(), c.tilt),
              target = tilted(Vec3(c.along_x, c.along_y, 0), c.tilt);
   // Falling vertically, 1 um (measured along the normal) before touching at the target.

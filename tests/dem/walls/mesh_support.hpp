@@ -1,8 +1,6 @@
 #pragma once
 // Meshes for wall tests: written as ASCII STL into the build tree and wrapped as
 // scene walls.
-#include <unistd.h>
-
 #include <array>
 #include <filesystem>
 #include <string>
@@ -77,9 +75,7 @@ inline std::string write_mesh(const MeshData& m, const std::string& name) {
   const std::filesystem::path dir =
       std::filesystem::path(GRAINFLOW_BINARY_DIR) / "test_output" / "walls";
   std::filesystem::create_directories(dir);
-  // The process id keeps apart the files of tests that CTest runs at once under one name (each
-  // parameter of a TEST_P is a process of its own, and several share a mesh name).
-  const std::string path = (dir / (std::to_string(::getpid()) + "_" + name)).string();
+  const std::string path = (dir / name).string();
   write_ascii_stl(path, m.v, m.t);
   return path;
 }
