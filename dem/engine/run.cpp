@@ -31,7 +31,10 @@ std::ostream& speaker(MPI_Comm comm, std::ostream& out) {
   return rank == 0 ? out : silent;
 }
 
-void print_report(const Simulation& sim, MPI_Comm comm, std::ostream& out) {
+// `run_anyway`: the user passed --allow-large-dt, so a refusal of the time step is a warning
+// (the run goes on) and is printed as one.
+void print_report(const Simulation& sim, MPI_Comm comm, std::ostream& out,
+                  bool run_anyway = false) {
   const Particles& p = sim.particles();
   double range[2] = {std::numeric_limits<double>::infinity(), 0};
   for (double r : p.radius) {
@@ -67,7 +70,12 @@ void print_report(const Simulation& sim, MPI_Comm comm, std::ostream& out) {
   if (sim.scene().parallel.reproducible)
     o << "force sums: canonical order (parallel.reproducible): results bit-identical on any "
          "number of ranks\n";
-  for (const std::string& note : sim.time_step_report().notes) o << note << "\n";
+  for (const std::string& note : sim.time_step_report().notes) {
+    if (run_anyway && note.starts_with("error: "))
+      o << "warning: " << note.substr(7) << " (running anyway: --allow-large-dt)\n";
+    else
+      o << note << "\n";
+  }
   for (const std::string& note : sim.walls().notes()) o << note << "\n";  // meshes read
 }
 
@@ -142,7 +150,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   if (scene.fluid)
     sim.add_force_term(make_fluid_forces(*scene.fluid, scene.gravity, scene.domain, comm));
   sim.initialise();
-  print_report(sim, comm, out);
+  print_report(sim, comm, out, options.allow_large_time_step);
   if (sim.time_step_report().verdict == TimeStepReport::Verdict::refuse &&
       !options.allow_large_time_step)
     throw SetupError(scene.file + ": error: refusing to run with this time step (see above); "

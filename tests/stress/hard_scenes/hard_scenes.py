@@ -779,11 +779,11 @@ def rotation(axis, angle):
     return np.eye(3) + math.sin(angle) * k + (1 - math.cos(angle)) * (k @ k)
 
 
-def plane_at(w, t):
-    """Point and unit normal of a plane wall at time t (DESIGN motion: P + V t + R (x0 - P))."""
-    p = np.asarray(w["point"], float)
-    n = np.asarray(w["normal"], float)
-    n = n / np.linalg.norm(n)
+def moved(w, t, point, direction):
+    """A wall's point and unit direction at time t (DESIGN motion: P + V t + R (x0 - P))."""
+    p = np.asarray(point, float)
+    d = np.asarray(direction, float)
+    d = d / np.linalg.norm(d)
     m = w.get("motion", {})
     v = np.asarray(m.get("velocity", [0, 0, 0]), float)
     om = m.get("angular_velocity", 0)
@@ -791,23 +791,18 @@ def plane_at(w, t):
         P = np.asarray(m.get("axis_point", [0, 0, 0]), float)
         R = rotation(m["axis"], om * t)
         p = P + R @ (p - P)
-        n = R @ n
-    return p + v * t, n
+        d = R @ d
+    return p + v * t, d
+
+
+def plane_at(w, t):
+    """Point and unit normal of a plane wall at time t."""
+    return moved(w, t, w["point"], w["normal"])
 
 
 def cylinder_at(w, t):
-    p = np.asarray(w["axis_point"], float)
-    a = np.asarray(w["axis"], float)
-    a = a / np.linalg.norm(a)
-    m = w.get("motion", {})
-    v = np.asarray(m.get("velocity", [0, 0, 0]), float)
-    om = m.get("angular_velocity", 0)
-    if om:
-        P = np.asarray(m.get("axis_point", [0, 0, 0]), float)
-        R = rotation(m["axis"], om * t)
-        p = P + R @ (p - P)
-        a = R @ a
-    return p + v * t, a
+    """Axis point and unit axis of a cylinder wall at time t."""
+    return moved(w, t, w["axis_point"], w["axis"])
 
 
 def wall_speed(w, extent):
