@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "dem/contact/normal_hooke.hpp"
+#include "dem/core/number_format.hpp"
 #include "dem/engine/restored_state.hpp"
 #include "dem/insert/insertion.hpp"
 #include "dem/walls/stl_reader.hpp"
@@ -174,7 +175,10 @@ void Simulation::check_walls_travel() {
   MPI_Allreduce(MPI_IN_PLACE, &smallest, 1, MPI_DOUBLE_INT, MPI_MINLOC, comm_);
   const WallTravelReport walls =
       check_wall_travel(scene_, walls_, dt_, std::isfinite(smallest.radius) ? smallest.radius : 0.0,
-                        smallest.material, table_);
+                        smallest.material, table_,
+                        report_.verdict == TimeStepReport::Verdict::refuse
+                            ? report_.recommended_step
+                            : std::numeric_limits<double>::infinity());
   for (const std::string& note : walls.notes) report_.notes.push_back(note);
   if (!walls.error.empty()) throw SetupError(walls.error);
 }
@@ -827,16 +831,18 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
     double r = 0, m = 0;
     int material = 0;
     long local = -1;  // index among this rank's particles (their force is known), or -1
+    Vec3 v = Vec3::Zero();
   };
   const auto find = [&](GlobalId id) {
     Body b;
     for (std::size_t i = 0; i < p_.size() && !b.found; ++i)
       if (p_.id[i] == id)
-        b = {true, p_.x[i], p_.radius[i], p_.mass[i], p_.material[i], static_cast<long>(i)};
+        b = {true,           p_.x[i], p_.radius[i], p_.mass[i], p_.material[i],
+             static_cast<long>(i), p_.v[i]};
     for (std::size_t q = 0; q < ghosts_.id.size() && !b.found; ++q)
       if (ghosts_.id[q] == id)
         b = {true, ghosts_.position(q), ghosts_.radius[q], ghosts_.mass[q], ghosts_.material[q],
-             -1};
+             -1,   ghosts_.v[q]};
     return b;
   };
   const Body a = find(w.a);
@@ -912,11 +918,40 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
       "time.rayleigh_fraction, or raise time.expected_max_speed so that grain check warns "
       "about it";
   if (w.speed < -1e-9) {
-    // Deep and already separating at its first sight: the centre jumped past the other
-    // body's surface (a two-sided mesh, another particle's centre) within one step.
-    o << ", moving apart at " << -w.speed << " m/s: the centre has most likely crossed the "
-      << "other surface within one step of dt = " << dt_ << " s (tunnelled; or the two were "
-      << "placed overlapping). A step of at most " << tc / kResolvingSteps << remedy;
+    // Deep and already separating at its first sight: the bodies went deep within one step
+    // (the centre past a two-sided mesh or another particle's centre, a thin rod through a
+    // sphere, a glancing blow). Its speed then is that of the whole relative motion, not the
+    // normal speed left now: at most |v_a| + |v_b|, or |v_a| + the fastest wall's sweep speed.
+    double v_rel = a.v.norm();
+    if (c.wall) {
+      double sweep = 0;
+      for (std::size_t k = 0; k < scene_.walls.size(); ++k)
+        sweep = std::max(sweep, wall_sweep_speed(scene_, walls_, k));
+      v_rel += sweep;
+    } else {
+      v_rel += b.v.norm();
+    }
+    v_rel = std::max(v_rel, -w.speed);
+    // A step in which that motion covers at most the limit overlap, and resolves an impact
+    // at that speed (1/20 of its contact time): the smaller.
+    const double tc_rel = pair_contact_time(scene_.contact, pc, constants_, c.r_star, c.m_star,
+                                            v_rel);
+    const double travel_step = at_limit / v_rel;
+    const double step = std::min(tc_rel / kResolvingSteps, travel_step);
+    o << ", moving apart at " << -w.speed << " m/s: it went this deep within one step of dt = "
+      << dt_ << " s (tunnelled: the centre across the other surface, a thin body through the "
+      << "sphere, or a "
+      << "glancing blow; or the two were placed overlapping), at a relative speed of up to "
+      << v_rel << " m/s";
+    if (step < dt_) {
+      o << ". A step of at most " << step << " s would resolve it (at that speed, a step's "
+        << "travel within the limit overlap of " << at_limit << " m, and 1/20 of the contact "
+        << "time, " << tc_rel << " s); lower time.step or time.rayleigh_fraction";
+    } else {
+      o << ", which dt already keeps within the limit: check the initial positions, or what "
+           "pressed the particle in (a moving wall, a load); a larger time.max_overlap lets a "
+           "deeper contact push it back out";
+    }
     return;
   }
   if (counters_.steps == 0 && w.speed <= 1e-9) {
@@ -938,21 +973,46 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
     o << ", approaching at " << w.speed << " m/s";
   else
     o << ", at rest";
-  if (steps < kResolvingSteps) {
+  // The step is to blame only when it does not resolve the contact and the contact, resolved,
+  // would stop within the limit: the undamped stop predicted from its energy and load now
+  // bounds a resolved run's deepest overlap (overload.hpp). But that energy is the integrated
+  // one, and velocity Verlet at N steps per contact overstates it: measured on Hertz impacts,
+  // the predicted stop exceeds the closed form by about 5/N^2 (4.3 % at 10.2 steps, 5.5 % at
+  // 8.5; docs/stability.md). Within that margin of the limit the step may still be the cause;
+  // beyond it, no step helps. Below kRefuseStepsPerContact (5) steps, where the start-up
+  // check refuses a step outright, the integrated energy is not evidence at all.
+  const double integration_error = steps < kRefuseStepsPerContact ? 1.0 : 5 / (steps * steps);
+  const bool step_is_the_cause =
+      steps < kResolvingSteps && stop * (1 - integration_error) <= at_limit;
+  if (step_is_the_cause) {
     o << ": the time step dt = " << dt_ << " s is too large to resolve this contact (it lasts "
       << tc << " s at that speed, " << steps << " steps; " << kResolvingSteps
-      << " resolve it). A step of at most " << tc / kResolvingSteps << remedy
-      << ". (With that step, by its energy and load now, " << stop_text()
-      << "; if it stops again the contact is overloaded, and the message will say what carries "
-         "it)";
+      << " resolve it). Resolved, the contact stops ";
+    if (stop <= at_limit)
+      o << "within the limit (by its energy and load now, " << stop_text() << ")";
+    else
+      o << "near the limit, or within it (by its energy and load now, " << stop_text()
+        << ", an energy that at " << steps << " steps per contact "
+        << (integration_error < 1 ? "may be overstated by about " +
+                                        significant(100 * integration_error, 2) + " %"
+                                  : std::string("is no evidence"))
+        << "; if a finer step stops again, the message will say what carries the contact)";
+    o << ". A step of at most " << tc / kResolvingSteps << remedy;
     return;
   }
   std::vector<const WallSet::Entry*> moving;
   for (const WallSet::Entry& e : walls_.walls())
     if (e.pose.moving()) moving.push_back(&e);
-  o << ". No time step prevents this: dt = " << dt_ << " s already resolves the contact (it lasts "
-    << tc << " s at that speed, " << steps << " steps; " << kResolvingSteps
-    << " resolve it). The contact is overloaded: the spring carries " << elastic_force(c, at_limit)
+  o << ". No time step prevents this: ";
+  if (steps >= kResolvingSteps)
+    o << "dt = " << dt_ << " s already resolves the contact (it lasts " << tc << " s at that speed, "
+      << steps << " steps; " << kResolvingSteps << " resolve it)";
+  else
+    o << "a finer step changes how the contact is integrated, not where it stops (it lasts " << tc
+      << " s at that speed, " << steps << " steps of dt = " << dt_ << " s; " << kResolvingSteps
+      << " resolve it: once the contact is carried, grain check's contact-time line says which "
+         "step does)";
+  o << ". The contact is overloaded: the spring carries " << elastic_force(c, at_limit)
     << " N at the limit";
   if (w.speed > 1e-9) o << "; the approach brings " << 0.5 * c.m_star * w.speed * w.speed << " J";
   if (c.load > 0)

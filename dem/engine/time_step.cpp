@@ -178,11 +178,12 @@ TimeStepReport check_time_step(const Scene& scene, const Particles& p, const Pai
     }
     const double fr = rep.dt / rep.rayleigh_time;
     const double steps = rep.contact_time / rep.dt;
+    rep.recommended_step =
+        std::min(kWarnRayleighFraction * rep.rayleigh_time, rep.contact_time / kWarnStepsPerContact);
     if (fr > kRefuseRayleighFraction || steps < kRefuseStepsPerContact) {
       rep.verdict = TimeStepReport::Verdict::refuse;
       o << "error: dt is too large to resolve contacts (limits: dt <= " << kRefuseRayleighFraction
-        << " t_R and >= " << kRefuseStepsPerContact << " steps per impact); use dt <= "
-        << std::min(kWarnRayleighFraction * rep.rayleigh_time, rep.contact_time / kWarnStepsPerContact)
+        << " t_R and >= " << kRefuseStepsPerContact << " steps per impact); use dt <= " << rep.recommended_step
         << " s";
       rep.notes.push_back(o.str());
     } else if (fr > kWarnRayleighFraction || steps < kWarnStepsPerContact) {
@@ -190,8 +191,7 @@ TimeStepReport check_time_step(const Scene& scene, const Particles& p, const Pai
       o << "warning: "
         << (fr > kWarnRayleighFraction ? "dt is above " + std::to_string(kWarnRayleighFraction).substr(0, 3) + " t_R"
                                        : "fewer than " + std::to_string(int(kWarnStepsPerContact)) + " steps per impact")
-        << "; contacts will be poorly resolved; dt <= "
-        << std::min(kWarnRayleighFraction * rep.rayleigh_time, rep.contact_time / kWarnStepsPerContact)
+        << "; contacts will be poorly resolved; dt <= " << rep.recommended_step
         << " s is recommended";
       rep.notes.push_back(o.str());
     }

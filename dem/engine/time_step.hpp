@@ -21,6 +21,9 @@ struct TimeStepReport {
   double rayleigh_time = 0;  // smallest over materials present
   double contact_time = 0;   // smallest over material pairs present, at expected_max_speed
   double dt = 0;
+  // The step the check recommends (its `use dt <=` / `is recommended` figure): at most
+  // kWarnRayleighFraction t_R and kWarnStepsPerContact steps per impact [s].
+  double recommended_step = 0;
   // Measured impact errors at dt (docs/accuracy-vs-cost.md) for the material pair (or
   // particle-wall pair) whose restitution suffers most at its steps per impact and e.
   std::optional<ImpactAccuracy> accuracy;

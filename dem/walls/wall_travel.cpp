@@ -88,7 +88,8 @@ double wall_sweep_speed(const Scene& scene, const WallSet& walls, std::size_t k)
 }
 
 WallTravelReport check_wall_travel(const Scene& scene, const WallSet& walls, double dt,
-                                   double r_min, int material, const PairTable& table) {
+                                   double r_min, int material, const PairTable& table,
+                                   double startup_step) {
   WallTravelReport rep;
   const double limit = scene.time.max_step_travel;
   long worst = -1;  // index into rep.walls
@@ -119,7 +120,9 @@ WallTravelReport check_wall_travel(const Scene& scene, const WallSet& walls, dou
   if (worst < 0) return rep;
   const WallTravel& w = rep.walls[worst];
   // The fastest wall sets the step; it fits every slower one too.
-  const double wall_fit = round_down_3(fit), step = round_down_3(fit / 2);
+  const double wall_fit = round_down_3(fit), travel_step = round_down_3(fit / 2);
+  const bool startup_smaller = startup_step < travel_step;
+  const double step = startup_smaller ? round_down_3(startup_step) : travel_step;
   rep.fitting_step = step;
   std::ostringstream o;
   o.precision(4);
@@ -131,6 +134,10 @@ WallTravelReport check_wall_travel(const Scene& scene, const WallSet& walls, dou
        "guard can see. A step of at most "
     << step << " s fits: the wall alone needs at most " << wall_fit
     << " s, and a particle it strikes leaves at up to twice the wall's speed";
+  if (startup_smaller)
+    o << " (" << travel_step << " s); the start-up check of dt against the Rayleigh and contact "
+         "times needs at most "
+      << round_down_3(startup_step) << " s";
   if (scene.contact.normal == NormalModel::hertz && material >= 0) {
     const int wall_material = scene.walls[w.index].material;
     const double mass = scene.materials[material].density * sphere_volume(r_min);

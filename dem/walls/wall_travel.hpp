@@ -13,6 +13,7 @@
 // vertices (a rigid motion keeps it), a plane's or cylinder's part inside the domain (the
 // domain's corners, plus |V| t_end for the axis' own travel). A cylinder's surface speed
 // (cylinder.angular_velocity) and a mesh's conveyor speed are along the surface: not counted.
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -49,8 +50,12 @@ double wall_sweep_speed(const Scene& scene, const WallSet& walls, std::size_t k)
 // With Hertz contacts, the message also gives the step that resolves the impact of that
 // particle (material `material`, unit at rest) on the wall at the wall's speed: 1/20 of the
 // Hertz contact time (R* = r_min, m* = its mass), as the particles' travel guard does.
+// `startup_step`: the largest step the start-up time-step check (check_time_step) accepts
+// when it refuses dt, else infinity: the proposal is never above it, so that rerunning with it
+// passes both checks.
 WallTravelReport check_wall_travel(const Scene& scene, const WallSet& walls, double dt,
-                                   double r_min, int material, const PairTable& table);
+                                   double r_min, int material, const PairTable& table,
+                                   double startup_step = std::numeric_limits<double>::infinity());
 
 // The smallest radius a distribution can draw.
 double min_radius(const SizeDistribution& d);

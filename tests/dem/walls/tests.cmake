@@ -1,14 +1,19 @@
-# The walls' travel guard and the start-up report through the command line (issue 17).
+# The walls' travel guard and the start-up report through the command line.
 # fast_rod.yaml: a rod (r 0.5 mm) at 150 m/s with dt = 2.5e-5 s against a bead of r = 1 mm,
 # 150 x 2.5e-5 / 1e-3 = 3.75 radii per step: refused by check and by run, with the steps
-# that fit (1e-3 / (2 x 150) = 3.33e-6 s, rounded down) and that resolve the impact.
+# that fit (1e-3 / (2 x 150) = 3.33e-6 s, rounded down, lowered to the 1.81e-7 s that the
+# start-up contact-time check of the same dt accepts) and that resolve the impact.
 set(_fast_rod_refusal
-    "fast_rod.yaml: error: wall 'rod' moves 3.75 x the smallest particle radius per step \\(sweep speed 150 m/s x dt = 2.5e-05 s = 0.00375 m; smallest radius 0.001 m\\); the limit is 1 \\(key time.max_step_travel;A step of at most 3.33e-06 s fits;on the wall at 150 m/s needs at most 8.28e-08 s")
+    "fast_rod.yaml: error: wall 'rod' moves 3.75 x the smallest particle radius per step \\(sweep speed 150 m/s x dt = 2.5e-05 s = 0.00375 m; smallest radius 0.001 m\\); the limit is 1 \\(key time.max_step_travel;A step of at most 1.81e-07 s fits;twice the wall's speed \\(3.33e-06 s\\); the start-up check of dt against the Rayleigh and contact times needs at most 1.81e-07 s;on the wall at 150 m/s needs at most 8.28e-08 s")
 grain_cli_test(walls_fast_rod_check_refused 1 "${_fast_rod_refusal}"
                CMD ${_grain} check ${_scenes}/walls/fast_rod.yaml)
 grain_cli_test(walls_fast_rod_run_refused 1 "${_fast_rod_refusal}"
                CMD ${_grain} run ${_scenes}/walls/fast_rod.yaml --output out
                WORKDIR ${_work}/walls_fast_rod FORBID "done:")
+# The first proposed step is accepted by every start-up check and runs to the end.
+grain_cli_test(walls_fast_rod_first_proposal_run 0 "done: 552 steps, 1 particles \\(0 removed\\)"
+               CMD ${_grain} run ${_scenes}/walls/fast_rod_first_proposal.yaml --output out
+               WORKDIR ${_work}/walls_fast_rod_first_proposal FORBID "error:")
 # At the proposed impact step the check reports the rod's travel and the run strikes the
 # bead (the physics of the rebound, (1 + e) U, is checked in wall_travel_test).
 grain_cli_test(walls_fast_rod_proposed_step 0
