@@ -50,6 +50,25 @@ double stopping_overlap(const ContactLoad& c, double ks, double cs) {
   return kNoStop;
 }
 
+double equilibrium_overlap(const ContactLoad& c) {
+  // The first δ where the spring carries the load and the cohesion: F_el − F_c ≥ W, found by
+  // a march and a bisection on the bracketing interval.
+  const auto net = [&](double d) { return elastic_force(c, d) - cohesion_force(c, d) - c.load; };
+  constexpr int n = 2000;
+  const double h = c.r_small / n;
+  if (net(0) >= 0) return 0;
+  for (int k = 1; k <= n; ++k) {
+    double lo = (k - 1) * h, hi = k * h;
+    if (net(hi) < 0) continue;
+    for (int i = 0; i < 60; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (net(mid) >= 0 ? hi : lo) = mid;
+    }
+    return hi;
+  }
+  return kNoStop;
+}
+
 ContactLoad at_first_touch(const ContactLoad& c) {
   ContactLoad t = c;
   const double d0 = std::max(c.overlap, 0.0);

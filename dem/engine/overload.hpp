@@ -37,6 +37,9 @@ double cohesion_force(const ContactLoad& c, double overlap);  // SJKR k_c A(δ)
 // smaller radius (a ratio of 1, the largest time.max_overlap).
 double stopping_overlap(const ContactLoad& c, double stiffness_scale = 1,
                         double cohesion_scale = 1);
+// The overlap where the spring alone carries the constant load and the cohesion (the
+// contact at rest there stays there); kNoStop when not within the smaller radius.
+double equilibrium_overlap(const ContactLoad& c);
 // The same contact at its first touch (δ = 0), with the approach speed the energy balance
 // gives there: ½ m* v₀² = ½ m* v² + E_el(δ₀) − W δ₀ − ∫₀^δ₀ F_c. What a stiffer material or a
 // weaker cohesion would do is asked from there (stiffness_factor_for, cohesion_factor_for).

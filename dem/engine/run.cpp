@@ -54,7 +54,10 @@ void print_report(const Simulation& sim, MPI_Comm comm, std::ostream& out,
     o << " (none at the start; the stream insertions add them during the run)\n";
   else
     o << " (the scene has no particles: no insertion entry placed any)\n";
-  o << "contact law: " << sim.contact_law_name() << "\n";
+  if (sim.scene().contacts_possible)
+    o << "contact law: " << sim.contact_law_name() << "\n";
+  else
+    o << "contact law: none needed (no walls, one particle: nothing can touch)\n";
   if (d.size() > 1) {
     o << "MPI ranks: " << d.size() << " as a " << d.dims()[0] << " x " << d.dims()[1] << " x "
       << d.dims()[2] << " grid";

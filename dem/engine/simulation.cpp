@@ -764,8 +764,34 @@ bool Simulation::check_contacts(const ContactGuards& s, bool finite_here) const 
       << travel_limit
       << " (key time.max_step_travel). So fast a particle can pass through a mesh wall or "
          "another particle between two steps without ever overlapping it, which no contact "
-         "guard can see. A step of at most "
-      << travel_limit * r / speed << " s keeps it within the limit";
+         "guard can see. A step of at most ";
+    // Within the limit, and (when the start-up time-step check refuses dt as well, which it
+    // reports only after this first step) within what that check accepts.
+    const double within = round_down_3(travel_limit * r / speed);
+    const bool startup = report_.verdict == TimeStepReport::Verdict::refuse &&
+                         report_.recommended_step < within;
+    if (startup)
+      o << round_down_3(report_.recommended_step) << " s keeps it within the limit (" << within
+        << " s) and passes the start-up check of dt against the Rayleigh and contact times, "
+           "which refuses dt = "
+        << dt_ << " s too";
+    else
+      o << within << " s keeps it within the limit";
+    // A one-way flow faster than the particle drags it on towards its own speed: a step
+    // that fits only today's speed is refused again a few steps later.
+    double fluid_max = 0;
+    if (scene_.fluid)
+      for (int corner = 0; corner < 8; ++corner) {
+        const Vec3 at((corner & 1) ? scene_.domain.hi[0] : scene_.domain.lo[0],
+                     (corner & 2) ? scene_.domain.hi[1] : scene_.domain.lo[1],
+                     (corner & 4) ? scene_.domain.hi[2] : scene_.domain.lo[2]);
+        fluid_max =
+            std::max(fluid_max, scene_.fluid->field.sample(at, scene_.gravity).velocity.norm());
+      }
+    if (fluid_max > speed)
+      o << "; the fluid reaches " << fluid_max << " m/s in the domain and drags the particle "
+        << "towards it: a step of at most " << round_down_3(travel_limit * r / fluid_max)
+        << " s keeps it within the limit at that speed";
     if (scene_.contact.normal == NormalModel::hertz) {
       // An impact at that speed on a wall of its own material: R* = r, m* = m.
       const double tc =
@@ -898,9 +924,16 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
   std::string load_by;
   if (n.squaredNorm() > 0) {
     const double own = elastic_force(c, c.overlap) - cohesion_force(c, c.overlap);
+    // The implicit drag K (u_f - v) acts through the velocity update, not p_.force: add it.
+    const auto force_on = [&](long i) {
+      Vec3 f = p_.force[i];
+      if (static_cast<std::size_t>(i) < drag_.coefficient.size())
+        f += drag_.coefficient[i] * (drag_.fluid_velocity[i] - p_.v[i]);
+      return f;
+    };
     const auto pressing = [&](const Body& body, double sign, GlobalId id) {
       const double load =
-          body.local >= 0 ? own - sign * p_.force[body.local].dot(n) : -sign * body.m * g.dot(n);
+          body.local >= 0 ? own - sign * force_on(body.local).dot(n) : -sign * body.m * g.dot(n);
       if (load > c.load) {
         c.load = load;
         load_by = "particle " + std::to_string(id);
@@ -981,9 +1014,17 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
   // 8.5; docs/stability.md). Within that margin of the limit the step may still be the cause;
   // beyond it, no step helps. Below kRefuseStepsPerContact (5) steps, where the start-up
   // check refuses a step outright, the integrated energy is not evidence at all.
+  // The overstatement is of the contact's oscillation about its equilibrium under the load
+  // (the whole stop for an impact, nothing for a contact pressed slowly to its limit).
+  // Below kRefuseStepsPerContact, only a load the spring cannot carry within the limit
+  // (the equilibrium beyond it) acquits the step.
   const double integration_error = steps < kRefuseStepsPerContact ? 1.0 : 5 / (steps * steps);
+  const double equilibrium = equilibrium_overlap(c);
   const bool step_is_the_cause =
-      steps < kResolvingSteps && stop * (1 - integration_error) <= at_limit;
+      steps < kRefuseStepsPerContact
+          ? equilibrium <= at_limit
+          : steps < kResolvingSteps && stop < kNoStop &&
+                stop - integration_error * (stop - std::min(equilibrium, stop)) <= at_limit;
   if (step_is_the_cause) {
     o << ": the time step dt = " << dt_ << " s is too large to resolve this contact (it lasts "
       << tc << " s at that speed, " << steps << " steps; " << kResolvingSteps
@@ -1016,7 +1057,7 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
     << " N at the limit";
   if (w.speed > 1e-9) o << "; the approach brings " << 0.5 * c.m_star * w.speed * w.speed << " J";
   if (c.load > 0)
-    o << "; the other forces on " << load_by << " (weight, neighbours, walls) press it with "
+    o << "; the other forces on " << load_by << " (weight, fluid, neighbours, walls) press it with "
       << c.load << " N";
   if (c.cohesion > 0)
     o << "; cohesion (cohesion_energy_density " << c.cohesion << " J/m^3) pulls it in with "

@@ -89,7 +89,9 @@ TimeStepReport check_time_step(const Scene& scene, const Particles& p, const Pai
 
   rep.rayleigh_time = inf;
   std::string rayleigh_material;
-  for (int m = 0; m < nm; ++m)
+  // A scene in which nothing can touch has no contact to resolve (its materials' elastic
+  // constants may be left out): neither time applies.
+  for (int m = 0; m < nm && scene.contacts_possible; ++m)
     if (r_min[m] < inf) {
       const double t = rayleigh_time(scene.materials[m], r_min[m]);
       if (t < rep.rayleigh_time) {
@@ -103,7 +105,7 @@ TimeStepReport check_time_step(const Scene& scene, const Particles& p, const Pai
   std::string contact_pair;
   std::vector<PairImpact> impacts;  // every pair present, for the accuracy estimate
   auto mass = [&](int m) { return scene.materials[m].density * sphere_volume(r_min[m]); };
-  for (int a = 0; a < nm; ++a) {
+  for (int a = 0; a < nm && scene.contacts_possible; ++a) {
     if (r_min[a] == inf) continue;
     for (int b = a; b < nm; ++b) {
       if (r_min[b] == inf) continue;
@@ -141,6 +143,10 @@ TimeStepReport check_time_step(const Scene& scene, const Particles& p, const Pai
       << "' particle)";
     rep.notes.push_back(o.str());
     o.str("");
+  } else if (!scene.contacts_possible && p.size() > 0) {
+    rep.notes.push_back(
+        "no contact can happen (no walls, one particle): Rayleigh and contact times do not "
+        "apply");
   } else {
     rep.notes.push_back("no particles: Rayleigh and contact times do not apply");
   }

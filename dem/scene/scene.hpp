@@ -14,8 +14,10 @@ namespace grainflow {
 
 struct Material {
   std::string name;
-  double youngs_modulus = 0;  // Y > 0 [Pa]
-  double poisson_ratio = 0;   // -1 < nu < 0.5
+  // Y > 0 [Pa], -1 < nu < 0.5; both 0 when not given, which only a scene in which no contact
+  // can happen allows (Scene::contacts_possible).
+  double youngs_modulus = 0;
+  double poisson_ratio = 0;
   double density = 0;         // > 0 [kg/m^3]
 };
 
@@ -200,6 +202,10 @@ struct Scene {
   OutputSettings output;
   ParallelSettings parallel;
   std::optional<FluidSettings> fluid;  // one-way fluid (docs/scene-reference.md, `fluid:`)
+  // False when nothing in the scene can touch: no walls, and one particle (a fill entry of
+  // count 1 or a CSV file of one row; no stream or snapshot). Then `contact`, `interactions`
+  // and the materials' elastic constants may be left out.
+  bool contacts_possible = true;
 
   int material_index(const std::string& name) const;  // -1 if absent
   const MaterialPair& pair(int a, int b) const;       // precondition: complete table

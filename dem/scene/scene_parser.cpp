@@ -16,6 +16,7 @@
 #include <array>
 #include <climits>
 #include <cmath>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
@@ -79,9 +80,13 @@ Domain parse_domain(const Field& f) {
   return d;
 }
 
+const std::vector<std::string> kTimeKeys = {"step",        "rayleigh_fraction",
+                                            "end",         "expected_max_speed",
+                                            "max_overlap", "min_steps_per_contact",
+                                            "max_step_travel"};
+
 TimeSettings parse_time(const Field& f) {
-  const Map m = f.map({"step", "rayleigh_fraction", "end", "expected_max_speed", "max_overlap",
-                       "min_steps_per_contact", "max_step_travel"});
+  const Map m = f.map(kTimeKeys);
   m.exactly_one_of("step", "rayleigh_fraction",
                    "`step` is the time step in s, `rayleigh_fraction` sets it as a fraction of "
                    "the Rayleigh time");
@@ -100,7 +105,19 @@ TimeSettings parse_time(const Field& f) {
 // holds kMaxMaterials^2 / 2 = 500 500 entries at most.
 constexpr std::size_t kMaxMaterials = 1000;
 
-std::vector<Material> parse_materials(const Field& f) {
+// A scene error kept for later: what contacts need is required only when contacts can happen
+// (Scene::contacts_possible), which is known once the walls and insertions are read.
+using Deferred = std::vector<std::exception_ptr>;
+template <class F>
+void defer(Deferred& later, F&& check) {
+  try {
+    check();
+  } catch (const SceneError&) {
+    later.push_back(std::current_exception());
+  }
+}
+
+std::vector<Material> parse_materials(const Field& f, Deferred& later) {
   std::vector<Material> out;
   std::map<std::string, int> first_line;
   const std::vector<Field> items = f.non_empty_items("define at least one material");
@@ -118,8 +135,14 @@ std::vector<Material> parse_materials(const Field& f) {
       name.fail("duplicate material name '" + mat.name + "' (first defined at line " +
                 std::to_string(it->second) + "); give each material a unique name");
     first_line.emplace(mat.name, name.line());
-    mat.youngs_modulus = m.number("youngs_modulus", kPositive);
-    mat.poisson_ratio = m.number("poisson_ratio", Range{-1, 0.5, false, false});
+    if (m.find("youngs_modulus"))
+      mat.youngs_modulus = m.number("youngs_modulus", kPositive);
+    else
+      defer(later, [&] { m.number("youngs_modulus", kPositive); });
+    if (m.find("poisson_ratio"))
+      mat.poisson_ratio = m.number("poisson_ratio", Range{-1, 0.5, false, false});
+    else
+      defer(later, [&] { m.number("poisson_ratio", Range{-1, 0.5, false, false}); });
     mat.density = m.number("density", kPositive);
     out.push_back(mat);
   }
@@ -140,7 +163,8 @@ const std::vector<std::string> kPairPropertyKeys = {"restitution", "friction", "
 std::size_t pair_count(std::size_t n) { return n * (n + 1) / 2; }
 
 // The complete pair table, in the canonical order Scene::pair expects.
-std::vector<MaterialPair> parse_pairs(const Map& top, const std::vector<Material>& materials) {
+std::vector<MaterialPair> parse_pairs(const Map& top, const std::vector<Material>& materials,
+                                      Deferred& later) {
   std::map<std::pair<int, int>, std::pair<MaterialPair, int>> listed;  // (a,b) -> (props, line)
   if (const auto list = top.find("interactions")) {
     std::vector<std::string> keys = kPairPropertyKeys;
@@ -183,9 +207,12 @@ std::vector<MaterialPair> parse_pairs(const Map& top, const std::vector<Material
       } else {
         const std::string pair = materials[a].name + ", " + materials[b].name;
         const Field at = top.find("interactions").value_or(top.get("materials"));
-        at.fail_at_key("no interaction properties for material pair (" + pair +
-                       "); add an entry with `materials: [" + pair +
-                       "]` to interactions, or give interaction_defaults for unlisted pairs");
+        defer(later, [&] {
+          at.fail_at_key("no interaction properties for material pair (" + pair +
+                         "); add an entry with `materials: [" + pair +
+                         "]` to interactions, or give interaction_defaults for unlisted pairs");
+        });
+        p.restitution = 1;  // never used: no contact can happen if this stands
       }
       p.a = a;
       p.b = b;
@@ -630,6 +657,35 @@ OutputSettings parse_output(const Field& f) {
   return o;
 }
 
+// Whether any two bodies of the scene can touch (Scene::contacts_possible).
+bool contacts_possible(const Scene& s) {
+  if (!s.walls.empty()) return true;
+  long particles = 0;
+  for (const Insertion& ins : s.insertions) {
+    switch (ins.kind) {
+      case Insertion::Kind::fill:
+        if (!ins.count) return true;  // a volume fraction: many
+        particles += *ins.count;
+        break;
+      case Insertion::Kind::csv: {
+        std::ifstream in(ins.csv_file);
+        if (!in) return true;  // read (and refused) later
+        std::string line;
+        long rows = -1;  // the header
+        while (std::getline(in, line))
+          if (line.find_first_not_of(" \t\r") != std::string::npos && line[0] != '#') ++rows;
+        particles += std::max(0L, rows);
+        break;
+      }
+      case Insertion::Kind::stream:
+      case Insertion::Kind::snapshot:
+        return true;
+    }
+    if (particles > 1) return true;
+  }
+  return particles != 1;  // an empty scene keeps every key (nothing is gained by leaving any out)
+}
+
 const std::vector<std::string> kTopLevelKeys = {
     "domain",  "gravity",   "time",  "materials", "interactions", "interaction_defaults",
     "contact", "neighbour", "walls", "insert",    "output", "parallel", "fluid"};
@@ -646,15 +702,29 @@ Scene build_scene(const Field& root) {
   s.domain = parse_domain(top.get("domain", "add `domain: {min: [x, y, z], max: [x, y, z]}`"));
   s.gravity = top.vec3_or("gravity", Vec3::Zero());
   s.time = parse_time(top.get("time", "add `time: {step: <s>, end: <s>}`"));
-  s.materials = parse_materials(top.get("materials", "add a list of materials"));
-  s.pairs = parse_pairs(top, s.materials);
-  s.contact = parse_contact(top.get("contact", "add `contact: {normal: hertz}`"));
+  Deferred for_contacts;  // errors that stand only if contacts can happen
+  s.materials = parse_materials(top.get("materials", "add a list of materials"), for_contacts);
+  s.pairs = parse_pairs(top, s.materials, for_contacts);
+  if (const auto c = top.find("contact"))
+    s.contact = parse_contact(*c);
+  else
+    defer(for_contacts, [&] { top.get("contact", "add `contact: {normal: hertz}`"); });
   if (const auto n = top.find("neighbour")) s.neighbour = parse_neighbour(*n);
   if (const auto w = top.find("walls")) s.walls = parse_walls(*w, s.materials);
   if (const auto i = top.find("insert")) s.insertions = parse_insertions(*i, s);
   if (const auto o = top.find("output")) s.output = parse_output(*o);
   if (const auto p = top.find("parallel")) s.parallel = parse_parallel(*p);
   if (const auto f = top.find("fluid")) s.fluid = parse_fluid_section(*f, s.gravity);
+  s.contacts_possible = contacts_possible(s);
+  if (s.contacts_possible && !for_contacts.empty()) std::rethrow_exception(for_contacts.front());
+  // The Rayleigh time needs the elastic constants of every material a particle uses.
+  if (s.time.rayleigh_fraction)
+    for (const Material& mat : s.materials)
+      if (mat.youngs_modulus == 0)
+        top.get("time").map(kTimeKeys).get("rayleigh_fraction").fail_at_key(
+            "the Rayleigh time needs youngs_modulus and poisson_ratio of material '" + mat.name +
+            "', which are left out (no contact can happen in this scene); give `step: <s>` "
+            "instead");
   return s;
 }
 

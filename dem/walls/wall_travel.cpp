@@ -1,5 +1,7 @@
 #include "dem/walls/wall_travel.hpp"
 
+#include "dem/core/number_format.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -27,15 +29,6 @@ double farthest_domain_corner(const Domain& d, const WallMotion& m) {
 }
 
 bool parallel(const Vec3& a, const Vec3& b) { return a.cross(b).norm() <= 1e-12; }
-
-// x rounded down to three significant digits: a step printed from it is not above it.
-double round_down_3(double x) {
-  if (!(x > 0) || !std::isfinite(x)) return x;
-  const double scale = std::pow(10.0, std::floor(std::log10(x)) - 2);
-  double y = std::floor(x / scale) * scale;
-  while (y > x) y = std::nextafter(y, 0.0);
-  return y;
-}
 
 }  // namespace
 

@@ -28,6 +28,14 @@ grain_cli_test(check_minimal 0 "Rayleigh time t_R = ;contact time t_c = ;steps p
                CMD ${_grain} check ${_scenes}/minimal.yaml)
 # The travel guard's speed for the smallest bead: r / dt = 0.4004 mm / (0.07 t_R), with
 # t_R = pi r sqrt(rho / G) / (0.1631 nu + 0.8766) = 4.896e-5 s (DESIGN.md §3): 116.8 m/s.
+# One bead in a periodic column of water, nothing it could touch: no contact law, no
+# interactions, no elastic constants in the scene; grain check says none is needed.
+grain_cli_test(check_lone_bead 0
+               "contact law: none needed;no contact can happen \\(no walls, one particle\\)"
+               CMD ${_grain} check ${_scenes}/fluid/lone_bead.yaml)
+grain_cli_test(run_lone_bead 0 "done: 2000 steps, 1 particles \\(0 removed\\)"
+               CMD ${_grain} run ${_scenes}/fluid/lone_bead.yaml --output out --no-progress
+               WORKDIR ${_work}/lone_bead)
 grain_cli_test(check_reports_travel_limit 0
                "travel guard: a particle that moves more than 1 x its radius in one step stops the run [(]key time.max_step_travel[)]: above 116.[78] m/s for the smallest"
                CMD ${_grain} check ${_scenes}/minimal.yaml FORBID "warning")

@@ -90,7 +90,7 @@ TEST(SceneParser, BaseSceneIsValidAndTakesDefaults) {
   EXPECT_DOUBLE_EQ(s.time.expected_max_speed, 1.0);
   EXPECT_DOUBLE_EQ(s.time.max_overlap, 0.25);
   EXPECT_DOUBLE_EQ(s.time.min_steps_per_contact, 5.0);  // grain check's refusal threshold
-  EXPECT_DOUBLE_EQ(s.time.max_step_travel, 1.0);  // radii per step (docs/stability.md)
+  EXPECT_DOUBLE_EQ(s.time.max_step_travel, 1.0);        // radii per step (docs/stability.md)
   ASSERT_EQ(s.pairs.size(), 1u);
   EXPECT_DOUBLE_EQ(s.pairs[0].restitution, 0.9);
   EXPECT_DOUBLE_EQ(s.pairs[0].friction, 0.5);
@@ -252,6 +252,56 @@ TEST(SceneParser, MinimalExampleIsValid) {
   EXPECT_EQ(s.insertions[0].count, 500);
 }
 
+// One particle and no walls: nothing can touch, so the contact law, the interactions and the
+// elastic constants may be left out; a second particle, a wall or a Rayleigh step needs them.
+const std::string kLoneBead =
+    "domain: {min: [0, 0, 0], max: [0.01, 0.01, 0.05], periodic: [true, true, true]}\n"  // 1
+    "time: {step: 1e-4, end: 0.01}\n"                                                    // 2
+    "materials:\n"                                                                       // 3
+    "  - {name: glass, density: 2500}\n"                                                 // 4
+    "insert:\n"                                                                          // 5
+    "  - type: fill\n"                                                                   // 6
+    "    region: {box: {min: [0, 0, 0], max: [0.01, 0.01, 0.05]}}\n"                     // 7
+    "    count: 1\n"                                                                     // 8
+    "    material: glass\n"                                                              // 9
+    "    radius: {distribution: constant, value: 3e-4}\n";                               // 10
+
+TEST(SceneParser, ContactKeysMayBeLeftOutWhenNothingCanTouch) {
+  const Scene lone = parse_scene(kLoneBead, kLabel);
+  EXPECT_FALSE(lone.contacts_possible);
+  EXPECT_EQ(lone.materials.at(0).youngs_modulus, 0.0);
+  EXPECT_EQ(lone.materials.at(0).density, 2500.0);
+  const Scene file = load_scene(kScenes + "/fluid/lone_bead.yaml");
+  EXPECT_FALSE(file.contacts_possible);
+  // Every complete scene with several particles or walls can touch.
+  EXPECT_TRUE(load_scene(kScenes + "/minimal.yaml").contacts_possible);
+}
+
+TEST(SceneErrors, ContactKeysAreRequiredWhenParticlesCanTouch) {
+  // Two particles: the first key left out is named where it belongs.
+  const std::string two =
+      expect_at(error_of(with("    count: 1\n", "    count: 2\n", kLoneBead)), 4, 5);
+  EXPECT_THAT(two, HasSubstr("missing required key 'youngs_modulus' in materials[0]"));
+  // A wall, with the elastic constants given: the interactions, then the contact law.
+  const std::string elastic =
+      "  - {name: glass, density: 2500, youngs_modulus: 5e6, poisson_ratio: 0.3}\n";
+  const std::string with_wall = with("  - {name: glass, density: 2500}\n", elastic, kLoneBead) +
+                                "walls:\n  - {type: plane, name: floor, point: [0, 0, 0], normal: "
+                                "[0, 0, 1], material: glass}\n";
+  const std::string pairs = error_of(with_wall).what();
+  EXPECT_THAT(pairs, HasSubstr("no interaction properties for material pair (glass, glass)"));
+  const std::string law = error_of(with_wall + "interaction_defaults: {restitution: 0.5}\n").what();
+  EXPECT_THAT(law, HasSubstr("missing required key 'contact' in the top level"));
+  // The Rayleigh time needs the elastic constants even when nothing can touch.
+  const std::string rayleigh =
+      expect_at(error_of(with("time: {step: 1e-4, end: 0.01}",
+                              "time: {rayleigh_fraction: 0.2, end: 0.01}", kLoneBead)),
+                2, 8);
+  EXPECT_THAT(rayleigh, HasSubstr("the Rayleigh time needs youngs_modulus and poisson_ratio of "
+                                  "material 'glass'"));
+  EXPECT_THAT(rayleigh, HasSubstr("give `step: <s>` instead"));
+}
+
 TEST(SceneParser, HookeCharacteristicVelocityAndConstantRadius) {
   const Scene s = parse_scene(with("  normal: hertz\n",
                                    "  normal: hooke\n"
@@ -409,14 +459,13 @@ TEST(SceneErrors, ValueOutOfRangeStatesRangeAndValue) {
   EXPECT_THAT(radius,
               HasSubstr("insert[0].radius.value: value -1e-3 is out of range; it must be > 0"));
 
-  const std::string steps = expect_at(
-      error_of(with("end: 0.5", "end: 0.5\n  min_steps_per_contact: -1")), 7, 26);
+  const std::string steps =
+      expect_at(error_of(with("end: 0.5", "end: 0.5\n  min_steps_per_contact: -1")), 7, 26);
   EXPECT_THAT(steps, HasSubstr("time.min_steps_per_contact: value -1 is out of range; it must "
                                "be >= 0"));
-  EXPECT_DOUBLE_EQ(
-      parse_scene(with("end: 0.5", "end: 0.5\n  min_steps_per_contact: 0"), kLabel)
-          .time.min_steps_per_contact,
-      0.0);  // 0 turns the steps-per-contact guard off
+  EXPECT_DOUBLE_EQ(parse_scene(with("end: 0.5", "end: 0.5\n  min_steps_per_contact: 0"), kLabel)
+                       .time.min_steps_per_contact,
+                   0.0);  // 0 turns the steps-per-contact guard off
   const std::string travel =
       expect_at(error_of(with("end: 0.5", "end: 0.5\n  max_step_travel: -0.5")), 7, 20);
   EXPECT_THAT(travel, HasSubstr("time.max_step_travel: value -0.5 is out of range; it must be "
@@ -615,18 +664,22 @@ TEST(SceneErrors, MissingFileHasNoPosition) {
 }
 
 TEST(SceneErrors, DuplicateWallName) {
-  const std::string walls =
-      "walls:\n"                                                                           // 17
-      "  - {type: plane, name: floor, point: [0, 0, 0], normal: [0, 0, 1], material: glass}\n"  // 18
-      "  - {type: plane, point: [0, 0, 1], normal: [0, 0, -1], material: glass}\n"            // 19
-      "  - {type: plane, name: floor, point: [0, 0, 0], normal: [1, 0, 0], material: glass}\n";  // 20
+  const std::
+      string
+          walls =
+              "walls:\n"  // 17
+              "  - {type: plane, name: floor, point: [0, 0, 0], normal: [0, 0, 1], material: "
+              "glass}\n"                                                                    // 18
+              "  - {type: plane, point: [0, 0, 1], normal: [0, 0, -1], material: glass}\n"  // 19
+              "  - {type: plane, name: floor, point: [0, 0, 0], normal: [1, 0, 0], material: "
+              "glass}\n";  // 20
   const std::string msg = expect_at(error_of(kBase + walls), 20, 25);
   EXPECT_THAT(msg, HasSubstr("walls[2].name: duplicate wall name 'floor'"));
   // The unnamed wall is 'wall1'; naming a later one so collides too.
-  const std::string msg2 = expect_at(error_of(kBase + with("name: floor, point: [0, 0, 0], normal: [1",
-                                                           "name: wall1, point: [0, 0, 0], normal: [1",
-                                                           walls)),
-                                     20, 25);
+  const std::string msg2 =
+      expect_at(error_of(kBase + with("name: floor, point: [0, 0, 0], normal: [1",
+                                      "name: wall1, point: [0, 0, 0], normal: [1", walls)),
+                20, 25);
   EXPECT_THAT(msg2, HasSubstr("duplicate wall name 'wall1'"));
 }
 
@@ -683,11 +736,11 @@ TEST(SceneErrors, MaterialCountIsBounded) {
 
 TEST(SceneErrors, FillCountMustFitTheRegionByVolume) {
   const std::string fill =
-      "insert:\n"                                              // 17
-      "  - type: fill\n"                                       // 18
-      "    region: {box: {min: [0, 0, 0], max: [1, 1, 0.5]}}\n"  // 19
-      "    count: 1e9\n"                                       // 20
-      "    material: glass\n"                                  // 21
+      "insert:\n"                                                     // 17
+      "  - type: fill\n"                                              // 18
+      "    region: {box: {min: [0, 0, 0], max: [1, 1, 0.5]}}\n"       // 19
+      "    count: 1e9\n"                                              // 20
+      "    material: glass\n"                                         // 21
       "    radius: {distribution: uniform, min: 1e-3, max: 2e-3}\n";  // 22
   // 1e9 spheres of r >= 1 mm: 1e9 (4/3) pi 1e-9 = 4.18879 m^3 > 0.5 m^3.
   const std::string msg = expect_at(error_of(kBase + fill), 20, 12);
@@ -711,8 +764,9 @@ TEST(SceneParser, CheckpointSettings) {
               HasSubstr("output.checkpoint_interval: value 0 is out of range; it must be > 0"));
   EXPECT_THAT(expect_at(error_of(kBase + "output:\n  checkpoint_interval: soon\n"), 18, 24),
               HasSubstr("expected a number, got 'soon'"));
-  EXPECT_THAT(expect_at(error_of(kBase + "output:\n  checkpoint_keep: 0\n"), 18, 20),
-              HasSubstr("output.checkpoint_keep: value 0 is out of range; it must be in [1, 1000]"));
+  EXPECT_THAT(
+      expect_at(error_of(kBase + "output:\n  checkpoint_keep: 0\n"), 18, 20),
+      HasSubstr("output.checkpoint_keep: value 0 is out of range; it must be in [1, 1000]"));
   EXPECT_THAT(expect_at(error_of(kBase + "output:\n  checkpoint_keep: 2.5\n"), 18, 20),
               HasSubstr("expected a whole number, got '2.5'"));
   EXPECT_THAT(expect_at(error_of(kBase + "output:\n  checkpoint_every: 1\n"), 18, 3),
