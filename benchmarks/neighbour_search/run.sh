@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Neighbour search against the size of the domain (issue 17 item 6): the same heap of
+# Neighbour search against the size of the domain: the same heap of
 # 16 000 spheres (r = 0.35 mm, a 24 mm box walled on five sides, settling under gravity)
 # in cubic domains of 8 cm, 2 m and 20 m, run side by side in interleaved rounds (machine
 # noise hits all three alike); prints each run's loop time and the medians' ratios to the

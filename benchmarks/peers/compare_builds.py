@@ -10,7 +10,7 @@ rank count and compares every snapshot's ids, positions, velocities and spins by
 build restarts from each build's last-but-one checkpoint, and every restarted run's last snapshot
 must equal the uninterrupted run's byte for byte (checkpoints written by either build, read by
 either). The scene's folder is copied (without output*) to --work/<label>/; exit code 1 when
-anything differs. Used for the optimisations of docs/performance.md, which must not change a bit.
+anything differs. Used for the optimisations of docs/performance-history.md, which must not change a bit.
 """
 import argparse
 import glob
