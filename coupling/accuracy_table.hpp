@@ -3,11 +3,22 @@
 // (docs/accuracy-vs-cost-coupled.md), for grainFoam's start-up report. The numbers are copied
 // from benchmarks/accuracy_cost/coupled/coupled_results.csv (measured 2026-12-01, branch
 // h-coupling; the test tests/coupling/accuracy_table_test.cpp fails if the two disagree).
-// C++17.
-#include <optional>
+// Each table holds for the case it was measured on (regime, drag law, and the settings it
+// kept fixed); a run is quoted a table only when it matches all of them. C++17.
 #include <string>
 
 namespace grainflow::coupling {
+
+// The measured cases: a packed bed (3300 beads, eps = 0.40, drag gidaspow) and a lone sphere
+// settling in water (drag schiller_naumann).
+enum class Regime { packed_bed, single_particle, other };
+
+// A packed bed: more than one particle and a mean void fraction at the particles up to
+// 0.5. The bed of the tables has 0.40; random loose packing is about 0.44, so a mean above
+// 0.5 is an expanded (fluidised) or dilute suspension, which no table measured.
+inline constexpr double kPackedBedMaxVoidFraction = 0.5;
+Regime classify_regime(long particles, double mean_void_fraction_at_particles);
+const char* regime_name(Regime r);
 
 struct FootprintAccuracy {
   const char* method;
@@ -19,10 +30,13 @@ struct FootprintAccuracy {
 
 struct IntervalAccuracy {
   int steps_per_fluid;  // DEM steps per fluid step
-  double dp_error;      // fixed-bed pressure drop against Ergun, relative (2 d cells, divided)
-  double cpu_per_second;  // total CPU seconds per simulated second of that bed
+  double error;         // relative: bed pressure drop vs Ergun, or settling speed vs terminal
+  double cpu_per_second;  // total CPU seconds per simulated second of that case
 };
 
+// Packed bed, drag gidaspow, 20 DEM steps per fluid step.
+inline constexpr const char* kFootprintDrag = "gidaspow";
+inline constexpr int kFootprintSteps = 20;
 inline constexpr FootprintAccuracy kFootprintAccuracy[] = {
     {"centre", "cell", 2, -0.1253, 0.040},
     {"centre", "cell", 3, -0.1202, 0.046},
@@ -44,19 +58,54 @@ inline constexpr FootprintAccuracy kFootprintAccuracy[] = {
     {"smoothed", "cellPoint", 4, -0.1444, 0.381},
 };
 
-inline constexpr IntervalAccuracy kIntervalAccuracy[] = {
-    {2, -0.0555, 301},
-    {5, -0.0617, 153},
-    {10, -0.0671, 106},
-    {20, -0.0726, 81},
-    {50, -0.0797, 65},
-    {100, -0.0845, 61},
+// A coupling-interval sweep: the case and the settings it kept fixed.
+struct IntervalSweep {
+  const char* name;  // for messages
+  Regime regime;
+  const char* drag;
+  const char* method;
+  const char* sampling;
+  double cell_over_d;
+  const char* quantity;  // what the error measures
+  const IntervalAccuracy* rows;
+  int size;
 };
 
-// One or two lines: the measured packed-bed error and cost share of this footprint and
-// sampling at this cell size (interpolated in cell_over_d within the measured 2-4 d, nothing
-// outside it), and of this coupling interval (interpolated in log N within 2-100).
-std::string describe_coupled_accuracy(const std::string& method, const std::string& sampling,
-                                      double cell_over_d, int steps_per_fluid);
+// Packed bed (error: pressure drop vs Ergun).
+inline constexpr IntervalAccuracy kIntervalAccuracy[] = {
+    {2, -0.0555, 301}, {5, -0.0617, 153},  {10, -0.0671, 106},
+    {20, -0.0726, 81}, {50, -0.0797, 65}, {100, -0.0845, 61},
+};
+// The settlingParticle tutorial (error: mean settling speed vs Schiller-Naumann terminal).
+inline constexpr IntervalAccuracy kSettlingIntervalAccuracy[] = {
+    {1, 0.01103, 691}, {5, 0.01104, 148},  {10, 0.01106, 81},
+    {20, 0.01108, 46}, {50, 0.01119, 21}, {100, 0.01142, 13},
+};
+inline constexpr IntervalSweep kIntervalSweeps[] = {
+    {"packed-bed", Regime::packed_bed, "gidaspow", "divided", "cell", 2, "packed-bed pressure drop vs Ergun",
+     kIntervalAccuracy, 6},
+    {"settling-sphere", Regime::single_particle, "schiller_naumann", "divided", "cell", 10,
+     "settling speed vs Schiller-Naumann terminal", kSettlingIntervalAccuracy, 6},
+};
+
+// Cell sizes and ranges are compared with this relative tolerance: a mesh whose cells are
+// 4 d up to round-off (4.00000000000002) is at the measured 4 d.
+inline constexpr double kRelativeTolerance = 1e-6;
+
+struct CoupledSettings {
+  Regime regime = Regime::other;
+  double mean_void_fraction = 1;  // at the particles, for the report
+  std::string drag;
+  std::string method;    // void-fraction footprint
+  std::string sampling;  // cell or cellPoint
+  double cell_over_d = 0;
+  int steps_per_fluid = 1;
+};
+
+// Lines (the first without indentation, the others indented by two spaces) saying what the
+// measured tables give for these settings, interpolated within the measured ranges only
+// (cell size linearly within 2-4 d, the interval in log N), and plainly when no table
+// matches the case and why.
+std::string describe_coupled_accuracy(const CoupledSettings& s);
 
 }  // namespace grainflow::coupling

@@ -106,6 +106,24 @@ DemLink::DemLink(const std::string& scene_file, double fluid_density, double flu
         << ": error: grainFoam's pressure excludes the hydrostatic part (rho_f g.x); add "
            "`pressure: {hydrostatic: false}` to the fluid block and list buoyancy in "
            "fluid.forces\n";
+  // The output keys that belong to grain's own run loop: grainFoam's write times replace them.
+  for (const auto& [key, where] : m.scene.output.given) {
+    const char* instead = nullptr;
+    if (key == "log_interval")
+      instead = "grainFoam logs the particles (count, contacts, overlap, time split) at every "
+                "write time of system/controlDict (writeControl, writeInterval)";
+    else if (key == "progress")
+      instead = "grainFoam's progress is OpenFOAM's `Time = ...` line at every fluid step";
+    else if (key == "checkpoint_interval")
+      instead = "grainFoam writes a DEM checkpoint at every write time of system/controlDict "
+                "(writeInterval), next to the fluid fields a restart needs";
+    else if (key == "checkpoint_keep")
+      instead = "grainFoam keeps the checkpoints of the last purgeWrite write times "
+                "(system/controlDict purgeWrite; 0 keeps all)";
+    if (instead)
+      why << where << ": error: output." << key << " is not used by a coupled run: " << instead
+          << "; remove it (grainFoam honours output.directory and output.snapshot_interval)\n";
+  }
   if (!why.str().empty()) throw std::runtime_error(why.str());
   // Checks the force list against the coupled solver (pressure without hydrostatics).
   try {
@@ -133,6 +151,29 @@ bool DemLink::needs_vorticity() const {
 }
 std::string DemLink::drag_law() const { return impl_->scene.fluid->drag_law; }
 double DemLink::end_time() const { return impl_->scene.time.end; }
+std::string DemLink::end_time_source() const { return impl_->scene.time.end_source; }
+
+namespace {
+std::string given_at(const OutputSettings& o, const std::string& key) {
+  for (const auto& [k, where] : o.given)
+    if (k == key) return where;
+  return {};
+}
+}  // namespace
+
+std::string DemLink::output_directory() const {
+  const OutputSettings& o = impl_->scene.output;
+  return given_at(o, "directory").empty() ? std::string() : o.directory;
+}
+std::string DemLink::output_directory_source() const {
+  return given_at(impl_->scene.output, "directory");
+}
+double DemLink::snapshot_interval() const {
+  return impl_->scene.output.snapshot_interval.value_or(0);
+}
+std::string DemLink::snapshot_interval_source() const {
+  return given_at(impl_->scene.output, "snapshot_interval");
+}
 
 void DemLink::use_processor_grid(const ProcessorGrid& grid) { impl_->grid = grid; }
 

@@ -115,7 +115,16 @@ class DemLink {
   char vans_model() const;  // 'A' or 'B'
   bool needs_vorticity() const;
   std::string drag_law() const;
-  double end_time() const;
+  double end_time() const;           // the scene's time.end [s]
+  std::string end_time_source() const;  // "file:line" of time.end
+  // The scene's output block as a coupled run honours it: the folder for particle snapshots
+  // and checkpoints (empty: not given) and the simulated time between snapshots (0: not
+  // given). Its other keys are refused by the constructor (grainFoam writes its log and
+  // checkpoints at the fluid's write times).
+  std::string output_directory() const;
+  std::string output_directory_source() const;  // "file:line" of output.directory
+  double snapshot_interval() const;
+  std::string snapshot_interval_source() const;  // "file:line" of output.snapshot_interval
 
   // Takes the processor grid of the fluid's decomposition (call before initialise());
   // the DEM then runs on a communicator ordered so that this rank owns exactly the box

@@ -8,6 +8,7 @@ Needs matplotlib and numpy (Debian: python3-matplotlib); no display is required.
 """
 import argparse
 import csv
+import os
 import sys
 
 try:
@@ -15,9 +16,11 @@ try:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import numpy as np
-except ImportError as e:  # pragma: no cover - environment problem, not a code path
-    sys.exit(f"plot_log.py needs matplotlib and numpy ({e}); on Debian: apt install "
-             "python3-matplotlib, and run it with /usr/bin/python3")
+except ImportError:  # this python3 lacks them: scripts/python.sh finds one that has them
+    if os.environ.get("GRAINFLOW_PYTHON_CHOSEN"):
+        raise
+    _helper = os.path.join(os.path.dirname(os.path.realpath(__file__)), "python.sh")
+    os.execv(_helper, [_helper, os.path.abspath(__file__), *sys.argv[1:]])
 
 DEFAULT_COLUMNS = ["particles", "ke_trans_J", "ke_rot_J", "max_overlap_ratio"]
 

@@ -27,18 +27,18 @@ fi
 start=$(date +%s)
 if [[ "${1:-}" == "--short" ]]; then
   "$BIN" --short --check --out "$work" | tail -n 3
-  /usr/bin/python3 "$ROOT/benchmarks/accuracy_cost/report.py" "$work" --out "$work/report"
+  "$ROOT/scripts/python.sh" "$ROOT/benchmarks/accuracy_cost/report.py" "$work" --out "$work/report"
   echo "short run passed in $(( $(date +%s) - start )) s; results in $work"
 else
   "$BIN" --check --out "$work" --rounds "${ROUNDS:-5}"
   secs=$(( $(date +%s) - start ))
-  /usr/bin/python3 "$ROOT/benchmarks/accuracy_cost/report.py" "$work" --repo "$ROOT" \
+  "$ROOT/scripts/python.sh" "$ROOT/benchmarks/accuracy_cost/report.py" "$work" --repo "$ROOT" \
     --meta "The full run took ${secs} s of wall time."
   echo "full run in ${secs} s; raw CSV files in $work"
   if [[ "${DEM_ONLY:-0}" != 1 ]]; then
-    /usr/bin/python3 "$ROOT/benchmarks/accuracy_cost/coupled/coupled_sweeps.py" --work "$work/coupled"
+    "$ROOT/scripts/python.sh" "$ROOT/benchmarks/accuracy_cost/coupled/coupled_sweeps.py" --work "$work/coupled"
     cp "$work/coupled/coupled_results.csv" "$ROOT/benchmarks/accuracy_cost/coupled/coupled_results.csv"
-    /usr/bin/python3 "$ROOT/benchmarks/accuracy_cost/coupled/plot_coupled.py" \
+    "$ROOT/scripts/python.sh" "$ROOT/benchmarks/accuracy_cost/coupled/plot_coupled.py" \
       "$ROOT/benchmarks/accuracy_cost/coupled/coupled_results.csv" "$ROOT/docs" > "$work/coupled_tables.md"
     echo "coupled sweeps done; tables for docs/accuracy-vs-cost-coupled.md in $work/coupled_tables.md"
   fi

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The cost of `parallel: {reproducible: true}` on the settled bed of settling_bed.yaml.
 
-    /usr/bin/python3 benchmarks/peers/reproducible_cost.py --grain build/bin/grain [--rounds 3] [--ranks 1 2]
+    scripts/python.sh benchmarks/peers/reproducible_cost.py --grain build/bin/grain [--rounds 3] [--ranks 1 2]
 
 grain alone (no peer): the bed of compare_liggghts.py (30 720 spheres, settled once and cached
 in --work) runs its timed steps with the mode off and on, side by side in each round (off, on,

@@ -22,4 +22,4 @@ fi
 [ -x /usr/bin/time ] || { echo "run.sh: /usr/bin/time is needed for peak memory (Debian package 'time')" >&2; exit 1; }
 
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
-exec /usr/bin/python3 "$HERE/compare_liggghts.py" --grain "$GRAIN" "$@"
+exec "$ROOT/scripts/python.sh" "$HERE/compare_liggghts.py" --grain "$GRAIN" "$@"

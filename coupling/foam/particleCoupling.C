@@ -176,7 +176,13 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
                             "meshes are boxes (decomposeParDict method simple or hierarchical)"
                          << exit(FatalError);
   dem_->use_processor_grid(grid);
-  snapshotDir_ = mesh.time().rootPath() / mesh.time().globalCaseName() / "particles";
+  // The scene's output.directory, relative to the case folder (not processorN/), or
+  // <case>/particles.
+  {
+    const fileName caseDir = mesh.time().rootPath() / mesh.time().globalCaseName();
+    const fileName given(dem_->output_directory());
+    snapshotDir_ = given.empty() ? caseDir / "particles" : given.isAbsolute() ? given : caseDir / given;
+  }
   // Snapshots, checkpoints and diagnostics go there: a read-only or full disk fails now,
   // not at the first write time.
   try {
@@ -248,6 +254,21 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
                             "time, or deltaT or the scene's time step changed"
                          << exit(FatalError);
   checkpointKeep_ = time.controlDict().lookupOrDefault<label>("purgeWrite", 0);
+
+  // --- output.snapshot_interval: snapshots at fluid steps, the first at or after each
+  // multiple of the interval (within half a fluid step, as grain does with its steps) ----
+  snapshotInterval_ = dem_->snapshot_interval();
+  if (snapshotInterval_ > 0 && snapshotInterval_ < dtFluid * (1 - 1e-9)) {
+    std::ostringstream why;  // 6 digits, not the case's writePrecision
+    why << dem_->snapshot_interval_source() << ": error: output.snapshot_interval "
+        << snapshotInterval_ << " s is shorter than the fluid time step deltaT " << dtFluid
+        << " s (system/controlDict): grainFoam writes snapshots after fluid steps; use an "
+           "interval of at least deltaT";
+    FatalErrorInFunction << "\n" << why.str().c_str() << exit(FatalError);
+  }
+  if (snapshotInterval_ > 0)
+    snapshotIndex_ =
+        static_cast<long>(std::floor((time.value() + 0.5 * dtFluid) / snapshotInterval_));
 
   // --- cell location: structured fast path when the local mesh is a uniform grid ----
   {
@@ -368,24 +389,37 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
                                                 : "octree search on some ranks")
        << endl;
 
-  // Where these settings sit on the measured curves: cell edge over mean diameter.
-  {
-    const coupling::ParticleSet mine_particles = dem_->particles(false);
-    double sums[3] = {0, double(mine_particles.local), 0};
-    for (double r : mine_particles.radius) sums[0] += 2 * r;
-    sums[2] = sum(mesh.V().field());
-    MPI_Allreduce(MPI_IN_PLACE, sums, 3, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
-    const double cells = double(returnReduce(mesh.nCells(), sumOp<label>()));
-    if (sums[1] > 0) {
-      const double cellOverD = std::cbrt(sums[2] / cells) / (sums[0] / sums[1]);
-      Info << "  " << coupling::describe_coupled_accuracy(method, sampling, cellOverD, subSteps_).c_str()
-           << endl;
-    }
-  }
-
   buildFootprints();
   deposit();
   if (restartIndex_ > 0) continueVoidFraction();
+
+  // Where these settings sit on the measured curves: the regime (particle count, mean void
+  // fraction in the particles' cells), the drag law, cell edge over mean diameter.
+  {
+    // diameters, particles, mesh volume, eps of the located particles' cells, located
+    double sums[5] = {0, double(particles_.local()), 0, 0, 0};
+    for (std::size_t i = 0; i < particles_.local(); ++i) {
+      sums[0] += 2 * particles_.radius(i);
+      if (centreCell_[i] < 0) continue;
+      sums[3] += voidFraction_[centreCell_[i]];
+      sums[4] += 1;
+    }
+    sums[2] = sum(mesh.V().field());
+    MPI_Allreduce(MPI_IN_PLACE, sums, 5, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+    const double cells = double(returnReduce(mesh.nCells(), sumOp<label>()));
+    if (sums[1] > 0) {
+      coupling::CoupledSettings settings;
+      settings.mean_void_fraction = sums[4] > 0 ? sums[3] / sums[4] : 1;
+      settings.regime = coupling::classify_regime(std::lround(sums[1]), settings.mean_void_fraction);
+      settings.drag = dem_->drag_law();
+      settings.method = method;
+      settings.sampling = sampling;
+      settings.cell_over_d = std::cbrt(sums[2] / cells) / (sums[0] / sums[1]);
+      settings.steps_per_fluid = subSteps_;
+      Info << "  " << coupling::describe_coupled_accuracy(settings).c_str() << endl;
+    }
+  }
+
   voidFraction_.oldTime();  // keep old times for ddt(voidfraction)
 }
 
@@ -883,13 +917,38 @@ void ParticleCoupling::evolve() {
   couplingSeconds_ += seconds_since(t0);
 }
 
+void ParticleCoupling::writeSnapshot() {
+  const Foam::Time& time = mesh_.time();
+  dem_->write_snapshot(snapshotDir_, time.timeIndex(), restartIndex_ > 0 ? restartIndex_ : -1);
+}
+
+void ParticleCoupling::writeSnapshotIfDue() {
+  using namespace Foam;
+  if (snapshotInterval_ <= 0) return;
+  const Time& time = mesh_.time();
+  const double t = time.value(), dt = time.deltaTValue();
+  const bool first = time.timeIndex() == 0 && restartIndex_ == 0;
+  const bool last = t >= time.endTime().value() - 0.5 * dt;
+  if (!first && !last && t < (snapshotIndex_ + 1) * snapshotInterval_ - 0.5 * dt) return;
+  if (last && lastSnapshotIndex_ == time.timeIndex()) return;
+  auto t0 = Clock::now();
+  try {
+    writeSnapshot();
+  } catch (const std::exception& e) {
+    FatalErrorInFunction << "\n" << e.what() << exit(FatalError);
+  }
+  outputSeconds_ += seconds_since(t0);
+  snapshotIndex_ = static_cast<long>(std::floor(t / snapshotInterval_ + 0.5));
+  lastSnapshotIndex_ = time.timeIndex();
+}
+
 void ParticleCoupling::write() {
   using namespace Foam;
   auto t0 = Clock::now();
   const Time& time = mesh_.time();
   std::string checkpoint;
   try {
-    dem_->write_snapshot(snapshotDir_, time.timeIndex(), restartIndex_ > 0 ? restartIndex_ : -1);
+    if (snapshotInterval_ <= 0) writeSnapshot();
     checkpoint = dem_->write_checkpoint(
         snapshotDir_, checkpointKeep_ > 0 ? static_cast<int>(checkpointKeep_) : INT_MAX);
   } catch (const std::exception& e) {

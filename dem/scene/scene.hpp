@@ -5,6 +5,7 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dem/core/types.hpp"
@@ -60,6 +61,7 @@ struct TimeSettings {
   std::optional<double> step;                     // dt [s] > 0, or
   std::optional<double> rayleigh_fraction;        // dt = fraction * Rayleigh time, (0, 1]
   double end = 0;                                 // simulated end time [s] > 0
+  std::string end_source;                         // "file:line" of time.end, for messages
   double expected_max_speed = 1.0;                // for the Hertz contact-time check [m/s]
   double max_overlap = 0.25;  // overlap / smaller radius that stops the run, (0, 1]
   // Hertz contacts: t_c(v)/dt at a contact's own approach speed v below this stops the
@@ -173,6 +175,9 @@ struct OutputSettings {
   bool progress = true;                    // terminal progress line with ETA
   std::optional<double> checkpoint_interval; // simulated seconds between checkpoints; none: off
   int checkpoint_keep = 2;                   // periodic checkpoints kept on disk (>= 1)
+  // The keys the scene gives, with "file:line" of each (grainFoam
+  // honours some and refuses the others, naming where they are).
+  std::vector<std::pair<std::string, std::string>> given;
 };
 
 struct NeighbourSettings {

@@ -94,6 +94,7 @@ TimeSettings parse_time(const Field& f) {
   t.step = m.maybe_number("step", kPositive);
   t.rayleigh_fraction = m.maybe_number("rayleigh_fraction", kUnitOpenBelow);
   t.end = m.number("end", kPositive);
+  t.end_source = f.source().label + ":" + std::to_string(m.find("end")->key_mark().line + 1);
   t.expected_max_speed = m.number_or("expected_max_speed", 1.0, kPositive);
   t.max_overlap = m.number_or("max_overlap", 0.25, Range{0, 1, false, true});
   t.min_steps_per_contact = m.number_or("min_steps_per_contact", 5, kNonNegative);
@@ -647,6 +648,10 @@ OutputSettings parse_output(const Field& f) {
   const Map m = f.map({"directory", "snapshot_interval", "log_interval", "progress",
                        "checkpoint_interval", "checkpoint_keep"});
   OutputSettings o;
+  for (const char* key : {"directory", "snapshot_interval", "log_interval", "progress",
+                          "checkpoint_interval", "checkpoint_keep"})
+    if (const auto v = m.find(key))
+      o.given.emplace_back(key, f.source().label + ":" + std::to_string(v->key_mark().line + 1));
   if (const auto d = m.find("directory")) o.directory = d->text();
   o.snapshot_interval = m.maybe_number("snapshot_interval", kPositive);
   o.log_interval = m.maybe_number("log_interval", kPositive);

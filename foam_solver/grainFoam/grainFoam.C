@@ -21,6 +21,7 @@
 #include <mpi.h>
 
 #include <chrono>
+#include <sstream>
 
 #include "coupling/foam/particleCoupling.H"
 #include "dem/engine/stop_signals.hpp"
@@ -67,6 +68,29 @@ void solve(const Foam::argList& args) {
   // fields and the DEM checkpoint, and exit 0; a restart (startFrom latestTime) continues
   // bit-identically.
   const grainflow::StopSignals stopSignals(true);
+
+  // The run ends at the earlier of system/controlDict's endTime and the scene's time.end.
+  {
+    const scalar sceneEnd = particles.sceneEndTime(), foamEnd = runTime.endTime().value();
+    // As typed (6 digits), not at the case's writePrecision.
+    const auto text = [](double x) {
+      std::ostringstream s;
+      s << x;
+      return s.str();
+    };
+    if (sceneEnd < foamEnd) {
+      Info << "grainFoam: ends at t = " << text(sceneEnd).c_str() << " s, the scene's time.end ("
+           << particles.sceneEndTimeSource().c_str() << "), before system/controlDict's endTime "
+           << text(foamEnd).c_str() << " s" << endl;
+      runTime.setEndTime(sceneEnd);
+    } else {
+      Info << "grainFoam: ends at t = " << text(foamEnd).c_str()
+           << " s, system/controlDict's endTime (the scene's time.end, "
+           << particles.sceneEndTimeSource().c_str() << ", is " << text(sceneEnd).c_str() << " s)"
+           << endl;
+    }
+  }
+  particles.writeSnapshotIfDue();
 
   Info << "\nStarting time loop\n" << endl;
   while (runTime.run()) {
@@ -150,6 +174,7 @@ void solve(const Foam::argList& args) {
 
     runTime.write();
     if (runTime.writeTime()) particles.write();
+    particles.writeSnapshotIfDue();
     runTime.printExecutionTime(Info);
 
     const int signal = grainflow::StopSignals::agreed(MPI_COMM_WORLD);

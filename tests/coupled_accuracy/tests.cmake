@@ -5,8 +5,12 @@
 if(NOT TARGET grainFoam OR NOT TARGET grainflowFoamBCs)
   return()
 endif()
+grainflow_find_python(GRAINFLOW_SWEEPS_PYTHON "h5py,numpy" "accuracy_cost.coupled_short is")
+if(NOT GRAINFLOW_SWEEPS_PYTHON)
+  return()
+endif()
 add_test(NAME accuracy_cost.coupled_short
-         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/benchmarks/accuracy_cost/coupled/coupled_sweeps.py
+         COMMAND ${GRAINFLOW_SWEEPS_PYTHON} ${PROJECT_SOURCE_DIR}/benchmarks/accuracy_cost/coupled/coupled_sweeps.py
                  --short --work ${CMAKE_CURRENT_BINARY_DIR}/accuracy_cost_coupled_short
                  --build ${PROJECT_BINARY_DIR})
 set_tests_properties(accuracy_cost.coupled_short PROPERTIES

@@ -17,7 +17,10 @@ snapshots against references that do not come from the coupling itself:
                         feels no net force and stays where it is;
   cellpoint_ranks       rank independence of cellPoint sampling: sinking beads next to the
                         processor patch end where the 1-rank run puts them, to round-off;
-  refuses_bad_setup     three set-ups grainFoam must refuse, with the message it must give.
+  refuses_bad_setup     three set-ups grainFoam must refuse, with the message it must give;
+  scene_output          the scene's output block and time.end: snapshots at the interval's
+                        multiples in the given folder, the run ending at the earlier end
+                        time, the keys grainFoam does not use refused where they are.
 
 Exit status 0 when every check holds; otherwise each failed check is printed and the exit
 status is 1. Logs stay in the case folders (log.<program>). Shared helpers:
@@ -597,9 +600,82 @@ def nan_guard(runner, checks):
                       f"particles (307)")
 
 
+# --- coupling.scene_output --------------------------------------------------------------
+
+def scene_output(runner, checks):
+    """What grainFoam takes from the scene's output block and time.end (docs/coupling.md),
+    on cases/neutral_particle (deltaT 1e-3 s, endTime 0.1 s, write times 0.05 and 0.1 s)
+    with the bead 1 % denser than the water, so that it sinks.
+
+    1. output: {directory: out/beads, snapshot_interval: 0.004}. Reference, from the
+       definition (a snapshot at the start and at the fluid step nearest each multiple of
+       the interval): 0.1 / 0.004 + 1 = 26 snapshots at t = 0.004 k, k = 0..25, each within
+       1e-9 s of it (the fluid time sums 1e-3 s steps: round-off is 1e-16 s), all in
+       <case>/out/beads, with the two write times' checkpoints there and no particles/.
+       The bead keeps sinking between them (its depth falls monotonically), so they are
+       snapshots of the run, not copies of one state.
+       The start-up accuracy line names the regime, a single particle, and quotes no
+       packed-bed (Ergun) figure.
+    2. time.end 0.03 s, earlier than endTime: the last fluid step is t = 0.03 s (30 steps),
+       and the log says so naming particle.yaml:9 (the end key).
+    3. output.log_interval is refused naming particle.yaml and its line and what grainFoam
+       uses instead (writeInterval); a snapshot_interval shorter than deltaT is refused
+       naming deltaT."""
+    denser = ("particle.yaml", "poisson_ratio: 0.3, density: 1000", "poisson_ratio: 0.3, density: 1010")
+    case = runner.fresh_case("neutral_particle", "output_block", [
+        denser,
+        ("particle.yaml", "fluid:\n", "output: {directory: out/beads, snapshot_interval: 0.004}\nfluid:\n")])
+    log = runner.solve(case, 1)
+    checks.expect(not os.path.exists(os.path.join(case, "particles")),
+                  "output.directory: no <case>/particles folder")
+    snaps = snapshots(case, os.path.join("out", "beads")) if os.path.isdir(
+        os.path.join(case, "out", "beads")) else []
+    times = [t for t, _ in snaps]
+    want = [0.004 * k for k in range(26)]
+    checks.expect(len(times) == 26 and all(abs(a - b) < 1e-9 for a, b in zip(times, want)),
+                  f"snapshot_interval 0.004 s: {len(times)} snapshots (26) at "
+                  f"{', '.join(f'{t:g}' for t in times[:4])}, ... {times[-1] if times else ''}"
+                  " (0, 0.004, ..., 0.1)")
+    depths = [s["position"][0][2] for _, s in snaps]
+    checks.expect(len(depths) > 2 and all(b < a for a, b in zip(depths, depths[1:])),
+                  "the bead sinks from one snapshot to the next")
+    folder = os.path.join(case, "out", "beads")
+    checkpoints = sorted(n for n in os.listdir(folder) if n.startswith("checkpoint_")) if os.path.isdir(folder) else []
+    checks.expect(len(checkpoints) == 2,
+                  f"the write times' DEM checkpoints are in out/beads: {checkpoints} (2)")
+    accuracy = [line for line in log.splitlines() if "accuracy (docs/accuracy-vs-cost-coupled.md)" in line]
+    checks.expect(len(accuracy) == 1 and "single particle" in accuracy[0] and "Ergun" not in log,
+                  f"accuracy line: a single particle, no packed-bed figure ({accuracy})")
+
+    case = runner.fresh_case("neutral_particle", "time_end", [denser, ("particle.yaml", "  end: 1\n", "  end: 0.03\n")])
+    log = runner.solve(case, 1)
+    steps = re.findall(r"^Time = (\S+)$", log, re.MULTILINE)
+    checks.expect(len(steps) == 30 and abs(float(steps[-1]) - 0.03) < 1e-12,
+                  f"time.end 0.03 s before endTime 0.1 s: {len(steps)} fluid steps, the last at "
+                  f"t = {steps[-1] if steps else None} (30, 0.03)")
+    checks.expect(re.search(r"grainFoam: ends at t = 0.03 s, the scene's time.end \(\S*particle\.yaml:9\)", log)
+                  is not None, "the log says the run ends at the scene's time.end, particle.yaml:9")
+
+    case = runner.fresh_case("neutral_particle", "log_interval", [
+        ("particle.yaml", "fluid:\n", "output:\n  log_interval: 0.01\nfluid:\n")])
+    runner.run(case, "blockMesh", "blockMesh")
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    checks.expect(re.search(r"particle\.yaml:17: error: output\.log_interval is not used by a coupled "
+                            r"run: .*writeInterval", log) is not None,
+                  "output.log_interval: refused at particle.yaml:17, naming writeInterval")
+    case = runner.fresh_case("neutral_particle", "short_interval", [
+        ("particle.yaml", "fluid:\n", "output: {snapshot_interval: 5e-4}\nfluid:\n")])
+    runner.run(case, "blockMesh", "blockMesh")
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    checks.expect(re.search(r"particle\.yaml:16: error: output\.snapshot_interval 0\.0005 s is shorter "
+                            r"than the fluid time step deltaT 0\.001 s", log) is not None,
+                  "snapshot_interval 5e-4 s < deltaT 1e-3 s: refused at particle.yaml:16")
+
+
 TESTS = {f.__name__: f for f in (void_fraction_volume, exchange_balance, neutrally_buoyant,
                                   cellpoint_ranks,
-                                 refuses_bad_setup, restart, stop_signal, nan_guard)}
+                                 refuses_bad_setup, restart, stop_signal, nan_guard,
+                                 scene_output)}
 
 
 if __name__ == "__main__":

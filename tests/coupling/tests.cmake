@@ -24,6 +24,10 @@
 #   coupling.stop_signal           the same case, SIGTERM mid-run (on 2 ranks to one rank only):
 #       exit 0 with the message, the time written with its checkpoint; restarted, it ends
 #       bit-identical to a run stopped at that time by endTime and restarted. About 25 s.
+#   coupling.scene_output          cases/neutral_particle: output.directory and
+#       output.snapshot_interval honoured (26 snapshots at 0.004 k s in out/beads), time.end
+#       before endTime ends the run there, output.log_interval and a snapshot interval
+#       under deltaT refused naming the scene's line.
 #   coupling.nan_guard             a NaN velocity put into the checkpoint: the restarted run
 #       stops at the first DEM step naming that particle, with a diagnostic snapshot.
 if(NOT TARGET grainFoam)
@@ -82,14 +86,9 @@ set_tests_properties(coupling.point_interpolation PROPERTIES
   PROCESSORS 2
   TIMEOUT 300)
 
-# h5py reads the particle snapshots: Debian's python3-h5py, as in tests/dem/app/tests.cmake.
-find_program(GRAINFLOW_COUPLING_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
-if(GRAINFLOW_COUPLING_PYTHON)
-  execute_process(COMMAND ${GRAINFLOW_COUPLING_PYTHON} -c "import h5py, numpy"
-                  RESULT_VARIABLE _coupling_no_h5py OUTPUT_QUIET ERROR_QUIET)
-endif()
-if(NOT GRAINFLOW_COUPLING_PYTHON OR NOT _coupling_no_h5py EQUAL 0)
-  message(STATUS "python3 with h5py and numpy not found: the coupling.* command tests are skipped")
+# h5py reads the particle snapshots (scripts/python.sh picks the Python).
+grainflow_find_python(GRAINFLOW_COUPLING_PYTHON "h5py,numpy" "the coupling.* command tests are")
+if(NOT GRAINFLOW_COUPLING_PYTHON)
   return()
 endif()
 
@@ -121,4 +120,5 @@ grainflow_coupling_test(restart 2)
 set_tests_properties(coupling.restart PROPERTIES TIMEOUT 600)  # ~45 s on a quiet machine
 grainflow_coupling_test(stop_signal 2)
 grainflow_coupling_test(nan_guard 2)
+grainflow_coupling_test(scene_output 1)
 set_tests_properties(coupling.stop_signal PROPERTIES TIMEOUT 600)  # ~25 s on a quiet machine

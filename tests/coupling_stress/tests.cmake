@@ -33,14 +33,9 @@ if(NOT TARGET grainFoam OR NOT TARGET grainflowFoamBCs)
   return()
 endif()
 
-# h5py reads the particle snapshots: Debian's python3-h5py, as in tests/coupling/tests.cmake.
-find_program(GRAINFLOW_STRESS_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
-if(GRAINFLOW_STRESS_PYTHON)
-  execute_process(COMMAND ${GRAINFLOW_STRESS_PYTHON} -c "import h5py, numpy"
-                  RESULT_VARIABLE _stress_no_h5py OUTPUT_QUIET ERROR_QUIET)
-endif()
-if(NOT GRAINFLOW_STRESS_PYTHON OR NOT _stress_no_h5py EQUAL 0)
-  message(STATUS "python3 with h5py and numpy not found: the coupling_stress.* tests are skipped")
+# h5py reads the particle snapshots (scripts/python.sh picks the Python).
+grainflow_find_python(GRAINFLOW_STRESS_PYTHON "h5py,numpy" "the coupling_stress.* tests are")
+if(NOT GRAINFLOW_STRESS_PYTHON)
   return()
 endif()
 

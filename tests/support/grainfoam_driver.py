@@ -136,9 +136,10 @@ def read_scalar_field(path):
     return values
 
 
-def snapshots(case):
-    """Particle snapshots of a case, sorted by time: [(time, {dataset: array})]."""
-    folder = os.path.join(case, "particles")
+def snapshots(case, folder="particles"):
+    """Particle snapshots of a case (in <case>/<folder>), sorted by time:
+    [(time, {dataset: array})]."""
+    folder = os.path.join(case, folder)
     out = []
     for name in sorted(os.listdir(folder)):
         if name.startswith("particles_") and name.endswith(".h5"):  # not the checkpoints

@@ -2,7 +2,12 @@
 # Shared by the CFD-DEM tutorials' Allrun scripts: meshes the case, optionally decomposes it,
 # and runs grainFoam serially or under mpirun. Source it from a case folder, then call
 #   run_case "$@"        (arguments: [-np N]; environment: GRAINFLOW_BUILD_DIR)
+#   grainflow_python analyse.py ...   Python with what the script imports (scripts/python.sh)
 set -euo pipefail
+
+grainflow_python() {
+  "${GRAINFLOW_SOURCE_DIR:-$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)}/scripts/python.sh" "$@"
+}
 
 run_case() {
   local np=1

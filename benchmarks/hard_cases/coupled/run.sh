@@ -17,7 +17,7 @@ status=0
 for case in dense_bed_10x_umf particles_larger_than_cells on_faces_and_corners_2ranks \
             crowded_cell_2ranks emptied_and_refilled_cells fast_crossing_ranks; do
   echo "== $case (scale $SCALE)"
-  /usr/bin/python3 "$ROOT/tests/coupling_stress/stress_cases.py" "$case" \
+  "$ROOT/scripts/python.sh" "$ROOT/tests/coupling_stress/stress_cases.py" "$case" \
     --foam-env "$ROOT/scripts/foam_env.sh" --solver "$BUILD/bin/grainFoam" \
     --mpiexec mpiexec --lib-dir "$BUILD/lib" --cases "$ROOT/tests/coupling_stress/cases" \
     --work "$WORK/$case" | tee "$WORK.$case.log" | grep -E "^  (ok|FAIL)|failed checks" || status=1

@@ -42,8 +42,8 @@ if [ "$compare_only" -eq 0 ]; then
       { as_root apt-get update -qq &&
         as_root apt-get install -y -qq --no-install-recommends openfoam openfoam-examples; }
   fi
-  /usr/bin/python3 "$HERE/make_cases.py" "$description" "$OUT/cases"
-  start=$(/usr/bin/python3 -c "import yaml,sys; print(yaml.safe_load(open(sys.argv[1]))['start'])" "$description")
+  "$ROOT/scripts/python.sh" "$HERE/make_cases.py" "$description" "$OUT/cases"
+  start=$("$ROOT/scripts/python.sh" --needs yaml -c "import yaml,sys; print(yaml.safe_load(open(sys.argv[1]))['start'])" "$description")
   if [ "$start" = settled ]; then
     # The settled bed is cached in $OUT/settled.h5 (delete it to settle again).
     if [ ! -f "$OUT/settled.h5" ]; then
@@ -53,7 +53,7 @@ if [ "$compare_only" -eq 0 ]; then
       last=$(ls "$OUT"/cases/settle/output/particles_*.h5 | sort | tail -1)
       cp "$last" "$OUT/settled.h5"
     fi
-    /usr/bin/python3 "$HERE/make_cases.py" "$description" "$OUT/cases" --positions "$OUT/settled.h5"
+    "$ROOT/scripts/python.sh" "$HERE/make_cases.py" "$description" "$OUT/cases" --positions "$OUT/settled.h5"
   fi
   codes=($(/usr/bin/python3 -c "import json,sys; print(' '.join(json.load(open(sys.argv[1]))['codes']))" "$OUT/cases/setup.json"))
   for code in "${codes[@]}"; do
@@ -78,4 +78,4 @@ if [ "$compare_only" -eq 0 ]; then
     done
   done
 fi
-/usr/bin/python3 "$HERE/compare.py" "$OUT"
+"$ROOT/scripts/python.sh" "$HERE/compare.py" "$OUT"

@@ -96,22 +96,9 @@ grain_cli_test(overlap_guard_stops_run 1
                WORKDIR ${_work}/overlap_guard)
 
 # Reliability (docs/reliability.md): SIGTERM finishes the step, writes a checkpoint, exits 0.
-# These read HDF5 with h5py: use the first python3 that has it (Debian's python3-h5py).
-find_program(GRAINFLOW_H5PY_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
-if(NOT GRAINFLOW_H5PY_PYTHON)
-  find_program(GRAINFLOW_H5PY_PYTHON python3)
-endif()
-set(GRAINFLOW_PYTHON3 "")
-if(GRAINFLOW_H5PY_PYTHON)
-  execute_process(COMMAND ${GRAINFLOW_H5PY_PYTHON} -c "import h5py" RESULT_VARIABLE _no_h5py
-                  OUTPUT_QUIET ERROR_QUIET)
-  if(_no_h5py EQUAL 0)
-    set(GRAINFLOW_PYTHON3 ${GRAINFLOW_H5PY_PYTHON})
-  endif()
-endif()
-if(NOT GRAINFLOW_PYTHON3)
-  message(STATUS "python3 with h5py not found: the SIGTERM and NaN-guard tests of grain are skipped")
-else()
+# These read HDF5 with h5py (scripts/python.sh picks the Python).
+grainflow_find_python(GRAINFLOW_PYTHON3 "h5py,numpy" "the SIGTERM and NaN-guard tests of grain are")
+if(GRAINFLOW_PYTHON3)
   add_test(NAME grain.stop_signal_writes_checkpoint
            COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/stop_signal.sh ${_grain}
                    ${_scenes}/stop_signal.yaml ${_work}/stop_signal ${GRAINFLOW_PYTHON3})

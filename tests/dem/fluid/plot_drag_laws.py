@@ -2,7 +2,7 @@
 """K/K_Stokes against void fraction at three Reynolds numbers for every drag law.
 
 Uses the independent formulas of drag_reference.py (same folder). Writes
-docs/models/fluid-forces-drag.png. Run: /usr/bin/python3 tests/dem/fluid/plot_drag_laws.py
+docs/models/fluid-forces-drag.png. Run: scripts/python.sh tests/dem/fluid/plot_drag_laws.py
 """
 import math
 import os

@@ -5,13 +5,9 @@
 # on 2 ranks.
 # Bound: under 3 minutes on 2 shared cores (measured figure in docs/stability.md); a run over
 # 25 s counts as a failure of its seed.
-find_program(GRAINFLOW_HARD_SCENES_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
-if(GRAINFLOW_HARD_SCENES_PYTHON)
-  execute_process(COMMAND ${GRAINFLOW_HARD_SCENES_PYTHON} -c "import h5py, numpy, yaml"
-                  RESULT_VARIABLE _hard_scenes_missing OUTPUT_QUIET ERROR_QUIET)
-endif()
-if(NOT GRAINFLOW_HARD_SCENES_PYTHON OR NOT _hard_scenes_missing EQUAL 0)
-  message(STATUS "python3 with h5py, numpy and yaml not found: the test hard_scenes.ci is skipped")
+# h5py reads the particle snapshots (scripts/python.sh picks the Python).
+grainflow_find_python(GRAINFLOW_HARD_SCENES_PYTHON "h5py,numpy,yaml" "the test hard_scenes.ci is")
+if(NOT GRAINFLOW_HARD_SCENES_PYTHON)
   return()
 endif()
 add_test(NAME hard_scenes.ci
