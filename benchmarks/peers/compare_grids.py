@@ -5,13 +5,14 @@
 
 Runs grain alone (no LIGGGHTS) on the bed of compare_liggghts.py (settled once, cached in
 --work), on `--ranks` ranks, with
-  * `parallel: {grid: [N, 1, 1]}` (what the default gave before the particle-aware rule),
+  * `parallel: {grid: [N, 1, 1]}` (the least-cut-area grid of this box alone, uniform planes),
   * no `parallel.grid` (the default: docs/parallel.md, "The default grid"),
 and the same bed in a domain four times as tall (its least-cut-area grid by the box alone,
 1 x 1 x N, cuts the bed across its height), with the three grids N x 1 x 1, default and
-1 x 1 x N. Rounds are interleaved (every configuration once per round) so that the noise of a
-shared machine hits all alike; prints each run's rate and the median over rounds of the
-per-round ratio to N x 1 x 1 in the same domain.
+1 x 1 x N. Rounds are interleaved (every configuration once per round, every other round in
+reverse order) so that the noise of a shared machine hits all alike; prints the load average
+before each round, each run's rate and the median over rounds of the per-round ratio to
+N x 1 x 1 in the same domain.
 """
 import argparse
 import os
@@ -71,7 +72,10 @@ def main():
     rates = {key: [] for key in configs}
     grids = {}
     for r in range(args.rounds):
-        for key in configs:
+        # The machine's load (a shared machine's noise hits every configuration of a round).
+        print(f"round {r + 1}: load average {os.getloadavg()[0]:.2f}", flush=True)
+        # Odd rounds in reverse order: a load that drifts during a round favours neither side.
+        for key in (list(configs) if r % 2 == 0 else list(configs)[::-1]):
             out, seconds, _, _ = mpirun(n, [args.grain, "run", names[key], "--no-progress"], gcase, gcase)
             m = re.search(r"done: .*? ([0-9.e+]+) particle-steps/s", out)
             g = re.search(r"MPI ranks: .*", out)

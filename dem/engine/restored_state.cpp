@@ -34,6 +34,45 @@ bool near(double value, double reference) {
   return std::abs(value - reference) <= kMassTolerance * std::abs(reference);
 }
 
+// The stored processor grid: what Decomposition::set_cuts accepts, for the scene's domain.
+void check_grid(const CheckpointGrid& g, const Domain& dom, const StateSource& src) {
+  if (g.ranks < 1)
+    fail(src, "ranks", 0, "", "the rank count " + std::to_string(g.ranks) + " is not >= 1");
+  long long product = 1;
+  for (int a = 0; a < 3; ++a) {
+    if (g.dims[a] < 1 || g.dims[a] > g.ranks)
+      fail(src, "dims", static_cast<std::size_t>(a), "",
+           std::string("the ranks along ") + "xyz"[a] + ", " + std::to_string(g.dims[a]) +
+               ", are not in [1, " + std::to_string(g.ranks) + "] (dataset 'ranks')");
+    product *= g.dims[a];
+  }
+  if (product != g.ranks)
+    fail(src, "dims", 0, "",
+         "the grid " + std::to_string(g.dims[0]) + " x " + std::to_string(g.dims[1]) + " x " +
+             std::to_string(g.dims[2]) + " has " + std::to_string(product) +
+             " boxes, but the file was written by " + std::to_string(g.ranks) +
+             " ranks (dataset 'ranks')");
+  for (int a = 0; a < 3; ++a) {
+    const std::string name = std::string("cuts_") + "xyz"[a];
+    const std::vector<double>& c = g.cuts[a];
+    if (c.size() != static_cast<std::size_t>(g.dims[a]) + 1)
+      fail(src, name, 0, "",
+           std::to_string(c.size()) + " planes for " + std::to_string(g.dims[a]) +
+               " rank(s) along " + "xyz"[a] + " (dataset 'dims'); there must be " +
+               std::to_string(g.dims[a] + 1));
+    if (c.front() != dom.lo[a] || c.back() != dom.hi[a])
+      fail(src, name, c.front() != dom.lo[a] ? 0 : c.size() - 1, "",
+           "the planes run from " + number(c.front()) + " to " + number(c.back()) +
+               " m, not from the domain's lo " + number(dom.lo[a]) + " to its hi " +
+               number(dom.hi[a]) + " m along " + "xyz"[a]);
+    for (std::size_t k = 1; k < c.size(); ++k)
+      if (!std::isfinite(c[k]) || !(c[k] > c[k - 1]))
+        fail(src, name, k, "",
+             "the plane " + number(c[k]) + " m is not a finite number above the one before, " +
+                 number(c[k - 1]) + " m (the planes must increase strictly)");
+  }
+}
+
 }  // namespace
 
 void check_particle_records(const Particles& p, const Scene& scene, const StateSource& src,
@@ -92,6 +131,8 @@ void check_checkpoint(const CheckpointData& d, const Scene& scene, std::size_t w
   if (!std::isfinite(d.dt) || !(d.dt > 0))
     attribute("dt", "the time step " + number(d.dt) + " s is not a finite number > 0");
   if (d.step < 0) attribute("step", "the step " + std::to_string(d.step) + " is negative");
+
+  if (d.grid) check_grid(*d.grid, scene.domain, {d.file, "/decomposition/", src.advice});
 
   const Particles& p = d.particles;
   check_particle_records(p, scene, src, true);

@@ -49,7 +49,9 @@ void check_particle_records(const Particles& p, const Scene& scene, const StateS
 // step finite and non-negative (dt > 0); the implicit drag (when present) finite with K >= 0;
 // every spring's particle an id of the file, its partner an id of the file or a wall history
 // column below `wall_columns`, its tangential and rolling parts finite; `stream_counts`
-// (particles each stream delivered, restored from the file) below next_id. Throws StateError.
+// (particles each stream delivered, restored from the file) below next_id; the processor grid
+// (when present): ranks >= 1, dims in [1, ranks] whose product is ranks, dims+1 planes per
+// axis, strictly increasing, from the domain's lo to its hi exactly. Throws StateError.
 void check_checkpoint(const CheckpointData& d, const Scene& scene, std::size_t wall_columns,
                       double stream_max_radius, const std::vector<long>& stream_counts);
 

@@ -68,6 +68,13 @@ void print_report(const Simulation& sim, MPI_Comm comm, std::ostream& out,
       for (int k = 1; k < d.dims()[a]; ++k) o << (k > 1 ? ", " : " ") << d.cuts(a)[k];
       o << " m";
     }
+    switch (sim.grid_choice()) {
+      case Simulation::GridChoice::given: o << " (parallel.grid)"; break;
+      case Simulation::GridChoice::imposed: o << " (imposed planes)"; break;
+      case Simulation::GridChoice::checkpoint: o << " (default: the checkpoint's)"; break;
+      case Simulation::GridChoice::particles: o << " (default: for the particles)"; break;
+      case Simulation::GridChoice::domain: o << " (default: for the domain)"; break;
+    }
     o << "\n";
   }
   if (sim.scene().parallel.reproducible)

@@ -99,7 +99,18 @@ void Simulation::initialise() {
           << " m); enlarge the domain along it or reduce the skin";
       throw SetupError(msg.str());
     }
-  if (automatic_grid_ && !cuts_imposed_ && decomp_->size() > 1) fit_grid_to_domain();
+  if (cuts_imposed_) {
+    grid_choice_ = GridChoice::imposed;
+  } else if (automatic_grid_) {
+    // On as many ranks as wrote the checkpoint, its boxes: the run continues bit for bit.
+    if (restored_grid_ && restored_grid_->ranks == decomp_->size())
+      take_restored_grid(*restored_grid_);
+    else if (decomp_->size() > 1)
+      fit_grid_to_particles();
+    else
+      grid_choice_ = GridChoice::domain;  // one box, the domain
+  }
+  restored_grid_.reset();
   for (int a = 0; a < 3; ++a)
     if (decomp_->dims()[a] > 1 && decomp_->thinnest_box() < cutoff_) {
       std::ostringstream msg;
@@ -483,15 +494,52 @@ void Simulation::balance_cuts() {
                                     decomp_->hi() + Vec3::Constant(cutoff_), cutoff_);
 }
 
-void Simulation::fit_grid_to_domain() {
-  // The grid is a function of the scene alone (the domain and the interaction range), so a
-  // restart builds the same boxes and continues bit for bit.
-  const std::array<int, 3> dims =
-      choose_processor_grid(decomp_->size(), decomp_->length(), cutoff_);
+void Simulation::remake_decomposition(const std::array<int, 3>& dims) {
   if (dims == decomp_->dims()) return;
   exchange_.reset();
   decomp_ = std::make_unique<Decomposition>(comm_, scene_.domain, dims);
   exchange_ = std::make_unique<Exchange>(*decomp_);
+}
+
+void Simulation::fit_grid_to_particles() {
+  const Vec3 length = decomp_->length();
+  // Particles still to come (streams) land where the scene sends them, not where the
+  // particles of the start are: such a scene, like an empty one, is cut for its domain.
+  const bool by_particles = p_.size() > 0 && streams_.empty();
+  std::optional<Vec3> extent;
+  if (by_particles) {
+    Vec3 lo = p_.x[0], hi = p_.x[0];
+    for (const Vec3& x : p_.x) {
+      lo = lo.cwiseMin(x);
+      hi = hi.cwiseMax(x);
+    }
+    // The cut through the particles plus the ghost layer on either side of it.
+    extent = ((hi - lo) + Vec3::Constant(cutoff_)).cwiseMin(length);
+  }
+  const std::array<int, 3> dims = choose_processor_grid(decomp_->size(), length, cutoff_, extent);
+  remake_decomposition(dims);
+  grid_choice_ = by_particles ? GridChoice::particles : GridChoice::domain;
+  if (!by_particles) return;
+  const Domain& d = scene_.domain;
+  std::vector<double> coordinate(p_.size());
+  for (int a = 0; a < 3; ++a) {
+    if (dims[a] == 1) continue;
+    for (std::size_t i = 0; i < p_.size(); ++i) coordinate[i] = p_.x[i][a];
+    decomp_->set_cuts(a, balanced_cut_planes(coordinate, d.lo[a], d.hi[a], dims[a], cutoff_));
+  }
+}
+
+void Simulation::take_restored_grid(const CheckpointGrid& grid) {
+  remake_decomposition(grid.dims);
+  for (int a = 0; a < 3; ++a) {
+    try {
+      decomp_->set_cuts(a, grid.cuts[a]);
+    } catch (const std::invalid_argument& e) {  // check_checkpoint has refused such planes
+      throw SetupError(scene_.file + ": error: the cut planes along " +
+                       std::string(1, "xyz"[a]) + " of the restored checkpoint: " + e.what());
+    }
+  }
+  grid_choice_ = GridChoice::checkpoint;
 }
 
 void Simulation::set_cut_planes(int axis, const std::vector<double>& planes) {
@@ -538,6 +586,7 @@ void Simulation::restore(const CheckpointData& checkpoint) {
   counters_.steps = checkpoint.step;
   next_id_ = checkpoint.next_id;
   restored_springs_ = checkpoint.springs;
+  restored_grid_ = checkpoint.grid;
   restored_ = true;
 }
 
@@ -553,6 +602,10 @@ void Simulation::write_checkpoint(const std::string& path) {
     d.drag_fluid_velocity = drag_.fluid_velocity;
   }
   d.streams = streams_.save_state();
+  CheckpointGrid& grid = d.grid.emplace();
+  grid.ranks = decomp_->size();
+  grid.dims = decomp_->dims();
+  for (int a = 0; a < 3; ++a) grid.cuts[a] = decomp_->cuts(a);
   // Every spring, listed under each partner that this rank owns.
   if (sweep_.has_history) {
     const std::size_t lists = local_list_.offsets.size();

@@ -79,8 +79,9 @@ class Simulation {
   // keeps each on the rank that owns it). `insert = false` starts empty: tests add
   // particles by hand — on every rank alike — before initialise().
   // processor_grid {0,0,0} takes the scene's `parallel.grid`; when that is {0,0,0} too, the
-  // grid is chosen by initialise() once the interaction range is known (docs/parallel.md,
-  // "The default grid"), unless set_cut_planes() imposed planes.
+  // grid and its cut planes are chosen by initialise() (docs/parallel.md, "The default
+  // grid"): those of the checkpoint restored on as many ranks, else for the particles then
+  // present, unless set_cut_planes() imposed planes.
   explicit Simulation(const Scene& scene, bool insert = true, MPI_Comm comm = MPI_COMM_WORLD,
                       std::array<int, 3> processor_grid = {0, 0, 0});
 
@@ -161,15 +162,31 @@ class Simulation {
   // Largest over mean particle count per rank (1 = perfectly balanced). Collective.
   double load_imbalance() const;
 
+  // Where initialise() took the processor grid from.
+  enum class GridChoice {
+    given,       // processor_grid or the scene's `parallel.grid`, uniform planes
+    imposed,     // set_cut_planes()
+    checkpoint,  // the restored checkpoint's grid and planes (written on as many ranks)
+    particles,   // the default rule for the particles present at initialise()
+    domain,      // the default rule for the domain alone (no particles yet, or streams)
+  };
+  GridChoice grid_choice() const { return grid_choice_; }
+
   double kinetic_energy_translational() const;  // this rank
   double kinetic_energy_rotational() const;     // this rank
 
  private:
   void rebuild(bool keep_drag = false);
   void balance_cuts();  // moves cut planes toward equal particle counts (collective)
-  // The default grid (automatic grid, no imposed planes): the least cut area among the grids
-  // whose boxes are at least as thick as the interaction range, uniform planes.
-  void fit_grid_to_domain();
+  // The default grid (automatic grid, no imposed planes, no checkpoint grid for this rank
+  // count): the least cut area through the particles' extent among the grids whose boxes are
+  // at least as thick as the interaction range, planes at the particle-count quantiles;
+  // without particles at the start, or with stream insertions, for the domain alone with
+  // uniform planes. Every rank holds every particle when it runs, so all choose the same.
+  void fit_grid_to_particles();
+  // The checkpoint's grid and planes (restore(), written on as many ranks).
+  void take_restored_grid(const CheckpointGrid& grid);
+  void remake_decomposition(const std::array<int, 3>& dims);  // uniform planes
   ContactGuards compute_forces();  // gravity, contacts, then the force terms
   void apply_force_terms();  // non-contact terms only
   void restore_implicit_drag();  // initialise() after restore()
@@ -256,6 +273,8 @@ class Simulation {
   bool state_finite_ = true;                        // after the last step(), this rank's particles
   bool finite_everywhere_ = true;                   // the same, every rank's
   bool restored_ = false;                           // initialise() keeps the forces read
+  std::optional<CheckpointGrid> restored_grid_;     // from restore(), until initialise()
+  GridChoice grid_choice_ = GridChoice::given;
   bool automatic_grid_ = false;  // neither the caller nor the scene gave the grid
   bool cuts_imposed_ = false;    // set_cut_planes() was called
   bool initialised_ = false;

@@ -12,8 +12,10 @@
 namespace grainflow {
 namespace {
 
-// Format 2 added the group 'streams'; format 1 files are read (without it).
-constexpr const char* kFormat = "grainflow-checkpoint-2";
+// Format 2 added the group 'streams', format 3 the group 'decomposition'; files of the
+// earlier formats are read (without them).
+constexpr const char* kFormat = "grainflow-checkpoint-3";
+constexpr const char* kCutNames[3] = {"cuts_x", "cuts_y", "cuts_z"};
 
 // Packs per-particle and per-spring records into doubles (ids bit-exact).
 std::vector<double> pack(const CheckpointData& d) {
@@ -47,8 +49,11 @@ std::uintmax_t expected_bytes(const CheckpointData& d) {
   const std::uintmax_t n = d.particles.size(), per_particle = 8 + 5 * 24 + 3 * 8 + 4;
   const std::uintmax_t drag = d.drag_coefficient.empty() ? 0 : 32;
   const std::uintmax_t streams = d.streams ? d.streams->size() : 0;
-  return n * (per_particle + drag) + d.springs.size() * (2 * 8 + 2 * 24) + streams + 17 * 3072 +
-         8192;
+  std::uintmax_t grid = 0;
+  if (d.grid)
+    for (const auto& c : d.grid->cuts) grid += 8 * c.size();
+  return n * (per_particle + drag) + d.springs.size() * (2 * 8 + 2 * 24) + streams + grid +
+         22 * 3072 + 8192;
 }
 
 // Appends the records of one rank's buffer to `out`.
@@ -236,6 +241,17 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
                "writing the group 'streams'");
     if (s >= 0) H5Gclose(s);
   }
+  if (fail.ok() && d.grid) {
+    const CheckpointGrid& grid = *d.grid;
+    const hid_t s = H5Gcreate2(f.id(), "decomposition", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    bool ok = s >= 0 && write_array(fail, s, "ranks", H5T_NATIVE_INT, 1, 1, &grid.ranks) &&
+              write_array(fail, s, "dims", H5T_NATIVE_INT, 3, 1, grid.dims.data());
+    for (int axis = 0; axis < 3 && ok; ++axis)
+      ok = write_array(fail, s, kCutNames[axis], H5T_NATIVE_DOUBLE, grid.cuts[axis].size(), 1,
+                       grid.cuts[axis].data());
+    fail.check(ok, "writing the group 'decomposition'");
+    if (s >= 0) H5Gclose(s);
+  }
   // Closing flushes HDF5's metadata cache: on a full disk this is often where it fails.
   fail.check(f.close(), "closing (flushing) the file");
   return fail.error();
@@ -300,6 +316,7 @@ void write_checkpoint(MPI_Comm comm, const std::string& path, const CheckpointDa
     d.step = local.step;
     d.next_id = local.next_id;
     d.streams = local.streams;
+    d.grid = local.grid;
     for (int r = 0; r < size; ++r) unpack(all.data() + displs[r], counts[r], d);
     const std::string part = path + ".part";
     // A foreseeable full disk is refused before HDF5 starts: a checksummed (chunked) file
@@ -385,6 +402,23 @@ CheckpointData read_checkpoint(const std::string& path) {
       const auto text =
           read_array<unsigned char>(f, "/streams/state", H5T_NATIVE_UCHAR, 1, length, error);
       if (error.empty()) d.streams = std::string(text.begin(), text.end());
+    }
+    // Optional (format 3): the shapes here, the values in check_checkpoint.
+    if (error.empty() && H5Lexists(f, "decomposition", H5P_DEFAULT) > 0) {
+      CheckpointGrid grid;
+      std::size_t one = 1, three = 3;
+      const auto ranks = read_array<int>(f, "/decomposition/ranks", H5T_NATIVE_INT, 1, one, error);
+      const auto dims = read_array<int>(f, "/decomposition/dims", H5T_NATIVE_INT, 1, three, error);
+      for (int axis = 0; axis < 3; ++axis) {
+        std::size_t planes = static_cast<std::size_t>(-1);
+        const std::string name = std::string("/decomposition/") + kCutNames[axis];
+        grid.cuts[axis] = read_array<double>(f, name.c_str(), H5T_NATIVE_DOUBLE, 1, planes, error);
+      }
+      if (error.empty()) {
+        grid.ranks = ranks[0];
+        for (int axis = 0; axis < 3; ++axis) grid.dims[axis] = dims[axis];
+        d.grid = std::move(grid);
+      }
     }
     H5Fclose(f);
     if (error.empty()) {

@@ -11,7 +11,7 @@
 // verifies on reading: read_checkpoint names the dataset whose checksum fails. What the
 // values must satisfy is checked by check_checkpoint (dem/engine/restored_state.hpp).
 //
-// Layout: attributes format ("grainflow-checkpoint-2"), time, dt, step, next_id;
+// Layout: attributes format ("grainflow-checkpoint-3"), time, dt, step, next_id;
 // /particles/{id, position, velocity, angular_velocity, force, torque, radius, mass,
 // inertia, material} — force and torque are those of the step's end, which the next
 // velocity-Verlet half kick uses (recomputing them would advance the springs twice);
@@ -21,10 +21,15 @@
 // /springs/{particle, partner, tangential, rolling}, where a wall spring
 // has partner = -1 - wall index. A pair's spring may be listed once per partner;
 // /streams/state (uint8 text, StreamInsertion::save_state(): the stream insertions'
-// delivered totals, radii drawn but not placed and generator states). Format 1 files
-// (before stream state was saved) have no /streams group.
+// delivered totals, radii drawn but not placed and generator states);
+// /decomposition/{ranks, dims, cuts_x, cuts_y, cuts_z}: the processor grid the run used when
+// it wrote the file — its rank count, ranks per axis and each axis's dims+1 cut planes from
+// the domain's lo to its hi — so that a restart on as many ranks continues on the same boxes
+// (docs/parallel.md, "The default grid"). Format 1 files (before stream state was saved)
+// have no /streams group; format 1 and 2 files have no /decomposition group.
 #include <mpi.h>
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -41,6 +46,13 @@ struct CheckpointSpring {
   Vec3 rolling;
 };
 
+// The processor grid of the run that wrote a checkpoint.
+struct CheckpointGrid {
+  int ranks = 1;                            // MPI ranks of that run
+  std::array<int, 3> dims{1, 1, 1};         // ranks per axis
+  std::array<std::vector<double>, 3> cuts;  // per axis: dims+1 planes, lo .. hi
+};
+
 struct CheckpointData {
   double time = 0;
   double dt = 0;
@@ -55,6 +67,8 @@ struct CheckpointData {
   // The stream insertions' progress (taken from rank 0 when writing); absent in a format 1
   // file, which cannot continue a scene with streams.
   std::optional<std::string> streams;
+  // The processor grid (taken from rank 0 when writing); absent in format 1 and 2 files.
+  std::optional<CheckpointGrid> grid;
   std::string file;  // set by read_checkpoint: where it came from, for messages
 };
 

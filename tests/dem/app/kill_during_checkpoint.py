@@ -98,7 +98,7 @@ def check_checkpoints(out, kill):
             fail(f"after kill {kill}: {path}: particle ids are not 1 .. {PARTICLES} once each")
         if not np.all(np.isfinite(positions)):
             fail(f"after kill {kill}: {path} holds non-finite positions")
-        if step != int(CHECKPOINT.match(name).group(1)) or fmt != b"grainflow-checkpoint-2":
+        if step != int(CHECKPOINT.match(name).group(1)) or fmt != b"grainflow-checkpoint-3":
             fail(f"after kill {kill}: {path}: step {step} / format {fmt!r} do not match")
     return names
 

@@ -164,6 +164,20 @@ elif case == "next_id":
     edit(lambda f: f.attrs.__setitem__("next_id", np.int64(ids.max())))
     expect = f_ + r": error: attribute 'next_id' of the root group: next_id = %d is not above " \
         r"the largest particle id %d" % (ids.max(), ids.max())
+elif case == "grid_ranks":  # written on 1 rank: a 1 x 1 x 1 grid said to be of 2 ranks
+    edit(setitem("decomposition/ranks", 0, 2))
+    expect = f_ + r": error: dataset '/decomposition/dims', index 0: the grid 1 x 1 x 1 has 1 " \
+        r"boxes, but the file was written by 2 ranks"
+elif case == "grid_planes":  # 3 ranks along x whose middle planes go backwards
+    def planes(f):
+        f["decomposition/ranks"][0] = 3
+        f["decomposition/dims"][...] = np.array([3, 1, 1], "<i4")
+        del f["decomposition/cuts_x"]
+        f.create_dataset("decomposition/cuts_x", data=np.array([0, 0.009, 0.006, 0.015]),
+                         chunks=(4,), fletcher32=True)
+    edit(planes)
+    expect = f_ + r": error: dataset '/decomposition/cuts_x', index 2: the plane 0.006 m is not " \
+        r"a finite number above the one before, 0.009 m \(the planes must increase strictly\)"
 else:
     fail("unknown case " + case)
 

@@ -153,7 +153,7 @@ if(GRAINFLOW_PYTHON3)
   foreach(_kind checkpoint snapshot)
     set(_cases ${_state_cases})
     if(_kind STREQUAL "checkpoint")
-      list(APPEND _cases spring_partner spring_wall next_id)
+      list(APPEND _cases spring_partner spring_wall next_id grid_ranks grid_planes)
     endif()
     foreach(_case ${_cases})
       add_test(NAME grain.state_file_checks.${_kind}.${_case}
