@@ -694,7 +694,8 @@ ContactGuards Simulation::compute_forces() {
     // scale of the whole force), so the forces are summed as without the record.
     fluid_explicit_ = p_.force;
     apply_force_terms();
-    for (std::size_t i = 0; i < p_.size(); ++i) fluid_explicit_[i] = p_.force[i] - fluid_explicit_[i];
+    for (std::size_t i = 0; i < p_.size(); ++i)
+      fluid_explicit_[i] = p_.force[i] - fluid_explicit_[i];
   } else {
     fluid_explicit_.clear();  // of another step: never to be read as this one's
     apply_force_terms();
@@ -1175,9 +1176,10 @@ SnapshotExtras Simulation::snapshot_extras(SnapshotFieldSet fields) const {
   if (wants("torque")) {
     e.torque.resize(n);
     for (std::size_t i = 0; i < n; ++i)
-      e.torque[i] = spin_drag ? Vec3(p_.torque[i] + drag_.spin_coefficient[i] *
-                                                         (drag_.fluid_spin[i] - p_.omega[i]))
-                              : p_.torque[i];
+      e.torque[i] =
+          spin_drag
+              ? Vec3(p_.torque[i] + drag_.spin_coefficient[i] * (drag_.fluid_spin[i] - p_.omega[i]))
+              : p_.torque[i];
   }
   if (wants("fluid_force")) {
     if (!terms_.empty() && fluid_explicit_.size() != n)

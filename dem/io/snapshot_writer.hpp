@@ -48,8 +48,7 @@ class SnapshotWriter {
   // OutputError (naming the file, the failing operation, the HDF5/OS reason and the rank).
   // `extras` must hold every field of the set beyond the default ones, sized p.size()
   // (std::logic_error otherwise).
-  std::string write(const Particles& p, double time, long step,
-                    const SnapshotExtras& extras = {});
+  std::string write(const Particles& p, double time, long step, const SnapshotExtras& extras = {});
 
   // Continues an existing series (a restarted run): takes the snapshots already in the
   // directory, in index order, up to the first one missing, unreadable or past `up_to_step`,

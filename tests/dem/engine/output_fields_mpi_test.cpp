@@ -53,8 +53,8 @@ int world_rank() {
 // A fresh, empty directory per test, the same path on every rank.
 fs::path test_directory() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "output_fields_mpi_test" /
-                       info->name();
+  const fs::path dir =
+      fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "output_fields_mpi_test" / info->name();
   if (world_rank() == 0) {
     fs::remove_all(dir);
     fs::create_directories(dir);
@@ -74,7 +74,7 @@ const char* kAllFields =
 struct SnapshotFile {
   double time = 0;
   long step = 0;
-  std::map<std::string, std::vector<double>> data;   // flattened (N x components)
+  std::map<std::string, std::vector<double>> data;        // flattened (N x components)
   std::map<std::string, std::vector<std::int64_t>> ints;  // id, material, coordination
   std::size_t size() const { return ints.at("id").size(); }
   std::size_t row_of(std::int64_t id) const {
@@ -89,7 +89,9 @@ struct SnapshotFile {
     const auto& a = data.at(name);
     return {a[3 * i], a[3 * i + 1], a[3 * i + 2]};
   }
-  double scalar(const std::string& name, std::int64_t id) const { return data.at(name)[row_of(id)]; }
+  double scalar(const std::string& name, std::int64_t id) const {
+    return data.at(name)[row_of(id)];
+  }
   std::int64_t integer(const std::string& name, std::int64_t id) const {
     return ints.at(name)[row_of(id)];
   }
@@ -237,8 +239,8 @@ TEST(OutputFields, HookeContactsGiveClosedFormForceTorqueCoordinationOverlap) {
     for (std::int64_t id = 1; id <= 4; ++id) EXPECT_EQ(s.vec("fluid_force", id), Vec3::Zero());
     // Every field is an Attribute of the XDMF index, with its units in the file.
     const std::string xml = slurp(dir / "particles.xdmf");
-    for (const char* name : {"force", "torque", "coordination", "fluid_force", "overlap_max",
-                             "velocity", "material"})
+    for (const char* name :
+         {"force", "torque", "coordination", "fluid_force", "overlap_max", "velocity", "material"})
       EXPECT_EQ(count(xml, std::string("<Attribute Name=\"") + name + "\""), 1u) << name;
   }
   MPI_Barrier(MPI_COMM_WORLD);
@@ -249,7 +251,8 @@ TEST(OutputFields, HookeContactsGiveClosedFormForceTorqueCoordinationOverlap) {
 TEST(OutputFields, FluidForceIsSchillerNaumannDragAndCsvSpinReachesTheSnapshot) {
   const fs::path dir = test_directory();
   const fs::path csv = dir / "bead.csv";
-  if (world_rank() == 0) std::ofstream(csv) << "x,y,z,radius,wx,wy,wz\n0.005,0.005,0.005,5e-4,1.5,-2.25,3\n";
+  if (world_rank() == 0)
+    std::ofstream(csv) << "x,y,z,radius,wx,wy,wz\n0.005,0.005,0.005,5e-4,1.5,-2.25,3\n";
   MPI_Barrier(MPI_COMM_WORLD);
   const double mu = 1e-3, rho_f = 1000, d = 1e-3, rho_p = 2500;
   const Vec3 u(0, 0, 0.01), g(0, 0, -9.81);
@@ -261,10 +264,13 @@ TEST(OutputFields, FluidForceIsSchillerNaumannDragAndCsvSpinReachesTheSnapshot) 
       "materials: [{name: glass, youngs_modulus: 5e4, poisson_ratio: 0.3, density: 2500}]\n"
       "interactions: [{materials: [glass, glass], restitution: 0.5, friction: 0.5}]\n"
       "contact: {normal: hertz}\n"
-      "insert: [{type: csv, file: " + csv.string() + ", material: glass}]\n"
-      "fluid: {density: 1000, viscosity: 1e-3, velocity: [0, 0, 0.01], void_fraction: 1,\n"
-      "        drag: schiller_naumann, model: B, forces: [drag, pressure_gradient, viscous]}\n"
-      "output: {progress: false, snapshot_interval: 1e-5, fields: " + kAllFields + "}\n",
+      "insert: [{type: csv, file: " +
+          csv.string() +
+          ", material: glass}]\n"
+          "fluid: {density: 1000, viscosity: 1e-3, velocity: [0, 0, 0.01], void_fraction: 1,\n"
+          "        drag: schiller_naumann, model: B, forces: [drag, pressure_gradient, viscous]}\n"
+          "output: {progress: false, snapshot_interval: 1e-5, fields: " +
+          kAllFields + "}\n",
       (dir / "drag.yaml").string());
   RunOptions options;
   options.progress = false;
@@ -330,9 +336,11 @@ TEST(OutputFields, SpinningSphereOnAFrictionalPlaneEndsRollingAtTwoSevenths) {
       "contact: {normal: hertz, tangential: history}\n"
       "walls: [{type: plane, name: floor, point: [0, 0, 0], normal: [0, 0, 1], "
       "material: glass}]\n"
-      "insert: [{type: csv, file: " + csv.string() + ", material: glass}]\n"
-      "output: {progress: false, fields: [velocity, angular_velocity, force, coordination, "
-      "overlap_max]}\n",
+      "insert: [{type: csv, file: " +
+          csv.string() +
+          ", material: glass}]\n"
+          "output: {progress: false, fields: [velocity, angular_velocity, force, coordination, "
+          "overlap_max]}\n",
       (dir / "rolling.yaml").string());
   RunOptions options;
   options.progress = false;
@@ -378,7 +386,9 @@ const std::string kBedScene =
     "fluid: {density: 1000, viscosity: 1e-3, velocity: [0, 0, 0.02], void_fraction: 1,\n"
     "        drag: schiller_naumann, model: B, forces: [drag, pressure_gradient, viscous]}\n"
     "output: {progress: false, snapshot_interval: 0.0075, checkpoint_interval: 0.015,\n"
-    "         fields: " + std::string(kAllFields) + "}\n"
+    "         fields: " +
+    std::string(kAllFields) +
+    "}\n"
     "parallel: {reproducible: true}\n";
 
 void expect_same_fields(const fs::path& a, const fs::path& b) {
@@ -465,8 +475,10 @@ TEST(OutputFields, WindowWritesEveryStepBetweenStartAndStopOnly) {
       "materials: [{name: glass, youngs_modulus: 5e4, poisson_ratio: 0.3, density: 2500}]\n"
       "interactions: [{materials: [glass, glass], restitution: 0.5, friction: 0.5}]\n"
       "contact: {normal: hertz}\n"
-      "insert: [{type: csv, file: " + csv.string() + ", material: glass}]\n"
-      "output: {progress: false, snapshot_interval: 1e-4, start: 0.0035, stop: 0.0045}\n",
+      "insert: [{type: csv, file: " +
+          csv.string() +
+          ", material: glass}]\n"
+          "output: {progress: false, snapshot_interval: 1e-4, start: 0.0035, stop: 0.0045}\n",
       (dir / "window.yaml").string());
   RunOptions options;
   options.progress = false;
