@@ -170,13 +170,24 @@ def neutrally_buoyant(runner, checks):
     it by 0.3 mm (the control below), a missing buoyancy or a hydrostatic pressure counted
     twice by far more. The snapshot's fields (output.fields): fluid_force, the coupling's
     force on the bead, is the buoyancy rho_f V g upward to round-off (1e-12 of it), force
-    (weight + fluid) is zero to 1e-12 m g, coordination 0."""
+    (weight + fluid) is zero to 1e-12 m g, coordination 0. The snapshot window: model B's
+    scene has output.start 0.06 s, so of the write times 0.05 and 0.1 s (controlDict) only
+    0.1 s has a snapshot, while both have a checkpoint; model A's has both snapshots."""
     for model in ("A", "B"):
-        case = runner.fresh_case("neutral_particle", f"neutral_{model}",
-                                 [("particle.yaml", "model: B", f"model: {model}"), FIELDS_EDIT])
+        edits = [("particle.yaml", "model: B", f"model: {model}"), FIELDS_EDIT]
+        if model == "B":
+            edits.append(("particle.yaml", "coordination]}", "coordination], start: 0.06}"))
+        case = runner.fresh_case("neutral_particle", f"neutral_{model}", edits)
         log = runner.solve(case, 1)
         checks.expect(f"VANS model {model}" in log, f"model {model}: the solver says VANS model {model}")
         snaps = snapshots(case)
+        times = [t for t, _ in snaps]
+        want = [0.1] if model == "B" else [0.05, 0.1]
+        checks.expect(len(times) == len(want) and np.allclose(times, want, rtol=0, atol=1e-9),
+                      f"model {model}: snapshots at {times} s, {want} s expected")
+        checkpoints = sorted(n for n in os.listdir(os.path.join(case, "particles"))
+                             if n.startswith("checkpoint_"))
+        checks.expect(len(checkpoints) == 2, f"model {model}: checkpoints {checkpoints}, 2 expected")
         t, last = snaps[-1] if snaps else (0.0, None)
         if last is None or len(last["id"]) != 1:
             checks.expect(False, f"model {model}: a snapshot with one particle")
