@@ -232,6 +232,7 @@ void DemLink::initialise() {
     // The first force evaluation, before the fluid is sampled, sees fluid at rest, eps = 1.
     Impl* self = &m;
     m.fluid->set_sampler([self](const Vec3&) { return self->to_sample(FluidAtParticle{}); });
+    m.sim->record_fluid_force((m.scene.output.fields & snapshot_field_bit("fluid_force")) != 0);
     m.sim->initialise();
     m.fluid->reset_late_samples();
   } catch (const std::exception& e) {
@@ -480,7 +481,12 @@ void DemLink::advance(int steps, const std::string& diagnostic_directory) {
   Simulation& sim = impl_->simulation();
   const FloatingPointTrapsOff traps_off;
   try {
+    // A snapshot may follow this advance: the fluid's share of the last sub-step's forces is
+    // kept when the scene's output.fields asks for fluid_force.
+    const bool fluid_force =
+        (impl_->scene.output.fields & snapshot_field_bit("fluid_force")) != 0;
     for (int k = 0; k < steps; ++k) {
+      sim.record_fluid_force(fluid_force && k == steps - 1);
       sim.step();
       guard_finite_after_step(sim, diagnostic_directory, impl_->dem_comm);
     }
@@ -507,13 +513,21 @@ DemSummary DemLink::summary() const {
 void DemLink::write_snapshot(const std::string& directory, long step, long continue_after) {
   Impl& m = *impl_;
   try {
+    // The scene's output window: outside it no snapshot is written (the checkpoints are).
+    const Simulation& sim = m.simulation();
+    const double half = 0.5 * sim.dt();
+    if ((m.scene.output.start && sim.time() < *m.scene.output.start - half) ||
+        (m.scene.output.stop && sim.time() > *m.scene.output.stop + half))
+      return;
     if (!m.snapshots || m.snapshot_directory != directory) {
       prepare_output_directory(directory);
-      m.snapshots = std::make_unique<SnapshotWriter>(m.dem_comm, directory);
+      m.snapshots = std::make_unique<SnapshotWriter>(m.dem_comm, directory, "particles",
+                                                     m.scene.output.fields);
       m.snapshot_directory = directory;
       if (continue_after >= 0) m.snapshots->continue_series(continue_after);
     }
-    m.snapshots->write(m.simulation().particles(), m.simulation().time(), step);
+    m.snapshots->write(sim.particles(), sim.time(), step,
+                       sim.snapshot_extras(m.snapshots->fields()));
   } catch (const std::exception& e) {
     throw std::runtime_error(e.what());
   }

@@ -613,4 +613,60 @@ void steps_per_contact_sweep(ContactSweep& s) {
   }
 }
 
+void tally_contacts(const Particles& p, const Ghosts& g, const NeighbourList& local_list,
+                    const NeighbourList& ghost_list, const WallSet& walls,
+                    const WallNeighbours& wall_neighbours, std::vector<int>& count,
+                    std::vector<double>& overlap_max) {
+  count.assign(p.size(), 0);
+  overlap_max.assign(p.size(), 0.0);
+  const auto add = [&](std::size_t i, double ratio) {
+    ++count[i];
+    overlap_max[i] = std::max(overlap_max[i], ratio);
+  };
+  const Vec3 zero = Vec3::Zero();
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    // Half list: each local pair once, counted for both.
+    for (int k = local_list.offsets[i]; k < local_list.offsets[i + 1]; ++k) {
+      const std::size_t j = local_list.j[k];
+      const Vec3 d = p.x[i] - p.x[j];
+      const double rs = p.radius[i] + p.radius[j];
+      if (apart(d, rs)) continue;
+      const double ratio = (rs - std::sqrt(d.squaredNorm())) / std::min(p.radius[i], p.radius[j]);
+      add(i, ratio);
+      add(j, ratio);
+    }
+    // The ghost's owner counts the pair for its own particle.
+    for (int k = ghost_list.offsets[i]; k < ghost_list.offsets[i + 1]; ++k) {
+      const std::size_t q = ghost_list.j[k];
+      const Vec3 d = (p.x[i] - g.x[q]) + (zero - g.shift[q]);
+      const double rs = p.radius[i] + g.radius[q];
+      if (apart(d, rs)) continue;
+      add(i, (rs - std::sqrt(d.squaredNorm())) / std::min(p.radius[i], g.radius[q]));
+    }
+  }
+  for (std::size_t w = 0; w < walls.walls().size(); ++w) {
+    const WallSet::Entry& wall = walls.walls()[w];
+    if (wall.kind == Wall::Kind::mesh) {
+      const TriangleMesh& mesh = walls.mesh(wall);
+      const bool moving = wall.pose.moving();
+      MeshTouch touch[TriangleMesh::kMaxTouches];
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        const int n = mesh.touches(moving ? wall.pose.to_body(p.x[i]) : p.x[i], p.radius[i], touch);
+        for (int k = 0; k < n; ++k) add(i, touch[k].overlap / p.radius[i]);
+      }
+      continue;
+    }
+    const WallNeighbours::List& list = wall_neighbours.lists[w];
+    const std::size_t n = list.all ? p.size() : list.i.size();
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::size_t i = list.all ? k : static_cast<std::size_t>(list.i[k]);
+      WallTouch t;
+      const bool touching = wall.kind == Wall::Kind::plane
+                                ? touch_plane(wall.plane, p.x[i], p.radius[i], t)
+                                : touch_cylinder(wall.cylinder, p.x[i], p.radius[i], t);
+      if (touching) add(i, t.overlap / p.radius[i]);
+    }
+  }
+}
+
 }  // namespace grainflow

@@ -126,4 +126,13 @@ SweepChoice select_sweep(const ContactSettings& settings, bool canonical = false
 // the steps where some contact could fail (Simulation::contact_may_be_unresolved).
 void steps_per_contact_sweep(ContactSweep& s);
 
+// Each local particle's touching contacts (overlap > 0, the force sweep's test) with
+// particles (local and ghost) and walls, as `count`, and the largest overlap / smaller radius
+// among them as `overlap_max` (0 without contacts), at the present positions. A pass of its
+// own over the same lists and walls as the force sweep, for snapshots that ask for it.
+void tally_contacts(const Particles& p, const Ghosts& ghosts, const NeighbourList& local_list,
+                    const NeighbourList& ghost_list, const WallSet& walls,
+                    const WallNeighbours& wall_neighbours, std::vector<int>& count,
+                    std::vector<double>& overlap_max);
+
 }  // namespace grainflow

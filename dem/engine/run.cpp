@@ -156,6 +156,9 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
                       "checkpoint_<step>.h5");
   Simulation sim(scene, !options.restart, comm);
   if (options.restart) sim.restore(read_checkpoint(*options.restart));
+  // fluid_force needs the force terms' share kept, at the steps that write a snapshot.
+  const bool wants_fluid_force = (scene.output.fields & snapshot_field_bit("fluid_force")) != 0;
+  sim.record_fluid_force(wants_fluid_force);  // the first forces (snapshot of step 0)
   const long first_step = sim.counters().steps;  // 0, or the checkpoint's step
   if (scene.fluid)
     sim.add_force_term(make_fluid_forces(*scene.fluid, scene.gravity, scene.domain, comm));
@@ -168,7 +171,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
                                   "--allow-large-dt to run anyway");
   guard_finite(sim, has_non_finite(sim.particles()), dir, comm);
 
-  SnapshotWriter snapshots(comm, dir);
+  SnapshotWriter snapshots(comm, dir, "particles", scene.output.fields);
   const std::string log_path = (std::filesystem::path(dir) / "log.csv").string();
   std::optional<LogTable> log_table;
   if (options.restart) {
@@ -241,7 +244,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   };
   auto write_snapshot = [&](double t, long k) {
     try {
-      snapshots.write(sim.particles(), t, k);
+      snapshots.write(sim.particles(), t, k, sim.snapshot_extras(snapshots.fields()));
     } catch (const OutputError& e) {
       throw resumable(e);
     }
@@ -254,11 +257,22 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   auto written = [&](double every) {
     return every > 0 ? static_cast<long>(std::floor((t0 + 0.5 * dt) / every)) : 0L;
   };
-  long snap_index = written(snap_every), log_index = written(log_every);
+  long log_index = written(log_every);
+  // Snapshots at origin + i * snap_every inside the window [output.start, output.stop]
+  // (within half a step), and at the last step when it is inside; snap_index is the last i
+  // written (-1: the window has not begun).
+  const double snap_origin = scene.output.start.value_or(0.0);
+  const double snap_end = scene.output.stop.value_or(std::numeric_limits<double>::infinity());
+  const auto in_window = [&](double t) {
+    return t >= snap_origin - 0.5 * dt && t <= snap_end + 0.5 * dt;
+  };
+  long snap_index = t0 < snap_origin - 0.5 * dt
+                        ? -1L
+                        : static_cast<long>(std::floor((t0 - snap_origin + 0.5 * dt) / snap_every));
   long check_index = written(check_every);
   long snap_step = first_step, log_step = first_step;  // last step written
   if (!options.restart) {
-    write_snapshot(sim.time(), 0);
+    if (in_window(sim.time())) write_snapshot(sim.time(), 0);
     sum.particles_start = write_log().particles;
   } else {
     sum.particles_start = sim.global_state().particles;
@@ -269,7 +283,13 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
       std::max(1L, static_cast<long>(std::ceil(scene.time.end / dt - 0.5 - 1e-9)));
   double particle_steps = 0;  // this rank's
   std::ostringstream stop_message;
+  const auto snapshot_due = [&](double t, long k) {
+    return in_window(t) && (t >= snap_origin + (snap_index + 1) * snap_every - 0.5 * dt ||
+                            (k == total_steps && snap_step != k));
+  };
   for (long k = first_step + 1; k <= total_steps; ++k) {
+    // The step adds dt to the time exactly so: whether it ends with a snapshot is known now.
+    if (wants_fluid_force) sim.record_fluid_force(snapshot_due(sim.time() + dt, k));
     sim.step();
     guard_finite_after_step(sim, dir, comm);
     particle_steps += static_cast<double>(sim.particles().size());
@@ -280,9 +300,9 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
       log_index = static_cast<long>(std::floor(t / log_every + 0.5));
       global_particles = write_log().particles;
     }
-    if (t >= (snap_index + 1) * snap_every - 0.5 * dt || (last && snap_step != k)) {
+    if (snapshot_due(t, k)) {
       snap_step = k;
-      snap_index = static_cast<long>(std::floor(t / snap_every + 0.5));
+      snap_index = static_cast<long>(std::floor((t - snap_origin) / snap_every + 0.5));
       write_snapshot(t, k);
     }
     if (check_every > 0 && !last && t >= (check_index + 1) * check_every - 0.5 * dt) {

@@ -650,6 +650,7 @@ void Simulation::refresh_spin_drag() {
 }
 
 void Simulation::rebuild(bool keep_drag) {
+  fluid_explicit_.clear();  // in the old order; a recording evaluation follows a step's rebuild
   // The positions of the last build are done with (the skin test asked them); released
   // now, they do not add to the memory peak of the rebuild.
   std::vector<Vec3>().swap(x_at_build_);
@@ -745,7 +746,17 @@ ContactGuards Simulation::compute_forces() {
   fresh_from_kick_ = false;
   counters_.contacts = s.contacts;
   counters_.max_overlap_ratio = s.max_overlap_ratio;
-  apply_force_terms();
+  if (record_fluid_ && !terms_.empty()) {
+    // The terms add to the contact forces; their share is the difference (rounded at the
+    // scale of the whole force), so the forces are summed as without the record.
+    fluid_explicit_ = p_.force;
+    apply_force_terms();
+    for (std::size_t i = 0; i < p_.size(); ++i)
+      fluid_explicit_[i] = p_.force[i] - fluid_explicit_[i];
+  } else {
+    fluid_explicit_.clear();  // of another step: never to be read as this one's
+    apply_force_terms();
+  }
   return {s.worst, s.unresolved, fastest_particle(v2_local)};
 }
 
@@ -1297,6 +1308,49 @@ double Simulation::kinetic_energy_translational() const {
 double Simulation::kinetic_energy_rotational() const {
   double e = 0;
   for (std::size_t i = 0; i < p_.size(); ++i) e += 0.5 * p_.inertia[i] * p_.omega[i].squaredNorm();
+  return e;
+}
+
+SnapshotExtras Simulation::snapshot_extras(SnapshotFieldSet fields) const {
+  SnapshotExtras e;
+  const std::size_t n = p_.size();
+  const auto wants = [&](const char* name) { return (fields & snapshot_field_bit(name)) != 0; };
+  const bool drag = !drag_.coefficient.empty();
+  const bool spin_drag = !drag_.spin_coefficient.empty();
+  // The implicit drag at the present velocity: the half kick that ended the step solved
+  // v' = v + h/m (F + K (u - v')), so K (u - v') is the drag it applied, and the next one
+  // starts from it.
+  const auto drag_on = [&](std::size_t i) {
+    return drag ? Vec3(drag_.coefficient[i] * (drag_.fluid_velocity[i] - p_.v[i])) : Vec3::Zero();
+  };
+  if (wants("force")) {
+    e.force.resize(n);
+    for (std::size_t i = 0; i < n; ++i) e.force[i] = p_.force[i] + drag_on(i);
+  }
+  if (wants("torque")) {
+    e.torque.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      e.torque[i] =
+          spin_drag
+              ? Vec3(p_.torque[i] + drag_.spin_coefficient[i] * (drag_.fluid_spin[i] - p_.omega[i]))
+              : p_.torque[i];
+  }
+  if (wants("fluid_force")) {
+    if (!terms_.empty() && fluid_explicit_.size() != n)
+      throw std::logic_error(
+          "Simulation::snapshot_extras: fluid_force asked without record_fluid_force() on for "
+          "the step's force evaluation");
+    e.fluid_force.assign(n, Vec3::Zero());
+    for (std::size_t i = 0; i < n; ++i)
+      e.fluid_force[i] = (terms_.empty() ? Vec3::Zero() : fluid_explicit_[i]) + drag_on(i);
+  }
+  if (wants("coordination") || wants("overlap_max")) {
+    std::vector<int> count;
+    std::vector<double> overlap;
+    tally_contacts(p_, ghosts_, local_list_, ghost_list_, walls_, wall_neighbours_, count, overlap);
+    if (wants("coordination")) e.coordination = std::move(count);
+    if (wants("overlap_max")) e.overlap_max = std::move(overlap);
+  }
   return e;
 }
 

@@ -23,6 +23,7 @@
 #include "dem/engine/time_step.hpp"
 #include "dem/insert/stream_insertion.hpp"
 #include "dem/io/checkpoint.hpp"
+#include "dem/io/snapshot_writer.hpp"
 #include "dem/neighbour/verlet_list.hpp"
 #include "dem/neighbour/wall_neighbours.hpp"
 #include "dem/parallel/decomposition.hpp"
@@ -159,6 +160,18 @@ class Simulation {
   GlobalId next_id() const { return next_id_; }
   GlobalId& next_id() { return next_id_; }
 
+  // Snapshot fields beyond the particle state, at the end of the last step (or of
+  // initialise()), for the fields of `fields` (others stay empty). force and torque: the
+  // totals the next half kick uses, the implicit drag K (u - v) included at the present v;
+  // fluid_force: the force terms' part of it (needs record_fluid_force() on for the step
+  // that computed the forces; zero without force terms); coordination and overlap_max:
+  // one pass over the touching contacts (overlap > 0) of the step's lists and walls.
+  // Not collective.
+  SnapshotExtras snapshot_extras(SnapshotFieldSet fields) const;
+  // Keeps the force terms' explicit part of each particle's force in the force evaluations
+  // that follow (one copy of the forces per evaluation), for snapshot_extras' fluid_force.
+  void record_fluid_force(bool on) { record_fluid_ = on; }
+
   // Largest over mean particle count per rank (1 = perfectly balanced). Collective.
   double load_imbalance() const;
 
@@ -262,6 +275,10 @@ class Simulation {
   std::vector<TermLimit> force_limits_;
   std::vector<std::string> force_limit_notes_;
   Counters counters_;
+  // record_fluid_force(): the force terms' explicit force on each particle, as of the last
+  // force evaluation that recorded it.
+  bool record_fluid_ = false;
+  std::vector<Vec3> fluid_explicit_;
   TimeStepReport report_;
   std::vector<CheckpointSpring> restored_springs_;  // from restore(), until initialise()
   // The checkpoint's implicit drag by global id (K, u), until initialise().

@@ -297,8 +297,9 @@ std::string outside_domain_reason(const Domain& d, const Vec3& x, double r) {
 }
 
 // The columns a particle file may have; x, y, z and radius are required, vx, vy, vz
-// come together.
-const std::vector<std::string> kCsvColumns = {"x", "y", "z", "radius", "vx", "vy", "vz", "material"};
+// come together, and so do wx, wy, wz.
+const std::vector<std::string> kCsvColumns = {"x",  "y",  "z",  "radius", "vx",      "vy",
+                                              "vz", "wx", "wy", "wz",     "material"};
 
 void read_csv(const Scene& scene, const WallSet* walls, const Insertion& ins, Particles& p,
               GlobalId& next_id, OverlapGrid& grid) {
@@ -314,7 +315,8 @@ void read_csv(const Scene& scene, const WallSet* walls, const Insertion& ins, Pa
     throw InsertionError(where + ": error: " + what + " (particle file of the insertion at " +
                          ins.source + ")");
   };
-  const std::string allowed = "columns: x,y,z,radius (required), vx,vy,vz, material (optional)";
+  const std::string allowed =
+      "columns: x,y,z,radius (required), vx,vy,vz, wx,wy,wz, material (optional)";
   std::string line;
   long lineno = 0, header_line = 0;
   std::vector<std::string> header;
@@ -343,6 +345,11 @@ void read_csv(const Scene& scene, const WallSet* walls, const Insertion& ins, Pa
     fail(header_line, "the header has only " + std::to_string(velocity_columns) +
                           " of the velocity columns vx,vy,vz; give all three or none");
   const bool has_v = velocity_columns == 3;
+  const int spin_columns = static_cast<int>(col.count("wx") + col.count("wy") + col.count("wz"));
+  if (spin_columns != 0 && spin_columns != 3)
+    fail(header_line, "the header has only " + std::to_string(spin_columns) +
+                          " of the angular velocity columns wx,wy,wz; give all three or none");
+  const bool has_w = spin_columns == 3;
   long particles = 0;
   while (std::getline(in, line)) {
     ++lineno;
@@ -364,6 +371,7 @@ void read_csv(const Scene& scene, const WallSet* walls, const Insertion& ins, Pa
     const double r = number("radius");
     if (r <= 0) fail(lineno, "radius must be > 0, got " + cells[col["radius"]]);
     const Vec3 v = has_v ? Vec3(number("vx"), number("vy"), number("vz")) : ins.velocity;
+    const Vec3 w = has_w ? Vec3(number("wx"), number("wy"), number("wz")) : Vec3::Zero();
     int mat = ins.material;
     if (col.count("material")) {
       const std::string& name = cells[col["material"]];
@@ -386,7 +394,7 @@ void read_csv(const Scene& scene, const WallSet* walls, const Insertion& ins, Pa
                        " with radius " + format_number(grid.radius(k)) +
                        "; particles must not overlap at insertion (move one or shrink it)");
     grid.add(x, r);
-    p.add(next_id++, x, v, Vec3::Zero(), r, mat, scene.materials[mat].density);
+    p.add(next_id++, x, v, w, r, mat, scene.materials[mat].density);
     ++particles;
   }
   if (particles == 0)

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <stdexcept>
 #include <string_view>
 #include <utility>
 
@@ -212,8 +213,12 @@ std::string six_digits(std::size_t index) {
 
 }  // namespace
 
-SnapshotWriter::SnapshotWriter(MPI_Comm comm, std::string directory, std::string basename)
-    : comm_(comm), directory_(std::move(directory)), basename_(std::move(basename)) {
+SnapshotWriter::SnapshotWriter(MPI_Comm comm, std::string directory, std::string basename,
+                               SnapshotFieldSet fields)
+    : comm_(comm),
+      directory_(std::move(directory)),
+      basename_(std::move(basename)),
+      fields_(fields | snapshot_required_fields) {
   MPI_Comm_rank(comm_, &rank_);
   MPI_Comm_size(comm_, &size_);
 }
@@ -237,7 +242,11 @@ std::size_t SnapshotWriter::continue_series(long up_to_step) {
     if (!read("time", H5T_NATIVE_DOUBLE, &t) || !read("step", H5T_NATIVE_INT64, &s) ||
         !read("count", H5T_NATIVE_INT64, &n) || s > up_to_step)
       break;
-    entries_.push_back({file_name, t, static_cast<long>(s), static_cast<long>(n)});
+    SnapshotFieldSet held = 0;
+    for (std::size_t k = 0; k < snapshot_fields.size(); ++k)
+      if (H5Lexists(file.get(), snapshot_fields[k].name, H5P_DEFAULT) > 0)
+        held |= SnapshotFieldSet{1} << k;
+    entries_.push_back({file_name, t, static_cast<long>(s), static_cast<long>(n), held});
   }
   H5Eclear2(H5E_DEFAULT);
   return entries_.size();
@@ -247,7 +256,20 @@ std::string SnapshotWriter::index_path() const {
   return (std::filesystem::path(directory_) / (basename_ + ".xdmf")).string();
 }
 
-std::string SnapshotWriter::write(const Particles& p, double time, long step) {
+std::string SnapshotWriter::write(const Particles& p, double time, long step,
+                                  const SnapshotExtras& extras) {
+  const auto wants = [&](const char* name) { return (fields_ & snapshot_field_bit(name)) != 0; };
+  const auto check_size = [&](const char* name, std::size_t n) {
+    if (wants(name) && n != p.size())
+      throw std::logic_error(std::string("SnapshotWriter::write: the extra field '") + name +
+                             "' has " + std::to_string(n) + " values for " +
+                             std::to_string(p.size()) + " particles");
+  };
+  check_size("force", extras.force.size());
+  check_size("torque", extras.torque.size());
+  check_size("coordination", extras.coordination.size());
+  check_size("fluid_force", extras.fluid_force.size());
+  check_size("overlap_max", extras.overlap_max.size());
   const std::string file_name = basename_ + "_" + six_digits(entries_.size()) + ".h5";
   const std::string path = (std::filesystem::path(directory_) / file_name).string();
   // Written under a temporary name and renamed once closed: a run killed mid-write never
@@ -273,9 +295,12 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step) {
   // Data plus HDF5's metadata, about 3 kB per checksummed dataset (measured: 4000 particles
   // take 454 040 bytes, 432 000 of them data).
   std::uintmax_t bytes_per_particle = 0;
-  for (const SnapshotField& f : snapshot_fields)
+  for (std::size_t k = 0; k < snapshot_fields.size(); ++k) {
+    const SnapshotField& f = snapshot_fields[k];
+    if (!(fields_ & (SnapshotFieldSet{1} << k))) continue;
     bytes_per_particle +=
         static_cast<std::uintmax_t>(f.components) * (f.type == SnapshotField::Type::Int32 ? 4 : 8);
+  }
   Agreement agreement(comm_, rank_, size_, path,
                       bytes_per_particle * static_cast<std::uintmax_t>(total) + 32768);
   try {
@@ -305,18 +330,28 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step) {
       return a.empty() ? nullptr : a.front().data();
     };
     write_dataset(out, agreement, field("position"), slice, vectors(p.x));
-    write_dataset(out, agreement, field("velocity"), slice, vectors(p.v));
-    write_dataset(out, agreement, field("angular_velocity"), slice, vectors(p.omega));
-    write_dataset(out, agreement, field("radius"), slice, p.radius.data());
-    {
+    // Every rank holds the same set, so all take part in the same collective writes.
+    const auto optional = [&](const char* name, const void* data) {
+      if (wants(name)) write_dataset(out, agreement, field(name), slice, data);
+    };
+    optional("velocity", vectors(p.v));
+    optional("angular_velocity", vectors(p.omega));
+    optional("radius", p.radius.data());
+    if (wants("diameter")) {
       // Not kept between snapshots: it would add 8 bytes per particle to the run's peak.
       std::vector<double> diameter(p.size());
       for (std::size_t i = 0; i < p.size(); ++i) diameter[i] = 2.0 * p.radius[i];
       write_dataset(out, agreement, field("diameter"), slice, diameter.data());
     }
-    write_dataset(out, agreement, field("mass"), slice, p.mass.data());
-    write_dataset(out, agreement, field("material"), slice, p.material.data());
-    static_assert(snapshot_fields.size() == 8, "a new snapshot field needs its write above");
+    optional("mass", p.mass.data());
+    optional("material", p.material.data());
+    optional("force", vectors(extras.force));
+    optional("torque", vectors(extras.torque));
+    static_assert(sizeof(int) == 4, "coordination is written as int32");
+    optional("coordination", extras.coordination.data());
+    optional("fluid_force", vectors(extras.fluid_force));
+    optional("overlap_max", extras.overlap_max.data());
+    static_assert(snapshot_fields.size() == 13, "a new snapshot field needs its write above");
 
     const HdfTypes f64 = hdf_types(SnapshotField::Type::Float64);
     const HdfTypes i64 = hdf_types(SnapshotField::Type::Int64);
@@ -336,7 +371,7 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step) {
     throw;
   }
 
-  entries_.push_back({file_name, t, static_cast<long>(s), static_cast<long>(total)});
+  entries_.push_back({file_name, t, static_cast<long>(s), static_cast<long>(total), fields_});
   std::string index_error;
   if (rank_ == 0) {
     try {

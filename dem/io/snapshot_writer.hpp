@@ -6,6 +6,8 @@
 // File layout (see snapshot_fields in xdmf_index.hpp), N = global particle count:
 //   /id (int64, N)  /position, /velocity, /angular_velocity (double, N x 3)
 //   /radius, /diameter, /mass (double, N)  /material (int32, N)
+//   on request (the writer's field set): /force, /torque, /fluid_force (double, N x 3),
+//   /coordination (int32, N), /overlap_max (double, N)
 //   each dataset is chunked with a Fletcher32 checksum (hdf5_checksum.hpp) and has a string
 //   attribute "units"; the root group has the attributes
 //   time (double, s), step (int64), count (int64, = N) and grainflow_version (string).
@@ -20,18 +22,33 @@
 
 namespace grainflow {
 
+// The fields of a snapshot that are not particle state, one value per local particle, in the
+// particles' order (Simulation::snapshot_extras); a field the writer does not write may be
+// left empty.
+struct SnapshotExtras {
+  std::vector<Vec3> force;          // total force of the step's end [N]
+  std::vector<Vec3> torque;         // total torque of the step's end [N m]
+  std::vector<int> coordination;    // touching contacts (particles and walls)
+  std::vector<Vec3> fluid_force;    // the fluid's force [N] (zero without fluid)
+  std::vector<double> overlap_max;  // largest overlap / smaller radius of its contacts
+};
+
 class SnapshotWriter {
  public:
   // `directory` must exist (prepare_output_directory). Files are named
   // <directory>/<basename>_<6-digit index>.h5 and the index <directory>/<basename>.xdmf.
-  SnapshotWriter(MPI_Comm comm, std::string directory, std::string basename = "particles");
+  // `fields`: the datasets each file holds (id and position always).
+  SnapshotWriter(MPI_Comm comm, std::string directory, std::string basename = "particles",
+                 SnapshotFieldSet fields = snapshot_default_fields);
 
   // Collective over the communicator: every rank calls it with its own particles (possibly
   // none) and the same time and step. Writes the next snapshot file (under a temporary name,
   // renamed when complete), then rewrites the XDMF index atomically to list every snapshot
   // written so far. Returns the snapshot's path. On any failure every rank throws the same
   // OutputError (naming the file, the failing operation, the HDF5/OS reason and the rank).
-  std::string write(const Particles& p, double time, long step);
+  // `extras` must hold every field of the set beyond the default ones, sized p.size()
+  // (std::logic_error otherwise).
+  std::string write(const Particles& p, double time, long step, const SnapshotExtras& extras = {});
 
   // Continues an existing series (a restarted run): takes the snapshots already in the
   // directory, in index order, up to the first one missing, unreadable or past `up_to_step`,
@@ -41,6 +58,7 @@ class SnapshotWriter {
 
   std::size_t snapshots_written() const { return entries_.size(); }
   std::string index_path() const;
+  SnapshotFieldSet fields() const { return fields_; }
 
  private:
   MPI_Comm comm_;
@@ -48,6 +66,7 @@ class SnapshotWriter {
   int size_ = 1;
   std::string directory_;
   std::string basename_;
+  SnapshotFieldSet fields_;
   std::vector<XdmfEntry> entries_;
 };
 

@@ -102,8 +102,10 @@ std::string render_xdmf(const std::vector<XdmfEntry>& entries, const std::string
       data_item(out, e, f, "          ");
       out += "        </Geometry>\n";
     }
-    for (const SnapshotField& f : snapshot_fields) {
+    for (std::size_t k = 0; k < snapshot_fields.size(); ++k) {
+      const SnapshotField& f = snapshot_fields[k];
       if (std::string_view(f.name) == snapshot_geometry_field) continue;
+      if (!(e.fields & (SnapshotFieldSet{1} << k))) continue;
       out += "        <Attribute Name=\"" + std::string(f.name) + "\" AttributeType=\"" +
              (f.components == 1 ? "Scalar" : "Vector") + "\" Center=\"Node\">\n";
       data_item(out, e, f, "          ");

@@ -5,7 +5,10 @@
 // Polyvertex topology without a connectivity DataItem gets the default connectivity 0..N-1
 // (Xdmf2 XdmfTopology::Update), i.e. one vertex cell per particle.
 #include <array>
+#include <cstddef>
+#include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace grainflow {
@@ -20,7 +23,9 @@ struct SnapshotField {
   const char* units;  // stored as the dataset's "units" attribute
 };
 
-inline constexpr std::array<SnapshotField, 8> snapshot_fields{{
+// The first eight are the default set; the others are written when the scene's
+// `output.fields` asks for them (docs/scene-reference.md).
+inline constexpr std::array<SnapshotField, 13> snapshot_fields{{
     {"id", 1, SnapshotField::Type::Int64, "1"},
     {"position", 3, SnapshotField::Type::Float64, "m"},
     {"velocity", 3, SnapshotField::Type::Float64, "m/s"},
@@ -29,7 +34,28 @@ inline constexpr std::array<SnapshotField, 8> snapshot_fields{{
     {"diameter", 1, SnapshotField::Type::Float64, "m"},
     {"mass", 1, SnapshotField::Type::Float64, "kg"},
     {"material", 1, SnapshotField::Type::Int32, "1"},
+    {"force", 3, SnapshotField::Type::Float64, "N"},
+    {"torque", 3, SnapshotField::Type::Float64, "N m"},
+    {"coordination", 1, SnapshotField::Type::Int32, "1"},
+    {"fluid_force", 3, SnapshotField::Type::Float64, "N"},
+    {"overlap_max", 1, SnapshotField::Type::Float64, "1"},
 }};
+
+// A set of snapshot fields: bit k stands for snapshot_fields[k].
+using SnapshotFieldSet = std::uint32_t;
+
+// The bit of the field called `name`, or 0 when no field has that name.
+constexpr SnapshotFieldSet snapshot_field_bit(std::string_view name) {
+  for (std::size_t k = 0; k < snapshot_fields.size(); ++k)
+    if (name == snapshot_fields[k].name) return SnapshotFieldSet{1} << k;
+  return 0;
+}
+
+// What every snapshot holds: id and position (the XDMF geometry needs them).
+inline constexpr SnapshotFieldSet snapshot_required_fields =
+    snapshot_field_bit("id") | snapshot_field_bit("position");
+// The set written when the scene does not give `output.fields`.
+inline constexpr SnapshotFieldSet snapshot_default_fields = (SnapshotFieldSet{1} << 8) - 1;
 
 // The field XDMF uses as the points' coordinates; every other field becomes an Attribute.
 inline constexpr const char* snapshot_geometry_field = "position";
@@ -39,10 +65,11 @@ struct XdmfEntry {
   double time;       // [s]
   long step;
   long count;  // global number of particles in the file
+  SnapshotFieldSet fields = snapshot_default_fields;  // the datasets the file holds
 };
 
 // The complete index for `entries` (in the order given), as one Temporal Collection named
-// `series_name` of Uniform Polyvertex grids.
+// `series_name` of Uniform Polyvertex grids; each grid lists the fields its file holds.
 std::string render_xdmf(const std::vector<XdmfEntry>& entries, const std::string& series_name);
 
 // Replaces `path` by `content` atomically: writes `path`.tmp in the same directory, flushes it

@@ -3,6 +3,7 @@
 // Plain data; the parser (scene_parser.hpp) guarantees every invariant documented
 // here, so the engine never re-validates.
 #include <array>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <utility>
@@ -163,7 +164,7 @@ struct Insertion {
   int material = 0;
   Vec3 velocity = Vec3::Zero();
   unsigned seed = 1;
-  // csv: columns x,y,z,radius and optionally vx,vy,vz,material (material by name)
+  // csv: columns x,y,z,radius and optionally vx,vy,vz, wx,wy,wz, material (material by name)
   std::string csv_file;  // resolved relative to the scene file's folder
   std::string source;    // "file:line" of this entry, for messages
 };
@@ -178,6 +179,12 @@ struct OutputSettings {
   // The keys the scene gives, with "file:line" of each (grainFoam
   // honours some and refuses the others, naming where they are).
   std::vector<std::pair<std::string, std::string>> given;
+  // The snapshot datasets to write, a SnapshotFieldSet (dem/io/xdmf_index.hpp): bit k for
+  // snapshot_fields[k]; id and position always. Default: the first eight fields.
+  std::uint32_t fields = (std::uint32_t{1} << 8) - 1;
+  // Snapshots only at times in [start, stop] (simulated seconds); start < stop.
+  std::optional<double> start;
+  std::optional<double> stop;
 };
 
 struct NeighbourSettings {

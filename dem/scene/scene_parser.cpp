@@ -31,6 +31,7 @@
 #include <utility>
 #include <vector>
 
+#include "dem/io/xdmf_index.hpp"
 #include "dem/scene/fluid_section.hpp"
 #include "dem/scene/yaml_reader.hpp"
 
@@ -644,9 +645,9 @@ std::vector<Insertion> parse_insertions(const Field& f, const Scene& scene) {
   return out;
 }
 
-OutputSettings parse_output(const Field& f) {
+OutputSettings parse_output(const Field& f, const TimeSettings& time) {
   const Map m = f.map({"directory", "snapshot_interval", "log_interval", "progress",
-                       "checkpoint_interval", "checkpoint_keep"});
+                       "checkpoint_interval", "checkpoint_keep", "fields", "start", "stop"});
   OutputSettings o;
   for (const char* key : {"directory", "snapshot_interval", "log_interval", "progress",
                           "checkpoint_interval", "checkpoint_keep"})
@@ -659,6 +660,33 @@ OutputSettings parse_output(const Field& f) {
   o.checkpoint_interval = m.maybe_number("checkpoint_interval", kPositive);
   if (const auto k = m.find("checkpoint_keep"))
     o.checkpoint_keep = static_cast<int>(k->integer(Range{1, 1000, true, true}));
+  if (const auto fields = m.find("fields")) {
+    std::vector<std::string> names;
+    for (const SnapshotField& s : snapshot_fields) names.emplace_back(s.name);
+    o.fields = snapshot_required_fields;
+    for (const Field& item : fields->non_empty_items("list the snapshot fields to write, e.g. "
+                                                     "[velocity, radius, force]; allowed: " +
+                                                     join(names))) {
+      if (!item.node().IsScalar())
+        item.fail("expected a field name, got " + item.got() + "; allowed: " + join(names));
+      const std::string name = item.node().Scalar();
+      const SnapshotFieldSet bit = snapshot_field_bit(name);
+      if (bit == 0)
+        item.fail("unknown snapshot field '" + name + "'; allowed: " + join(names) +
+                  suggestion(name, names));
+      o.fields |= bit;
+    }
+  }
+  o.start = m.maybe_number("start", kNonNegative);
+  o.stop = m.maybe_number("stop", kPositive);
+  if (o.start && o.stop && !(*o.start < *o.stop))
+    m.get("stop").fail("output.stop (" + format_number(*o.stop) +
+                       " s) must be after output.start (" + format_number(*o.start) +
+                       " s); snapshots are written at times in [start, stop]");
+  if (o.start && *o.start > time.end)
+    m.get("start").fail("output.start (" + format_number(*o.start) +
+                        " s) is after time.end (" + format_number(time.end) +
+                        " s): no snapshot would be written; give a start <= time.end");
   return o;
 }
 
@@ -717,7 +745,7 @@ Scene build_scene(const Field& root) {
   if (const auto n = top.find("neighbour")) s.neighbour = parse_neighbour(*n);
   if (const auto w = top.find("walls")) s.walls = parse_walls(*w, s.materials);
   if (const auto i = top.find("insert")) s.insertions = parse_insertions(*i, s);
-  if (const auto o = top.find("output")) s.output = parse_output(*o);
+  if (const auto o = top.find("output")) s.output = parse_output(*o, s.time);
   if (const auto p = top.find("parallel")) s.parallel = parse_parallel(*p);
   if (const auto f = top.find("fluid")) s.fluid = parse_fluid_section(*f, s.gravity);
   s.contacts_possible = contacts_possible(s);

@@ -14,7 +14,8 @@ snapshots against references that do not come from the coupling itself:
   exchange_balance      Newton's third law: the fluid's exchange source is minus the sum
                         of the fluid forces on the particles;
   neutrally_buoyant     closed form: a particle as dense as the fluid, in fluid at rest,
-                        feels no net force and stays where it is;
+                        feels no net force and stays where it is; its snapshot's
+                        fluid_force is the buoyancy -rho_f V g and its force zero;
   cellpoint_ranks       rank independence of cellPoint sampling: sinking beads next to the
                         processor patch end where the 1-rank run puts them, to round-off;
   refuses_bad_setup     three set-ups grainFoam must refuse, with the message it must give;
@@ -151,6 +152,17 @@ def exchange_balance(runner, checks):
 START = np.array([0.00437, 0.00512, 0.00463])
 
 
+# The snapshot fields the neutrally_buoyant cases ask for (output.fields).
+FIELDS_EDIT = ("particle.yaml", "forces: [drag, pressure_gradient, viscous, buoyancy]",
+               "forces: [drag, pressure_gradient, viscous, buoyancy]\n"
+               "output: {fields: [velocity, radius, force, fluid_force, coordination]}")
+G = 9.81
+
+
+def bead_weight(particles, density):
+    return density * 4 / 3 * math.pi * float(particles["radius"][0]) ** 3 * G
+
+
 def neutrally_buoyant(runner, checks):
     """One bead with the fluid's density, at rest in fluid at rest, model A and model B:
     gravity m g and buoyancy -rho_f V g cancel, drag, pressure-gradient and viscous forces
@@ -159,13 +171,26 @@ def neutrally_buoyant(runner, checks):
     round-off size (1e-16 of m g) would move it by ~1e-17 m (0 is measured: the forces
     cancel exactly and the fluid stays exactly at rest); a density 1 % off already moves
     it by 0.3 mm (the control below), a missing buoyancy or a hydrostatic pressure counted
-    twice by far more."""
+    twice by far more. The snapshot's fields (output.fields): fluid_force, the coupling's
+    force on the bead, is the buoyancy rho_f V g upward to round-off (1e-12 of it), force
+    (weight + fluid) is zero to 1e-12 m g, coordination 0. The snapshot window: model B's
+    scene has output.start 0.06 s, so of the write times 0.05 and 0.1 s (controlDict) only
+    0.1 s has a snapshot, while both have a checkpoint; model A's has both snapshots."""
     for model in ("A", "B"):
-        case = runner.fresh_case("neutral_particle", f"neutral_{model}",
-                                 [("particle.yaml", "model: B", f"model: {model}")])
+        edits = [("particle.yaml", "model: B", f"model: {model}"), FIELDS_EDIT]
+        if model == "B":
+            edits.append(("particle.yaml", "coordination]}", "coordination], start: 0.06}"))
+        case = runner.fresh_case("neutral_particle", f"neutral_{model}", edits)
         log = runner.solve(case, 1)
         checks.expect(f"VANS model {model}" in log, f"model {model}: the solver says VANS model {model}")
         snaps = snapshots(case)
+        times = [t for t, _ in snaps]
+        want = [0.1] if model == "B" else [0.05, 0.1]
+        checks.expect(len(times) == len(want) and np.allclose(times, want, rtol=0, atol=1e-9),
+                      f"model {model}: snapshots at {times} s, {want} s expected")
+        checkpoints = sorted(n for n in os.listdir(os.path.join(case, "particles"))
+                             if n.startswith("checkpoint_"))
+        checks.expect(len(checkpoints) == 2, f"model {model}: checkpoints {checkpoints}, 2 expected")
         t, last = snaps[-1] if snaps else (0.0, None)
         if last is None or len(last["id"]) != 1:
             checks.expect(False, f"model {model}: a snapshot with one particle")
@@ -175,16 +200,38 @@ def neutrally_buoyant(runner, checks):
         checks.expect(abs(t - 0.1) < 1e-9, f"model {model}: last snapshot at t = {t:g} s (0.1 s)")
         checks.expect(moved < 1e-9, f"model {model}: displacement {moved:.3g} m < 1e-9 m")
         checks.expect(speed < 1e-8, f"model {model}: speed {speed:.3g} m/s < 1e-8 m/s")
+        if "fluid_force" not in last:
+            checks.expect(False, f"model {model}: the snapshot lacks the fields of output.fields")
+            continue
+        weight = bead_weight(last, 1000)
+        fluid = last["fluid_force"][0]
+        checks.expect(np.max(np.abs(fluid - [0, 0, weight])) < 1e-12 * weight,
+                      f"model {model}: fluid_force {fluid} N = buoyancy (0, 0, {weight:.6g}) N")
+        total = last["force"][0]
+        checks.expect(np.max(np.abs(total)) < 1e-12 * weight,
+                      f"model {model}: force {total} N = 0 (weight + buoyancy)")
+        checks.expect(int(last["coordination"][0]) == 0, f"model {model}: coordination 0")
 
     # Control: 1 % denser, the bead must sink (so a bead that never moves fails the test).
     # Stokes: terminal speed 2/9 (rho_p - rho_f) g r^2 / mu = 7.8 mm/s, relaxation time
     # rho_p d^2 / (18 mu) = 0.081 s, so it sinks ~0.33 mm in 0.1 s; > 0.01 mm is asked.
+    # Its fluid_force is the buoyancy plus an upward drag that has not yet caught up with the
+    # net weight (still accelerating at 0.1 s, a relaxation time in), so
+    # rho_f V g < fluid_force_z < m g, and force = fluid_force + m g (to 1e-12 m g).
     case = runner.fresh_case("neutral_particle", "denser", [
-        ("particle.yaml", "poisson_ratio: 0.3, density: 1000", "poisson_ratio: 0.3, density: 1010")])
+        ("particle.yaml", "poisson_ratio: 0.3, density: 1000", "poisson_ratio: 0.3, density: 1010"),
+        FIELDS_EDIT])
     runner.solve(case, 1)
     t, last = snapshots(case)[-1]
     sunk = START[2] - last["position"][0][2]
     checks.expect(sunk > 1e-5, f"control, 1 % denser: sinks {sunk:.3g} m in {t:g} s (> 1e-5 m)")
+    weight, buoyancy = bead_weight(last, 1010), bead_weight(last, 1000)
+    fluid, total = last["fluid_force"][0], last["force"][0]
+    checks.expect(buoyancy < fluid[2] < weight,
+                  f"control: fluid_force_z {fluid[2]:.6g} N between the buoyancy {buoyancy:.6g} N "
+                  f"and the weight {weight:.6g} N")
+    checks.expect(np.max(np.abs(total - (fluid - [0, 0, weight]))) < 1e-12 * weight,
+                  f"control: force {total} N = fluid_force {fluid} N + weight")
 
 
 # --- coupling.cellpoint_ranks -----------------------------------------------------------

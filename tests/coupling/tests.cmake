@@ -13,7 +13,9 @@
 #       fluid's exchange source is minus the sum of the fluid forces on the particles
 #       (Newton's third law) to 1e-12 relative, 1 and 2 ranks.
 #   coupling.neutrally_buoyant     cases/neutral_particle: one bead as dense as water at rest
-#       in water at rest, models A and B: after 0.1 s it has moved < 1e-9 m, speed < 1e-8 m/s.
+#       in water at rest, models A and B: after 0.1 s it has moved < 1e-9 m, speed < 1e-8 m/s;
+#       its snapshot's fluid_force (output.fields) is the buoyancy and its force zero; with
+#       output.start between the two write times only the second has a snapshot.
 #   coupling.refuses_bad_setup     processor meshes that are not boxes (2 ranks), deltaT not
 #       a whole number of DEM steps, fluid.density != rho: each stops with its message.
 #   coupling.restart               cases/periodic_box under 10 g in a flow: 400 fluid steps vs

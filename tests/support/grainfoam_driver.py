@@ -138,14 +138,15 @@ def read_scalar_field(path):
 
 def snapshots(case, folder="particles"):
     """Particle snapshots of a case (in <case>/<folder>), sorted by time:
-    [(time, {dataset: array})]."""
+    [(time, {dataset: array})], every dataset a file holds (the scene's output.fields), rows
+    sorted by id."""
     folder = os.path.join(case, folder)
     out = []
     for name in sorted(os.listdir(folder)):
         if name.startswith("particles_") and name.endswith(".h5"):  # not the checkpoints
             with h5py.File(os.path.join(folder, name), "r") as f:
                 order = np.argsort(f["id"][:])
-                data = {k: f[k][:][order] for k in ("id", "position", "velocity", "radius")}
+                data = {k: f[k][:][order] for k in f.keys()}
                 out.append((float(f.attrs["time"]), data))
     return sorted(out, key=lambda s: s[0])
 

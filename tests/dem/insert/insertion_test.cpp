@@ -165,6 +165,17 @@ TEST(CsvInsertion, ReadsColumnsAndReportsBadRows) {
   ASSERT_EQ(p.size(), 2u);
   EXPECT_EQ(p.v[0], Vec3(1, 2, 3));
   EXPECT_EQ(p.radius[1], 0.002);
+  EXPECT_EQ(p.omega[0], Vec3::Zero());  // no wx,wy,wz columns: no spin
+
+  // wx,wy,wz give each particle its spin, read as written (rad/s).
+  const auto spinning = (dir / "spin.csv").string();
+  std::ofstream(spinning) << "x,y,z,radius,wz,wx,wy\n0,0,0,0.001,-30.5,10,20\n";
+  s.insertions[0].csv_file = spinning;
+  Particles ps;
+  insert_particles(s, ps, next);
+  ASSERT_EQ(ps.size(), 1u);
+  EXPECT_EQ(ps.omega[0], Vec3(10, 20, -30.5));
+  EXPECT_EQ(ps.v[0], Vec3::Zero());
 
   const auto bad = (dir / "bad.csv").string();
   std::ofstream(bad) << "x,y,z,radius\n0,0,0,0.001\n0.0015,0,0,0.001\n";
@@ -236,7 +247,7 @@ TEST_F(BrokenCsv, EmptyOrHeaderOnly) {
 TEST_F(BrokenCsv, MissingUnknownRepeatedAndPartialColumns) {
   EXPECT_THAT(error_of("x,y,radius\n0,0,0.1\n"),
               HasSubstr(at(1) + "header lacks column 'z'; columns: x,y,z,radius (required), "
-                                "vx,vy,vz, material (optional)"));
+                                "vx,vy,vz, wx,wy,wz, material (optional)"));
   // A misspelt column would otherwise be ignored with its values.
   EXPECT_THAT(error_of("x,y,z,radius,vX,vy,vz\n0,0,0,0.1,1,0,0\n"),
               HasSubstr(at(1) + "unknown column 'vX' in the header; allowed columns: x,y,z,radius"));
@@ -245,6 +256,9 @@ TEST_F(BrokenCsv, MissingUnknownRepeatedAndPartialColumns) {
   EXPECT_THAT(error_of("x,y,z,radius,vz\n0,0,0,0.1,-1\n"),
               HasSubstr(at(1) + "the header has only 1 of the velocity columns vx,vy,vz; give all "
                                 "three or none"));
+  EXPECT_THAT(error_of("x,y,z,radius,wx,wz\n0,0,0,0.1,1,2\n"),
+              HasSubstr(at(1) + "the header has only 2 of the angular velocity columns wx,wy,wz; "
+                                "give all three or none"));
   EXPECT_THAT(error_of("x,y,z,radius\n0,0,0,0.1\n0.5,0.5\n"),
               HasSubstr(at(3) + "expected 4 columns, found 2"));
   EXPECT_THAT(error_of("x,y,z,radius\n0,0,0,0.1,7\n"), HasSubstr(at(2) + "expected 4 columns, found 5"));

@@ -205,6 +205,72 @@ TEST(SnapshotWriter, RankZeroOwnsNoParticles) { write_and_check({0, 3}); }
 
 TEST(SnapshotWriter, NoParticlesAnywhereGivesEmptyDatasets) { write_and_check({0, 0}); }
 
+// Extra fields (output.fields) land in rank order like the state, with their stored types;
+// fields not asked for are absent. Reference: the same deterministic values (exact).
+void write_and_check_extras(const std::vector<int>& pattern) {
+  const std::vector<int> counts = counts_for_world(pattern);
+  const std::string dir = test_directory();
+  const int rank = world_rank();
+  const SnapshotFieldSet fields = snapshot_required_fields | snapshot_field_bit("force") |
+                                  snapshot_field_bit("coordination") |
+                                  snapshot_field_bit("overlap_max");
+  SnapshotWriter writer(MPI_COMM_WORLD, dir, "particles", fields);
+  const auto extras_of = [](int r, int n) {
+    SnapshotExtras e;
+    for (int i = 0; i < n; ++i) {
+      e.force.emplace_back(1.0 / (3 + i + 10 * r), -1e-300 * i, 7.0 * r);
+      e.coordination.push_back(i + 100 * r);
+      e.overlap_max.push_back(0.1 * i + r / 3.0);
+    }
+    return e;
+  };
+  const Particles p = make_particles(rank, counts[static_cast<std::size_t>(rank)]);
+  const std::string path =
+      writer.write(p, 0.25, 3, extras_of(rank, counts[static_cast<std::size_t>(rank)]));
+  if (rank == 0) {
+    SCOPED_TRACE(path);
+    std::vector<double> force, overlap;
+    std::vector<std::int32_t> coordination;
+    for (int r = 0; r < static_cast<int>(counts.size()); ++r) {
+      const SnapshotExtras e = extras_of(r, counts[static_cast<std::size_t>(r)]);
+      for (std::size_t i = 0; i < e.force.size(); ++i) {
+        append3(force, e.force[i]);
+        coordination.push_back(e.coordination[i]);
+        overlap.push_back(e.overlap_max[i]);
+      }
+    }
+    const hsize_t n = coordination.size();
+    const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    ASSERT_GE(file, 0);
+    std::vector<double> got_force, got_overlap;
+    std::vector<std::int32_t> got_coordination;
+    read_dataset(file, "/force", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {n, 3}, got_force);
+    read_dataset(file, "/coordination", H5T_STD_I32LE, H5T_NATIVE_INT32, {n}, got_coordination);
+    read_dataset(file, "/overlap_max", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {n}, got_overlap);
+    for (const char* absent : {"velocity", "torque", "fluid_force", "material"})
+      EXPECT_EQ(H5Lexists(file, absent, H5P_DEFAULT), 0) << absent;
+    EXPECT_GE(H5Fclose(file), 0);
+    EXPECT_EQ(got_force, force);
+    EXPECT_EQ(got_coordination, coordination);
+    EXPECT_EQ(got_overlap, overlap);
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+}
+
+TEST(SnapshotWriter, ExtraFieldsLandInRankOrder) { write_and_check_extras({3, 5}); }
+
+TEST(SnapshotWriter, ExtraFieldsWhenRankOneOwnsNoParticles) { write_and_check_extras({4, 0}); }
+
+// A field of the writer's set without its values is a programming error, found before any
+// collective call (on every rank alike, as every rank lacks it).
+TEST(SnapshotWriter, MissingExtraFieldIsALogicError) {
+  const std::string dir = test_directory();
+  SnapshotWriter writer(MPI_COMM_WORLD, dir, "particles",
+                        snapshot_default_fields | snapshot_field_bit("torque"));
+  EXPECT_THROW(writer.write(make_particles(world_rank(), 2), 0.0, 0), std::logic_error);
+  MPI_Barrier(MPI_COMM_WORLD);
+}
+
 // Runs python's strict XML parser on the index and prints one line per grid:
 //   <grid name> <time> <topology type> <elements> then "<tag>:<name> <dims> <type> <prec> <ref>"
 // for the geometry and every attribute.

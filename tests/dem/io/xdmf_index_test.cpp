@@ -55,7 +55,8 @@ TEST(XdmfIndex, TimeIsPrintedToFullPrecision) {
 }
 
 TEST(XdmfIndex, EveryFieldIsReferencedWithItsShape) {
-  const std::string xml = render_xdmf({{"s_000004.h5", 0.5, 50, 12}}, "s");
+  const SnapshotFieldSet all = (SnapshotFieldSet{1} << snapshot_fields.size()) - 1;
+  const std::string xml = render_xdmf({{"s_000004.h5", 0.5, 50, 12, all}}, "s");
   for (const SnapshotField& f : snapshot_fields) {
     const std::string dims = f.components == 1 ? "12" : "12 3";
     const std::string ref = std::string("Dimensions=\"") + dims + "\">s_000004.h5:/" + f.name + "<";
@@ -63,6 +64,22 @@ TEST(XdmfIndex, EveryFieldIsReferencedWithItsShape) {
   }
   EXPECT_NE(xml.find("<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"12\""),
             std::string::npos);
+}
+
+// Each grid lists the fields its file holds: the default set, or the set of output.fields.
+TEST(XdmfIndex, GridsListOnlyTheFieldsTheirFileHolds) {
+  const std::string plain = render_xdmf({{"p_000000.h5", 0.0, 0, 3}}, "p");
+  EXPECT_EQ(count(plain, "<Attribute "), 7u);  // the default eight, less the geometry
+  EXPECT_EQ(count(plain, ":/force<"), 0u);
+  const SnapshotFieldSet some =
+      snapshot_required_fields | snapshot_field_bit("force") | snapshot_field_bit("coordination");
+  const std::string xml = render_xdmf({{"p_000001.h5", 0.1, 1, 3, some}}, "p");
+  EXPECT_EQ(count(xml, "<Attribute "), 3u);  // id, force, coordination
+  EXPECT_EQ(count(xml, "<Attribute Name=\"force\" AttributeType=\"Vector\""), 1u);
+  EXPECT_EQ(count(xml, "<Attribute Name=\"coordination\" AttributeType=\"Scalar\""), 1u);
+  EXPECT_EQ(count(xml, "NumberType=\"Int\" Precision=\"4\" Dimensions=\"3\">p_000001.h5:/coordination<"),
+            1u);
+  EXPECT_EQ(count(xml, ":/velocity<"), 0u);
 }
 
 TEST(XdmfIndex, SpecialCharactersAreEscaped) {

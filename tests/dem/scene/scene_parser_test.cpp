@@ -2,6 +2,7 @@
 // mistake is reported once, as a SceneError whose file:line:column points at the
 // offending key or value and whose text says what was wrong and what is allowed.
 #include "dem/scene/scene_parser.hpp"
+#include "dem/io/xdmf_index.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -771,6 +772,44 @@ TEST(SceneParser, CheckpointSettings) {
               HasSubstr("expected a whole number, got '2.5'"));
   EXPECT_THAT(expect_at(error_of(kBase + "output:\n  checkpoint_every: 1\n"), 18, 3),
               HasSubstr("checkpoint_interval, checkpoint_keep"));
+}
+
+// output.fields / start / stop: the default is the eight state fields; a list selects
+// fields (id and position always); unknown names, an inverted window and a window after the
+// end are refused at the value, naming the key and what is allowed.
+TEST(SceneParser, SnapshotFieldsAndWindow) {
+  const Scene none = parse_scene(kBase, kLabel);
+  EXPECT_EQ(none.output.fields, snapshot_default_fields);
+  EXPECT_FALSE(none.output.start);
+  EXPECT_FALSE(none.output.stop);
+
+  const Scene s = parse_scene(
+      kBase + "output:\n  fields: [force, coordination]\n  start: 0.1\n  stop: 0.2\n", kLabel);
+  EXPECT_EQ(s.output.fields, snapshot_required_fields | snapshot_field_bit("force") |
+                                 snapshot_field_bit("coordination"));
+  EXPECT_EQ(s.output.start, 0.1);
+  EXPECT_EQ(s.output.stop, 0.2);
+
+  // Lines 17-18 are the output block appended to the 16-line base.
+  const std::string unknown =
+      expect_at(error_of(kBase + "output:\n  fields: [velocity, torqe]\n"), 18, 22);
+  EXPECT_THAT(unknown, HasSubstr("output.fields[1]: unknown snapshot field 'torqe'; allowed: id, "
+                                 "position, velocity, angular_velocity, radius, diameter, mass, "
+                                 "material, force, torque, coordination, fluid_force, "
+                                 "overlap_max (did you mean 'torque'?)"));
+  EXPECT_THAT(expect_at(error_of(kBase + "output:\n  fields: []\n"), 18, 11),
+              HasSubstr("output.fields: the list is empty"));
+  EXPECT_THAT(expect_at(error_of(kBase + "output:\n  fields: force\n"), 18, 11),
+              HasSubstr("output.fields: expected a list"));
+  EXPECT_THAT(
+      expect_at(error_of(kBase + "output:\n  start: 0.3\n  stop: 0.2\n"), 19, 9),
+      HasSubstr("output.stop: output.stop (0.2 s) must be after output.start (0.3 s)"));
+  EXPECT_THAT(expect_at(error_of(kBase + "output:\n  start: 0.7\n"), 18, 10),
+              HasSubstr("output.start (0.7 s) is after time.end (0.5 s)"));
+  EXPECT_THAT(expect_at(error_of(kBase + "output:\n  stop: later\n"), 18, 9),
+              HasSubstr("output.stop: expected a number, got 'later'"));
+  EXPECT_THAT(expect_at(error_of(kBase + "output:\n  start: -1\n"), 18, 10),
+              HasSubstr("output.start: value -1 is out of range; it must be >= 0"));
 }
 
 // parallel.reproducible: off by default, `true` selects canonical summation, and a value
