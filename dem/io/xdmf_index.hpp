@@ -66,7 +66,17 @@ struct XdmfEntry {
   long step;
   long count;  // global number of particles in the file
   SnapshotFieldSet fields = snapshot_default_fields;  // the datasets the file holds
+  // The contact network's global counts (contact_network.hpp): particle pairs and wall
+  // contacts; -1 when the file holds no network.
+  long contacts = -1;
+  long wall_contacts = -1;
 };
+
+// The contact network of one entry as XDMF grids, for a Spatial collection of the entry's
+// time: one Uniform Polyline grid per group (/contacts, /wall_contacts), one line of 2 nodes
+// per contact (its `ends`), every other dataset a Cell attribute. Each line of the result
+// starts with `indent`; empty when the entry holds no network.
+std::string render_contact_grids(const XdmfEntry& entry, const std::string& indent);
 
 // The complete index for `entries` (in the order given), as one Temporal Collection named
 // `series_name` of Uniform Polyvertex grids; each grid lists the fields its file holds.
