@@ -10,8 +10,8 @@
 //    mu F_n opposing the slip, acting on the plane at r - delta_w below the centre (Hertz
 //    1881; Cundall & Strack 1979). Tolerance 1e-9 relative: the overlaps come from
 //    coordinates of 1e-2 m, rounded at 2e-18 m, against overlaps of 1e-5 m.
-//  - A frictional bed in a one-way upward flow against a floor plane, a side plane and a side
-//    mesh (periodic in y): Newton's second law as the snapshot states it, for every particle,
+//  - A frictional bed poured through a one-way air flow onto a floor plane, against a side
+//    plane and a side mesh (periodic in y): Newton's second law as the snapshot states it, for every particle,
 //    sum of its pair forces (+ on the lower id, - on the other) + its wall forces + m g +
 //    fluid_force = force (the snapshot's total), to round-off; and 2 M + W = the sum of the
 //    coordination field (an independent count of the touching contacts).
@@ -257,6 +257,7 @@ TEST(ContactNetwork, NetworkAskedWithoutRecordingIsALogicError) {
       "time: {step: 1e-6, end: 1e-3}\n"
       "materials: [{name: glass, youngs_modulus: 5e6, poisson_ratio: 0.3, density: 2500}]\n"
       "interactions: [{materials: [glass, glass], restitution: 0.5, friction: 0.5}]\n"
+      "contact: {normal: hertz}\n"
       "output: {progress: false}\n",
       "off.yaml");
   EXPECT_FALSE(scene.output.contacts);  // the default
@@ -276,13 +277,13 @@ TEST(ContactNetwork, NetworkAskedWithoutRecordingIsALogicError) {
 
 // --- a bed against planes and a mesh, on 1 and 2 ranks, restarted ---------------------------
 
-// A vertical square mesh at x = 0.012 facing the bed, 2 x 2 squares of two triangles each
+// A vertical square mesh at x = 0.006 facing the bed, 2 x 2 squares of two triangles each
 // (shared edges and vertices), beyond the periodic y range.
 std::string write_side_mesh(const fs::path& dir) {
   std::vector<Vec3> v;
   std::vector<std::array<int, 3>> t;
   for (int j = 0; j <= 2; ++j)
-    for (int i = 0; i <= 2; ++i) v.emplace_back(0.012, -0.004 + 0.01 * i, 0.015 * j);
+    for (int i = 0; i <= 2; ++i) v.emplace_back(0.006, -0.002 + 0.005 * i, 0.015 * j);
   for (int j = 0; j < 2; ++j)
     for (int i = 0; i < 2; ++i) {
       const int a = 3 * j + i, b = a + 1, c = a + 4, d = a + 3;
@@ -296,9 +297,9 @@ std::string write_side_mesh(const fs::path& dir) {
 }
 
 std::string bed_scene(const std::string& mesh) {
-  return "domain: {min: [0, 0, 0], max: [0.012, 0.012, 0.03], periodic: [false, true, false]}\n"
+  return "domain: {min: [0, 0, 0], max: [0.006, 0.006, 0.03], periodic: [false, true, false]}\n"
          "gravity: [0, 0, -9.81]\n"
-         "time: {rayleigh_fraction: 0.15, end: 0.03}\n"
+         "time: {rayleigh_fraction: 0.15, end: 0.04}\n"
          "materials: [{name: glass, youngs_modulus: 5e6, poisson_ratio: 0.3, density: 2500}]\n"
          "interactions: [{materials: [glass, glass], restitution: 0.5, friction: 0.5}]\n"
          "contact: {normal: hertz, tangential: history}\n"
@@ -310,13 +311,13 @@ std::string bed_scene(const std::string& mesh) {
          ", material: glass}\n"
          "insert:\n"
          "  - type: fill\n"
-         "    region: {box: {min: [0.0006, 0, 0.0006], max: [0.0114, 0.012, 0.004]}}\n"
+         "    region: {box: {min: [0.0006, 0, 0.0006], max: [0.0054, 0.006, 0.008]}}\n"
          "    count: 150\n"
          "    material: glass\n"
          "    radius: {distribution: uniform, min: 4e-4, max: 6e-4}\n"
-         "fluid: {density: 1000, viscosity: 1e-3, velocity: [0, 0, 0.02], void_fraction: 1,\n"
+         "fluid: {density: 1.2, viscosity: 1.8e-5, velocity: [0.2, 0.1, 0.5], void_fraction: 1,\n"
          "        drag: schiller_naumann, model: B, forces: [drag, pressure_gradient, viscous]}\n"
-         "output: {progress: false, snapshot_interval: 0.0075, checkpoint_interval: 0.015,\n"
+         "output: {progress: false, snapshot_interval: 0.01, checkpoint_interval: 0.02,\n"
          "         fields: [mass, force, fluid_force, coordination], contacts: true}\n"
          "parallel: {reproducible: true}\n";
 }
@@ -330,16 +331,19 @@ struct NetworkForces {
 
 NetworkForces network_forces(const Snapshot& s) {
   NetworkForces out;
+  const auto add = [&](std::int64_t id, const Vec3& f) {
+    out.on.try_emplace(id, Vec3::Zero()).first->second += f;
+  };
   const auto& id = s.pairs.at("id");
   for (std::size_t k = 0; k < s.pair_count(); ++k) {
     const Vec3 f = row3(s.pairs.at("normal_force"), k) + row3(s.pairs.at("tangential_force"), k);
-    out.on[std::llround(id[2 * k])] += f;
-    out.on[std::llround(id[2 * k + 1])] -= f;
+    add(std::llround(id[2 * k]), f);
+    add(std::llround(id[2 * k + 1]), -f);
     out.largest = std::max(out.largest, f.norm());
   }
   for (std::size_t k = 0; k < s.wall_count(); ++k) {
     const Vec3 f = row3(s.walls.at("normal_force"), k) + row3(s.walls.at("tangential_force"), k);
-    out.on[std::llround(s.walls.at("id")[k])] += f;
+    add(std::llround(s.walls.at("id")[k]), f);
     out.largest = std::max(out.largest, f.norm());
   }
   return out;
@@ -413,7 +417,7 @@ TEST(ContactNetwork, BedBalancesForcesIsTheSameOnOneAndTwoRanksAndContinuesAfter
 
   const auto np1 = snapshots_in(dir / "np1"), np2 = snapshots_in(dir / "np2");
   const auto again = snapshots_in(dir / "restart");
-  ASSERT_EQ(np1.size(), 5u);  // t = 0, 0.0075, ..., 0.03
+  ASSERT_EQ(np1.size(), 5u);  // t = 0, 0.01, ..., 0.04
   ASSERT_EQ(np2.size(), np1.size());
   ASSERT_EQ(again.size(), np1.size());
   const Vec3 g(0, 0, -9.81);
@@ -453,7 +457,7 @@ TEST(ContactNetwork, BedBalancesForcesIsTheSameOnOneAndTwoRanksAndContinuesAfter
   EXPECT_GT(mesh_seen, 0);
   // 1 and 2 ranks: the same state (parallel.reproducible), so the same contacts and forces.
   for (std::size_t k = 0; k < np1.size(); ++k) expect_same_networks(np1[k], np2[k], 1e-13);
-  // The restart (from t = 0.015 s) writes the uninterrupted run's networks, bit for bit.
+  // The restart (from t = 0.02 s) writes the uninterrupted run's networks, bit for bit.
   for (std::size_t k = 3; k < np1.size(); ++k) expect_same_networks(np2[k], again[k], 0);
   // Its index lists the network of every snapshot, the earlier ones read back from their
   // files, each with its own count of lines.
