@@ -3,7 +3,6 @@
 #include <fcntl.h>
 #include <unistd.h>
 
-#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <cstdio>
@@ -92,9 +91,12 @@ void data_item(std::string& out, const std::string& file, long count, const Snap
 // One group of the contact network as a Polyline grid: the `ends` dataset is the geometry,
 // two nodes per contact, and lines need no connectivity DataItem (Xdmf2 gives a topology
 // without one the default connectivity 0..2M-1, i.e. nodes 2k and 2k+1 for line k).
+// An empty group has no grid: ParaView's XDMF reader fails on a geometry of no nodes (and
+// then leaves an empty block).
 template <std::size_t N>
 void contact_grid(std::string& out, const XdmfEntry& e, const char* group, long count,
                   const std::array<ContactField, N>& fields, const std::string& indent) {
+  if (count <= 0) return;
   const std::string in = indent + "  ", item = indent + "    ";
   out += indent + "<Grid Name=\"" + group + "\" GridType=\"Uniform\">\n";
   out += in + "<Topology TopologyType=\"Polyline\" NumberOfElements=\"" +
@@ -106,8 +108,23 @@ void contact_grid(std::string& out, const XdmfEntry& e, const char* group, long 
     out += in + "</Geometry>\n";
   }
   for (const ContactField& c : fields) {
-    // The line ends are the geometry; the pairs' ids (M x 2) have no XDMF attribute type.
-    if (c.rows != 1 || c.field.components == 2) continue;
+    if (c.rows != 1) continue;  // the line ends: the geometry
+    if (c.field.components == 2) {
+      // The pairs' ids (M x 2): one scalar per column, "id_a" and "id_b", each a HyperSlab
+      // (start, stride, count per dimension) of the dataset.
+      for (int column = 0; column < 2; ++column) {
+        out += in + "<Attribute Name=\"" + c.field.name + (column == 0 ? "_a" : "_b") +
+               "\" AttributeType=\"Scalar\" Center=\"Cell\">\n";
+        out += item + "<DataItem ItemType=\"HyperSlab\" Dimensions=\"" + std::to_string(count) +
+               " 1\" Type=\"HyperSlab\">\n";
+        out += item + "  <DataItem Dimensions=\"3 2\" Format=\"XML\">0 " +
+               std::to_string(column) + " 1 1 " + std::to_string(count) + " 1</DataItem>\n";
+        data_item(out, e.file, count, c.field, (item + "  ").c_str(), group);
+        out += item + "</DataItem>\n";
+        out += in + "</Attribute>\n";
+      }
+      continue;
+    }
     out += in + "<Attribute Name=\"" + c.field.name + "\" AttributeType=\"" +
            (c.field.components == 1 ? "Scalar" : "Vector") + "\" Center=\"Cell\">\n";
     data_item(out, e.file, count, c.field, item.c_str(), group);
@@ -122,8 +139,7 @@ std::string render_contact_grids(const XdmfEntry& e, const std::string& indent) 
   std::string out;
   if (e.contacts < 0) return out;
   contact_grid(out, e, pair_contact_group, e.contacts, pair_contact_fields, indent);
-  contact_grid(out, e, wall_contact_group, std::max(e.wall_contacts, 0L), wall_contact_fields,
-               indent);
+  contact_grid(out, e, wall_contact_group, e.wall_contacts, wall_contact_fields, indent);
   return out;
 }
 

@@ -74,8 +74,10 @@ struct XdmfEntry {
 
 // The contact network of one entry as XDMF grids, for a Spatial collection of the entry's
 // time: one Uniform Polyline grid per group (/contacts, /wall_contacts), one line of 2 nodes
-// per contact (its `ends`), every other dataset a Cell attribute. Each line of the result
-// starts with `indent`; empty when the entry holds no network.
+// per contact (its `ends`), every other dataset a Cell attribute (the pairs' ids as `id_a`
+// and `id_b`, HyperSlabs of the M x 2 dataset); a group without contacts
+// has no grid. Each line of the result starts with `indent`; empty when the entry holds no
+// network.
 std::string render_contact_grids(const XdmfEntry& entry, const std::string& indent);
 
 // The complete index for `entries` (in the order given), as one Temporal Collection named

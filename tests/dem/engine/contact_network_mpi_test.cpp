@@ -460,10 +460,9 @@ TEST(ContactNetwork, BedBalancesForcesIsTheSameOnOneAndTwoRanksAndContinuesAfter
   // The restart (from t = 0.02 s) writes the uninterrupted run's networks, bit for bit.
   for (std::size_t k = 3; k < np1.size(); ++k) expect_same_networks(np2[k], again[k], 0);
   // Its index lists the network of every snapshot, the earlier ones read back from their
-  // files, each with its own count of lines.
+  // files, each with its own count of lines (a group without contacts has no grid).
   const std::string xml = slurp(dir / "restart" / "particles.xdmf");
-  EXPECT_EQ(count(xml, "<Grid Name=\"contacts\""), np1.size());
-  EXPECT_EQ(count(xml, "<Grid Name=\"wall_contacts\""), np1.size());
+  EXPECT_EQ(count(xml, "CollectionType=\"Spatial\""), np1.size());
   std::vector<long> lines, expected;
   const std::string polyline = "TopologyType=\"Polyline\" NumberOfElements=\"";
   for (std::size_t at = xml.find(polyline); at != std::string::npos;
@@ -471,8 +470,8 @@ TEST(ContactNetwork, BedBalancesForcesIsTheSameOnOneAndTwoRanksAndContinuesAfter
     lines.push_back(std::stol(xml.substr(at + polyline.size())));
   for (const fs::path& file : again) {
     const Snapshot s = read_snapshot(file);
-    expected.push_back(static_cast<long>(s.pair_count()));
-    expected.push_back(static_cast<long>(s.wall_count()));
+    for (const std::size_t n : {s.pair_count(), s.wall_count()})
+      if (n > 0) expected.push_back(static_cast<long>(n));
   }
   EXPECT_EQ(lines, expected);
 }

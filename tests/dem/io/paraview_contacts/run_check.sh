@@ -13,4 +13,5 @@ fi
 rm -rf "$work"
 mkdir -p "$work"
 "$mpiexec" -np 2 --oversubscribe "$grain" run "$here/pile.yaml" --output "$work/out" --no-progress
-pvbatch "$here/contact_network_paraview.py" "$work/out" "${PICTURE:-}"
+# PICTURE=<file.png> also renders the last time (pvbatch cannot take an empty argument).
+pvbatch "$here/contact_network_paraview.py" "$work/out" ${PICTURE:+"$PICTURE"}
