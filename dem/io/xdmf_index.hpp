@@ -3,7 +3,9 @@
 // time series of particle point clouds, while the per-particle arrays stay in the HDF5 files.
 // Format: XDMF 2 (https://www.xdmf.org/index.php/Xdmf2_Model_and_Format_Archive). A
 // Polyvertex topology without a connectivity DataItem gets the default connectivity 0..N-1
-// (Xdmf2 XdmfTopology::Update), i.e. one vertex cell per particle.
+// (Xdmf2 XdmfTopology::Update), i.e. one vertex cell per particle. A snapshot with a contact
+// network (output.contacts) is a Spatial collection of that grid and the network's Polyline
+// grids (render_contact_grids).
 #include <array>
 #include <cstddef>
 #include <cstdint>

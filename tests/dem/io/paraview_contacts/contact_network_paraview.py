@@ -14,8 +14,8 @@ import sys
 import h5py
 import numpy as np
 from paraview import servermanager
-from paraview.simple import (ColorBy, ExtractBlock, GetActiveViewOrCreate, Render,
-                             ResetCamera, SaveScreenshot, Show, XDMFReader)
+from paraview.simple import (ColorBy, GetActiveViewOrCreate, Render, ResetCamera,
+                             SaveScreenshot, Show, XDMFReader)
 from vtkmodules.numpy_interface import dataset_adapter as dsa
 
 GROUPS = {"contacts": ["point", "normal_force", "tangential_force",
@@ -100,27 +100,25 @@ def main():
     print(f"contact_network_paraview: {len(times)} times, {lines_total} contact lines read "
           f"by ParaView's XDMF reader, equal to the files")
     if picture:
+        # The reader's blocks are named per time ("contacts[3]"), so the whole multiblock is
+        # shown: the lines coloured by their normal force, the beads (no such array) as grey
+        # points.
         view = GetActiveViewOrCreate("RenderView")
         view.ViewSize = [800, 600]
-        lines = ExtractBlock(Input=reader)
-        lines.Selectors = ["/Root/contacts"]
-        display = Show(lines, view)
+        view.ViewTime = times[-1]
+        reader.UpdatePipeline(times[-1])
+        display = Show(reader, view)
         ColorBy(display, ("CELLS", "normal_force_magnitude"))
         display.LineWidth = 3
-        display.RescaleTransferFunctionToDataRange(True)
+        display.PointSize = 4
+        display.RescaleTransferFunctionToDataRange(False, True)
         display.SetScalarBarVisibility(view, True)
-        beads = ExtractBlock(Input=reader)
-        beads.Selectors = ["/Root/particles"]
-        bead_display = Show(beads, view)
-        bead_display.Opacity = 0.2
-        view.ViewTime = times[-1]
-        view.CameraPosition = [0.03, -0.03, 0.02]
+        view.CameraPosition = [0.03, -0.03, 0.015]
         view.CameraFocalPoint = [0, 0, 0.003]
         view.CameraViewUp = [0, 0, 1]
         ResetCamera()
         Render()
         SaveScreenshot(picture, view)
         print(f"contact_network_paraview: wrote {picture}")
-
 
 main()
