@@ -2,10 +2,10 @@
 
 #include <hdf5.h>
 
+#include <array>
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
-#include <array>
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
@@ -163,8 +163,7 @@ struct OpenFile {
 // `group`: the group below the root holding the dataset (nullptr: the root).
 void write_dataset(const OpenFile& out, Agreement& agreement, const SnapshotField& f,
                    const Slice& slice, const void* data, const char* group = nullptr) {
-  const std::string dset_path =
-      (group ? std::string("/") + group : std::string()) + "/" + f.name;
+  const std::string dset_path = (group ? std::string("/") + group : std::string()) + "/" + f.name;
   const int rank = f.components == 1 ? 1 : 2;
   const hsize_t comps = static_cast<hsize_t>(f.components);
   const hsize_t file_dims[2] = {slice.total, comps};
@@ -211,10 +210,9 @@ void write_dataset(const OpenFile& out, Agreement& agreement, const SnapshotFiel
 // One group of the contact network (contact_network.hpp): `n_local` contacts of this rank,
 // `data[k]` the array of fields[k]. Collective; returns the global count.
 template <std::size_t N>
-std::int64_t write_contact_group(const OpenFile& out, Agreement& agreement, MPI_Comm comm,
-                                 int rank, const char* group,
-                                 const std::array<ContactField, N>& fields, std::size_t n_local,
-                                 const std::array<const void*, N>& data) {
+std::int64_t write_contact_group(const OpenFile& out, Agreement& agreement, MPI_Comm comm, int rank,
+                                 const char* group, const std::array<ContactField, N>& fields,
+                                 std::size_t n_local, const std::array<const void*, N>& data) {
   const std::int64_t n = static_cast<std::int64_t>(n_local);
   std::int64_t offset = 0, total = 0;
   MPI_Exscan(&n, &offset, 1, MPI_INT64_T, MPI_SUM, comm);
@@ -282,8 +280,7 @@ std::size_t SnapshotWriter::continue_series(long up_to_step) {
     const char* groups[2] = {pair_contact_group, wall_contact_group};
     for (int k = 0; k < 2; ++k) {
       if (H5Lexists(file.get(), groups[k], H5P_DEFAULT) <= 0) continue;
-      Hid attr(H5Aopen_by_name(file.get(), groups[k], "count", H5P_DEFAULT, H5P_DEFAULT),
-               H5Aclose);
+      Hid attr(H5Aopen_by_name(file.get(), groups[k], "count", H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
       if (!attr.valid() || H5Aread(attr.get(), H5T_NATIVE_INT64, &counts[k]) < 0) counts[k] = -1;
     }
     entries_.push_back({file_name, t, static_cast<long>(s), static_cast<long>(n), held,

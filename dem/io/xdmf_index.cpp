@@ -99,8 +99,8 @@ void contact_grid(std::string& out, const XdmfEntry& e, const char* group, long 
   if (count <= 0) return;
   const std::string in = indent + "  ", item = indent + "    ";
   out += indent + "<Grid Name=\"" + group + "\" GridType=\"Uniform\">\n";
-  out += in + "<Topology TopologyType=\"Polyline\" NumberOfElements=\"" +
-         std::to_string(count) + "\" NodesPerElement=\"2\"/>\n";
+  out += in + "<Topology TopologyType=\"Polyline\" NumberOfElements=\"" + std::to_string(count) +
+         "\" NodesPerElement=\"2\"/>\n";
   for (const ContactField& c : fields) {
     if (c.rows != 2) continue;
     out += in + "<Geometry GeometryType=\"XYZ\">\n";
@@ -117,8 +117,8 @@ void contact_grid(std::string& out, const XdmfEntry& e, const char* group, long 
                "\" AttributeType=\"Scalar\" Center=\"Cell\">\n";
         out += item + "<DataItem ItemType=\"HyperSlab\" Dimensions=\"" + std::to_string(count) +
                " 1\" Type=\"HyperSlab\">\n";
-        out += item + "  <DataItem Dimensions=\"3 2\" Format=\"XML\">0 " +
-               std::to_string(column) + " 1 1 " + std::to_string(count) + " 1</DataItem>\n";
+        out += item + "  <DataItem Dimensions=\"3 2\" Format=\"XML\">0 " + std::to_string(column) +
+               " 1 1 " + std::to_string(count) + " 1</DataItem>\n";
         data_item(out, e.file, count, c.field, (item + "  ").c_str(), group);
         out += item + "</DataItem>\n";
         out += in + "</Attribute>\n";

@@ -646,9 +646,9 @@ std::vector<Insertion> parse_insertions(const Field& f, const Scene& scene) {
 }
 
 OutputSettings parse_output(const Field& f, const TimeSettings& time) {
-  const Map m = f.map({"directory", "snapshot_interval", "log_interval", "progress",
-                       "checkpoint_interval", "checkpoint_keep", "fields", "start", "stop",
-                       "contacts"});
+  const Map m =
+      f.map({"directory", "snapshot_interval", "log_interval", "progress", "checkpoint_interval",
+             "checkpoint_keep", "fields", "start", "stop", "contacts"});
   OutputSettings o;
   for (const char* key : {"directory", "snapshot_interval", "log_interval", "progress",
                           "checkpoint_interval", "checkpoint_keep"})

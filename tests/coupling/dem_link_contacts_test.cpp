@@ -39,7 +39,9 @@ std::vector<double> read(hid_t file, const std::string& path) {
   return out;
 }
 
-Vec3 row(const std::vector<double>& a, std::size_t k) { return {a[3 * k], a[3 * k + 1], a[3 * k + 2]}; }
+Vec3 row(const std::vector<double>& a, std::size_t k) {
+  return {a[3 * k], a[3 * k + 1], a[3 * k + 2]};
+}
 
 TEST(DemLinkContacts, SnapshotsHoldTheNetworkOfTheLastSubStep) {
   const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "dem_link_contacts";

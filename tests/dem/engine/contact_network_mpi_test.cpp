@@ -11,9 +11,9 @@
 //    1881; Cundall & Strack 1979). Tolerance 1e-9 relative: the overlaps come from
 //    coordinates of 1e-2 m, rounded at 2e-18 m, against overlaps of 1e-5 m.
 //  - A frictional bed poured through a one-way air flow onto a floor plane, against a side
-//    plane and a side mesh (periodic in y): Newton's second law as the snapshot states it, for every particle,
-//    sum of its pair forces (+ on the lower id, - on the other) + its wall forces + m g +
-//    fluid_force = force (the snapshot's total), to round-off; and 2 M + W = the sum of the
+//    plane and a side mesh (periodic in y): Newton's second law as the snapshot states it, for
+//    every particle, sum of its pair forces (+ on the lower id, - on the other) + its wall forces +
+//    m g + fluid_force = force (the snapshot's total), to round-off; and 2 M + W = the sum of the
 //    coordination field (an independent count of the touching contacts).
 //  - The same bed on 1 and 2 ranks (parallel.reproducible: the same state on both): the same
 //    pairs by ids, none twice, and the same forces; a restart from the checkpoint continues
@@ -89,8 +89,7 @@ std::vector<double> read_doubles(hid_t file, const std::string& path) {
   out.resize(static_cast<std::size_t>(H5Sget_simple_extent_npoints(space)));
   H5Sclose(space);
   if (!out.empty()) {
-    EXPECT_GE(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()), 0)
-        << path;
+    EXPECT_GE(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()), 0) << path;
   }
   H5Dclose(d);
   return out;
@@ -125,7 +124,9 @@ struct Snapshot {
   }
 };
 
-Vec3 row3(const std::vector<double>& a, std::size_t k) { return {a[3 * k], a[3 * k + 1], a[3 * k + 2]}; }
+Vec3 row3(const std::vector<double>& a, std::size_t k) {
+  return {a[3 * k], a[3 * k + 1], a[3 * k + 2]};
+}
 
 Snapshot read_snapshot(const fs::path& path) {
   Snapshot s;
@@ -244,8 +245,9 @@ TEST(ContactNetwork, HertzPairAndWallContactGiveClosedFormForces) {
     EXPECT_EQ(count(xml, "CollectionType=\"Spatial\""), 1u);
     EXPECT_EQ(count(xml, "TopologyType=\"Polyline\" NumberOfElements=\"1\" NodesPerElement=\"2\""),
               2u);
-    EXPECT_EQ(count(xml, "<Attribute Name=\"normal_force_magnitude\" AttributeType=\"Scalar\" "
-                         "Center=\"Cell\">"),
+    EXPECT_EQ(count(xml,
+                    "<Attribute Name=\"normal_force_magnitude\" AttributeType=\"Scalar\" "
+                    "Center=\"Cell\">"),
               2u);
   }
   MPI_Barrier(MPI_COMM_WORLD);
@@ -440,7 +442,8 @@ TEST(ContactNetwork, BedBalancesForcesIsTheSameOnOneAndTwoRanksAndContinuesAfter
       // Round-off: ~10 contact forces summed in two orders, each split into parts within
       // an ulp: 1e-12 of the largest contact force is hundreds of ulps; the weight and the
       // fluid force add their own ulps.
-      const double tol = 1e-12 * net.largest + 1e-13 * mass[i] * g.norm() + 1e-13 * row3(fluid, i).norm();
+      const double tol =
+          1e-12 * net.largest + 1e-13 * mass[i] * g.norm() + 1e-13 * row3(fluid, i).norm();
       expect_vec_near(row3(force, i), contacts + mass[i] * g + row3(fluid, i), tol,
                       "balance of particle " + std::to_string(id));
       coordination += s.particles.at("coordination")[i];
