@@ -233,6 +233,7 @@ void DemLink::initialise() {
     Impl* self = &m;
     m.fluid->set_sampler([self](const Vec3&) { return self->to_sample(FluidAtParticle{}); });
     m.sim->record_fluid_force((m.scene.output.fields & snapshot_field_bit("fluid_force")) != 0);
+    m.sim->record_contacts(m.scene.output.contacts);
     m.sim->initialise();
     m.fluid->reset_late_samples();
   } catch (const std::exception& e) {
@@ -482,11 +483,14 @@ void DemLink::advance(int steps, const std::string& diagnostic_directory) {
   const FloatingPointTrapsOff traps_off;
   try {
     // A snapshot may follow this advance: the fluid's share of the last sub-step's forces is
-    // kept when the scene's output.fields asks for fluid_force.
+    // kept when the scene's output.fields asks for fluid_force, and that sub-step's contact
+    // network when output.contacts asks for it (one report pass per advance).
     const bool fluid_force =
         (impl_->scene.output.fields & snapshot_field_bit("fluid_force")) != 0;
+    const bool contacts = impl_->scene.output.contacts;
     for (int k = 0; k < steps; ++k) {
       sim.record_fluid_force(fluid_force && k == steps - 1);
+      sim.record_contacts(contacts && k == steps - 1);
       sim.step();
       guard_finite_after_step(sim, diagnostic_directory, impl_->dem_comm);
     }
@@ -526,8 +530,12 @@ void DemLink::write_snapshot(const std::string& directory, long step, long conti
       m.snapshot_directory = directory;
       if (continue_after >= 0) m.snapshots->continue_series(continue_after);
     }
+    // A restored run's first forces come from the checkpoint, without a network: a snapshot
+    // before the first advance has none.
+    const bool network = m.scene.output.contacts && sim.contact_network_recorded();
     m.snapshots->write(sim.particles(), sim.time(), step,
-                       sim.snapshot_extras(m.snapshots->fields()));
+                       sim.snapshot_extras(m.snapshots->fields()),
+                       network ? &sim.contact_network() : nullptr);
   } catch (const std::exception& e) {
     throw std::runtime_error(e.what());
   }

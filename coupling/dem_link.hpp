@@ -187,7 +187,9 @@ class DemLink {
   // After restore(), the first call continues the series there: snapshots with step <=
   // `continue_after` are kept, later ones (of the stopped run) are overwritten. The files hold
   // the scene's output.fields (fluid_force: the coupling's force on each particle at the end
-  // of the last advance); outside the scene's output.start / output.stop nothing is written.
+  // of the last advance) and, with output.contacts, the contact network of the last
+  // advance's last sub-step; outside the scene's output.start / output.stop nothing is
+  // written.
   void write_snapshot(const std::string& directory, long step, long continue_after = -1);
   // Writes the complete DEM state to <directory>/checkpoint_<DEM step>.h5 and deletes the
   // oldest beyond `keep` (after restore(), the directory's checkpoints up to the restored

@@ -65,6 +65,16 @@ struct ContactLaw {
     }
     return r;
   }
+
+  // The normal part of evaluate()'s force on i, as its component along g.n (the same
+  // operations, so the same value): for contact reports, which split the force.
+  template <class PC>
+  static double normal_force(const ContactGeometry& g, const PC& pc, const ContactConstants& cc) {
+    const SpringDashpot s = Normal::coefficients(pc, cc, g.r_star, g.m_star, g.overlap);
+    const double fn = s.kn * g.overlap - s.gn * dot(g.v_rel, g.n);
+    if constexpr (Cohesion::enabled) return fn - Cohesion::force(g, pc.cohesion_energy_density);
+    return fn;
+  }
 };
 
 }  // namespace grainflow

@@ -88,12 +88,11 @@ template <class V>
 [[gnu::always_inline]] inline V reduced_mass(const Body<V>& a, const Body<V>& b) {
   return a.m * b.m / (a.m + b.m);
 }
-template <class Law, class V, class PC>
-[[gnu::always_inline]] inline ContactResultT<V> pair_force(const ContactSweep& s, const V3<V>& d,
-                                                           const Body<V>& a, const Body<V>& b,
-                                                           V r_star, V m_star, const PC& pc,
-                                                           V3<V>& tangential, V3<V>& rolling,
-                                                           V& overlap) {
+// The geometry the law sees for the touching pair (a, b) with displacement d = x_a - x_b.
+template <class Law, class V>
+[[gnu::always_inline]] inline ContactGeometryT<V> pair_geometry(const V3<V>& d, const Body<V>& a,
+                                                                const Body<V>& b, V r_star,
+                                                                V m_star, V& overlap) {
   const V rs = a.r + b.r;
   const V dist = lane_sqrt(squared_norm(d));
   ContactGeometryT<V> g;
@@ -118,6 +117,15 @@ template <class Law, class V, class PC>
   if constexpr (Law::needs_roll_inertia)
     g.roll_inertia =
         1.0 / (1.0 / (a.inertia + a.m * a.r * a.r) + 1.0 / (b.inertia + b.m * b.r * b.r));
+  return g;
+}
+template <class Law, class V, class PC>
+[[gnu::always_inline]] inline ContactResultT<V> pair_force(const ContactSweep& s, const V3<V>& d,
+                                                           const Body<V>& a, const Body<V>& b,
+                                                           V r_star, V m_star, const PC& pc,
+                                                           V3<V>& tangential, V3<V>& rolling,
+                                                           V& overlap) {
+  const ContactGeometryT<V> g = pair_geometry<Law>(d, a, b, r_star, m_star, overlap);
   return Law::evaluate(g, pc, s.constants, tangential, rolling, s.dt);
 }
 
@@ -498,8 +506,133 @@ void sweep(ContactSweep& s) {
 }
 
 template <class Law>
+void report_contacts(const ContactSweep& s, ContactNetwork& out) {
+  out.clear();
+  const Particles& p = s.p;
+  const Ghosts& g = s.ghosts;
+  const Vec3 zero = Vec3::Zero();
+  PairContacts& pairs = out.pairs;
+  // A touching pair in canonical orientation (a the lower id, d = x_a - x_b) with copies of
+  // its springs.
+  const auto add_pair = [&](GlobalId ia, GlobalId ib, const Vec3& xa, const Vec3& d,
+                            const Body<double>& a, const Body<double>& b,
+                            const PairCoefficients& pc, Vec3 ht, Vec3 hr) {
+    double overlap = 0;
+    const ContactGeometry geo =
+        pair_geometry<Law>(d, a, b, reduced_radius(a, b), reduced_mass(a, b), overlap);
+    const ContactResult r = Law::evaluate(geo, pc, s.constants, ht, hr, s.dt);
+    const double fn = Law::normal_force(geo, pc, s.constants);
+    const Vec3 normal = fn * geo.n;
+    pairs.id.push_back({ia, ib});
+    pairs.ends.push_back(xa);
+    pairs.ends.push_back(xa - d);
+    pairs.point.push_back(xa - geo.arm_i * geo.n);
+    pairs.normal_force.push_back(normal);
+    pairs.tangential_force.push_back(r.force - normal);
+    pairs.normal_force_magnitude.push_back(std::abs(fn));
+    pairs.overlap.push_back(overlap);
+  };
+  const auto spring = [](const ListSprings& springs, int k) {
+    ContactHistory h;
+    if constexpr (Law::keeps_tangential) h.tangential = springs.tangential[k];
+    if constexpr (Law::keeps_rolling) h.rolling = springs.rolling[k];
+    return h;
+  };
+  const auto body = [&](std::size_t i) {
+    return Body<double>{p.v[i], p.omega[i], p.radius[i], p.mass[i], p.inertia[i]};
+  };
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    for (int k = s.local_list.offsets[i]; k < s.local_list.offsets[i + 1]; ++k) {
+      const std::size_t j = s.local_list.j[k];
+      if (apart(p.x[i] - p.x[j], p.radius[i] + p.radius[j])) continue;
+      const std::size_t a = p.id[i] < p.id[j] ? i : j, b = a == i ? j : i;
+      const ContactHistory h = spring(s.local_springs, k);
+      add_pair(p.id[a], p.id[b], p.x[a], Vec3(p.x[a] - p.x[b]), body(a), body(b),
+               s.table(p.material[a], p.material[b]), h.tangential, h.rolling);
+    }
+    for (int k = s.ghost_list.offsets[i]; k < s.ghost_list.offsets[i + 1]; ++k) {
+      const std::size_t q = s.ghost_list.j[k];
+      // The ghost's owner (or, for a periodic image of a local particle, the other entry)
+      // reports the pair when the ghost has the lower id.
+      if (!(p.id[i] < g.id[q])) continue;
+      const Vec3 d = (p.x[i] - g.x[q]) + (zero - g.shift[q]);
+      if (apart(d, p.radius[i] + g.radius[q])) continue;
+      const ContactHistory h = spring(s.ghost_springs, k);
+      add_pair(p.id[i], g.id[q], p.x[i], d, body(i),
+               Body<double>{g.v[q], g.omega[q], g.radius[q], g.mass[q], g.inertia[q]},
+               s.table(p.material[i], g.material[q]), h.tangential, h.rolling);
+    }
+  }
+  WallContacts& walls = out.walls;
+  const auto add_wall = [&](std::size_t i, int w, const WallTouch& t, int material,
+                            ContactHistory h) {
+    const ContactGeometry geo = wall_geometry<Law>(p, i, t);
+    const PairCoefficients& pc = s.table(p.material[i], material);
+    const ContactResult r = Law::evaluate(geo, pc, s.constants, h.tangential, h.rolling, s.dt);
+    const double fn = Law::normal_force(geo, pc, s.constants);
+    const Vec3 normal = fn * geo.n;
+    const Vec3 point = p.x[i] - geo.arm_i * geo.n;
+    walls.id.push_back(p.id[i]);
+    walls.wall.push_back(w);
+    walls.ends.push_back(p.x[i]);
+    walls.ends.push_back(point);
+    walls.point.push_back(point);
+    walls.normal_force.push_back(normal);
+    walls.tangential_force.push_back(r.force - normal);
+    walls.normal_force_magnitude.push_back(std::abs(fn));
+    walls.overlap.push_back(geo.overlap);
+  };
+  // The walls as wall_sweep() finds their contacts and springs.
+  for (std::size_t w = 0; w < s.walls.walls().size(); ++w) {
+    const WallSet::Entry& wall = s.walls.walls()[w];
+    const int index = static_cast<int>(w);
+    if (wall.kind == Wall::Kind::mesh) {
+      constexpr int kSlots = WallSet::kMeshSlots;
+      const TriangleMesh& mesh = s.walls.mesh(wall);
+      const bool moving = wall.pose.moving();
+      const bool conveyor = wall.surface_velocity.squaredNorm() > 0;
+      const Vec3 belt = wall.pose.direction_to_world(wall.surface_velocity);
+      MeshTouch touch[TriangleMesh::kMaxTouches];
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        const double r = p.radius[i];
+        const int n = mesh.touches(moving ? wall.pose.to_body(p.x[i]) : p.x[i], r, touch);
+        bool used[kSlots] = {};
+        for (int k = 0; k < n; ++k) {
+          const WallTouch t = mesh_wall_touch(wall, touch[k], p.x[i], r, moving, conveyor, belt);
+          ContactHistory h;
+          if constexpr (Law::has_history) {
+            const int best = mesh_slot(s.wall_history, wall.column, i, t.n, used);
+            if (best >= 0) {
+              used[best] = true;
+              h = s.wall_history[wall.column + 2 * best][i];
+            }
+          }
+          add_wall(i, index, t, wall.material, h);
+        }
+      }
+      continue;
+    }
+    const WallNeighbours::List& list = s.wall_neighbours.lists[w];
+    const std::vector<ContactHistory>& history = s.wall_history[wall.column];
+    const std::size_t n = list.all ? p.size() : list.i.size();
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::size_t i = list.all ? k : static_cast<std::size_t>(list.i[k]);
+      WallTouch t;
+      const bool touching = wall.kind == Wall::Kind::plane
+                                ? touch_plane(wall.plane, p.x[i], p.radius[i], t)
+                                : touch_cylinder(wall.cylinder, p.x[i], p.radius[i], t);
+      if (!touching) continue;
+      if (wall.pose.moving())
+        t.surface_velocity += wall.pose.velocity_at(p.x[i] - (p.radius[i] - t.overlap) * t.n);
+      add_wall(i, index, t, wall.material, Law::has_history ? history[k] : ContactHistory{});
+    }
+  }
+}
+
+template <class Law>
 SweepChoice choice(bool canonical) {
   return {canonical ? &sweep<Law, true> : &sweep<Law, false>,
+          &report_contacts<Law>,
           Law::has_history,
           Law::keeps_tangential,
           Law::keeps_rolling,

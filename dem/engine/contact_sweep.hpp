@@ -17,6 +17,7 @@
 #include "dem/contact/pair_coefficients.hpp"
 #include "dem/core/particles.hpp"
 #include "dem/engine/canonical_sum.hpp"
+#include "dem/io/contact_network.hpp"
 #include "dem/neighbour/verlet_list.hpp"
 #include "dem/neighbour/wall_neighbours.hpp"
 #include "dem/parallel/ghosts.hpp"
@@ -106,9 +107,18 @@ struct ContactSweep {
 };
 
 using SweepFunction = void (*)(ContactSweep&);
+// The contact network (scene key output.contacts) of the state the sweep is about to
+// evaluate: every touching contact the force sweep finds, with the force it will apply,
+// from the same inputs and law, but with copies of the springs, so nothing changes. Run
+// before the sweep, it gives the forces the sweep adds to the particles (to round-off).
+// Each contact is reported once over all ranks: a pair by the rank that owns its lower id
+// (a local-ghost pair whose ghost has the lower id is the other rank's), a wall contact by
+// the particle's rank. Replaces `out`'s contents.
+using ReportFunction = void (*)(const ContactSweep&, ContactNetwork&);
 
 struct SweepChoice {
   SweepFunction run;
+  ReportFunction report;  // for the same law
   bool has_history;       // pair/wall histories must be kept
   bool keeps_tangential;  // of which tangential springs
   bool keeps_rolling;     // and rolling springs (EPSD)

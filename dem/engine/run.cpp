@@ -159,6 +159,9 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   // fluid_force needs the force terms' share kept, at the steps that write a snapshot.
   const bool wants_fluid_force = (scene.output.fields & snapshot_field_bit("fluid_force")) != 0;
   sim.record_fluid_force(wants_fluid_force);  // the first forces (snapshot of step 0)
+  // output.contacts: the contact network of the force evaluations that end with a snapshot.
+  const bool wants_contacts = scene.output.contacts;
+  sim.record_contacts(wants_contacts);
   const long first_step = sim.counters().steps;  // 0, or the checkpoint's step
   if (scene.fluid)
     sim.add_force_term(make_fluid_forces(*scene.fluid, scene.gravity, scene.domain, comm));
@@ -244,7 +247,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   };
   auto write_snapshot = [&](double t, long k) {
     try {
-      snapshots.write(sim.particles(), t, k, sim.snapshot_extras(snapshots.fields()));
+      snapshots.write(sim.particles(), t, k, sim.snapshot_extras(snapshots.fields()),
+                      wants_contacts ? &sim.contact_network() : nullptr);
     } catch (const OutputError& e) {
       throw resumable(e);
     }
@@ -290,6 +294,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   for (long k = first_step + 1; k <= total_steps; ++k) {
     // The step adds dt to the time exactly so: whether it ends with a snapshot is known now.
     if (wants_fluid_force) sim.record_fluid_force(snapshot_due(sim.time() + dt, k));
+    if (wants_contacts) sim.record_contacts(snapshot_due(sim.time() + dt, k));
     sim.step();
     guard_finite_after_step(sim, dir, comm);
     particle_steps += static_cast<double>(sim.particles().size());

@@ -588,6 +588,7 @@ void Simulation::restore(const CheckpointData& checkpoint) {
   restored_springs_ = checkpoint.springs;
   restored_grid_ = checkpoint.grid;
   restored_ = true;
+  network_recorded_ = false;
 }
 
 void Simulation::write_checkpoint(const std::string& path) {
@@ -730,6 +731,14 @@ ContactGuards Simulation::compute_forces() {
       uniform_, 0,             0.0,              WorstContact{}, UnresolvedContact{}};
   // clang-format on
   s.canonical = &canonical_;
+  // Before the sweep: it reads the springs as the sweep will, and leaves them unchanged.
+  if (record_contacts_) {
+    sweep_.report(s, network_);
+    network_recorded_ = true;
+  } else if (network_recorded_) {
+    network_.clear();  // of another step: never to be read as this one's
+    network_recorded_ = false;
+  }
   sweep_.run(s);
   // The fastest local particle bounds both the steps-per-contact gate and the travel guard;
   // kick_and_drift() has found it (in the same order) unless a rebuild came since.
@@ -1352,6 +1361,14 @@ SnapshotExtras Simulation::snapshot_extras(SnapshotFieldSet fields) const {
     if (wants("overlap_max")) e.overlap_max = std::move(overlap);
   }
   return e;
+}
+
+const ContactNetwork& Simulation::contact_network() const {
+  if (!network_recorded_)
+    throw std::logic_error(
+        "Simulation::contact_network: the last force evaluation did not record the contacts "
+        "(record_contacts() off, or the forces were restored from a checkpoint)");
+  return network_;
 }
 
 GlobalState Simulation::global_state() const {

@@ -171,6 +171,17 @@ class Simulation {
   // Keeps the force terms' explicit part of each particle's force in the force evaluations
   // that follow (one copy of the forces per evaluation), for snapshot_extras' fluid_force.
   void record_fluid_force(bool on) { record_fluid_ = on; }
+  // Keeps the contact network (output.contacts) of the force evaluations that follow: one
+  // report pass over the contacts before each such evaluation's sweep (ReportFunction,
+  // contact_sweep.hpp); off, nothing is done. Turn it on for the steps that end with a
+  // snapshot.
+  void record_contacts(bool on) { record_contacts_ = on; }
+  // The contact network of the last force evaluation, recorded there (see record_contacts).
+  // Throws std::logic_error when that evaluation did not record it (off, or the forces
+  // came from a checkpoint). Not collective: this rank's contacts.
+  const ContactNetwork& contact_network() const;
+  // Whether contact_network() holds the last force evaluation's network.
+  bool contact_network_recorded() const { return network_recorded_; }
 
   // Largest over mean particle count per rank (1 = perfectly balanced). Collective.
   double load_imbalance() const;
@@ -279,6 +290,9 @@ class Simulation {
   // force evaluation that recorded it.
   bool record_fluid_ = false;
   std::vector<Vec3> fluid_explicit_;
+  bool record_contacts_ = false;   // record_contacts()
+  bool network_recorded_ = false;  // network_ is the last force evaluation's
+  ContactNetwork network_;
   TimeStepReport report_;
   std::vector<CheckpointSpring> restored_springs_;  // from restore(), until initialise()
   // The checkpoint's implicit drag by global id (K, u), until initialise().

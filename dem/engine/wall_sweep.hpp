@@ -15,11 +15,9 @@
 
 namespace grainflow {
 
-// Evaluates one particle-wall contact and adds its force and torque to particle i.
+// The geometry the law sees for particle i touching a wall as `t` describes.
 template <class Law>
-void apply_wall_contact(ContactSweep& s, std::size_t i, const WallTouch& t, int material,
-                        ContactHistory& h) {
-  Particles& p = s.p;
+inline ContactGeometry wall_geometry(const Particles& p, std::size_t i, const WallTouch& t) {
   ContactGeometry g;
   g.n = t.n;
   g.overlap = t.overlap;
@@ -39,6 +37,15 @@ void apply_wall_contact(ContactSweep& s, std::size_t i, const WallTouch& t, int 
   }
   if constexpr (Law::needs_roll_inertia)
     g.roll_inertia = p.inertia[i] + p.mass[i] * p.radius[i] * p.radius[i];
+  return g;
+}
+
+// Evaluates one particle-wall contact and adds its force and torque to particle i.
+template <class Law>
+void apply_wall_contact(ContactSweep& s, std::size_t i, const WallTouch& t, int material,
+                        ContactHistory& h) {
+  Particles& p = s.p;
+  const ContactGeometry g = wall_geometry<Law>(p, i, t);
   const ContactResult r = Law::evaluate(g, s.table(p.material[i], material), s.constants,
                                         h.tangential, h.rolling, s.dt);
   p.force[i] += r.force;
@@ -71,6 +78,41 @@ void wall_sweep_one(ContactSweep& s, const WallSet::Entry& wall, const WallNeigh
   }
 }
 
+// A mesh contact found in the body frame, in the world: normal, overlap and the wall's
+// velocity at the contact point (motion and conveyor belt, `belt` in the world frame).
+inline WallTouch mesh_wall_touch(const WallSet::Entry& wall, const MeshTouch& touch, const Vec3& x,
+                                 double r, bool moving, bool conveyor, const Vec3& belt) {
+  WallTouch t;
+  t.n = moving ? wall.pose.direction_to_world(touch.n) : touch.n;
+  t.overlap = touch.overlap;
+  t.surface_velocity.setZero();
+  if (moving) t.surface_velocity = wall.pose.velocity_at(x - (r - t.overlap) * t.n);
+  if (conveyor) t.surface_velocity += belt - belt.dot(t.n) * t.n;
+  return t;
+}
+
+// The history slot of particle i's mesh contact with normal n: the unused slot whose key
+// normal is closest to n (within WallSet::kSlotMatchCosine), else a free one, else a stale
+// one; -1 when all are used. Reads the keys only (the sweep then sets the chosen key to n).
+inline int mesh_slot(const std::vector<std::vector<ContactHistory>>& history, int column,
+                     std::size_t i, const Vec3& n, const bool* used) {
+  constexpr int kSlots = WallSet::kMeshSlots;
+  int best = -1;
+  double best_cos = WallSet::kSlotMatchCosine;
+  for (int j = 0; j < kSlots; ++j) {
+    const Vec3& key = history[column + 2 * j + 1][i].tangential;
+    if (!used[j] && key.dot(n) > best_cos) {
+      best = j;
+      best_cos = key.dot(n);
+    }
+  }
+  for (int j = 0; j < kSlots && best < 0; ++j)
+    if (!used[j] && history[column + 2 * j + 1][i].tangential.isZero(0)) best = j;
+  for (int j = 0; j < kSlots && best < 0; ++j)  // stale key of an older contact
+    if (!used[j]) best = j;
+  return best;
+}
+
 // A mesh: every contact of the particle with the mesh (one per touching feature,
 // triangle_mesh.hpp), each with the history slot whose key normal matches it.
 template <class Law>
@@ -87,27 +129,10 @@ void mesh_sweep(ContactSweep& s, const WallSet::Entry& wall, const TriangleMesh&
     const int n = mesh.touches(moving ? wall.pose.to_body(p.x[i]) : p.x[i], r, touch);
     bool used[kSlots] = {};
     for (int k = 0; k < n; ++k) {
-      WallTouch t;
-      t.n = moving ? wall.pose.direction_to_world(touch[k].n) : touch[k].n;
-      t.overlap = touch[k].overlap;
-      t.surface_velocity.setZero();
-      if (moving) t.surface_velocity = wall.pose.velocity_at(p.x[i] - (r - t.overlap) * t.n);
-      if (conveyor) t.surface_velocity += belt - belt.dot(t.n) * t.n;
+      const WallTouch t = mesh_wall_touch(wall, touch[k], p.x[i], r, moving, conveyor, belt);
       ContactHistory* h = &scratch;
       if constexpr (Law::has_history) {
-        int best = -1;
-        double best_cos = WallSet::kSlotMatchCosine;
-        for (int j = 0; j < kSlots; ++j) {
-          const Vec3& key = s.wall_history[wall.column + 2 * j + 1][i].tangential;
-          if (!used[j] && key.dot(t.n) > best_cos) {
-            best = j;
-            best_cos = key.dot(t.n);
-          }
-        }
-        for (int j = 0; j < kSlots && best < 0; ++j)
-          if (!used[j] && s.wall_history[wall.column + 2 * j + 1][i].tangential.isZero(0)) best = j;
-        for (int j = 0; j < kSlots && best < 0; ++j)  // stale key of an older contact
-          if (!used[j]) best = j;
+        const int best = mesh_slot(s.wall_history, wall.column, i, t.n, used);
         if (best >= 0) {
           used[best] = true;
           s.wall_history[wall.column + 2 * best + 1][i].tangential = t.n;

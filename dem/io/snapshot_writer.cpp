@@ -2,6 +2,7 @@
 
 #include <hdf5.h>
 
+#include <array>
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
@@ -159,9 +160,10 @@ struct OpenFile {
   hid_t dxpl;  // transfer: collective MPI-IO
 };
 
+// `group`: the group below the root holding the dataset (nullptr: the root).
 void write_dataset(const OpenFile& out, Agreement& agreement, const SnapshotField& f,
-                   const Slice& slice, const void* data) {
-  const std::string dset_path = std::string("/") + f.name;
+                   const Slice& slice, const void* data, const char* group = nullptr) {
+  const std::string dset_path = (group ? std::string("/") + group : std::string()) + "/" + f.name;
   const int rank = f.components == 1 ? 1 : 2;
   const hsize_t comps = static_cast<hsize_t>(f.components);
   const hsize_t file_dims[2] = {slice.total, comps};
@@ -205,6 +207,33 @@ void write_dataset(const OpenFile& out, Agreement& agreement, const SnapshotFiel
   agreement.check(dset.close(), "closing dataset " + dset_path);
 }
 
+// One group of the contact network (contact_network.hpp): `n_local` contacts of this rank,
+// `data[k]` the array of fields[k]. Collective; returns the global count.
+template <std::size_t N>
+std::int64_t write_contact_group(const OpenFile& out, Agreement& agreement, MPI_Comm comm, int rank,
+                                 const char* group, const std::array<ContactField, N>& fields,
+                                 std::size_t n_local, const std::array<const void*, N>& data) {
+  const std::int64_t n = static_cast<std::int64_t>(n_local);
+  std::int64_t offset = 0, total = 0;
+  MPI_Exscan(&n, &offset, 1, MPI_INT64_T, MPI_SUM, comm);
+  if (rank == 0) offset = 0;  // MPI_Exscan leaves rank 0's result undefined
+  MPI_Allreduce(&n, &total, 1, MPI_INT64_T, MPI_SUM, comm);
+  const std::string path = std::string("/") + group;
+  Hid g(H5Gcreate2(out.file, path.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+  agreement.check(g.valid(), "creating group " + path);
+  const HdfTypes i64 = hdf_types(SnapshotField::Type::Int64);
+  agreement.check(write_scalar_attribute(g.get(), "count", i64, &total),
+                  "writing the count attribute of " + path);
+  agreement.check(g.close(), "closing group " + path);
+  for (std::size_t k = 0; k < N; ++k) {
+    const hsize_t rows = static_cast<hsize_t>(fields[k].rows);
+    const Slice slice{rows * static_cast<hsize_t>(offset), rows * static_cast<hsize_t>(n),
+                      rows * static_cast<hsize_t>(total)};
+    write_dataset(out, agreement, fields[k].field, slice, data[k], group);
+  }
+  return total;
+}
+
 std::string six_digits(std::size_t index) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%06zu", index);
@@ -246,7 +275,16 @@ std::size_t SnapshotWriter::continue_series(long up_to_step) {
     for (std::size_t k = 0; k < snapshot_fields.size(); ++k)
       if (H5Lexists(file.get(), snapshot_fields[k].name, H5P_DEFAULT) > 0)
         held |= SnapshotFieldSet{1} << k;
-    entries_.push_back({file_name, t, static_cast<long>(s), static_cast<long>(n), held});
+    // The contact network's counts (group attribute "count"), -1 when the file has none.
+    std::int64_t counts[2] = {-1, -1};
+    const char* groups[2] = {pair_contact_group, wall_contact_group};
+    for (int k = 0; k < 2; ++k) {
+      if (H5Lexists(file.get(), groups[k], H5P_DEFAULT) <= 0) continue;
+      Hid attr(H5Aopen_by_name(file.get(), groups[k], "count", H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+      if (!attr.valid() || H5Aread(attr.get(), H5T_NATIVE_INT64, &counts[k]) < 0) counts[k] = -1;
+    }
+    entries_.push_back({file_name, t, static_cast<long>(s), static_cast<long>(n), held,
+                        static_cast<long>(counts[0]), static_cast<long>(counts[1])});
   }
   H5Eclear2(H5E_DEFAULT);
   return entries_.size();
@@ -257,7 +295,7 @@ std::string SnapshotWriter::index_path() const {
 }
 
 std::string SnapshotWriter::write(const Particles& p, double time, long step,
-                                  const SnapshotExtras& extras) {
+                                  const SnapshotExtras& extras, const ContactNetwork* contacts) {
   const auto wants = [&](const char* name) { return (fields_ & snapshot_field_bit(name)) != 0; };
   const auto check_size = [&](const char* name, std::size_t n) {
     if (wants(name) && n != p.size())
@@ -291,6 +329,8 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step,
   const Slice slice{static_cast<hsize_t>(offset), static_cast<hsize_t>(n_local),
                     static_cast<hsize_t>(total)};
 
+  // The contact network's sizes over all ranks (-1: not written).
+  std::int64_t pair_contacts = -1, wall_contacts = -1;
   QuietHdf5Errors quiet;
   // Data plus HDF5's metadata, about 3 kB per checksummed dataset (measured: 4000 particles
   // take 454 040 bytes, 432 000 of them data).
@@ -301,8 +341,17 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step,
     bytes_per_particle +=
         static_cast<std::uintmax_t>(f.components) * (f.type == SnapshotField::Type::Int32 ? 4 : 8);
   }
-  Agreement agreement(comm_, rank_, size_, path,
-                      bytes_per_particle * static_cast<std::uintmax_t>(total) + 32768);
+  std::uintmax_t bytes = bytes_per_particle * static_cast<std::uintmax_t>(total) + 32768;
+  if (contacts) {
+    // 152 bytes per pair (ids, line ends, point, two forces, magnitude, overlap), 140 per
+    // wall contact, and the metadata of 15 more datasets.
+    std::int64_t n[2] = {static_cast<std::int64_t>(contacts->pairs.size()),
+                         static_cast<std::int64_t>(contacts->walls.size())};
+    MPI_Allreduce(MPI_IN_PLACE, n, 2, MPI_INT64_T, MPI_SUM, comm_);
+    bytes += 152 * static_cast<std::uintmax_t>(n[0]) + 140 * static_cast<std::uintmax_t>(n[1]) +
+             15 * 3072;
+  }
+  Agreement agreement(comm_, rank_, size_, path, bytes);
   try {
     agreement.check_space();
     Hid fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
@@ -353,6 +402,23 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step,
     optional("overlap_max", extras.overlap_max.data());
     static_assert(snapshot_fields.size() == 13, "a new snapshot field needs its write above");
 
+    if (contacts) {
+      static_assert(sizeof(std::array<GlobalId, 2>) == 2 * sizeof(std::int64_t));
+      const PairContacts& c = contacts->pairs;
+      const auto ids = [](const auto& a) { return a.empty() ? nullptr : a.data(); };
+      static_assert(pair_contact_fields.size() == 7, "a new contact field needs its array here");
+      pair_contacts = write_contact_group(
+          out, agreement, comm_, rank_, pair_contact_group, pair_contact_fields, c.size(),
+          {ids(c.id), vectors(c.ends), vectors(c.point), vectors(c.normal_force),
+           vectors(c.tangential_force), ids(c.normal_force_magnitude), ids(c.overlap)});
+      const WallContacts& w = contacts->walls;
+      static_assert(wall_contact_fields.size() == 8, "a new contact field needs its array here");
+      wall_contacts = write_contact_group(
+          out, agreement, comm_, rank_, wall_contact_group, wall_contact_fields, w.size(),
+          {ids(w.id), ids(w.wall), vectors(w.ends), vectors(w.point), vectors(w.normal_force),
+           vectors(w.tangential_force), ids(w.normal_force_magnitude), ids(w.overlap)});
+    }
+
     const HdfTypes f64 = hdf_types(SnapshotField::Type::Float64);
     const HdfTypes i64 = hdf_types(SnapshotField::Type::Int64);
     ok = write_scalar_attribute(file.get(), "time", f64, &t) &&
@@ -371,7 +437,8 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step,
     throw;
   }
 
-  entries_.push_back({file_name, t, static_cast<long>(s), static_cast<long>(total), fields_});
+  entries_.push_back({file_name, t, static_cast<long>(s), static_cast<long>(total), fields_,
+                      static_cast<long>(pair_contacts), static_cast<long>(wall_contacts)});
   std::string index_error;
   if (rank_ == 0) {
     try {

@@ -11,12 +11,15 @@
 //   each dataset is chunked with a Fletcher32 checksum (hdf5_checksum.hpp) and has a string
 //   attribute "units"; the root group has the attributes
 //   time (double, s), step (int64), count (int64, = N) and grainflow_version (string).
+//   With a contact network (write()'s `contacts`): the groups /contacts and /wall_contacts
+//   (contact_network.hpp).
 #include <mpi.h>
 
 #include <string>
 #include <vector>
 
 #include "dem/core/particles.hpp"
+#include "dem/io/contact_network.hpp"
 #include "dem/io/output_directory.hpp"
 #include "dem/io/xdmf_index.hpp"
 
@@ -48,7 +51,10 @@ class SnapshotWriter {
   // OutputError (naming the file, the failing operation, the HDF5/OS reason and the rank).
   // `extras` must hold every field of the set beyond the default ones, sized p.size()
   // (std::logic_error otherwise).
-  std::string write(const Particles& p, double time, long step, const SnapshotExtras& extras = {});
+  // `contacts`: the contact network to write with it (contact_network.hpp), this rank's part;
+  // given on every rank or on none.
+  std::string write(const Particles& p, double time, long step, const SnapshotExtras& extras = {},
+                    const ContactNetwork* contacts = nullptr);
 
   // Continues an existing series (a restarted run): takes the snapshots already in the
   // directory, in index order, up to the first one missing, unreadable or past `up_to_step`,

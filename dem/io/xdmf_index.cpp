@@ -3,12 +3,14 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <array>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <string_view>
 
+#include "dem/io/contact_network.hpp"
 #include "dem/io/output_directory.hpp"
 
 namespace grainflow {
@@ -55,21 +57,28 @@ const char* number_type(SnapshotField::Type t) {
 
 int precision(SnapshotField::Type t) { return t == SnapshotField::Type::Int32 ? 4 : 8; }
 
-void data_item(std::string& out, const XdmfEntry& e, const SnapshotField& f, const char* indent) {
+// A DataItem of `count` rows of field f in `file`; `group`: the dataset's group (nullptr: the
+// root).
+void data_item(std::string& out, const std::string& file, long count, const SnapshotField& f,
+               const char* indent, const char* group = nullptr) {
   out += indent;
   out += "<DataItem Format=\"HDF\" NumberType=\"";
   out += number_type(f.type);
   out += "\" Precision=\"";
   out += std::to_string(precision(f.type));
   out += "\" Dimensions=\"";
-  out += std::to_string(e.count);
+  out += std::to_string(count);
   if (f.components != 1) {
     out += ' ';
     out += std::to_string(f.components);
   }
   out += "\">";
-  out += xml_escape(e.file);
+  out += xml_escape(file);
   out += ":/";
+  if (group) {
+    out += group;
+    out += '/';
+  }
   out += f.name;
   out += "</DataItem>\n";
 }
@@ -79,7 +88,60 @@ void data_item(std::string& out, const XdmfEntry& e, const SnapshotField& f, con
                     ". Check free space and permissions of the output directory.");
 }
 
+// One group of the contact network as a Polyline grid: the `ends` dataset is the geometry,
+// two nodes per contact, and lines need no connectivity DataItem (Xdmf2 gives a topology
+// without one the default connectivity 0..2M-1, i.e. nodes 2k and 2k+1 for line k).
+// An empty group has no grid: ParaView's XDMF reader fails on a geometry of no nodes (and
+// then leaves an empty block).
+template <std::size_t N>
+void contact_grid(std::string& out, const XdmfEntry& e, const char* group, long count,
+                  const std::array<ContactField, N>& fields, const std::string& indent) {
+  if (count <= 0) return;
+  const std::string in = indent + "  ", item = indent + "    ";
+  out += indent + "<Grid Name=\"" + group + "\" GridType=\"Uniform\">\n";
+  out += in + "<Topology TopologyType=\"Polyline\" NumberOfElements=\"" + std::to_string(count) +
+         "\" NodesPerElement=\"2\"/>\n";
+  for (const ContactField& c : fields) {
+    if (c.rows != 2) continue;
+    out += in + "<Geometry GeometryType=\"XYZ\">\n";
+    data_item(out, e.file, 2 * count, c.field, item.c_str(), group);
+    out += in + "</Geometry>\n";
+  }
+  for (const ContactField& c : fields) {
+    if (c.rows != 1) continue;  // the line ends: the geometry
+    if (c.field.components == 2) {
+      // The pairs' ids (M x 2): one scalar per column, "id_a" and "id_b", each a HyperSlab
+      // (start, stride, count per dimension) of the dataset.
+      for (int column = 0; column < 2; ++column) {
+        out += in + "<Attribute Name=\"" + c.field.name + (column == 0 ? "_a" : "_b") +
+               "\" AttributeType=\"Scalar\" Center=\"Cell\">\n";
+        out += item + "<DataItem ItemType=\"HyperSlab\" Dimensions=\"" + std::to_string(count) +
+               " 1\" Type=\"HyperSlab\">\n";
+        out += item + "  <DataItem Dimensions=\"3 2\" Format=\"XML\">0 " + std::to_string(column) +
+               " 1 1 " + std::to_string(count) + " 1</DataItem>\n";
+        data_item(out, e.file, count, c.field, (item + "  ").c_str(), group);
+        out += item + "</DataItem>\n";
+        out += in + "</Attribute>\n";
+      }
+      continue;
+    }
+    out += in + "<Attribute Name=\"" + c.field.name + "\" AttributeType=\"" +
+           (c.field.components == 1 ? "Scalar" : "Vector") + "\" Center=\"Cell\">\n";
+    data_item(out, e.file, count, c.field, item.c_str(), group);
+    out += in + "</Attribute>\n";
+  }
+  out += indent + "</Grid>\n";
+}
+
 }  // namespace
+
+std::string render_contact_grids(const XdmfEntry& e, const std::string& indent) {
+  std::string out;
+  if (e.contacts < 0) return out;
+  contact_grid(out, e, pair_contact_group, e.contacts, pair_contact_fields, indent);
+  contact_grid(out, e, wall_contact_group, e.wall_contacts, wall_contact_fields, indent);
+  return out;
+}
 
 std::string render_xdmf(const std::vector<XdmfEntry>& entries, const std::string& series_name) {
   std::string out;
@@ -92,24 +154,41 @@ std::string render_xdmf(const std::vector<XdmfEntry>& entries, const std::string
          "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
   for (const XdmfEntry& e : entries) {
     const std::string stem = std::filesystem::path(e.file).stem().string();
-    out += "      <Grid Name=\"" + xml_escape(stem) + "\" GridType=\"Uniform\">\n";
-    out += "        <Time Value=\"" + exact(e.time) + "\"/>\n";
-    out += "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" +
+    const std::string time = "<Time Value=\"" + exact(e.time) + "\"/>\n";
+    // With a contact network, the entry is a Spatial collection of the particles' grid and
+    // the network's grids, at one time.
+    const bool network = e.contacts >= 0;
+    const std::string in = network ? "          " : "        ";  // the grid's children
+    if (network) {
+      out += "      <Grid Name=\"" + xml_escape(stem) +
+             "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n";
+      out += "        " + time;
+      out += "        <Grid Name=\"particles\" GridType=\"Uniform\">\n";
+    } else {
+      out += "      <Grid Name=\"" + xml_escape(stem) + "\" GridType=\"Uniform\">\n";
+      out += in + time;
+    }
+    out += in + "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" +
            std::to_string(e.count) + "\" NodesPerElement=\"1\"/>\n";
+    const std::string item_indent = in + "  ";
     for (const SnapshotField& f : snapshot_fields) {
       if (std::string_view(f.name) != snapshot_geometry_field) continue;
-      out += "        <Geometry GeometryType=\"XYZ\">\n";
-      data_item(out, e, f, "          ");
-      out += "        </Geometry>\n";
+      out += in + "<Geometry GeometryType=\"XYZ\">\n";
+      data_item(out, e.file, e.count, f, item_indent.c_str());
+      out += in + "</Geometry>\n";
     }
     for (std::size_t k = 0; k < snapshot_fields.size(); ++k) {
       const SnapshotField& f = snapshot_fields[k];
       if (std::string_view(f.name) == snapshot_geometry_field) continue;
       if (!(e.fields & (SnapshotFieldSet{1} << k))) continue;
-      out += "        <Attribute Name=\"" + std::string(f.name) + "\" AttributeType=\"" +
+      out += in + "<Attribute Name=\"" + std::string(f.name) + "\" AttributeType=\"" +
              (f.components == 1 ? "Scalar" : "Vector") + "\" Center=\"Node\">\n";
-      data_item(out, e, f, "          ");
-      out += "        </Attribute>\n";
+      data_item(out, e.file, e.count, f, item_indent.c_str());
+      out += in + "</Attribute>\n";
+    }
+    if (network) {
+      out += "        </Grid>\n";
+      out += render_contact_grids(e, "        ");
     }
     out += "      </Grid>\n";
   }

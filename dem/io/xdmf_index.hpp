@@ -3,7 +3,9 @@
 // time series of particle point clouds, while the per-particle arrays stay in the HDF5 files.
 // Format: XDMF 2 (https://www.xdmf.org/index.php/Xdmf2_Model_and_Format_Archive). A
 // Polyvertex topology without a connectivity DataItem gets the default connectivity 0..N-1
-// (Xdmf2 XdmfTopology::Update), i.e. one vertex cell per particle.
+// (Xdmf2 XdmfTopology::Update), i.e. one vertex cell per particle. A snapshot with a contact
+// network (output.contacts) is a Spatial collection of that grid and the network's Polyline
+// grids (render_contact_grids).
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -66,7 +68,19 @@ struct XdmfEntry {
   long step;
   long count;  // global number of particles in the file
   SnapshotFieldSet fields = snapshot_default_fields;  // the datasets the file holds
+  // The contact network's global counts (contact_network.hpp): particle pairs and wall
+  // contacts; -1 when the file holds no network.
+  long contacts = -1;
+  long wall_contacts = -1;
 };
+
+// The contact network of one entry as XDMF grids, for a Spatial collection of the entry's
+// time: one Uniform Polyline grid per group (/contacts, /wall_contacts), one line of 2 nodes
+// per contact (its `ends`), every other dataset a Cell attribute (the pairs' ids as `id_a`
+// and `id_b`, HyperSlabs of the M x 2 dataset); a group without contacts
+// has no grid. Each line of the result starts with `indent`; empty when the entry holds no
+// network.
+std::string render_contact_grids(const XdmfEntry& entry, const std::string& indent);
 
 // The complete index for `entries` (in the order given), as one Temporal Collection named
 // `series_name` of Uniform Polyvertex grids; each grid lists the fields its file holds.

@@ -185,6 +185,9 @@ struct OutputSettings {
   // Snapshots only at times in [start, stop] (simulated seconds); start < stop.
   std::optional<double> start;
   std::optional<double> stop;
+  // Each snapshot also holds the contact network (touching pairs and wall contacts with
+  // their forces; dem/io/contact_network.hpp), indexed as lines in the XDMF.
+  bool contacts = false;
 };
 
 struct NeighbourSettings {

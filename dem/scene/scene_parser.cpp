@@ -646,8 +646,9 @@ std::vector<Insertion> parse_insertions(const Field& f, const Scene& scene) {
 }
 
 OutputSettings parse_output(const Field& f, const TimeSettings& time) {
-  const Map m = f.map({"directory", "snapshot_interval", "log_interval", "progress",
-                       "checkpoint_interval", "checkpoint_keep", "fields", "start", "stop"});
+  const Map m =
+      f.map({"directory", "snapshot_interval", "log_interval", "progress", "checkpoint_interval",
+             "checkpoint_keep", "fields", "start", "stop", "contacts"});
   OutputSettings o;
   for (const char* key : {"directory", "snapshot_interval", "log_interval", "progress",
                           "checkpoint_interval", "checkpoint_keep"})
@@ -657,6 +658,7 @@ OutputSettings parse_output(const Field& f, const TimeSettings& time) {
   o.snapshot_interval = m.maybe_number("snapshot_interval", kPositive);
   o.log_interval = m.maybe_number("log_interval", kPositive);
   if (const auto p = m.find("progress")) o.progress = p->boolean();
+  if (const auto c = m.find("contacts")) o.contacts = c->boolean();
   o.checkpoint_interval = m.maybe_number("checkpoint_interval", kPositive);
   if (const auto k = m.find("checkpoint_keep"))
     o.checkpoint_keep = static_cast<int>(k->integer(Range{1, 1000, true, true}));

@@ -812,6 +812,18 @@ TEST(SceneParser, SnapshotFieldsAndWindow) {
               HasSubstr("output.start: value -1 is out of range; it must be >= 0"));
 }
 
+// output.contacts: off by default, `true` writes the contact network, and a value that is not
+// a boolean is refused at the value (file:line:column), naming the key and what it accepts.
+TEST(SceneParser, OutputContacts) {
+  EXPECT_FALSE(parse_scene(kBase, kLabel).output.contacts);
+  EXPECT_TRUE(parse_scene(kBase + "output: {contacts: true}\n", kLabel).output.contacts);
+  EXPECT_FALSE(parse_scene(kBase + "output:\n  contacts: false\n", kLabel).output.contacts);
+  EXPECT_THAT(expect_at(error_of(kBase + "output:\n  contacts: pairs\n"), 18, 13),
+              HasSubstr("output.contacts: expected true or false, got 'pairs'"));
+  EXPECT_THAT(expect_at(error_of(kBase + "output:\n  contacts: [walls]\n"), 18, 13),
+              HasSubstr("output.contacts: expected true or false"));
+}
+
 // parallel.reproducible: off by default, `true` selects canonical summation, and a value
 // that is not a boolean names the key and what it accepts.
 TEST(SceneParser, ParallelReproducible) {
