@@ -81,41 +81,50 @@ void data_item(std::string& out, const XdmfEntry& e, const SnapshotField& f, con
 
 }  // namespace
 
-std::string render_xdmf(const std::vector<XdmfEntry>& entries, const std::string& series_name) {
+std::string render_xdmf_head(const std::string& series_name) {
   std::string out;
-  out.reserve(512 + entries.size() * 2048);
   out += "<?xml version=\"1.0\" ?>\n";
   out += "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n";
   out += "<Xdmf Version=\"2.0\">\n";
   out += "  <Domain>\n";
   out += "    <Grid Name=\"" + xml_escape(series_name) +
          "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-  for (const XdmfEntry& e : entries) {
-    const std::string stem = std::filesystem::path(e.file).stem().string();
-    out += "      <Grid Name=\"" + xml_escape(stem) + "\" GridType=\"Uniform\">\n";
-    out += "        <Time Value=\"" + exact(e.time) + "\"/>\n";
-    out += "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" +
-           std::to_string(e.count) + "\" NodesPerElement=\"1\"/>\n";
-    for (const SnapshotField& f : snapshot_fields) {
-      if (std::string_view(f.name) != snapshot_geometry_field) continue;
-      out += "        <Geometry GeometryType=\"XYZ\">\n";
-      data_item(out, e, f, "          ");
-      out += "        </Geometry>\n";
-    }
-    for (std::size_t k = 0; k < snapshot_fields.size(); ++k) {
-      const SnapshotField& f = snapshot_fields[k];
-      if (std::string_view(f.name) == snapshot_geometry_field) continue;
-      if (!(e.fields & (SnapshotFieldSet{1} << k))) continue;
-      out += "        <Attribute Name=\"" + std::string(f.name) + "\" AttributeType=\"" +
-             (f.components == 1 ? "Scalar" : "Vector") + "\" Center=\"Node\">\n";
-      data_item(out, e, f, "          ");
-      out += "        </Attribute>\n";
-    }
-    out += "      </Grid>\n";
+  return out;
+}
+
+std::string render_xdmf_entry(const XdmfEntry& e) {
+  std::string out;
+  out.reserve(2048);
+  const std::string stem = std::filesystem::path(e.file).stem().string();
+  out += "      <Grid Name=\"" + xml_escape(stem) + "\" GridType=\"Uniform\">\n";
+  out += "        <Time Value=\"" + exact(e.time) + "\"/>\n";
+  out += "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" +
+         std::to_string(e.count) + "\" NodesPerElement=\"1\"/>\n";
+  for (const SnapshotField& f : snapshot_fields) {
+    if (std::string_view(f.name) != snapshot_geometry_field) continue;
+    out += "        <Geometry GeometryType=\"XYZ\">\n";
+    data_item(out, e, f, "          ");
+    out += "        </Geometry>\n";
   }
-  out += "    </Grid>\n";
-  out += "  </Domain>\n";
-  out += "</Xdmf>\n";
+  for (std::size_t k = 0; k < snapshot_fields.size(); ++k) {
+    const SnapshotField& f = snapshot_fields[k];
+    if (std::string_view(f.name) == snapshot_geometry_field) continue;
+    if (!(e.fields & (SnapshotFieldSet{1} << k))) continue;
+    out += "        <Attribute Name=\"" + std::string(f.name) + "\" AttributeType=\"" +
+           (f.components == 1 ? "Scalar" : "Vector") + "\" Center=\"Node\">\n";
+    data_item(out, e, f, "          ");
+    out += "        </Attribute>\n";
+  }
+  out += "      </Grid>\n";
+  return out;
+}
+
+std::string render_xdmf_tail() { return "    </Grid>\n  </Domain>\n</Xdmf>\n"; }
+
+std::string render_xdmf(const std::vector<XdmfEntry>& entries, const std::string& series_name) {
+  std::string out = render_xdmf_head(series_name);
+  for (const XdmfEntry& e : entries) out += render_xdmf_entry(e);
+  out += render_xdmf_tail();
   return out;
 }
 
