@@ -25,16 +25,34 @@ if [ -n "$missing" ]; then
   exit 1
 fi
 if command -v Xvfb > /dev/null 2>&1; then
-  # Our own Xvfb on a free display (-displayfd); pvbatch fails to connect to the one that
-  # xvfb-run starts (it guards it with an xauth cookie), local connections to this one work.
-  fifo="$(mktemp -u /tmp/grainflow-xvfb.XXXXXX)"
-  mkfifo "$fifo"
-  Xvfb -displayfd 3 -nolisten tcp -screen 0 1280x1024x24 3> "$fifo" > /dev/null 2>&1 &
-  xvfb=$!
-  trap 'kill $xvfb 2> /dev/null && wait $xvfb 2> /dev/null; rm -f "$fifo"' EXIT
-  read -r -t 30 display < "$fifo" || { echo "error: Xvfb did not start" >&2; exit 1; }
-  status=0
-  DISPLAY=":$display" pvbatch --force-onscreen-rendering "$@" || status=$?
-  exit $status
+  # Our own Xvfb on a free display (-displayfd), for this run only (pvbatch fails to connect
+  # to the one xvfb-run starts, guarded by an xauth cookie). Seen here: pvbatch now and then
+  # aborts with "bad X server connection" on a fresh Xvfb (more often with other X servers
+  # running), so runs of this script take turns (flock), and an attempt that fails so is
+  # made again on a new server, up to three times.
+  exec 9> /tmp/grainflow-pvbatch.lock
+  flock -w 600 9 || { echo "error: waited 600 s for another pvbatch run to end" >&2; exit 1; }
+  work="$(mktemp -d /tmp/grainflow-pvbatch.XXXXXX)"
+  xvfb=""
+  trap '[ -z "$xvfb" ] || { kill $xvfb 2> /dev/null && wait $xvfb 2> /dev/null; }; rm -rf "$work"' EXIT
+  for attempt in 1 2 3; do
+    mkfifo "$work/display"
+    Xvfb -displayfd 3 -nolisten tcp -screen 0 1280x1024x24 3> "$work/display" 9>&- \
+      > /dev/null 2>&1 &
+    xvfb=$!
+    read -r -t 30 display < "$work/display" || { echo "error: Xvfb did not start" >&2; exit 1; }
+    sleep 1
+    status=0
+    DISPLAY=":$display" pvbatch --force-onscreen-rendering "$@" > "$work/out" 2>&1 || status=$?
+    kill $xvfb 2> /dev/null && wait $xvfb 2> /dev/null
+    xvfb=""
+    rm -f "$work/display"
+    if [ $status -ne 0 ] && [ $attempt -lt 3 ] && grep -q "bad X server connection" "$work/out"; then
+      echo "pvbatch.sh: pvbatch could not connect to Xvfb (attempt $attempt); again" >&2
+      continue
+    fi
+    cat "$work/out"
+    exit $status
+  done
 fi
 exec pvbatch --force-onscreen-rendering "$@"

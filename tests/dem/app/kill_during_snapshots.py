@@ -3,10 +3,10 @@
 
     kill_during_snapshots.py GRAIN SCENE WORKDIR [KILLS]
 
-Runs `grain run SCENE` (300 beads, a snapshot with all 13 fields every 10 steps, a checkpoint
-every 500) and kills it with SIGKILL KILLS times at a random moment 0 to 0.4 s after its
-index first exists, restarting each time from the newest checkpoint (or afresh when there is
-none yet). After each kill, `particles.xdmf`:
+Runs `grain run SCENE` (300 beads, a snapshot with all 13 fields every 10 steps, about 10 ms
+apart, a checkpoint every 100 steps) and kills it with SIGKILL KILLS times at a random moment
+0 to 0.3 s after the run has written (a restart: rewritten) its index, restarting each time
+from the newest checkpoint (or afresh when there is none yet). After each kill, `particles.xdmf`:
   - parses (Python's xml.etree, i.e. expat) as one Temporal Collection;
   - lists particles_000000 .. particles_<n-1> in order, times strictly increasing;
   - every file it lists exists and opens with h5py, with the listed time (exactly), count
@@ -26,9 +26,14 @@ import xml.etree.ElementTree as ET
 import h5py
 
 CHECKPOINT = re.compile(r"^checkpoint_(\d{9})\.h5$")
+RUNNING = []  # the grain process under test, killed when the test fails
 
 
 def fail(message, log=None):
+    for proc in RUNNING:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
     if log and os.path.exists(log):
         sys.stdout.write(open(log).read())
     print("FAIL: " + message)
@@ -79,7 +84,7 @@ def check_index(out, when):
 
 def main():
     grain, scene, work = sys.argv[1:4]
-    kills = int(sys.argv[4]) if len(sys.argv) > 4 else 12
+    kills = int(sys.argv[4]) if len(sys.argv) > 4 else 8
     rng = random.Random(20261202)
     subprocess.run(["rm", "-rf", work], check=True)
     out = os.path.join(work, "out")
@@ -92,28 +97,38 @@ def main():
         cmd = [grain, "run", scene, "--output", "out", "--no-progress"]
         if checkpoints:
             cmd += ["--restart", os.path.join("out", checkpoints[-1])]
-        return subprocess.Popen(cmd, stdout=open(log, "w"), stderr=subprocess.STDOUT), \
-            checkpoints[-1] if checkpoints else None
+        RUNNING[:] = [subprocess.Popen(cmd, stdout=open(log, "w"), stderr=subprocess.STDOUT)]
+        return RUNNING[0], checkpoints[-1] if checkpoints else None
 
-    def wait_for_index(proc, log, fresh_after=None):
+    index = os.path.join(out, "particles.xdmf")
+
+    def index_version():
+        try:
+            st = os.stat(index)
+            return (st.st_ino, st.st_mtime_ns, st.st_size)
+        except FileNotFoundError:
+            return None
+
+    def wait_for_new_index(proc, log, before):
+        """Waits until this run has written the index (a restart rewrites it whole)."""
         deadline = time.monotonic() + 60
-        index = os.path.join(out, "particles.xdmf")
         while time.monotonic() < deadline:
-            if os.path.exists(index) and (fresh_after is None or
-                                          os.stat(index).st_mtime_ns > fresh_after):
+            now = index_version()
+            if now is not None and now != before:
                 return
             if proc.poll() is not None:
                 fail(f"grain exited with code {proc.returncode} on its own", log)
-            time.sleep(0.005)
+            time.sleep(0.002)
         fail("no index within 60 s", log)
 
     listed = []
     started = time.monotonic()
     for kill in range(1, kills + 1):
         log = f"run_{kill:02d}.txt"
+        before = index_version()
         proc, restart = start(log)
-        wait_for_index(proc, log)
-        time.sleep(rng.uniform(0.0, 0.4))
+        wait_for_new_index(proc, log, before)
+        time.sleep(rng.uniform(0.0, 0.3))
         proc.send_signal(signal.SIGKILL)
         proc.wait()
         if proc.returncode != -signal.SIGKILL:
@@ -124,12 +139,13 @@ def main():
               f"index parses, lists {n} snapshots, each opens with the listed time and shapes")
 
     log = "run_last.txt"
+    before = index_version()
     proc, restart = start(log)
     if not restart:
         fail("no checkpoint was written before the last restart", log)
     # Runs on until its index has been rewritten and appended to, then stops cleanly.
-    wait_for_index(proc, log, fresh_after=os.stat(os.path.join(out, "particles.xdmf")).st_mtime_ns)
-    time.sleep(0.5)
+    wait_for_new_index(proc, log, before)
+    time.sleep(0.3)
     proc.send_signal(signal.SIGTERM)
     code = proc.wait(timeout=60)
     if code != 0:
