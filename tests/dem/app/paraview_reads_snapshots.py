@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""ParaView's own XDMF reader opens what `grain run` writes (docs/output.md).
+"""ParaView's own XDMF reader opens what `grain run` writes (docs/scene-reference.md).
 
     paraview_reads_snapshots.py GRAIN SCENE WORKDIR PVBATCH_SH
 
