@@ -83,10 +83,12 @@ int main(int argc, char** argv) {
     t_rewrite.push_back(rewrite((dir / "rewrite.xdmf").string(), all, b_rewrite));
     t_append.push_back(append((dir / "append.xdmf").string(), all, b_append));
   }
-  std::printf("| index update (%d snapshots of 2 particles) | median s (%d rounds) | bytes written |\n",
-              snapshots, rounds);
+  std::printf(
+      "| index update (%d snapshots of 2 particles) | median s (%d rounds) | bytes written |\n",
+      snapshots, rounds);
   std::printf("|---|---|---|\n");
-  std::printf("| rewrite + fsync + rename each time | %.3f | %.0f |\n", median(t_rewrite), b_rewrite);
+  std::printf("| rewrite + fsync + rename each time | %.3f | %.0f |\n", median(t_rewrite),
+              b_rewrite);
   std::printf("| append (XdmfIndexFile) | %.4f | %.0f |\n", median(t_append), b_append);
   std::printf("ratio rewrite / append: %.0f x in time, %.0f x in bytes\n",
               median(t_rewrite) / median(t_append), b_rewrite / b_append);

@@ -48,10 +48,10 @@ class SnapshotWriter {
   // renamed when complete), then adds it to the XDMF index: the first write of this writer
   // (and the first after continue_series) writes the index whole and renames it into place,
   // later ones append one time step in O(1) bytes, the file staying valid if the run is
-  // killed at any moment (xdmf_index_file.hpp). Returns the snapshot's path. On any failure every rank throws the same
-  // OutputError (naming the file, the failing operation, the HDF5/OS reason and the rank).
-  // `extras` must hold every field of the set beyond the default ones, sized p.size()
-  // (std::logic_error otherwise).
+  // killed at any moment (xdmf_index_file.hpp). Returns the snapshot's path. On any failure every
+  // rank throws the same OutputError (naming the file, the failing operation, the HDF5/OS reason
+  // and the rank). `extras` must hold every field of the set beyond the default ones, sized
+  // p.size() (std::logic_error otherwise).
   std::string write(const Particles& p, double time, long step, const SnapshotExtras& extras = {});
 
   // Continues an existing series (a restarted run): takes the snapshots already in the

@@ -98,14 +98,14 @@ std::string render_xdmf_appendable(const std::vector<XdmfEntry>& entries,
 }
 
 std::vector<XdmfIndexWrite> plan_xdmf_append(const XdmfIndexLayout& now,
-                                             const std::string& entry_xml,
-                                             XdmfIndexLayout& next) {
+                                             const std::string& entry_xml, XdmfIndexLayout& next) {
   if (entry_xml.find("?>") != std::string::npos)
     throw std::logic_error("plan_xdmf_append: an index entry must not contain \"?>\"");
   const std::string tail = render_xdmf_tail();
   const std::size_t end_mark = length(xdmf_index_end_mark);
   const std::size_t stage_mark = length(xdmf_index_stage_mark);
-  if (now.end != now.tail + tail.size() + end_mark || !in_one_block(now.tail, xdmf_index_tail_window()))
+  if (now.end != now.tail + tail.size() + end_mark ||
+      !in_one_block(now.tail, xdmf_index_tail_window()))
     throw std::logic_error("plan_xdmf_append: the layout is not one render_xdmf_appendable makes");
 
   const std::size_t a = now.end;

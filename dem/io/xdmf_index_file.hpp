@@ -45,8 +45,7 @@ std::string render_xdmf_appendable(const std::vector<XdmfEntry>& entries,
 // The writes that append `entry_xml` (one render_xdmf_entry) to a file of layout `now`; `next`
 // receives the layout after them. Throws std::logic_error if `entry_xml` contains "?>".
 std::vector<XdmfIndexWrite> plan_xdmf_append(const XdmfIndexLayout& now,
-                                             const std::string& entry_xml,
-                                             XdmfIndexLayout& next);
+                                             const std::string& entry_xml, XdmfIndexLayout& next);
 
 class XdmfIndexFile {
  public:

@@ -107,7 +107,7 @@ struct Batch {
   std::vector<std::string> states;
   std::vector<std::size_t> must_equal;  // index into states; a reference points to itself
   std::size_t appends_checked = 0;      // states that are not references
-  std::vector<std::size_t> old_refs;     // each append's old reference; its new one follows
+  std::vector<std::size_t> old_refs;    // each append's old reference; its new one follows
 };
 
 // Appends `e` to `file` (layout `layout`, listing `entries`) by the plan, adding to `batch` the
