@@ -22,6 +22,7 @@ PACKAGES=(
   libyaml-cpp-dev
   clang libclang-rt-14-dev
   python3 python3-numpy python3-matplotlib python3-h5py python3-yaml
+  paraview python3-paraview xvfb
 )
 
 log() { printf '[bootstrap] %s\n' "$*"; }

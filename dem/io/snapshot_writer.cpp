@@ -255,6 +255,7 @@ SnapshotWriter::SnapshotWriter(MPI_Comm comm, std::string directory, std::string
 std::size_t SnapshotWriter::continue_series(long up_to_step) {
   QuietHdf5Errors quiet;
   entries_.clear();
+  index_.reset();  // the next write() rewrites the index with the entries taken over
   for (;;) {
     const std::string file_name = basename_ + "_" + six_digits(entries_.size()) + ".h5";
     const std::string path = (std::filesystem::path(directory_) / file_name).string();
@@ -442,8 +443,14 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step,
   std::string index_error;
   if (rank_ == 0) {
     try {
-      write_file_atomically(index_path(), render_xdmf(entries_, basename_));
+      // The first snapshot of this writer (or the first after continue_series) writes the
+      // whole index; later ones append one time step (xdmf_index_file.hpp).
+      if (index_)
+        index_->append(entries_.back());
+      else
+        index_ = std::make_unique<XdmfIndexFile>(index_path(), basename_, entries_);
     } catch (const OutputError& e) {
+      index_.reset();  // the next snapshot, if any, rewrites the index whole
       index_error = e.what();
     }
   }

@@ -15,6 +15,7 @@
 //   (contact_network.hpp).
 #include <mpi.h>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,7 @@
 #include "dem/io/contact_network.hpp"
 #include "dem/io/output_directory.hpp"
 #include "dem/io/xdmf_index.hpp"
+#include "dem/io/xdmf_index_file.hpp"
 
 namespace grainflow {
 
@@ -46,11 +48,13 @@ class SnapshotWriter {
 
   // Collective over the communicator: every rank calls it with its own particles (possibly
   // none) and the same time and step. Writes the next snapshot file (under a temporary name,
-  // renamed when complete), then rewrites the XDMF index atomically to list every snapshot
-  // written so far. Returns the snapshot's path. On any failure every rank throws the same
-  // OutputError (naming the file, the failing operation, the HDF5/OS reason and the rank).
-  // `extras` must hold every field of the set beyond the default ones, sized p.size()
-  // (std::logic_error otherwise).
+  // renamed when complete), then adds it to the XDMF index: the first write of this writer
+  // (and the first after continue_series) writes the index whole and renames it into place,
+  // later ones append one time step in O(1) bytes, the file staying valid if the run is
+  // killed at any moment (xdmf_index_file.hpp). Returns the snapshot's path. On any failure every
+  // rank throws the same OutputError (naming the file, the failing operation, the HDF5/OS reason
+  // and the rank). `extras` must hold every field of the set beyond the default ones, sized
+  // p.size() (std::logic_error otherwise).
   // `contacts`: the contact network to write with it (contact_network.hpp), this rank's part;
   // given on every rank or on none.
   std::string write(const Particles& p, double time, long step, const SnapshotExtras& extras = {},
@@ -74,6 +78,7 @@ class SnapshotWriter {
   std::string basename_;
   SnapshotFieldSet fields_;
   std::vector<XdmfEntry> entries_;
+  std::unique_ptr<XdmfIndexFile> index_;  // rank 0: the open index, once written
 };
 
 }  // namespace grainflow

@@ -143,58 +143,67 @@ std::string render_contact_grids(const XdmfEntry& e, const std::string& indent) 
   return out;
 }
 
-std::string render_xdmf(const std::vector<XdmfEntry>& entries, const std::string& series_name) {
+std::string render_xdmf_head(const std::string& series_name) {
   std::string out;
-  out.reserve(512 + entries.size() * 2048);
   out += "<?xml version=\"1.0\" ?>\n";
   out += "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n";
   out += "<Xdmf Version=\"2.0\">\n";
   out += "  <Domain>\n";
   out += "    <Grid Name=\"" + xml_escape(series_name) +
          "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-  for (const XdmfEntry& e : entries) {
-    const std::string stem = std::filesystem::path(e.file).stem().string();
-    const std::string time = "<Time Value=\"" + exact(e.time) + "\"/>\n";
-    // With a contact network, the entry is a Spatial collection of the particles' grid and
-    // the network's grids, at one time.
-    const bool network = e.contacts >= 0;
-    const std::string in = network ? "          " : "        ";  // the grid's children
-    if (network) {
-      out += "      <Grid Name=\"" + xml_escape(stem) +
-             "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n";
-      out += "        " + time;
-      out += "        <Grid Name=\"particles\" GridType=\"Uniform\">\n";
-    } else {
-      out += "      <Grid Name=\"" + xml_escape(stem) + "\" GridType=\"Uniform\">\n";
-      out += in + time;
-    }
-    out += in + "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" +
-           std::to_string(e.count) + "\" NodesPerElement=\"1\"/>\n";
-    const std::string item_indent = in + "  ";
-    for (const SnapshotField& f : snapshot_fields) {
-      if (std::string_view(f.name) != snapshot_geometry_field) continue;
-      out += in + "<Geometry GeometryType=\"XYZ\">\n";
-      data_item(out, e.file, e.count, f, item_indent.c_str());
-      out += in + "</Geometry>\n";
-    }
-    for (std::size_t k = 0; k < snapshot_fields.size(); ++k) {
-      const SnapshotField& f = snapshot_fields[k];
-      if (std::string_view(f.name) == snapshot_geometry_field) continue;
-      if (!(e.fields & (SnapshotFieldSet{1} << k))) continue;
-      out += in + "<Attribute Name=\"" + std::string(f.name) + "\" AttributeType=\"" +
-             (f.components == 1 ? "Scalar" : "Vector") + "\" Center=\"Node\">\n";
-      data_item(out, e.file, e.count, f, item_indent.c_str());
-      out += in + "</Attribute>\n";
-    }
-    if (network) {
-      out += "        </Grid>\n";
-      out += render_contact_grids(e, "        ");
-    }
-    out += "      </Grid>\n";
+  return out;
+}
+
+std::string render_xdmf_entry(const XdmfEntry& e) {
+  std::string out;
+  out.reserve(2048);
+  const std::string stem = std::filesystem::path(e.file).stem().string();
+  const std::string time = "<Time Value=\"" + exact(e.time) + "\"/>\n";
+  // With a contact network, the entry is a Spatial collection of the particles' grid and
+  // the network's grids, at one time.
+  const bool network = e.contacts >= 0;
+  const std::string in = network ? "          " : "        ";  // the grid's children
+  if (network) {
+    out += "      <Grid Name=\"" + xml_escape(stem) +
+           "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n";
+    out += "        " + time;
+    out += "        <Grid Name=\"particles\" GridType=\"Uniform\">\n";
+  } else {
+    out += "      <Grid Name=\"" + xml_escape(stem) + "\" GridType=\"Uniform\">\n";
+    out += in + time;
   }
-  out += "    </Grid>\n";
-  out += "  </Domain>\n";
-  out += "</Xdmf>\n";
+  out += in + "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" +
+         std::to_string(e.count) + "\" NodesPerElement=\"1\"/>\n";
+  const std::string item_indent = in + "  ";
+  for (const SnapshotField& f : snapshot_fields) {
+    if (std::string_view(f.name) != snapshot_geometry_field) continue;
+    out += in + "<Geometry GeometryType=\"XYZ\">\n";
+    data_item(out, e.file, e.count, f, item_indent.c_str());
+    out += in + "</Geometry>\n";
+  }
+  for (std::size_t k = 0; k < snapshot_fields.size(); ++k) {
+    const SnapshotField& f = snapshot_fields[k];
+    if (std::string_view(f.name) == snapshot_geometry_field) continue;
+    if (!(e.fields & (SnapshotFieldSet{1} << k))) continue;
+    out += in + "<Attribute Name=\"" + std::string(f.name) + "\" AttributeType=\"" +
+           (f.components == 1 ? "Scalar" : "Vector") + "\" Center=\"Node\">\n";
+    data_item(out, e.file, e.count, f, item_indent.c_str());
+    out += in + "</Attribute>\n";
+  }
+  if (network) {
+    out += "        </Grid>\n";
+    out += render_contact_grids(e, "        ");
+  }
+  out += "      </Grid>\n";
+  return out;
+}
+
+std::string render_xdmf_tail() { return "    </Grid>\n  </Domain>\n</Xdmf>\n"; }
+
+std::string render_xdmf(const std::vector<XdmfEntry>& entries, const std::string& series_name) {
+  std::string out = render_xdmf_head(series_name);
+  for (const XdmfEntry& e : entries) out += render_xdmf_entry(e);
+  out += render_xdmf_tail();
   return out;
 }
 

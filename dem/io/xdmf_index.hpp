@@ -84,7 +84,17 @@ std::string render_contact_grids(const XdmfEntry& entry, const std::string& inde
 
 // The complete index for `entries` (in the order given), as one Temporal Collection named
 // `series_name` of Uniform Polyvertex grids; each grid lists the fields its file holds.
+// It is render_xdmf_head + render_xdmf_entry of each entry + render_xdmf_tail; the index file
+// (xdmf_index_file.hpp) appends one rendered entry at a time between the grids and the tail.
 std::string render_xdmf(const std::vector<XdmfEntry>& entries, const std::string& series_name);
+
+// Up to and including the opening tag of the Temporal Collection.
+std::string render_xdmf_head(const std::string& series_name);
+// Everything the index says about one snapshot: the elements of one time step, complete (they
+// contain no "?>", which the append relies on: xdmf_index_file.cpp).
+std::string render_xdmf_entry(const XdmfEntry& entry);
+// The closing tags of the collection, the domain and the document.
+std::string render_xdmf_tail();
 
 // Replaces `path` by `content` atomically: writes `path`.tmp in the same directory, flushes it
 // to disk, then renames it over `path`, so neither a reader nor a killed run ever sees a
