@@ -490,21 +490,21 @@ void canonical_pair_sweep(ContactSweep& s) {
     Vec3 *spring_t, *spring_r;
     bool counts;  // a contact with a ghost is counted by the owner of the lower id
   };
+  const auto canonical_local = [&](const Touching& t) __attribute__((always_inline)) {
+    const int i = t.i, j = l_partner[t.k];
+    const int a = L.id[i] < L.id[j] ? i : j, b = a == i ? j : i;
+    return Pair{&L,
+                a,
+                &L,
+                b,
+                Vec3(x[a] - x[b]),
+                Law::keeps_tangential ? l_springs_t + t.k : nullptr,
+                Law::keeps_rolling ? l_springs_r + t.k : nullptr,
+                true};
+  };
   const auto canonical = [&](const Touching& t) __attribute__((always_inline)) {
-    const int i = t.i;
-    if (t.k >= 0) {
-      const int j = l_partner[t.k];
-      const int a = L.id[i] < L.id[j] ? i : j, b = a == i ? j : i;
-      return Pair{&L,
-                  a,
-                  &L,
-                  b,
-                  Vec3(x[a] - x[b]),
-                  Law::keeps_tangential ? l_springs_t + t.k : nullptr,
-                  Law::keeps_rolling ? l_springs_r + t.k : nullptr,
-                  true};
-    }
-    const int e = ~t.k, q = g_partner[e];
+    if (t.k >= 0) return canonical_local(t);
+    const int i = t.i, e = ~t.k, q = g_partner[e];
     Vec3* st = Law::keeps_tangential ? g_springs_t + e : nullptr;
     Vec3* sr = Law::keeps_rolling ? g_springs_r + e : nullptr;
     return L.id[i] < G.id[q]
@@ -517,15 +517,18 @@ void canonical_pair_sweep(ContactSweep& s) {
   const auto table = [&](const Pair& c) -> const PairCoefficients& {
     return s.table(c.a->material[c.ia], c.b->material[c.ib]);
   };
-  const auto apply = [&](const Pair& c, const ContactResult& r, double overlap) {
-    c.a->force[c.ia] += r.force;
-    c.b->force[c.ib] -= r.force;
+  // Local: both bodies are local particles (c.a == c.b == &L, known to the compiler).
+  const auto apply = [&]<bool Local>(const Pair& c, const ContactResult& r, double overlap) {
+    const Source& A = Local ? L : *c.a;
+    const Source& B = Local ? L : *c.b;
+    A.force[c.ia] += r.force;
+    B.force[c.ib] -= r.force;
     if constexpr (Law::needs_spin) {
-      c.a->torque[c.ia] += r.torque_i;
-      c.b->torque[c.ib] += r.torque_j;
+      A.torque[c.ia] += r.torque_i;
+      B.torque[c.ib] += r.torque_j;
     }
-    s.contacts += c.counts;
-    const double ra = c.a->radius[c.ia], rb = c.b->radius[c.ib];
+    s.contacts += Local || c.counts;
+    const double ra = A.radius[c.ia], rb = B.radius[c.ib];
     const double min_r = std::min(ra, rb);
     if (gate.may_beat(overlap, min_r)) [[unlikely]]
       if (const double ratio = overlap / min_r; ratio > s.max_overlap_ratio) {
@@ -544,16 +547,24 @@ void canonical_pair_sweep(ContactSweep& s) {
         return s.table(u.material, u.material);
       })
                   : PairCoefficientLanes<V>{};
-  const auto lanes = [&]<bool Alike>(int m) __attribute__((always_inline)) {
-    for (int c = 0; c < m; c += W) {
-      Pair group[W];
+  // The W touching entries from batch[c] (the last one repeated to fill the group; its
+  // results are discarded). Local: all of them local pairs.
+  const auto group_lanes = [&]<bool Alike, bool Local>(int c, int m)
+                               __attribute__((always_inline)) {
+    Pair group[W];
 #pragma GCC unroll 4
-      for (int l = 0; l < W; ++l) group[l] = canonical(batch[std::min(c + l, m - 1)]);
+    for (int l = 0; l < W; ++l) {
+      const Touching& t = batch[std::min(c + l, m - 1)];
+      group[l] = Local ? canonical_local(t) : canonical(t);
+    }
+    const auto A = [&](int l) -> const Source& { return Local ? L : *group[l].a; };
+    const auto B = [&](int l) -> const Source& { return Local ? L : *group[l].b; };
+    {
       Body<V> a, b;
-      a.v = gather3<V>([&](int l) -> const Vec3& { return group[l].a->v[group[l].ia]; });
-      a.w = gather3<V>([&](int l) -> const Vec3& { return group[l].a->w[group[l].ia]; });
-      b.v = gather3<V>([&](int l) -> const Vec3& { return group[l].b->v[group[l].ib]; });
-      b.w = gather3<V>([&](int l) -> const Vec3& { return group[l].b->w[group[l].ib]; });
+      a.v = gather3<V>([&](int l) -> const Vec3& { return A(l).v[group[l].ia]; });
+      a.w = gather3<V>([&](int l) -> const Vec3& { return A(l).w[group[l].ia]; });
+      b.v = gather3<V>([&](int l) -> const Vec3& { return B(l).v[group[l].ib]; });
+      b.w = gather3<V>([&](int l) -> const Vec3& { return B(l).w[group[l].ib]; });
       V r_star, m_star;
       PairCoefficientLanes<V> pc;
       if constexpr (Alike) {
@@ -563,10 +574,10 @@ void canonical_pair_sweep(ContactSweep& s) {
         m_star = broadcast<V>(u.m_star);
         pc = uniform_pc;
       } else {
-        a.r = gather<V>([&](int l) { return group[l].a->radius[group[l].ia]; });
-        a.m = gather<V>([&](int l) { return group[l].a->mass[group[l].ia]; });
-        b.r = gather<V>([&](int l) { return group[l].b->radius[group[l].ib]; });
-        b.m = gather<V>([&](int l) { return group[l].b->mass[group[l].ib]; });
+        a.r = gather<V>([&](int l) { return A(l).radius[group[l].ia]; });
+        a.m = gather<V>([&](int l) { return A(l).mass[group[l].ia]; });
+        b.r = gather<V>([&](int l) { return B(l).radius[group[l].ib]; });
+        b.m = gather<V>([&](int l) { return B(l).mass[group[l].ib]; });
         r_star = reduced_radius(a, b);
         m_star = reduced_mass(a, b);
         pc = gather_coefficients<V>(
@@ -583,9 +594,21 @@ void canonical_pair_sweep(ContactSweep& s) {
       for (int l = 0; l < W; ++l) {
         if (c + l == m) break;
         if constexpr (Law::keeps_tangential) *group[l].spring_t = lane(ht, l);
-        apply(group[l], ContactResult{lane(r.force, l), lane(r.torque_i, l), lane(r.torque_j, l)},
-              overlap[l]);
+        apply.template operator()<Local>(
+            group[l], ContactResult{lane(r.force, l), lane(r.torque_i, l), lane(r.torque_j, l)},
+            overlap[l]);
       }
+    }
+  };
+  const auto lanes = [&]<bool Alike>(int m) __attribute__((always_inline)) {
+    for (int c = 0; c < m; c += W) {
+      bool local = true;
+#pragma GCC unroll 4
+      for (int l = 0; l < W; ++l) local &= batch[std::min(c + l, m - 1)].k >= 0;
+      if (local)
+        group_lanes.template operator()<Alike, true>(c, m);
+      else
+        group_lanes.template operator()<Alike, false>(c, m);
     }
   };
   const auto evaluate = [&](int m) __attribute__((always_inline)) {
@@ -604,7 +627,7 @@ void canonical_pair_sweep(ContactSweep& s) {
         double overlap;
         const ContactResult r = pair_force<Law>(s, p0.d, a, b, reduced_radius(a, b),
                                                 reduced_mass(a, b), table(p0), ht, hr, overlap);
-        apply(p0, r, overlap);
+        apply.template operator()<false>(p0, r, overlap);
       }
     }
   };
