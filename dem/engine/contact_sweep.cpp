@@ -457,12 +457,12 @@ void canonical_pair_sweep(ContactSweep& s) {
   };
   order.ghost_force.assign(g.size(), Vec3::Zero());
   order.ghost_torque.assign(g.size(), Vec3::Zero());
-  const Source L{p.id.data(),      p.v.data(),       p.omega.data(), p.radius.data(),
-                 p.mass.data(),    p.inertia.data(), p.material.data(), p.force.data(),
-                 p.torque.data()};
-  const Source G{g.id.data(),      g.v.data(),       g.omega.data(),          g.radius.data(),
-                 g.mass.data(),    g.inertia.data(), g.material.data(),       order.ghost_force.data(),
-                 order.ghost_torque.data()};
+  const Source L{p.id.data(),       p.v.data(),     p.omega.data(),
+                 p.radius.data(),   p.mass.data(),  p.inertia.data(),
+                 p.material.data(), p.force.data(), p.torque.data()};
+  const Source G{g.id.data(),       g.v.data(),               g.omega.data(),
+                 g.radius.data(),   g.mass.data(),            g.inertia.data(),
+                 g.material.data(), order.ghost_force.data(), order.ghost_torque.data()};
   const Vec3* x = p.x.data();
   const Vec3* g_x = g.x.data();
   const Vec3* g_shift = g.shift.data();

@@ -10,6 +10,8 @@
 // them. Exact comparison (keys are integers). Random polydisperse spheres in a box periodic
 // along x and y (one rank: every ghost is a periodic image, some particles pair with
 // several images), several seeds.
+#include "dem/engine/canonical_order.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,7 +19,6 @@
 #include <random>
 #include <tuple>
 
-#include "dem/engine/canonical_order.hpp"
 #include "dem/parallel/exchange.hpp"
 
 namespace grainflow {
