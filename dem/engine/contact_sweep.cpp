@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "dem/engine/canonical_sum.hpp"
+#include "dem/engine/canonical_order.hpp"
 #include "dem/engine/wall_sweep.hpp"
 
 namespace grainflow {
@@ -162,15 +162,7 @@ inline void keep_or_zero(bool keep, Vec3& h) {
     h[a] = std::bit_cast<double>(std::bit_cast<std::uint64_t>(h[a]) & mask);
 }
 
-// With Canonical (parallel.reproducible), the pair sweeps put each touching contact's two
-// shares in s.canonical (canonical_sum.hpp) instead of adding them to the particles: the
-// t-th touching contact of the sweep gets record t & mask of the ring, an entry that does
-// not touch the record of zeros. The sweeps then run over the owners [a, b) only.
-inline void put_shares(CanonicalSum::Share* shares, int record, const ContactResult& r) {
-  shares[record] = {r.force, {r.torque_i, r.torque_j}};
-}
-
-template <class Law, bool Canonical>
+template <class Law>
 void local_pair_sweep(ContactSweep& s, int a_first, int a_end) {
   Particles& p = s.p;
   const int n = static_cast<int>(p.size());
@@ -203,23 +195,12 @@ void local_pair_sweep(ContactSweep& s, int a_first, int a_end) {
   };
   const auto body = [&](int q) { return Body<double>{v[q], w[q], radius[q], mass[q], inertia[q]}; };
   // The contact's forces and torques on both bodies, its count and the overlap guard.
-  // Canonical: where the shares go (see put_shares).
-  [[maybe_unused]] int* slot = Canonical ? s.canonical->slot.data() : nullptr;
-  [[maybe_unused]] CanonicalSum::Share* shares = Canonical ? s.canonical->shares.data() : nullptr;
-  [[maybe_unused]] const int mask = Canonical ? s.canonical->mask : 0;
-  [[maybe_unused]] const int none = Canonical ? s.canonical->none : 0;
-  [[maybe_unused]] int touched = Canonical ? s.canonical_touching : 0;  // before this batch
-  const auto apply = [&](const Pair& c, const ContactResult& r, double overlap,
-                         [[maybe_unused]] int t) {
-    if constexpr (Canonical) {
-      put_shares(shares, (touched + t) & mask, r);
-    } else {
-      force[c.a] += r.force;
-      force[c.b] -= r.force;
-      if constexpr (Law::needs_spin) {
-        torque[c.a] += r.torque_i;
-        torque[c.b] += r.torque_j;
-      }
+  const auto apply = [&](const Pair& c, const ContactResult& r, double overlap) {
+    force[c.a] += r.force;
+    force[c.b] -= r.force;
+    if constexpr (Law::needs_spin) {
+      torque[c.a] += r.torque_i;
+      torque[c.b] += r.torque_j;
     }
     ++s.contacts;
     // The guard's details are gathered only for a new largest overlap (rare).
@@ -287,7 +268,7 @@ void local_pair_sweep(ContactSweep& s, int a_first, int a_end) {
         if (c + l == m) break;
         if constexpr (Law::keeps_tangential) springs_t[group[l].k] = lane(ht, l);
         apply(group[l], ContactResult{lane(r.force, l), lane(r.torque_i, l), lane(r.torque_j, l)},
-              overlap[l], c + l);
+              overlap[l]);
       }
     }
   };
@@ -308,7 +289,7 @@ void local_pair_sweep(ContactSweep& s, int a_first, int a_end) {
         const ContactResult r = pair_force<Law>(
             s, Vec3(x[p0.a] - x[p0.b]), a, b, reduced_radius(a, b), reduced_mass(a, b),
             s.table(material[p0.a], material[p0.b]), ht, hr, overlap);
-        apply(p0, r, overlap, c);
+        apply(p0, r, overlap);
       }
     }
   };
@@ -323,18 +304,15 @@ void local_pair_sweep(ContactSweep& s, int a_first, int a_end) {
       const int i = owner[k], j = partner[k];
       const bool touching = !apart(x[i] - x[j], radius[i] + radius[j]);
       batch[m] = {i, k};
-      if constexpr (Canonical) slot[k] = touching ? (touched + m) & mask : none;
       m += touching;
       if constexpr (Law::keeps_tangential) keep_or_zero(touching, springs_t[k]);
       if constexpr (Law::keeps_rolling) keep_or_zero(touching, springs_r[k]);
     }
     evaluate(m);
-    if constexpr (Canonical) touched += m;
   }
-  if constexpr (Canonical) s.canonical_touching = touched;
 }
 
-template <class Law, bool Canonical>
+template <class Law>
 void ghost_pair_sweep(ContactSweep& s, int a_first, int a_end) {
   Particles& p = s.p;
   const Ghosts& g = s.ghosts;
@@ -386,22 +364,10 @@ void ghost_pair_sweep(ContactSweep& s, int a_first, int a_end) {
     return c.local_first ? s.table(material[c.i], g_material[c.q])
                          : s.table(g_material[c.q], material[c.i]);
   };
-  // Canonical: the ghost list's entries and records follow the local list's.
-  [[maybe_unused]] int* slot =
-      Canonical ? s.canonical->slot.data() + s.canonical->ghost_base : nullptr;
-  [[maybe_unused]] CanonicalSum::Share* shares = Canonical ? s.canonical->shares.data() : nullptr;
-  [[maybe_unused]] const int mask = Canonical ? s.canonical->mask : 0;
-  [[maybe_unused]] const int none = Canonical ? s.canonical->none : 0;
-  [[maybe_unused]] int touched = Canonical ? s.canonical_touching : 0;
-  const auto apply = [&](const Pair& c, const ContactResult& r, double overlap,
-                         [[maybe_unused]] int t) {
+  const auto apply = [&](const Pair& c, const ContactResult& r, double overlap) {
     const int i = c.i, q = c.q;
-    if constexpr (Canonical) {
-      put_shares(shares, (touched + t) & mask, r);
-    } else {
-      force[i] += c.local_first ? r.force : Vec3(-r.force);
-      if constexpr (Law::needs_spin) torque[i] += c.local_first ? r.torque_i : r.torque_j;
-    }
+    force[i] += c.local_first ? r.force : Vec3(-r.force);
+    if constexpr (Law::needs_spin) torque[i] += c.local_first ? r.torque_i : r.torque_j;
     // Both owners see this contact; the owner of the lower id counts it.
     if (c.local_first) ++s.contacts;
     const double min_r = std::min(radius[i], g_radius[q]);
@@ -446,7 +412,7 @@ void ghost_pair_sweep(ContactSweep& s, int a_first, int a_end) {
           if (c + l == m) break;
           if constexpr (Law::keeps_tangential) springs_t[group[l].k] = lane(ht, l);
           apply(group[l], ContactResult{lane(r.force, l), lane(r.torque_i, l), lane(r.torque_j, l)},
-                overlap[l], c + l);
+                overlap[l]);
         }
       }
     } else {
@@ -459,7 +425,7 @@ void ghost_pair_sweep(ContactSweep& s, int a_first, int a_end) {
         const ContactResult r =
             pair_force<Law>(s, p0.d, p0.first, p0.second, reduced_radius(p0.first, p0.second),
                             reduced_mass(p0.first, p0.second), table(p0), ht, hr, overlap);
-        apply(p0, r, overlap, c);
+        apply(p0, r, overlap);
       }
     }
   };
@@ -471,36 +437,257 @@ void ghost_pair_sweep(ContactSweep& s, int a_first, int a_end) {
       const int i = owner[k], q = partner[k];
       const bool touching = !apart((x[i] - g_x[q]) + (zero - g_shift[q]), radius[i] + g_radius[q]);
       batch[m] = {i, k};
-      if constexpr (Canonical) slot[k] = touching ? (touched + m) & mask : none;
       m += touching;
       if constexpr (Law::keeps_tangential) keep_or_zero(touching, springs_t[k]);
       if constexpr (Law::keeps_rolling) keep_or_zero(touching, springs_r[k]);
     }
     evaluate(m);
-    if constexpr (Canonical) touched += m;
   }
-  if constexpr (Canonical) s.canonical_touching = touched;
 }
 
-// Pairs, then walls. With Canonical the pairs' shares are added in canonical order before
-// the walls (in wall order) add theirs.
-// The canonical sweep goes over the owners a chunk at a time: a particle's local-list shares
-// come from owners up to itself (a half list, j > i) and its ghost-list shares from itself,
-// so its sum is complete after its chunk, while the shares are still in cache.
+// parallel.reproducible: the local and ghost pairs in the order of s.canonical
+// (canonical_order.hpp), each touching pair's force and torques added to both its particles
+// at once, in that order (a ghost's share goes to a sink). The pair force is the kernel of
+// the other sweeps, in the same lanes: a contact's result has the same bits in any lane.
+template <class Law>
+void canonical_pair_sweep(ContactSweep& s) {
+  Particles& p = s.p;
+  const Ghosts& g = s.ghosts;
+  CanonicalOrder& order = *s.canonical;
+  // Where a body's state is read and its share added: the local particles' arrays, or the
+  // ghosts' with the sinks.
+  struct Source {
+    const GlobalId* id;
+    const Vec3 *v, *w;
+    const double *radius, *mass, *inertia;
+    const int* material;
+    Vec3 *force, *torque;
+  };
+  order.ghost_force.assign(g.size(), Vec3::Zero());
+  order.ghost_torque.assign(g.size(), Vec3::Zero());
+  const Source L{p.id.data(),       p.v.data(),     p.omega.data(),
+                 p.radius.data(),   p.mass.data(),  p.inertia.data(),
+                 p.material.data(), p.force.data(), p.torque.data()};
+  const Source G{g.id.data(),       g.v.data(),               g.omega.data(),
+                 g.radius.data(),   g.mass.data(),            g.inertia.data(),
+                 g.material.data(), order.ghost_force.data(), order.ghost_torque.data()};
+  const Vec3* x = p.x.data();
+  const Vec3* g_x = g.x.data();
+  const Vec3* g_shift = g.shift.data();
+  const int* l_owner = s.local_list.owner.data();
+  const int* l_partner = s.local_list.j.data();
+  const int* g_owner = s.ghost_list.owner.data();
+  const int* g_partner = s.ghost_list.j.data();
+  Vec3* l_springs_t = Law::keeps_tangential ? s.local_springs.tangential.data() : nullptr;
+  Vec3* l_springs_r = Law::keeps_rolling ? s.local_springs.rolling.data() : nullptr;
+  Vec3* g_springs_t = Law::keeps_tangential ? s.ghost_springs.tangential.data() : nullptr;
+  Vec3* g_springs_r = Law::keeps_rolling ? s.ghost_springs.rolling.data() : nullptr;
+  const Vec3 zero = Vec3::Zero();
+  OverlapGate gate(s.max_overlap_ratio);
+  // A touching entry: k >= 0 the local-list entry k of the local particle i, k < 0 the
+  // ghost-list entry ~k.
+  Touching batch[2 * kBatch];
+  // Its two bodies in canonical orientation (the lower global id first), their
+  // displacement (x_a - x_b) + (shift_a - shift_b) and its springs.
+  struct Pair {
+    const Source* a;
+    int ia;
+    const Source* b;
+    int ib;
+    Vec3 d;
+    Vec3 *spring_t, *spring_r;
+    bool counts;  // a contact with a ghost is counted by the owner of the lower id
+  };
+  const auto canonical_local = [&](const Touching& t) __attribute__((always_inline)) {
+    const int i = t.i, j = l_partner[t.k];
+    const int a = L.id[i] < L.id[j] ? i : j, b = a == i ? j : i;
+    return Pair{&L,
+                a,
+                &L,
+                b,
+                Vec3(x[a] - x[b]),
+                Law::keeps_tangential ? l_springs_t + t.k : nullptr,
+                Law::keeps_rolling ? l_springs_r + t.k : nullptr,
+                true};
+  };
+  const auto canonical = [&](const Touching& t) __attribute__((always_inline)) {
+    if (t.k >= 0) return canonical_local(t);
+    const int i = t.i, e = ~t.k, q = g_partner[e];
+    Vec3* st = Law::keeps_tangential ? g_springs_t + e : nullptr;
+    Vec3* sr = Law::keeps_rolling ? g_springs_r + e : nullptr;
+    return L.id[i] < G.id[q]
+               ? Pair{&L, i, &G, q, (x[i] - g_x[q]) + (zero - g_shift[q]), st, sr, true}
+               : Pair{&G, q, &L, i, (g_x[q] - x[i]) + (g_shift[q] - zero), st, sr, false};
+  };
+  const auto body = [](const Source* src, int k) {
+    return Body<double>{src->v[k], src->w[k], src->radius[k], src->mass[k], src->inertia[k]};
+  };
+  const auto table = [&](const Pair& c) -> const PairCoefficients& {
+    return s.table(c.a->material[c.ia], c.b->material[c.ib]);
+  };
+  // Local: both bodies are local particles (c.a == c.b == &L, known to the compiler).
+  const auto apply = [&]<bool Local>(const Pair& c, const ContactResult& r, double overlap) {
+    const Source& A = Local ? L : *c.a;
+    const Source& B = Local ? L : *c.b;
+    A.force[c.ia] += r.force;
+    B.force[c.ib] -= r.force;
+    if constexpr (Law::needs_spin) {
+      A.torque[c.ia] += r.torque_i;
+      B.torque[c.ib] += r.torque_j;
+    }
+    s.contacts += Local || c.counts;
+    const double ra = A.radius[c.ia], rb = B.radius[c.ib];
+    const double min_r = std::min(ra, rb);
+    if (gate.may_beat(overlap, min_r)) [[unlikely]]
+      if (const double ratio = overlap / min_r; ratio > s.max_overlap_ratio) {
+        const double ma = c.a->mass[c.ia], mb = c.b->mass[c.ib];
+        s.worst.consider(ratio, s.max_overlap_ratio, c.a->id[c.ia], c.b->id[c.ib],
+                         c.d.normalized().dot(c.b->v[c.ib] - c.a->v[c.ia]), ra * rb / (ra + rb),
+                         ma * mb / (ma + mb), table(c).y_star);
+        gate.set(s.max_overlap_ratio);
+      }
+  };
+  const UniformPairs& u = s.uniform;
+  using V = PairLanes;
+  constexpr int W = lane_count<V>;
+  const PairCoefficientLanes<V> uniform_pc =
+      u.all_alike ? gather_coefficients<V>([&](int) -> const PairCoefficients& {
+        return s.table(u.material, u.material);
+      })
+                  : PairCoefficientLanes<V>{};
+  // The W touching entries from batch[c] (the last one repeated to fill the group; its
+  // results are discarded). Local: all of them local pairs.
+  const auto group_lanes = [&]<bool Alike, bool Local>(int c, int m)
+                               __attribute__((always_inline)) {
+    Pair group[W];
+#pragma GCC unroll 4
+    for (int l = 0; l < W; ++l) {
+      const Touching& t = batch[std::min(c + l, m - 1)];
+      group[l] = Local ? canonical_local(t) : canonical(t);
+    }
+    const auto A = [&](int l) -> const Source& { return Local ? L : *group[l].a; };
+    const auto B = [&](int l) -> const Source& { return Local ? L : *group[l].b; };
+    {
+      Body<V> a, b;
+      a.v = gather3<V>([&](int l) -> const Vec3& { return A(l).v[group[l].ia]; });
+      a.w = gather3<V>([&](int l) -> const Vec3& { return A(l).w[group[l].ia]; });
+      b.v = gather3<V>([&](int l) -> const Vec3& { return B(l).v[group[l].ib]; });
+      b.w = gather3<V>([&](int l) -> const Vec3& { return B(l).w[group[l].ib]; });
+      V r_star, m_star;
+      PairCoefficientLanes<V> pc;
+      if constexpr (Alike) {
+        a.r = b.r = broadcast<V>(u.radius);
+        a.m = b.m = broadcast<V>(u.mass);
+        r_star = broadcast<V>(u.r_star);
+        m_star = broadcast<V>(u.m_star);
+        pc = uniform_pc;
+      } else {
+        a.r = gather<V>([&](int l) { return A(l).radius[group[l].ia]; });
+        a.m = gather<V>([&](int l) { return A(l).mass[group[l].ia]; });
+        b.r = gather<V>([&](int l) { return B(l).radius[group[l].ib]; });
+        b.m = gather<V>([&](int l) { return B(l).mass[group[l].ib]; });
+        r_star = reduced_radius(a, b);
+        m_star = reduced_mass(a, b);
+        pc = gather_coefficients<V>(
+            [&](int l) -> const PairCoefficients& { return table(group[l]); });
+      }
+      V3<V> ht = zero3<V>(), hr = zero3<V>();
+      if constexpr (Law::keeps_tangential)
+        ht = gather3<V>([&](int l) -> const Vec3& { return *group[l].spring_t; });
+      V overlap;
+      const ContactResultT<V> r =
+          pair_force<Law>(s, gather3<V>([&](int l) -> const Vec3& { return group[l].d; }), a, b,
+                          r_star, m_star, pc, ht, hr, overlap);
+#pragma GCC unroll 4
+      for (int l = 0; l < W; ++l) {
+        if (c + l == m) break;
+        if constexpr (Law::keeps_tangential) *group[l].spring_t = lane(ht, l);
+        apply.template operator()<Local>(
+            group[l], ContactResult{lane(r.force, l), lane(r.torque_i, l), lane(r.torque_j, l)},
+            overlap[l]);
+      }
+    }
+  };
+  const auto lanes = [&]<bool Alike>(int m) __attribute__((always_inline)) {
+    for (int c = 0; c < m; c += W) {
+      bool local = true;
+#pragma GCC unroll 4
+      for (int l = 0; l < W; ++l) local &= batch[std::min(c + l, m - 1)].k >= 0;
+      if (local)
+        group_lanes.template operator()<Alike, true>(c, m);
+      else
+        group_lanes.template operator()<Alike, false>(c, m);
+    }
+  };
+  const auto evaluate = [&](int m) __attribute__((always_inline)) {
+    if constexpr (Law::lanes) {
+      if (u.all_alike)
+        lanes.template operator()<true>(m);
+      else
+        lanes.template operator()<false>(m);
+    } else {
+      Vec3 unused;
+      for (int c = 0; c < m; ++c) {
+        const Pair p0 = canonical(batch[c]);
+        Vec3& ht = Law::keeps_tangential ? *p0.spring_t : unused;
+        Vec3& hr = Law::keeps_rolling ? *p0.spring_r : unused;
+        const Body<double> a = body(p0.a, p0.ia), b = body(p0.b, p0.ib);
+        double overlap;
+        const ContactResult r = pair_force<Law>(s, p0.d, a, b, reduced_radius(a, b),
+                                                reduced_mass(a, b), table(p0), ht, hr, overlap);
+        apply.template operator()<false>(p0, r, overlap);
+      }
+    }
+  };
+  // The entries of each run, kBatch at a time: the touching ones are gathered (without a
+  // branch) and evaluated, in order, once kBatch of them have come together.
+  int m = 0;
+  const auto flush = [&](int least) __attribute__((always_inline)) {
+    if (m >= least) {
+      evaluate(m);
+      m = 0;
+    }
+  };
+  int k = 0, t = 0;
+  for (const CanonicalOrder::Run& run : order.runs) {
+    while (k < run.local_end) {
+      for (const int stop = std::min(run.local_end, k + kBatch); k < stop; ++k) {
+        const int i = l_owner[k], j = l_partner[k];
+        const bool touching = !apart(x[i] - x[j], L.radius[i] + L.radius[j]);
+        batch[m] = {i, k};
+        m += touching;
+        if constexpr (Law::keeps_tangential) keep_or_zero(touching, l_springs_t[k]);
+        if constexpr (Law::keeps_rolling) keep_or_zero(touching, l_springs_r[k]);
+      }
+      flush(kBatch);
+    }
+    while (t < run.ghost_end) {
+      for (const int stop = std::min(run.ghost_end, t + kBatch); t < stop; ++t) {
+        const int e = order.ghost_entries[t];
+        const int i = g_owner[e], q = g_partner[e];
+        const bool touching =
+            !apart((x[i] - g_x[q]) + (zero - g_shift[q]), L.radius[i] + G.radius[q]);
+        batch[m] = {i, ~e};
+        m += touching;
+        if constexpr (Law::keeps_tangential) keep_or_zero(touching, g_springs_t[e]);
+        if constexpr (Law::keeps_rolling) keep_or_zero(touching, g_springs_r[e]);
+      }
+      flush(kBatch);
+    }
+  }
+  flush(1);
+}
+
+// Pairs, then walls (in wall order). With Canonical (parallel.reproducible) the pairs in
+// canonical order, the default: the local list, then the ghost list.
 template <class Law, bool Canonical>
 void sweep(ContactSweep& s) {
-  const int n = static_cast<int>(s.p.size());
   if constexpr (Canonical) {
-    s.canonical_touching = 0;
-    for (int a = 0; a < n; a += CanonicalSum::kChunk) {
-      const int b = std::min(n, a + CanonicalSum::kChunk);
-      local_pair_sweep<Law, true>(s, a, b);
-      ghost_pair_sweep<Law, true>(s, a, b);
-      s.canonical->add_to(s.p, Law::needs_spin, a, b);
-    }
+    canonical_pair_sweep<Law>(s);
   } else {
-    local_pair_sweep<Law, false>(s, 0, n);
-    ghost_pair_sweep<Law, false>(s, 0, n);
+    const int n = static_cast<int>(s.p.size());
+    local_pair_sweep<Law>(s, 0, n);
+    ghost_pair_sweep<Law>(s, 0, n);
   }
   wall_sweep<Law>(s);
 }

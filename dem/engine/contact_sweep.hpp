@@ -16,7 +16,7 @@
 #include "dem/contact/contact_geometry.hpp"
 #include "dem/contact/pair_coefficients.hpp"
 #include "dem/core/particles.hpp"
-#include "dem/engine/canonical_sum.hpp"
+#include "dem/engine/canonical_order.hpp"
 #include "dem/io/contact_network.hpp"
 #include "dem/neighbour/verlet_list.hpp"
 #include "dem/neighbour/wall_neighbours.hpp"
@@ -100,10 +100,9 @@ struct ContactSweep {
   double max_overlap_ratio = 0;  // overlap / smaller radius
   WorstContact worst;            // the contact with that overlap
   UnresolvedContact unresolved;  // filled by steps_per_contact_sweep
-  // parallel.reproducible: the canonical order of the sums (set at each neighbour rebuild),
-  // for a sweep of select_sweep(..., true); unused otherwise.
-  CanonicalSum* canonical = nullptr;
-  int canonical_touching = 0;  // touching local-list entries (set by the local pair sweep)
+  // parallel.reproducible: the order of the pairs (set at each neighbour rebuild), for a
+  // sweep of select_sweep(..., true); unused otherwise.
+  CanonicalOrder* canonical = nullptr;
 };
 
 using SweepFunction = void (*)(ContactSweep&);
@@ -127,7 +126,7 @@ struct SweepChoice {
 };
 
 // `canonical`: the sweep for parallel.reproducible, which adds each particle's pair
-// contributions in canonical order (ContactSweep::canonical, canonical_sum.hpp).
+// contributions in canonical order (ContactSweep::canonical, canonical_order.hpp).
 SweepChoice select_sweep(const ContactSettings& settings, bool canonical = false);
 
 // The steps-per-contact test (UnresolvedContact) over every touching contact of the

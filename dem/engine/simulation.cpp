@@ -152,8 +152,7 @@ void Simulation::initialise() {
     restored_springs_.clear();
   }
 
-  grid_ = std::make_unique<BinGrid>(decomp_->lo() - Vec3::Constant(cutoff_),
-                                    decomp_->hi() + Vec3::Constant(cutoff_), cutoff_);
+  make_bin_grid();
   walls_.move_to(time_);
   walls_.fit_grids(r_max);  // mesh search cells of one particle diameter
   const bool restoring = restored_;
@@ -490,8 +489,16 @@ void Simulation::balance_cuts() {
     for (int k = n - 1; k >= 1; --k) cuts[k] = std::min(cuts[k], cuts[k + 1] - cutoff_);
     decomp_->set_cuts(a, cuts);
   }
-  grid_ = std::make_unique<BinGrid>(decomp_->lo() - Vec3::Constant(cutoff_),
-                                    decomp_->hi() + Vec3::Constant(cutoff_), cutoff_);
+  make_bin_grid();
+}
+
+void Simulation::make_bin_grid() {
+  if (scene_.parallel.reproducible)
+    grid_ = std::make_unique<BinGrid>(
+        BinGrid::anchored(scene_.domain.lo, scene_.domain.hi, cutoff_));
+  else
+    grid_ = std::make_unique<BinGrid>(decomp_->lo() - Vec3::Constant(cutoff_),
+                                      decomp_->hi() + Vec3::Constant(cutoff_), cutoff_);
 }
 
 void Simulation::remake_decomposition(const std::array<int, 3>& dims) {
@@ -681,7 +688,8 @@ void Simulation::rebuild(bool keep_drag) {
   grid_->build(p_, ghosts_, skin_, local_list_, ghost_list_);
   wall_neighbours_.build(p_, walls_, skin_);
   restore_histories(carried);
-  if (scene_.parallel.reproducible) canonical_.build(p_, ghosts_, local_list_, ghost_list_);
+  if (scene_.parallel.reproducible)
+    canonical_.build(p_, ghosts_, local_list_, ghost_list_, *grid_);
   if (carried.carries_drag) {
     drag_.coefficient.resize(p_.size());
     drag_.fluid_velocity.resize(p_.size());

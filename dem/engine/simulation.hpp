@@ -202,6 +202,10 @@ class Simulation {
  private:
   void rebuild(bool keep_drag = false);
   void balance_cuts();  // moves cut planes toward equal particle counts (collective)
+  // The bins of the neighbour search: over this rank's box widened by the interaction range,
+  // or with parallel.reproducible the lattice anchored at the domain (BinGrid::anchored),
+  // the same on every rank, whose bins are the particles' keys (canonical_order.hpp).
+  void make_bin_grid();
   // The default grid (automatic grid, no imposed planes, no checkpoint grid for this rank
   // count): the least cut area through the particles' extent among the grids whose boxes are
   // at least as thick as the interaction range, planes at the particle-count quantiles;
@@ -276,7 +280,7 @@ class Simulation {
   std::vector<std::vector<ContactHistory>> wall_history_;
   WallNeighbours wall_neighbours_;  // rebuilt with the Verlet lists
   UniformPairs uniform_;            // found with the Verlet lists
-  CanonicalSum canonical_;          // parallel.reproducible: built with the Verlet lists
+  CanonicalOrder canonical_;        // parallel.reproducible: built with the Verlet lists
   WallSet walls_;
   StreamInsertion streams_;
   std::vector<Vec3> x_at_build_;

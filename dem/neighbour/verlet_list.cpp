@@ -59,6 +59,21 @@ BinGrid::BinGrid(const Vec3& lo, const Vec3& hi, double bin_edge) : lo_(lo), hi_
   }
 }
 
+BinGrid BinGrid::anchored(const Vec3& lo, const Vec3& hi, double bin_edge) {
+  constexpr double kMaxPerAxis = (1 << 20) - 2;
+  BinGrid grid(lo, hi, bin_edge);
+  const Vec3 length = hi - lo;
+  for (int a = 0; a < 3; ++a) {
+    const double bins = std::clamp(std::floor(length[a] / bin_edge), 1.0, kMaxPerAxis);
+    const double edge = length[a] / bins;
+    grid.lo_[a] = lo[a] - edge;
+    grid.hi_[a] = hi[a] + edge;
+    grid.n_[a] = static_cast<int>(bins) + 2;
+    grid.inv_edge_[a] = bins / length[a];
+  }
+  return grid;
+}
+
 std::uint64_t BinGrid::key_of(const Vec3& x) const {
   std::uint64_t c[3];
   for (int a = 0; a < 3; ++a) {

@@ -60,6 +60,12 @@ class BinGrid {
   // The lattice of bins covering [lo, hi] with edges no smaller than bin_edge (at most
   // 2^20 bins per axis, so that a key fits in 60 bits; larger bins are still correct).
   BinGrid(const Vec3& lo, const Vec3& hi, double bin_edge);
+  // The lattice anchored at the domain [lo, hi] (parallel.reproducible): floor(L / bin_edge)
+  // bins across each axis of length L, plus one on either side for ghosts and periodic
+  // images (they lie within the interaction range <= one bin of the domain). Every rank of
+  // every decomposition has the same lattice, so a particle's bin (its key for
+  // CanonicalOrder) depends on its position only.
+  static BinGrid anchored(const Vec3& lo, const Vec3& hi, double bin_edge);
   // Key of the bin holding x: (k_z n_y + k_y) n_x + k_x, each k clamped to the lattice.
   std::uint64_t key_of(const Vec3& x) const;
   // Permutation that orders local particles by bin key, then by global id.

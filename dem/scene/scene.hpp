@@ -198,8 +198,8 @@ struct NeighbourSettings {
 struct ParallelSettings {
   std::array<int, 3> grid{0, 0, 0};  // ranks per axis; all 0: chosen for least cut area
   bool balance = false;              // move cut planes to balance particle counts
-  // Sum every particle's contact forces in a canonical order (by partner id), so that the
-  // trajectory does not depend on the rank count or grid (dem/engine/canonical_sum.hpp).
+  // Sum every particle's contact forces in a canonical order (by partner key), so that the
+  // trajectory does not depend on the rank count or grid (dem/engine/canonical_order.hpp).
   bool reproducible = false;
 };
 
