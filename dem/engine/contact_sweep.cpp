@@ -42,9 +42,11 @@ namespace {
 
 // The state of one body of a pair, as the pair kernel reads it: of one contact (V = double)
 // or of one body of each of the contacts in the lanes of V.
+// v, w at the half step (springs), vp, wp predicted at the step's end (dashpots;
+// Particles::v_pred). A law without torques reads only vp.
 template <class V>
 struct Body {
-  V3<V> v, w;
+  V3<V> v, w, vp, wp;
   V r, m, inertia;
 };
 
@@ -112,8 +114,11 @@ template <class Law, class V, class PC>
     const V3<V> arm_w = g.arm_i * a.w + g.arm_j * b.w;
     g.v_rel = a.v - b.v - cross(arm_w, g.n);
     g.w_rel = a.w - b.w;
-  } else {
-    g.v_rel = a.v - b.v;
+    const V3<V> arm_wp = g.arm_i * a.wp + g.arm_j * b.wp;
+    g.v_pred = a.vp - b.vp - cross(arm_wp, g.n);
+    g.w_pred = a.wp - b.wp;
+  } else {  // no spring: only the dashpot's velocity
+    g.v_pred = a.vp - b.vp;
   }
   if constexpr (Law::needs_roll_inertia)
     g.roll_inertia =
@@ -172,6 +177,8 @@ void local_pair_sweep(ContactSweep& s, int a_first, int a_end) {
   const Vec3* x = p.x.data();
   const Vec3* v = p.v.data();
   const Vec3* w = p.omega.data();
+  const Vec3* vp = p.v_pred.data();
+  const Vec3* wp = p.omega_pred.data();
   const double* radius = p.radius.data();
   const double* mass = p.mass.data();
   const double* inertia = p.inertia.data();
@@ -193,7 +200,9 @@ void local_pair_sweep(ContactSweep& s, int a_first, int a_end) {
     const int first = id[t.i] < id[j] ? t.i : j;
     return Pair{first, first == t.i ? j : t.i, t.k};
   };
-  const auto body = [&](int q) { return Body<double>{v[q], w[q], radius[q], mass[q], inertia[q]}; };
+  const auto body = [&](int q) {
+    return Body<double>{v[q], w[q], vp[q], wp[q], radius[q], mass[q], inertia[q]};
+  };
   // The contact's forces and torques on both bodies, its count and the overlap guard.
   // Canonical: where the shares go (see put_shares).
   [[maybe_unused]] int* slot = Canonical ? s.canonical->slot.data() : nullptr;
@@ -244,10 +253,16 @@ void local_pair_sweep(ContactSweep& s, int a_first, int a_end) {
 #pragma GCC unroll 4
       for (int l = 0; l < W; ++l) group[l] = canonical(batch[std::min(c + l, m - 1)]);
       Body<V> a, b;
-      a.v = gather3<V>([&](int l) -> const Vec3& { return v[group[l].a]; });
-      a.w = gather3<V>([&](int l) -> const Vec3& { return w[group[l].a]; });
-      b.v = gather3<V>([&](int l) -> const Vec3& { return v[group[l].b]; });
-      b.w = gather3<V>([&](int l) -> const Vec3& { return w[group[l].b]; });
+      a.vp = gather3<V>([&](int l) -> const Vec3& { return vp[group[l].a]; });
+      b.vp = gather3<V>([&](int l) -> const Vec3& { return vp[group[l].b]; });
+      if constexpr (Law::needs_spin) {
+        a.v = gather3<V>([&](int l) -> const Vec3& { return v[group[l].a]; });
+        a.w = gather3<V>([&](int l) -> const Vec3& { return w[group[l].a]; });
+        a.wp = gather3<V>([&](int l) -> const Vec3& { return wp[group[l].a]; });
+        b.v = gather3<V>([&](int l) -> const Vec3& { return v[group[l].b]; });
+        b.w = gather3<V>([&](int l) -> const Vec3& { return w[group[l].b]; });
+        b.wp = gather3<V>([&](int l) -> const Vec3& { return wp[group[l].b]; });
+      }
       V r_star, m_star;
       PairCoefficientLanes<V> pc;
       if constexpr (Alike) {
@@ -335,6 +350,8 @@ void ghost_pair_sweep(ContactSweep& s, int a_first, int a_end) {
   const Vec3* x = p.x.data();
   const Vec3* v = p.v.data();
   const Vec3* w = p.omega.data();
+  const Vec3* vp = p.v_pred.data();
+  const Vec3* wp = p.omega_pred.data();
   const double* radius = p.radius.data();
   const double* mass = p.mass.data();
   const double* inertia = p.inertia.data();
@@ -346,6 +363,8 @@ void ghost_pair_sweep(ContactSweep& s, int a_first, int a_end) {
   const Vec3* g_shift = g.shift.data();
   const Vec3* g_v = g.v.data();
   const Vec3* g_w = g.omega.data();
+  const Vec3* g_vp = g.v_pred.data();
+  const Vec3* g_wp = g.omega_pred.data();
   const double* g_radius = g.radius.data();
   const double* g_mass = g.mass.data();
   const double* g_inertia = g.inertia.data();
@@ -367,8 +386,9 @@ void ghost_pair_sweep(ContactSweep& s, int a_first, int a_end) {
   };
   const auto canonical = [&](const Touching& t) {
     const int i = t.i, q = partner[t.k];
-    const Body<double> local{v[i], w[i], radius[i], mass[i], inertia[i]};
-    const Body<double> ghost{g_v[q], g_w[q], g_radius[q], g_mass[q], g_inertia[q]};
+    const Body<double> local{v[i], w[i], vp[i], wp[i], radius[i], mass[i], inertia[i]};
+    const Body<double> ghost{g_v[q],   g_w[q],    g_vp[q],    g_wp[q],
+                             g_radius[q], g_mass[q], g_inertia[q]};
     const bool local_first = id[i] < g_id[q];
     return local_first
                ? Pair{i, q, t.k, true, local, ghost, (x[i] - g_x[q]) + (zero - g_shift[q])}
@@ -416,12 +436,18 @@ void ghost_pair_sweep(ContactSweep& s, int a_first, int a_end) {
 #pragma GCC unroll 4
         for (int l = 0; l < W; ++l) group[l] = canonical(batch[std::min(c + l, m - 1)]);
         Body<V> a, b;
-        a.v = gather3<V>([&](int l) -> const Vec3& { return group[l].first.v; });
-        a.w = gather3<V>([&](int l) -> const Vec3& { return group[l].first.w; });
+        a.vp = gather3<V>([&](int l) -> const Vec3& { return group[l].first.vp; });
+        b.vp = gather3<V>([&](int l) -> const Vec3& { return group[l].second.vp; });
+        if constexpr (Law::needs_spin) {
+          a.v = gather3<V>([&](int l) -> const Vec3& { return group[l].first.v; });
+          a.w = gather3<V>([&](int l) -> const Vec3& { return group[l].first.w; });
+          a.wp = gather3<V>([&](int l) -> const Vec3& { return group[l].first.wp; });
+          b.v = gather3<V>([&](int l) -> const Vec3& { return group[l].second.v; });
+          b.w = gather3<V>([&](int l) -> const Vec3& { return group[l].second.w; });
+          b.wp = gather3<V>([&](int l) -> const Vec3& { return group[l].second.wp; });
+        }
         a.r = gather<V>([&](int l) { return group[l].first.r; });
         a.m = gather<V>([&](int l) { return group[l].first.m; });
-        b.v = gather3<V>([&](int l) -> const Vec3& { return group[l].second.v; });
-        b.w = gather3<V>([&](int l) -> const Vec3& { return group[l].second.w; });
         b.r = gather<V>([&](int l) { return group[l].second.r; });
         b.m = gather<V>([&](int l) { return group[l].second.m; });
         const PairCoefficientLanes<V> pc = gather_coefficients<V>(

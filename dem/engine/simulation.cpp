@@ -83,6 +83,9 @@ Simulation::Simulation(const Scene& scene, bool insert, MPI_Comm comm,
 }
 
 void Simulation::initialise() {
+  // Before the first step the dashpots see the initial velocities (particles.hpp).
+  p_.v_pred = p_.v;
+  p_.omega_pred = p_.omega;
   double r_max = 0;
   for (double r : p_.radius) r_max = std::max(r_max, r);
   r_max = std::max(r_max, streams_.max_radius());  // particles still to come
@@ -292,6 +295,12 @@ void Simulation::kick_and_drift() {
   // pass sets them to gravity for the next evaluation (compute_forces()). Each particle's
   // operations are those of the separate passes, in the same order. A periodic side has
   // infinite bounds here: nothing leaves through it.
+  // The same pass predicts the end-of-step velocities the dashpots see (Particles::v_pred):
+  // the half kick's increment once more, v* = v(t + dt/2) + (v(t + dt/2) - v(t)), which is
+  // v(t) + dt F(t)/m without drag and includes the implicit drag's response with it. v* is
+  // v(t + dt) to O(dt^2), so the dashpot forces, and with them damped impacts, are second
+  // order in dt; the springs still see the half-step velocity (midpoint rule). The owner
+  // computes v* and sends it to the ghosts: both ranks of a pair read the same bits.
   const Domain& d = scene_.domain;
   constexpr double inf = std::numeric_limits<double>::infinity();
   Vec3 lo, hi;
@@ -306,6 +315,8 @@ void Simulation::kick_and_drift() {
   Vec3* xs = p_.x.data();
   Vec3* vs = p_.v.data();
   Vec3* ws = p_.omega.data();
+  Vec3* vps = p_.v_pred.data();
+  Vec3* wps = p_.omega_pred.data();
   Vec3* force = p_.force.data();
   Vec3* torque = p_.torque.data();
   const Vec3 g = scene_.gravity;
@@ -322,15 +333,21 @@ void Simulation::kick_and_drift() {
     double v2 = 0;
     for (std::size_t i = 0; i < n; ++i) {
       Vec3& v = vs[i];
+      const Vec3 v_start = v;
       if constexpr (!Drag) {
         v += (h / mass[i]) * force[i];
       } else {
         const double a = h / mass[i], k = drag_k[i];
         v = (v + a * (force[i] + k * fluid_u[i])) / (1 + a * k);
       }
-      if constexpr (Spin == kSpin) ws[i] += (h / inertia[i]) * torque[i];
-      if constexpr (Spin == kImplicitSpin)
-        ws[i] = implicit_spin(ws[i], h / inertia[i], torque[i], spin_k[i], fluid_w[i]);
+      vps[i] = v + (v - v_start);
+      if constexpr (Spin != kNoSpin) {
+        const Vec3 w_start = ws[i];
+        if constexpr (Spin == kSpin) ws[i] += (h / inertia[i]) * torque[i];
+        if constexpr (Spin == kImplicitSpin)
+          ws[i] = implicit_spin(ws[i], h / inertia[i], torque[i], spin_k[i], fluid_w[i]);
+        wps[i] = ws[i] + (ws[i] - w_start);
+      }
       force[i] = mass[i] * g;
       torque[i].setZero();
       Vec3& x = xs[i];
