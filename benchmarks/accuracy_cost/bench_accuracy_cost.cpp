@@ -527,6 +527,10 @@ void sweep_dt(const Settings& st, Checks& checks) {
     ImpactRig rig(c.spec);
     std::vector<double> e_rms, e_max, tc_rms, tc_max;
     for (double f : impact_fractions) {
+      // Below 3 steps per impact (the fast case at the coarsest fractions, far beyond the
+      // refusal limit of 5) a strongly damped contact is not even stable: the dashpot's
+      // predicted velocity overshoots. Those points are not measured.
+      if (checked_contact_time(c.spec) / (f * tr) < 3) continue;
       const ImpactErrors e =
           impact_errors(rig, c.spec, checked_contact_time(c.spec) / (f * tr), grid);
       csv.row(c.name, c.spec.model == NormalModel::hertz ? "hertz" : "hooke", c.spec.restitution,
