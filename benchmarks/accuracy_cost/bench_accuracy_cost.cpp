@@ -173,6 +173,7 @@ struct ImpactSpec {
   double youngs = kY;
   double v_char = 0;               // Hooke only
   double scaled_contact_time = 0;  // damped Hertz only: scaled_damped_contact_time(b(e))
+  DashpotVelocity dashpot = DashpotVelocity::half_step;  // contact.dashpot_velocity
 };
 
 ImpactSpec hertz_impact(double e, double v, double youngs) {
@@ -254,6 +255,7 @@ class ImpactRig {
   static Scene scene(const ImpactSpec& spec) {
     Scene s = base_scene(spec.youngs, spec.restitution);
     s.contact.normal = spec.model;
+    s.contact.dashpot_velocity = spec.dashpot;
     if (spec.model == NormalModel::hooke) s.contact.hooke_characteristic_velocity = spec.v_char;
     s.domain.lo = Vec3(-0.01, -0.01, -0.01);
     s.domain.hi = Vec3(0.03, 0.01, 0.01);
@@ -499,6 +501,13 @@ void sweep_dt(const Settings& st, Checks& checks) {
       cases.push_back({"fast_10ms", hertz_impact(e, 10, kY)});
       cases.push_back({"stiff_Y5e9", hertz_impact(e, kV, 5e9)});
     }
+  }
+  // contact.dashpot_velocity: predicted (the reference cases use the default, half_step).
+  for (double e : {0.9, 0.7, 0.5, 0.3, 0.1}) {
+    if (st.short_run && e != 0.5) continue;
+    ImpactSpec p = hertz_impact(e, kV, kY);
+    p.dashpot = DashpotVelocity::predicted;
+    cases.push_back({"predicted", p});
   }
   for (double e : {1.0, 0.9, 0.7, 0.5, 0.3, 0.1}) {
     if (st.short_run && e != 1.0 && e != 0.5) continue;

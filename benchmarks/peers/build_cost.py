@@ -2,13 +2,15 @@
 """The cost of a change: two grain builds side by side on the settled bed of settling_bed.yaml.
 
     scripts/python.sh benchmarks/peers/build_cost.py --base A/bin/grain --new B/bin/grain \
-        [--quick] [--rounds 5] [--ranks 1]
+        [--quick] [--rounds 5] [--ranks 1] [--new-contact "dashpot_velocity: predicted"]
 
 The bed of compare_liggghts.py (settled once with --base, cached in --work) runs its timed
 steps with each build in turn within a round (base, new, base, new, ...), so that both see the
 same load on a shared machine. Prints each run's particle-steps/s (grain's own loop timer) and,
 per rank count, the median over the rounds of the ratio new/base within a round, of the loop's
 wall time and of the process's CPU time, with the machine's load average before and after.
+--new-contact adds entries to the `contact` block of the new build's scene only (a setting the
+base build does not know).
 """
 import argparse
 import os
@@ -29,6 +31,7 @@ def main():
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--ranks", type=int, nargs="+", default=[1])
     ap.add_argument("--work", default=str(peers.HERE / "output"), help="folder for inputs and runs")
+    ap.add_argument("--new-contact", default="", help="entries added to the new build's contact block")
     args = ap.parse_args()
     os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
     os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
@@ -42,8 +45,16 @@ def main():
         case.mkdir(exist_ok=True)
         (case / "settled.h5").write_bytes((gcase / "settled.h5").read_bytes())
         for n in args.ranks:
-            (case / f"scene_np{n}.yaml").write_text((gcase / f"scene_np{n}.yaml").read_text())
+            text = (gcase / f"scene_np{n}.yaml").read_text()
+            if label == "new" and args.new_contact:
+                old = "contact: {normal: hertz, tangential: history}"
+                if old not in text:
+                    raise SystemExit(f"build_cost.py: no `{old}` in the scene to extend")
+                text = text.replace(old, old[:-1] + ", " + args.new_contact + "}")
+            (case / f"scene_np{n}.yaml").write_text(text)
         cases[label] = case
+    if args.rounds < 1:
+        return
     load_before = os.getloadavg()
     print(f"bed: {bed.count} spheres, {bed.steps} timed steps; {args.rounds} interleaved rounds; "
           f"load average {load_before[0]:.2f}", flush=True)

@@ -15,12 +15,16 @@
 
 namespace grainflow {
 
-template <class Normal, class Tangential, class Rolling, class Cohesion>
+// PredictedDashpot: contact.dashpot_velocity: predicted (the sweeps then hand the dashpots the
+// predicted end-of-step velocities; with false, the half-step ones, as plain velocity Verlet).
+template <class Normal, class Tangential, class Rolling, class Cohesion,
+          bool PredictedDashpot = false>
 struct ContactLaw {
   using normal = Normal;
   using tangential = Tangential;
   using rolling = Rolling;
   using cohesion = Cohesion;
+  static constexpr bool predicted_dashpot = PredictedDashpot;
   static constexpr bool keeps_tangential = Tangential::enabled;  // a tangential spring
   static constexpr bool keeps_rolling = std::is_same_v<Rolling, EpsdRolling>;  // a rolling one
   static constexpr bool has_history = keeps_tangential || keeps_rolling;
@@ -35,8 +39,8 @@ struct ContactLaw {
   // V. The normal force has no lower clamp: the contact ends when the overlap returns to zero,
   // which is the end-of-contact definition the restitution mappings assume. `tangential` and
   // `rolling` are the contact's springs (each touched only by a law that has it).
-  // Springs advance with the half-step velocities (g.v_rel, g.w_rel), dashpots take the
-  // predicted end-of-step ones (g.v_pred, g.w_pred): both second order in dt.
+  // Springs advance with the half-step velocities (g.v_rel, g.w_rel), dashpots take
+  // g.v_pred, g.w_pred (contact.dashpot_velocity: half-step, or predicted at the step's end).
   template <class V, class PC>
   [[gnu::always_inline]] static ContactResultT<V> evaluate(const ContactGeometryT<V>& g,
                                                            const PC& pc, const ContactConstants& cc,

@@ -6,8 +6,8 @@
 // - epsd: elastic-plastic spring-dashpot (Ai et al. 2011, model C): k_r = 2.25 k_n mu_r^2 R*^2,
 //   M_k <- M_k - k_r w_r dt limited to M_max; damping M_d = -C_r w_r with
 //   C_r = eta_r 2 sqrt(I_r k_r), switched off once the spring is fully mobilised. The spring
-//   turns with the half-step w_r (midpoint rule), the dashpot sees the w_r predicted at the
-//   step's end (ContactGeometry::w_pred). CDT's direction is that of the half-step w_r.
+//   turns with the half-step w_r (midpoint rule), the dashpot sees ContactGeometry::w_pred.
+//   CDT's direction is that of the half-step w_r.
 #include <cmath>
 
 #include "dem/contact/contact_geometry.hpp"

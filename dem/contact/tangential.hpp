@@ -5,7 +5,7 @@
 //   F_t = -k_t xi - gamma_t v_t*, and if |F_t| > mu F_n: F_t scaled to mu F_n and xi reset to
 //   the spring length consistent with it (xi = -(F_t + gamma_t v_t*) / k_t).
 // v_t is the half-step tangential velocity (the spring's increment over the step: midpoint
-// rule), v_t* the one predicted at the step's end (the dashpot, at the time of the force).
+// rule), v_t* the one the dashpot sees (ContactGeometry::v_pred).
 #include "dem/contact/contact_geometry.hpp"
 
 namespace grainflow {

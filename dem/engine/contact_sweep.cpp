@@ -114,11 +114,18 @@ template <class Law, class V, class PC>
     const V3<V> arm_w = g.arm_i * a.w + g.arm_j * b.w;
     g.v_rel = a.v - b.v - cross(arm_w, g.n);
     g.w_rel = a.w - b.w;
-    const V3<V> arm_wp = g.arm_i * a.wp + g.arm_j * b.wp;
-    g.v_pred = a.vp - b.vp - cross(arm_wp, g.n);
-    g.w_pred = a.wp - b.wp;
-  } else {  // no spring: only the dashpot's velocity
+    if constexpr (Law::predicted_dashpot) {
+      const V3<V> arm_wp = g.arm_i * a.wp + g.arm_j * b.wp;
+      g.v_pred = a.vp - b.vp - cross(arm_wp, g.n);
+      g.w_pred = a.wp - b.wp;
+    } else {
+      g.v_pred = g.v_rel;
+      g.w_pred = g.w_rel;
+    }
+  } else if constexpr (Law::predicted_dashpot) {  // no spring: only the dashpot's velocity
     g.v_pred = a.vp - b.vp;
+  } else {
+    g.v_pred = a.v - b.v;
   }
   if constexpr (Law::needs_roll_inertia)
     g.roll_inertia =
@@ -253,14 +260,20 @@ void local_pair_sweep(ContactSweep& s, int a_first, int a_end) {
 #pragma GCC unroll 4
       for (int l = 0; l < W; ++l) group[l] = canonical(batch[std::min(c + l, m - 1)]);
       Body<V> a, b;
-      a.vp = gather3<V>([&](int l) -> const Vec3& { return vp[group[l].a]; });
-      b.vp = gather3<V>([&](int l) -> const Vec3& { return vp[group[l].b]; });
-      if constexpr (Law::needs_spin) {
+      if constexpr (Law::predicted_dashpot) {
+        a.vp = gather3<V>([&](int l) -> const Vec3& { return vp[group[l].a]; });
+        b.vp = gather3<V>([&](int l) -> const Vec3& { return vp[group[l].b]; });
+      }
+      if constexpr (Law::needs_spin || !Law::predicted_dashpot) {
         a.v = gather3<V>([&](int l) -> const Vec3& { return v[group[l].a]; });
-        a.w = gather3<V>([&](int l) -> const Vec3& { return w[group[l].a]; });
-        a.wp = gather3<V>([&](int l) -> const Vec3& { return wp[group[l].a]; });
         b.v = gather3<V>([&](int l) -> const Vec3& { return v[group[l].b]; });
+      }
+      if constexpr (Law::needs_spin) {
+        a.w = gather3<V>([&](int l) -> const Vec3& { return w[group[l].a]; });
         b.w = gather3<V>([&](int l) -> const Vec3& { return w[group[l].b]; });
+      }
+      if constexpr (Law::needs_spin && Law::predicted_dashpot) {
+        a.wp = gather3<V>([&](int l) -> const Vec3& { return wp[group[l].a]; });
         b.wp = gather3<V>([&](int l) -> const Vec3& { return wp[group[l].b]; });
       }
       V r_star, m_star;
@@ -436,14 +449,20 @@ void ghost_pair_sweep(ContactSweep& s, int a_first, int a_end) {
 #pragma GCC unroll 4
         for (int l = 0; l < W; ++l) group[l] = canonical(batch[std::min(c + l, m - 1)]);
         Body<V> a, b;
-        a.vp = gather3<V>([&](int l) -> const Vec3& { return group[l].first.vp; });
-        b.vp = gather3<V>([&](int l) -> const Vec3& { return group[l].second.vp; });
-        if constexpr (Law::needs_spin) {
+        if constexpr (Law::predicted_dashpot) {
+          a.vp = gather3<V>([&](int l) -> const Vec3& { return group[l].first.vp; });
+          b.vp = gather3<V>([&](int l) -> const Vec3& { return group[l].second.vp; });
+        }
+        if constexpr (Law::needs_spin || !Law::predicted_dashpot) {
           a.v = gather3<V>([&](int l) -> const Vec3& { return group[l].first.v; });
-          a.w = gather3<V>([&](int l) -> const Vec3& { return group[l].first.w; });
-          a.wp = gather3<V>([&](int l) -> const Vec3& { return group[l].first.wp; });
           b.v = gather3<V>([&](int l) -> const Vec3& { return group[l].second.v; });
+        }
+        if constexpr (Law::needs_spin) {
+          a.w = gather3<V>([&](int l) -> const Vec3& { return group[l].first.w; });
           b.w = gather3<V>([&](int l) -> const Vec3& { return group[l].second.w; });
+        }
+        if constexpr (Law::needs_spin && Law::predicted_dashpot) {
+          a.wp = gather3<V>([&](int l) -> const Vec3& { return group[l].first.wp; });
           b.wp = gather3<V>([&](int l) -> const Vec3& { return group[l].second.wp; });
         }
         a.r = gather<V>([&](int l) { return group[l].first.r; });
@@ -535,11 +554,16 @@ SweepChoice choice(bool canonical) {
 }
 
 // Expands the run-time slot choice into one compile-time combination, one slot at a time.
+template <class N, class T, class R, class C>
+SweepChoice pick_dashpot(const ContactSettings& c, bool canonical) {
+  if (c.dashpot_velocity == DashpotVelocity::predicted)
+    return choice<ContactLaw<N, T, R, C, true>>(canonical);
+  return choice<ContactLaw<N, T, R, C, false>>(canonical);
+}
 template <class N, class T, class R>
 SweepChoice pick_cohesion(const ContactSettings& c, bool canonical) {
-  if (c.cohesion == CohesionModel::sjkr)
-    return choice<ContactLaw<N, T, R, SjkrCohesion>>(canonical);
-  return choice<ContactLaw<N, T, R, NoCohesion>>(canonical);
+  if (c.cohesion == CohesionModel::sjkr) return pick_dashpot<N, T, R, SjkrCohesion>(c, canonical);
+  return pick_dashpot<N, T, R, NoCohesion>(c, canonical);
 }
 template <class N, class T>
 SweepChoice pick_rolling(const ContactSettings& c, bool canonical) {
