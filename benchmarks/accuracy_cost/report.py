@@ -267,14 +267,16 @@ def write_doc(d, docs, meta):
           "exactly implicit dashpot, tried on the scaled impact in Python, leaves 0.87 % rms at "
           "e = 0.5 and N = 22). Over many impacts at random offsets — the dissipation of a flow "
           "— the mean is what counts. **Choose `predicted` for strongly damped materials "
-          "(e ≤ 0.5)**: at e = 0.1 it cuts the error four- to sevenfold at every step of "
-          "practical use. **Keep the default for e ≥ 0.7**: there the half-step velocity's lag "
+          "(e ≤ 0.5)**: at e = 0.1 it cuts the error four- to sevenfold from 20 steps per impact "
+          "up (2.5-fold at 11). **Keep the default for e ≥ 0.7**: there the half-step velocity's lag "
           "happens to be small (its mean error at e = 0.9 is a tenth of its rms), and the "
           "prediction's larger constant makes it up to 1.6× worse at 10–30 steps per impact. "
           "Below 3 steps per impact (beyond the refusal limit of `grain check`) a strongly damped "
           "contact with the predicted velocity is not even stable; those points are not "
-          "measured. Both cost the same (one more vector written per particle per step either "
-          "way). `grain check` quotes the default's table.\n")
+          "measured. `predicted` costs more per step (the first half kick writes the predicted "
+          "velocities, laws with torques read two velocities per body; measured side by side "
+          "with `benchmarks/peers/build_cost.py`, docs/models/contact-models.md); the default "
+          "runs plain velocity Verlet's loop. `grain check` quotes the default's table.\n")
 
     # --- 2. Hooke -------------------------------------------------------------------------
     w("## 2. Hooke versus Hertz, and Hooke's characteristic velocity\n")
