@@ -52,8 +52,14 @@ struct ContactGeometryT {
   V arm_i, arm_j;  // centre to contact point; arm_j = 0 for walls
   V r_star, m_star;
   V roll_inertia;  // EPSD: 1/I_r = 1/(I_i + m_i r_i^2) + 1/(I_j + m_j r_j^2)
-  V3<V> v_rel;     // velocity of i relative to j at the contact point
-  V3<V> w_rel;     // angular velocity of i minus that of j
+  // Velocity of i relative to j at the contact point, and angular velocity of i minus that of
+  // j: at the half step (v_rel, w_rel: the springs' increments, over the step) and those the
+  // dashpots see (v_pred, w_pred: Particles::v_pred, the half-step or the predicted
+  // end-of-step velocity).
+  V3<V> v_rel;
+  V3<V> w_rel;
+  V3<V> v_pred;
+  V3<V> w_pred;
   bool wall;
 };
 using ContactGeometry = ContactGeometryT<double>;

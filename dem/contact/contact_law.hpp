@@ -15,12 +15,16 @@
 
 namespace grainflow {
 
-template <class Normal, class Tangential, class Rolling, class Cohesion>
+// PredictedDashpot: contact.dashpot_velocity: predicted (the sweeps then hand the dashpots the
+// predicted end-of-step velocities; with false, the half-step ones, as plain velocity Verlet).
+template <class Normal, class Tangential, class Rolling, class Cohesion,
+          bool PredictedDashpot = false>
 struct ContactLaw {
   using normal = Normal;
   using tangential = Tangential;
   using rolling = Rolling;
   using cohesion = Cohesion;
+  static constexpr bool predicted_dashpot = PredictedDashpot;
   static constexpr bool keeps_tangential = Tangential::enabled;  // a tangential spring
   static constexpr bool keeps_rolling = std::is_same_v<Rolling, EpsdRolling>;  // a rolling one
   static constexpr bool has_history = keeps_tangential || keeps_rolling;
@@ -35,13 +39,15 @@ struct ContactLaw {
   // V. The normal force has no lower clamp: the contact ends when the overlap returns to zero,
   // which is the end-of-contact definition the restitution mappings assume. `tangential` and
   // `rolling` are the contact's springs (each touched only by a law that has it).
+  // Springs advance with the half-step velocities (g.v_rel, g.w_rel), dashpots take
+  // g.v_pred, g.w_pred (contact.dashpot_velocity: half-step, or predicted at the step's end).
   template <class V, class PC>
   [[gnu::always_inline]] static ContactResultT<V> evaluate(const ContactGeometryT<V>& g,
                                                            const PC& pc, const ContactConstants& cc,
                                                            V3<V>& tangential, V3<V>& rolling,
                                                            double dt) {
     const SpringDashpotT<V> s = Normal::coefficients(pc, cc, g.r_star, g.m_star, g.overlap);
-    const V vn = dot(g.v_rel, g.n);
+    const V vn = dot(g.v_pred, g.n);
     const V fn = s.kn * g.overlap - s.gn * vn;
     const V fn_pos = max0(fn);
     V fn_total = fn;
@@ -49,9 +55,10 @@ struct ContactLaw {
 
     ContactResultT<V> r{fn_total * g.n, zero3<V>(), zero3<V>()};
     if constexpr (Tangential::enabled) {
-      const V3<V> vt = g.v_rel - vn * g.n;
-      const V3<V> ft =
-          Tangential::template force<V>(vt, s.kt, s.gt, pc.friction * fn_pos, g.n, tangential, dt);
+      const V3<V> vt = g.v_rel - dot(g.v_rel, g.n) * g.n;
+      const V3<V> vt_pred = g.v_pred - vn * g.n;
+      const V3<V> ft = Tangential::template force<V>(vt, vt_pred, s.kt, s.gt, pc.friction * fn_pos,
+                                                     g.n, tangential, dt);
       r.force += ft;
       const V3<V> n_x_ft = cross(g.n, ft);
       r.torque_i = -g.arm_i * n_x_ft;

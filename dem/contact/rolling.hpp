@@ -5,7 +5,9 @@
 // - cdt: constant directional torque M = -M_max w_r/|w_r| (Ai et al. 2011, model A).
 // - epsd: elastic-plastic spring-dashpot (Ai et al. 2011, model C): k_r = 2.25 k_n mu_r^2 R*^2,
 //   M_k <- M_k - k_r w_r dt limited to M_max; damping M_d = -C_r w_r with
-//   C_r = eta_r 2 sqrt(I_r k_r), switched off once the spring is fully mobilised.
+//   C_r = eta_r 2 sqrt(I_r k_r), switched off once the spring is fully mobilised. The spring
+//   turns with the half-step w_r (midpoint rule), the dashpot sees ContactGeometry::w_pred.
+//   CDT's direction is that of the half-step w_r.
 #include <cmath>
 
 #include "dem/contact/contact_geometry.hpp"
@@ -38,6 +40,7 @@ struct EpsdRolling {
   static Vec3 torque(const ContactGeometry& g, double m_max, double kn, double mu_r,
                      const ContactConstants& cc, Vec3& spring, double dt) {
     const Vec3 wr = g.w_rel - g.w_rel.dot(g.n) * g.n;
+    const Vec3 wr_pred = g.w_pred - g.w_pred.dot(g.n) * g.n;
     const double kr = 2.25 * kn * mu_r * mu_r * g.r_star * g.r_star;
     rotate_into_tangent_plane(spring, g.n);
     spring -= kr * dt * wr;
@@ -47,7 +50,7 @@ struct EpsdRolling {
       return spring;  // fully mobilised: no damping (Ai et al. 2011, f = 0)
     }
     const double cr = cc.epsd_damping_ratio * 2 * std::sqrt(g.roll_inertia * kr);
-    return spring - cr * wr;
+    return spring - cr * wr_pred;
   }
 };
 

@@ -7,6 +7,8 @@ void Particles::reserve(std::size_t n) {
   x.reserve(n);
   v.reserve(n);
   omega.reserve(n);
+  v_pred.reserve(n);
+  omega_pred.reserve(n);
   force.reserve(n);
   torque.reserve(n);
   radius.reserve(n);
@@ -27,6 +29,8 @@ std::size_t Particles::add_raw(GlobalId gid, const Vec3& position, const Vec3& v
   x.push_back(position);
   v.push_back(velocity);
   omega.push_back(spin);
+  v_pred.push_back(velocity);
+  omega_pred.push_back(spin);
   force.push_back(Vec3::Zero());
   torque.push_back(Vec3::Zero());
   radius.push_back(r);
@@ -59,6 +63,8 @@ void Particles::permute(const std::vector<std::size_t>& perm) {
   apply_permutation(x, perm);
   apply_permutation(v, perm);
   apply_permutation(omega, perm);
+  apply_permutation(v_pred, perm);
+  apply_permutation(omega_pred, perm);
   apply_permutation(force, perm);
   apply_permutation(torque, perm);
   apply_permutation(radius, perm);
@@ -72,6 +78,8 @@ void Particles::remove_if(const std::vector<char>& remove) {
   compact(x, remove);
   compact(v, remove);
   compact(omega, remove);
+  compact(v_pred, remove);
+  compact(omega_pred, remove);
   compact(force, remove);
   compact(torque, remove);
   compact(radius, remove);

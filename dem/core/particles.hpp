@@ -15,6 +15,13 @@ struct Particles {
   std::vector<Vec3> x;           // position [m]
   std::vector<Vec3> v;           // velocity [m/s]
   std::vector<Vec3> omega;       // angular velocity [rad/s]
+  // With contact.dashpot_velocity: predicted, the velocities the contact dashpots see: during a
+  // step's force evaluation v and omega are those of the half step, and these the end-of-step
+  // values predicted from them, set by the step's first half kick (Simulation::kick_and_drift;
+  // docs/models/contact-models.md, "Integration"); before the first step, the initial v and
+  // omega. Unused (not updated) with the default half_step.
+  std::vector<Vec3> v_pred;      // [m/s]
+  std::vector<Vec3> omega_pred;  // [rad/s]
   std::vector<Vec3> force;       // total force of the current step [N]
   std::vector<Vec3> torque;      // total torque of the current step [N m]
   std::vector<double> radius;    // [m]

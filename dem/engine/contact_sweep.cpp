@@ -42,9 +42,11 @@ namespace {
 
 // The state of one body of a pair, as the pair kernel reads it: of one contact (V = double)
 // or of one body of each of the contacts in the lanes of V.
+// v, w at the half step (springs), vp, wp predicted at the step's end (dashpots;
+// Particles::v_pred). A law without torques reads only vp.
 template <class V>
 struct Body {
-  V3<V> v, w;
+  V3<V> v, w, vp, wp;
   V r, m, inertia;
 };
 
@@ -111,8 +113,18 @@ template <class Law, class V>
     const V3<V> arm_w = g.arm_i * a.w + g.arm_j * b.w;
     g.v_rel = a.v - b.v - cross(arm_w, g.n);
     g.w_rel = a.w - b.w;
+    if constexpr (Law::predicted_dashpot) {
+      const V3<V> arm_wp = g.arm_i * a.wp + g.arm_j * b.wp;
+      g.v_pred = a.vp - b.vp - cross(arm_wp, g.n);
+      g.w_pred = a.wp - b.wp;
+    } else {
+      g.v_pred = g.v_rel;
+      g.w_pred = g.w_rel;
+    }
+  } else if constexpr (Law::predicted_dashpot) {  // no spring: only the dashpot's velocity
+    g.v_pred = a.vp - b.vp;
   } else {
-    g.v_rel = a.v - b.v;
+    g.v_pred = a.v - b.v;
   }
   if constexpr (Law::needs_roll_inertia)
     g.roll_inertia =
@@ -172,6 +184,8 @@ void local_pair_sweep(ContactSweep& s, int a_first, int a_end) {
   const Vec3* x = p.x.data();
   const Vec3* v = p.v.data();
   const Vec3* w = p.omega.data();
+  const Vec3* vp = p.v_pred.data();
+  const Vec3* wp = p.omega_pred.data();
   const double* radius = p.radius.data();
   const double* mass = p.mass.data();
   const double* inertia = p.inertia.data();
@@ -193,7 +207,9 @@ void local_pair_sweep(ContactSweep& s, int a_first, int a_end) {
     const int first = id[t.i] < id[j] ? t.i : j;
     return Pair{first, first == t.i ? j : t.i, t.k};
   };
-  const auto body = [&](int q) { return Body<double>{v[q], w[q], radius[q], mass[q], inertia[q]}; };
+  const auto body = [&](int q) {
+    return Body<double>{v[q], w[q], vp[q], wp[q], radius[q], mass[q], inertia[q]};
+  };
   // The contact's forces and torques on both bodies, its count and the overlap guard.
   const auto apply = [&](const Pair& c, const ContactResult& r, double overlap) {
     force[c.a] += r.force;
@@ -233,10 +249,22 @@ void local_pair_sweep(ContactSweep& s, int a_first, int a_end) {
 #pragma GCC unroll 4
       for (int l = 0; l < W; ++l) group[l] = canonical(batch[std::min(c + l, m - 1)]);
       Body<V> a, b;
-      a.v = gather3<V>([&](int l) -> const Vec3& { return v[group[l].a]; });
-      a.w = gather3<V>([&](int l) -> const Vec3& { return w[group[l].a]; });
-      b.v = gather3<V>([&](int l) -> const Vec3& { return v[group[l].b]; });
-      b.w = gather3<V>([&](int l) -> const Vec3& { return w[group[l].b]; });
+      if constexpr (Law::predicted_dashpot) {
+        a.vp = gather3<V>([&](int l) -> const Vec3& { return vp[group[l].a]; });
+        b.vp = gather3<V>([&](int l) -> const Vec3& { return vp[group[l].b]; });
+      }
+      if constexpr (Law::needs_spin || !Law::predicted_dashpot) {
+        a.v = gather3<V>([&](int l) -> const Vec3& { return v[group[l].a]; });
+        b.v = gather3<V>([&](int l) -> const Vec3& { return v[group[l].b]; });
+      }
+      if constexpr (Law::needs_spin) {
+        a.w = gather3<V>([&](int l) -> const Vec3& { return w[group[l].a]; });
+        b.w = gather3<V>([&](int l) -> const Vec3& { return w[group[l].b]; });
+      }
+      if constexpr (Law::needs_spin && Law::predicted_dashpot) {
+        a.wp = gather3<V>([&](int l) -> const Vec3& { return wp[group[l].a]; });
+        b.wp = gather3<V>([&](int l) -> const Vec3& { return wp[group[l].b]; });
+      }
       V r_star, m_star;
       PairCoefficientLanes<V> pc;
       if constexpr (Alike) {
@@ -321,6 +349,8 @@ void ghost_pair_sweep(ContactSweep& s, int a_first, int a_end) {
   const Vec3* x = p.x.data();
   const Vec3* v = p.v.data();
   const Vec3* w = p.omega.data();
+  const Vec3* vp = p.v_pred.data();
+  const Vec3* wp = p.omega_pred.data();
   const double* radius = p.radius.data();
   const double* mass = p.mass.data();
   const double* inertia = p.inertia.data();
@@ -332,6 +362,8 @@ void ghost_pair_sweep(ContactSweep& s, int a_first, int a_end) {
   const Vec3* g_shift = g.shift.data();
   const Vec3* g_v = g.v.data();
   const Vec3* g_w = g.omega.data();
+  const Vec3* g_vp = g.v_pred.data();
+  const Vec3* g_wp = g.omega_pred.data();
   const double* g_radius = g.radius.data();
   const double* g_mass = g.mass.data();
   const double* g_inertia = g.inertia.data();
@@ -353,8 +385,9 @@ void ghost_pair_sweep(ContactSweep& s, int a_first, int a_end) {
   };
   const auto canonical = [&](const Touching& t) {
     const int i = t.i, q = partner[t.k];
-    const Body<double> local{v[i], w[i], radius[i], mass[i], inertia[i]};
-    const Body<double> ghost{g_v[q], g_w[q], g_radius[q], g_mass[q], g_inertia[q]};
+    const Body<double> local{v[i], w[i], vp[i], wp[i], radius[i], mass[i], inertia[i]};
+    const Body<double> ghost{g_v[q],   g_w[q],    g_vp[q],    g_wp[q],
+                             g_radius[q], g_mass[q], g_inertia[q]};
     const bool local_first = id[i] < g_id[q];
     return local_first
                ? Pair{i, q, t.k, true, local, ghost, (x[i] - g_x[q]) + (zero - g_shift[q])}
@@ -390,12 +423,24 @@ void ghost_pair_sweep(ContactSweep& s, int a_first, int a_end) {
 #pragma GCC unroll 4
         for (int l = 0; l < W; ++l) group[l] = canonical(batch[std::min(c + l, m - 1)]);
         Body<V> a, b;
-        a.v = gather3<V>([&](int l) -> const Vec3& { return group[l].first.v; });
-        a.w = gather3<V>([&](int l) -> const Vec3& { return group[l].first.w; });
+        if constexpr (Law::predicted_dashpot) {
+          a.vp = gather3<V>([&](int l) -> const Vec3& { return group[l].first.vp; });
+          b.vp = gather3<V>([&](int l) -> const Vec3& { return group[l].second.vp; });
+        }
+        if constexpr (Law::needs_spin || !Law::predicted_dashpot) {
+          a.v = gather3<V>([&](int l) -> const Vec3& { return group[l].first.v; });
+          b.v = gather3<V>([&](int l) -> const Vec3& { return group[l].second.v; });
+        }
+        if constexpr (Law::needs_spin) {
+          a.w = gather3<V>([&](int l) -> const Vec3& { return group[l].first.w; });
+          b.w = gather3<V>([&](int l) -> const Vec3& { return group[l].second.w; });
+        }
+        if constexpr (Law::needs_spin && Law::predicted_dashpot) {
+          a.wp = gather3<V>([&](int l) -> const Vec3& { return group[l].first.wp; });
+          b.wp = gather3<V>([&](int l) -> const Vec3& { return group[l].second.wp; });
+        }
         a.r = gather<V>([&](int l) { return group[l].first.r; });
         a.m = gather<V>([&](int l) { return group[l].first.m; });
-        b.v = gather3<V>([&](int l) -> const Vec3& { return group[l].second.v; });
-        b.w = gather3<V>([&](int l) -> const Vec3& { return group[l].second.w; });
         b.r = gather<V>([&](int l) { return group[l].second.r; });
         b.m = gather<V>([&](int l) { return group[l].second.m; });
         const PairCoefficientLanes<V> pc = gather_coefficients<V>(
@@ -829,11 +874,16 @@ SweepChoice choice(bool canonical) {
 }
 
 // Expands the run-time slot choice into one compile-time combination, one slot at a time.
+template <class N, class T, class R, class C>
+SweepChoice pick_dashpot(const ContactSettings& c, bool canonical) {
+  if (c.dashpot_velocity == DashpotVelocity::predicted)
+    return choice<ContactLaw<N, T, R, C, true>>(canonical);
+  return choice<ContactLaw<N, T, R, C, false>>(canonical);
+}
 template <class N, class T, class R>
 SweepChoice pick_cohesion(const ContactSettings& c, bool canonical) {
-  if (c.cohesion == CohesionModel::sjkr)
-    return choice<ContactLaw<N, T, R, SjkrCohesion>>(canonical);
-  return choice<ContactLaw<N, T, R, NoCohesion>>(canonical);
+  if (c.cohesion == CohesionModel::sjkr) return pick_dashpot<N, T, R, SjkrCohesion>(c, canonical);
+  return pick_dashpot<N, T, R, NoCohesion>(c, canonical);
 }
 template <class N, class T>
 SweepChoice pick_rolling(const ContactSettings& c, bool canonical) {

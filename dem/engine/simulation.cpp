@@ -83,6 +83,9 @@ Simulation::Simulation(const Scene& scene, bool insert, MPI_Comm comm,
 }
 
 void Simulation::initialise() {
+  // Before the first step the dashpots see the initial velocities (particles.hpp).
+  p_.v_pred = p_.v;
+  p_.omega_pred = p_.omega;
   double r_max = 0;
   for (double r : p_.radius) r_max = std::max(r_max, r);
   r_max = std::max(r_max, streams_.max_radius());  // particles still to come
@@ -291,6 +294,13 @@ void Simulation::kick_and_drift() {
   // pass sets them to gravity for the next evaluation (compute_forces()). Each particle's
   // operations are those of the separate passes, in the same order. A periodic side has
   // infinite bounds here: nothing leaves through it.
+  // With contact.dashpot_velocity: predicted, the same pass predicts the end-of-step
+  // velocities the dashpots see (Particles::v_pred):
+  // the half kick's increment once more, v* = v(t + dt/2) + (v(t + dt/2) - v(t)), which is
+  // v(t) + dt F(t)/m without drag and includes the implicit drag's response with it. v* is
+  // v(t + dt) to O(dt^2), so the dashpot forces, and with them damped impacts, are second
+  // order in dt; the springs still see the half-step velocity (midpoint rule). The owner
+  // computes v* and sends it to the ghosts: both ranks of a pair read the same bits.
   const Domain& d = scene_.domain;
   constexpr double inf = std::numeric_limits<double>::infinity();
   Vec3 lo, hi;
@@ -305,6 +315,8 @@ void Simulation::kick_and_drift() {
   Vec3* xs = p_.x.data();
   Vec3* vs = p_.v.data();
   Vec3* ws = p_.omega.data();
+  Vec3* vps = p_.v_pred.data();
+  Vec3* wps = p_.omega_pred.data();
   Vec3* force = p_.force.data();
   Vec3* torque = p_.torque.data();
   const Vec3 g = scene_.gravity;
@@ -316,20 +328,24 @@ void Simulation::kick_and_drift() {
   leaving_.clear();
   const double* spin_k = drag_.spin_coefficient.data();
   const Vec3* fluid_w = drag_.fluid_spin.data();
-  const auto pass = [&]<bool Drag, SpinKick Spin>() {
+  const auto pass = [&]<bool Drag, SpinKick Spin, bool Predict>() {
     bool moved_far = false;
     double v2 = 0;
     for (std::size_t i = 0; i < n; ++i) {
       Vec3& v = vs[i];
+      [[maybe_unused]] const Vec3 v_start = v;
       if constexpr (!Drag) {
         v += (h / mass[i]) * force[i];
       } else {
         const double a = h / mass[i], k = drag_k[i];
         v = (v + a * (force[i] + k * fluid_u[i])) / (1 + a * k);
       }
+      if constexpr (Predict) vps[i] = v + (v - v_start);
+      [[maybe_unused]] const Vec3 w_start = ws[i];
       if constexpr (Spin == kSpin) ws[i] += (h / inertia[i]) * torque[i];
       if constexpr (Spin == kImplicitSpin)
         ws[i] = implicit_spin(ws[i], h / inertia[i], torque[i], spin_k[i], fluid_w[i]);
+      if constexpr (Predict && Spin != kNoSpin) wps[i] = ws[i] + (ws[i] - w_start);
       force[i] = mass[i] * g;
       torque[i].setZero();
       Vec3& x = xs[i];
@@ -346,16 +362,21 @@ void Simulation::kick_and_drift() {
     moved_beyond_half_skin_ = moved_far;
     local_speed2_ = v2;
   };
+  const bool predict = scene_.contact.dashpot_velocity == DashpotVelocity::predicted;
+  const auto run = [&]<bool Drag, SpinKick Spin>() {
+    predict ? pass.template operator()<Drag, Spin, true>()
+            : pass.template operator()<Drag, Spin, false>();
+  };
   const bool drag = !drag_.coefficient.empty();
   const SpinKick spin = spin_kick(drag_, sweep_.needs_spin);
   if (drag && spin == kImplicitSpin)
-    pass.template operator()<true, kImplicitSpin>();
+    run.template operator()<true, kImplicitSpin>();
   else if (drag)
-    spin == kSpin ? pass.template operator()<true, kSpin>()
-                  : pass.template operator()<true, kNoSpin>();
+    spin == kSpin ? run.template operator()<true, kSpin>()
+                  : run.template operator()<true, kNoSpin>();
   else
-    spin == kSpin ? pass.template operator()<false, kSpin>()
-                  : pass.template operator()<false, kNoSpin>();
+    spin == kSpin ? run.template operator()<false, kSpin>()
+                  : run.template operator()<false, kNoSpin>();
   fresh_from_kick_ = true;
 }
 

@@ -29,11 +29,20 @@ inline ContactGeometry wall_geometry(const Particles& p, std::size_t i, const Wa
   g.r_star = p.radius[i];
   g.m_star = p.mass[i];
   g.wall = true;
+  // Springs: the half-step velocities; dashpots: Particles::v_pred (the wall's velocity is
+  // that of the step's end, exact for prescribed motion).
   if constexpr (Law::needs_spin) {
     g.v_rel = p.v[i] - t.surface_velocity - g.arm_i * p.omega[i].cross(g.n);
     g.w_rel = p.omega[i];
+    if constexpr (Law::predicted_dashpot) {
+      g.v_pred = p.v_pred[i] - t.surface_velocity - g.arm_i * p.omega_pred[i].cross(g.n);
+      g.w_pred = p.omega_pred[i];
+    } else {
+      g.v_pred = g.v_rel;
+      g.w_pred = g.w_rel;
+    }
   } else {
-    g.v_rel = p.v[i] - t.surface_velocity;
+    g.v_pred = (Law::predicted_dashpot ? p.v_pred[i] : p.v[i]) - t.surface_velocity;
   }
   if constexpr (Law::needs_roll_inertia)
     g.roll_inertia = p.inertia[i] + p.mass[i] * p.radius[i] * p.radius[i];
@@ -52,7 +61,7 @@ void apply_wall_contact(ContactSweep& s, std::size_t i, const WallTouch& t, int 
   if constexpr (Law::needs_spin) p.torque[i] += r.torque_i;
   ++s.contacts;
   if (const double ratio = g.overlap / p.radius[i]; ratio > s.max_overlap_ratio)
-    s.worst.consider(ratio, s.max_overlap_ratio, p.id[i], -1, -g.v_rel.dot(g.n), g.r_star, g.m_star,
+    s.worst.consider(ratio, s.max_overlap_ratio, p.id[i], -1, -g.v_pred.dot(g.n), g.r_star, g.m_star,
                      s.table(p.material[i], material).y_star);
 }
 

@@ -96,6 +96,8 @@ Snapshot read_snapshot(const std::string& path) {
   }
   p.inertia.resize(n);
   for (std::size_t i = 0; i < n; ++i) p.inertia[i] = 0.4 * p.mass[i] * p.radius[i] * p.radius[i];
+  p.v_pred = p.v;
+  p.omega_pred = p.omega;
   p.force.assign(n, Vec3::Zero());
   p.torque.assign(n, Vec3::Zero());
   return s;

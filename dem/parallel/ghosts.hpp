@@ -16,6 +16,7 @@ namespace grainflow {
 struct Ghosts {
   std::vector<GlobalId> id;
   std::vector<Vec3> x, shift, v, omega;
+  std::vector<Vec3> v_pred, omega_pred;  // the owner's Particles::v_pred and omega_pred
   std::vector<double> radius, mass, inertia;
   std::vector<int> material;
 
@@ -27,6 +28,8 @@ struct Ghosts {
     shift.clear();
     v.clear();
     omega.clear();
+    v_pred.clear();
+    omega_pred.clear();
     radius.clear();
     mass.clear();
     inertia.clear();

@@ -38,6 +38,9 @@ enum class NormalModel { hertz, hooke };
 enum class TangentialModel { none, history };
 enum class RollingModel { none, cdt, epsd };
 enum class CohesionModel { none, sjkr };
+// The velocity the contact dashpots see (docs/models/contact-models.md, "Integration"):
+// velocity Verlet's half-step velocity, or the end-of-step velocity predicted from it.
+enum class DashpotVelocity { half_step, predicted };
 
 struct ContactSettings {
   NormalModel normal = NormalModel::hertz;
@@ -50,6 +53,7 @@ struct ContactSettings {
   std::optional<double> hooke_kn;                       // [N/m] > 0
   std::optional<double> hooke_kt;                       // [N/m] > 0 (default: kt = kn)
   double epsd_damping_ratio = 0.3;                      // EPSD rolling viscous damping ratio in [0, 1]
+  DashpotVelocity dashpot_velocity = DashpotVelocity::half_step;
 };
 
 struct Domain {

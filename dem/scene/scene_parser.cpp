@@ -238,7 +238,8 @@ void parse_hooke(const Field& f, ContactSettings& c) {
 }
 
 ContactSettings parse_contact(const Field& f) {
-  const Map m = f.map({"normal", "tangential", "rolling", "cohesion", "hooke", "epsd"});
+  const Map m =
+      f.map({"normal", "tangential", "rolling", "cohesion", "hooke", "epsd", "dashpot_velocity"});
   ContactSettings c;
   c.normal = m.get("normal", "add `normal: hertz` or `normal: hooke`")
                  .choice<NormalModel>("normal contact model", {{"hertz", NormalModel::hertz},
@@ -254,6 +255,10 @@ ContactSettings parse_contact(const Field& f) {
   if (const auto co = m.find("cohesion"))
     c.cohesion = co->choice<CohesionModel>(
         "cohesion model", {{"none", CohesionModel::none}, {"sjkr", CohesionModel::sjkr}});
+  if (const auto d = m.find("dashpot_velocity"))
+    c.dashpot_velocity = d->choice<DashpotVelocity>(
+        "dashpot velocity",
+        {{"half_step", DashpotVelocity::half_step}, {"predicted", DashpotVelocity::predicted}});
 
   const std::optional<Field> hooke = m.find("hooke");
   if (c.normal == NormalModel::hooke)

@@ -202,4 +202,12 @@ if(GRAINFLOW_PYTHON3)
                    ${_work}/reproducible_snapshots ${MPIEXEC_EXECUTABLE})
   set_tests_properties(grain.reproducible_snapshots
                        PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}" TIMEOUT 300 PROCESSORS 2)
+  # The same with contact.dashpot_velocity: predicted: the predicted velocities reach the ghosts
+  # and migrating particles bit for bit, and a restart continues exactly.
+  add_test(NAME grain.reproducible_snapshots_predicted
+           COMMAND ${GRAINFLOW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/reproducible_snapshots.py
+                   ${_grain} ${_scenes}/periodic_bed_reproducible_predicted.yaml
+                   ${_work}/reproducible_snapshots_predicted ${MPIEXEC_EXECUTABLE})
+  set_tests_properties(grain.reproducible_snapshots_predicted
+                       PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}" TIMEOUT 300 PROCESSORS 2)
 endif()

@@ -66,6 +66,9 @@ std::vector<Case> random_cases(int count) {
     g.roll_inertia = 0;
     g.v_rel = 0.1 * Vec3(u(rng), u(rng), u(rng));
     g.w_rel = 100 * Vec3(u(rng), u(rng), u(rng));
+    // The predicted end-of-step velocities differ from the half-step ones by an O(dt) kick.
+    g.v_pred = g.v_rel + 0.01 * Vec3(u(rng), u(rng), u(rng));
+    g.w_pred = g.w_rel + 10 * Vec3(u(rng), u(rng), u(rng));
     g.wall = false;
     // Every third spring zero; the others from sticking (1e-8 m) to sliding (1e-5 m).
     const double length = k % 3 == 0 ? 0 : std::pow(10.0, -8 + 3 * (0.5 + 0.5 * u(rng)));
@@ -114,6 +117,8 @@ void check_lanes(const std::vector<Case>& cases, const std::vector<Scalar>& alon
   g.roll_inertia = V{};
   g.v_rel = gather3<V>([&](int l) -> const Vec3& { return geometry(l).v_rel; });
   g.w_rel = gather3<V>([&](int l) -> const Vec3& { return geometry(l).w_rel; });
+  g.v_pred = gather3<V>([&](int l) -> const Vec3& { return geometry(l).v_pred; });
+  g.w_pred = gather3<V>([&](int l) -> const Vec3& { return geometry(l).w_pred; });
   g.wall = false;
   const auto all = [&](double v) { return broadcast<V>(v); };
   const Coefficients<V> lanes_pc{all(pc.y_star), all(pc.g_star), all(pc.hertz_beta),
@@ -167,6 +172,8 @@ TEST(ContactLanes, ElasticNormalForceIsHertzInEveryLane) {
   for (Case& c : cases) {
     c.g.v_rel.setZero();
     c.g.w_rel.setZero();
+    c.g.v_pred.setZero();
+    c.g.w_pred.setZero();
     c.spring.setZero();
   }
   ContactGeometryT<Lanes2x2> g;
@@ -179,6 +186,8 @@ TEST(ContactLanes, ElasticNormalForceIsHertzInEveryLane) {
   g.m_star = gather<Lanes2x2>([&](int l) { return geometry(l).m_star; });
   g.v_rel = zero3<Lanes2x2>();
   g.w_rel = zero3<Lanes2x2>();
+  g.v_pred = zero3<Lanes2x2>();
+  g.w_pred = zero3<Lanes2x2>();
   g.wall = false;
   const auto all = [&](double v) { return broadcast<Lanes2x2>(v); };
   const Coefficients<Lanes2x2> lanes_pc{all(pc.y_star), all(pc.g_star), all(0.0),

@@ -490,6 +490,16 @@ TEST(SceneErrors, UnknownModelNameListsModels) {
   const std::string rolling = expect_at(error_of(kBase + "  rolling: friction\n"), 17, 12);
   EXPECT_THAT(rolling, HasSubstr("unknown rolling resistance model 'friction'; allowed: none, cdt, "
                                  "epsd"));
+
+  const std::string dashpot = expect_at(error_of(kBase + "  dashpot_velocity: end\n"), 17, 21);
+  EXPECT_THAT(dashpot, HasSubstr("contact.dashpot_velocity: unknown dashpot velocity 'end'; "
+                                 "allowed: half_step, predicted"));
+}
+
+TEST(SceneContact, DashpotVelocityDefaultsToHalfStep) {
+  EXPECT_EQ(parse_scene(kBase, kLabel).contact.dashpot_velocity, DashpotVelocity::half_step);
+  EXPECT_EQ(parse_scene(kBase + "  dashpot_velocity: predicted\n", kLabel).contact.dashpot_velocity,
+            DashpotVelocity::predicted);
 }
 
 TEST(SceneErrors, UnknownMaterialReferenceListsKnownNames) {
