@@ -504,18 +504,21 @@ void canonical_pair_sweep(ContactSweep& s) {
   struct Source {
     const GlobalId* id;
     const Vec3 *v, *w;
+    const Vec3 *vp, *wp;  // the dashpots' predicted velocities (Law::predicted_dashpot)
     const double *radius, *mass, *inertia;
     const int* material;
     Vec3 *force, *torque;
   };
   order.ghost_force.assign(g.size(), Vec3::Zero());
   order.ghost_torque.assign(g.size(), Vec3::Zero());
-  const Source L{p.id.data(),       p.v.data(),     p.omega.data(),
-                 p.radius.data(),   p.mass.data(),  p.inertia.data(),
-                 p.material.data(), p.force.data(), p.torque.data()};
-  const Source G{g.id.data(),       g.v.data(),               g.omega.data(),
-                 g.radius.data(),   g.mass.data(),            g.inertia.data(),
-                 g.material.data(), order.ghost_force.data(), order.ghost_torque.data()};
+  const Source L{p.id.data(),        p.v.data(),          p.omega.data(),
+                 p.v_pred.data(),    p.omega_pred.data(), p.radius.data(),
+                 p.mass.data(),      p.inertia.data(),    p.material.data(),
+                 p.force.data(),     p.torque.data()};
+  const Source G{g.id.data(),          g.v.data(),          g.omega.data(),
+                 g.v_pred.data(),      g.omega_pred.data(), g.radius.data(),
+                 g.mass.data(),        g.inertia.data(),    g.material.data(),
+                 order.ghost_force.data(), order.ghost_torque.data()};
   const Vec3* x = p.x.data();
   const Vec3* g_x = g.x.data();
   const Vec3* g_shift = g.shift.data();
@@ -565,7 +568,12 @@ void canonical_pair_sweep(ContactSweep& s) {
                : Pair{&G, q, &L, i, (g_x[q] - x[i]) + (g_shift[q] - zero), st, sr, false};
   };
   const auto body = [](const Source* src, int k) {
-    return Body<double>{src->v[k], src->w[k], src->radius[k], src->mass[k], src->inertia[k]};
+    if constexpr (Law::predicted_dashpot)
+      return Body<double>{src->v[k],      src->w[k],    src->vp[k],       src->wp[k],
+                          src->radius[k], src->mass[k], src->inertia[k]};
+    else
+      return Body<double>{src->v[k],      src->w[k],    Vec3::Zero(),     Vec3::Zero(),
+                          src->radius[k], src->mass[k], src->inertia[k]};
   };
   const auto table = [&](const Pair& c) -> const PairCoefficients& {
     return s.table(c.a->material[c.ia], c.b->material[c.ib]);
@@ -618,6 +626,12 @@ void canonical_pair_sweep(ContactSweep& s) {
       a.w = gather3<V>([&](int l) -> const Vec3& { return A(l).w[group[l].ia]; });
       b.v = gather3<V>([&](int l) -> const Vec3& { return B(l).v[group[l].ib]; });
       b.w = gather3<V>([&](int l) -> const Vec3& { return B(l).w[group[l].ib]; });
+      if constexpr (Law::predicted_dashpot) {
+        a.vp = gather3<V>([&](int l) -> const Vec3& { return A(l).vp[group[l].ia]; });
+        b.vp = gather3<V>([&](int l) -> const Vec3& { return B(l).vp[group[l].ib]; });
+        a.wp = gather3<V>([&](int l) -> const Vec3& { return A(l).wp[group[l].ia]; });
+        b.wp = gather3<V>([&](int l) -> const Vec3& { return B(l).wp[group[l].ib]; });
+      }
       V r_star, m_star;
       PairCoefficientLanes<V> pc;
       if constexpr (Alike) {
@@ -770,8 +784,23 @@ void report_contacts(const ContactSweep& s, ContactNetwork& out) {
     if constexpr (Law::keeps_rolling) h.rolling = springs.rolling[k];
     return h;
   };
+  // The dashpots' velocities as the sweep gives them (predicted ones only when the law reads
+  // them; Particles::v_pred).
   const auto body = [&](std::size_t i) {
-    return Body<double>{p.v[i], p.omega[i], p.radius[i], p.mass[i], p.inertia[i]};
+    if constexpr (Law::predicted_dashpot)
+      return Body<double>{p.v[i], p.omega[i], p.v_pred[i], p.omega_pred[i],
+                          p.radius[i], p.mass[i], p.inertia[i]};
+    else
+      return Body<double>{p.v[i], p.omega[i], Vec3::Zero(), Vec3::Zero(),
+                          p.radius[i], p.mass[i], p.inertia[i]};
+  };
+  const auto ghost_body = [&](std::size_t q) {
+    if constexpr (Law::predicted_dashpot)
+      return Body<double>{g.v[q], g.omega[q], g.v_pred[q], g.omega_pred[q],
+                          g.radius[q], g.mass[q], g.inertia[q]};
+    else
+      return Body<double>{g.v[q], g.omega[q], Vec3::Zero(), Vec3::Zero(),
+                          g.radius[q], g.mass[q], g.inertia[q]};
   };
   for (std::size_t i = 0; i < p.size(); ++i) {
     for (int k = s.local_list.offsets[i]; k < s.local_list.offsets[i + 1]; ++k) {
@@ -790,8 +819,7 @@ void report_contacts(const ContactSweep& s, ContactNetwork& out) {
       const Vec3 d = (p.x[i] - g.x[q]) + (zero - g.shift[q]);
       if (apart(d, p.radius[i] + g.radius[q])) continue;
       const ContactHistory h = spring(s.ghost_springs, k);
-      add_pair(p.id[i], g.id[q], p.x[i], d, body(i),
-               Body<double>{g.v[q], g.omega[q], g.radius[q], g.mass[q], g.inertia[q]},
+      add_pair(p.id[i], g.id[q], p.x[i], d, body(i), ghost_body(q),
                s.table(p.material[i], g.material[q]), h.tangential, h.rolling);
     }
   }
