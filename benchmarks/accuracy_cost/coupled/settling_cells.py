@@ -9,9 +9,12 @@ enough for the particle to fall `--fall` diameters (at least 6 cells) after reac
 terminal speed. Error: the mean settling speed over the second half of the fall against u_t
 from Schiller & Naumann (1933), C_D = 24/Re (1 + 0.15 Re^0.687).
 
-Usage: settling_cells.py [--re 2] [--cells 3,5,10] [--correction off] [--footprint divided]
-                         [--sampling cell] [--work DIR] [--build DIR] [--width 16]
-Prints one line per case and writes <work>/settling_cells.csv.
+Usage: settling_cells.py [--re 2] [--cells 3,5,10] [--correction oseenBrinkman]
+                         [--footprint divided] [--sampling cell] [--width 16] [--fall 40]
+                         [--courant 0.05] [--check PERCENT] [--work DIR] [--build DIR]
+Prints one line per case and appends to <work>/settling_cells.csv; with --check, exit 1 unless
+every |error| is within PERCENT. The tables of docs/models/undisturbed-velocity.md come from
+--courant 0.02 --width 16 at Re_t 0.1, 2 and 50, with and without --correction.
 """
 import argparse
 import csv
@@ -150,11 +153,13 @@ def run(case, build):
             rc = subprocess.call([FOAM] + cmd, cwd=case, stdout=out, stderr=subprocess.STDOUT, env=env)
         if rc != 0:
             sys.exit(f"settling_cells: {cmd[0]} failed, see {case}/{log}")
-    cpu = 0.0
+    cpu, imbalance = 0.0, 0.0
     for line in open(os.path.join(case, "log.grainFoam")):
         if line.startswith("ExecutionTime"):
             cpu = float(line.split()[2])
-    return cpu
+        if "relative imbalance" in line:
+            imbalance = max(imbalance, float(line.split()[-1]))
+    return cpu, imbalance
 
 
 def measure(case, info):
@@ -180,6 +185,8 @@ def main():
     ap.add_argument("--fall", type=float, default=40)
     ap.add_argument("--courant", type=float, default=0.05,
                     help="particle Courant number u_t dt / h of the fluid step (default 0.05)")
+    ap.add_argument("--check", type=float, default=None,
+                    help="exit 1 unless every |error| is within this many per cent")
     ap.add_argument("--work", default="/tmp/settling_cells")
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     a = ap.parse_args()
@@ -189,15 +196,16 @@ def main():
         case = os.path.join(a.work, name)
         subprocess.call(["rm", "-rf", case])
         info = make_case(case, n, a.re, a.width, a.fall, a.footprint, a.sampling, a.correction, a.courant)
-        cpu = run(case, a.build)
+        cpu, imbalance = run(case, a.build)
         err, wobble = measure(case, info)
         row = dict(re=a.re, cells_per_d=n, footprint=a.footprint, sampling=a.sampling,
                    correction=a.correction or "off", mu=info["mu"], u_t=info["u_t"],
-                   error_pct=100 * err, wobble_pct=100 * wobble, cpu_s=cpu, mesh_cells=info["cells"])
+                   error_pct=100 * err, wobble_pct=100 * wobble, cpu_s=cpu, mesh_cells=info["cells"],
+                   imbalance=imbalance)
         rows.append(row)
         print(f"settling_cells: Re_t {a.re:g}, cells {n:g} d, {a.footprint}/{a.sampling}, "
               f"correction {row['correction']}: error {100 * err:+.2f} % (wobble {100 * wobble:.2f} %), "
-              f"{info['cells']} cells, {cpu:.0f} s", flush=True)
+              f"{info['cells']} cells, {cpu:.0f} s, exchange imbalance {imbalance:.1e}", flush=True)
     out = os.path.join(a.work, "settling_cells.csv")
     new = not os.path.exists(out)
     with open(out, "a", newline="") as f:
@@ -205,6 +213,12 @@ def main():
         if new:
             wr.writeheader()
         wr.writerows(rows)
+    if a.check is not None:
+        bad = [r for r in rows if abs(r["error_pct"]) > a.check or r["imbalance"] > 1e-12]
+        print(f"settling_cells: {len(rows) - len(bad)} of {len(rows)} within {a.check:g} % "
+              f"with the exchange balanced to 1e-12: "
+              f"{'ok' if not bad else 'FAILED'}")
+        sys.exit(1 if bad else 0)
 
 
 if __name__ == "__main__":
