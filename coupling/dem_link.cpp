@@ -45,6 +45,8 @@ struct DemLink::Impl {
   std::vector<CoupledSample> pending;  // begin_fluid() .. end_fluid()
   std::vector<Vec3> pending_vorticity;  // the same, when a force reads the vorticity
   bool curl = false;                    // needs_vorticity()
+  std::vector<SelfDisturbance> pending_disturbance;  // when `self`
+  bool self = false;                                  // correct_self_disturbance()
   // The coupling's sampler of late arrivals (end_fluid), and whether the CoupledFluid's
   // sampler calls it already.
   std::function<FluidAtParticle(const std::array<double, 3>&)> late;
@@ -402,6 +404,8 @@ void DemLink::set_fluid(const std::vector<FluidAtParticle>& samples,
   end_fluid(std::move(late));
 }
 
+void DemLink::correct_self_disturbance(bool on) { impl_->self = on; }
+
 void DemLink::begin_fluid() {
   Impl& m = *impl_;
   const std::size_t n = m.simulation().particles().size();
@@ -412,6 +416,11 @@ void DemLink::begin_fluid() {
     m.pending_vorticity = m.fluid->take_spare_vorticity();
     m.pending_vorticity.clear();
     m.pending_vorticity.reserve(n);
+  }
+  if (m.self) {
+    m.pending_disturbance = m.fluid->take_spare_disturbance();
+    m.pending_disturbance.clear();
+    m.pending_disturbance.reserve(n);
   }
 }
 
@@ -427,6 +436,10 @@ DemLink::SampleRecords DemLink::fluid_samples() {
   if (m.curl) {
     m.pending_vorticity = m.fluid->take_spare_vorticity();
     m.pending_vorticity.resize(n);
+  }
+  if (m.self) {  // the records carry no disturbance: these particles get no correction
+    m.pending_disturbance = m.fluid->take_spare_disturbance();
+    m.pending_disturbance.assign(n, SelfDisturbance{});
   }
   const CoupledSample probe;
   const auto at = [&probe](const auto& member) {
@@ -448,6 +461,7 @@ void DemLink::add_fluid(const FluidAtParticle& f) {
   m.pending.push_back(CoupledSample{vec(f.velocity), f.void_fraction, vec(f.pressure_gradient),
                                     vec(f.viscous_stress_divergence)});
   if (m.curl) m.pending_vorticity.push_back(vec(f.vorticity));
+  if (m.self) m.pending_disturbance.push_back({f.disturbance_width, f.disturbance_screening});
 }
 
 void DemLink::end_fluid(std::function<FluidAtParticle(const std::array<double, 3>&)> late) {
@@ -466,10 +480,16 @@ void DemLink::end_fluid() {
   if (m.curl && m.pending_vorticity.size() != p.size())
     throw std::logic_error("DemLink: " + std::to_string(m.pending_vorticity.size()) +
                            " vorticity samples for " + std::to_string(p.size()) + " particles");
-  m.fluid->set(p.id, std::move(m.pending), m.curl ? std::move(m.pending_vorticity)
-                                                  : std::vector<Vec3>{});
+  if (m.self && m.pending_disturbance.size() != p.size())
+    throw std::logic_error("DemLink: " + std::to_string(m.pending_disturbance.size()) +
+                           " self-disturbance samples for " + std::to_string(p.size()) +
+                           " particles");
+  m.fluid->set(p.id, std::move(m.pending),
+               m.curl ? std::move(m.pending_vorticity) : std::vector<Vec3>{},
+               m.self ? std::move(m.pending_disturbance) : std::vector<SelfDisturbance>{});
   m.pending = {};  // moved from: empty
   m.pending_vorticity = {};
+  m.pending_disturbance = {};
   if (!m.sampler_set) {
     Impl* self = &m;
     m.fluid->set_sampler([self](const Vec3& x) { return self->to_sample(self->late(arr(x))); });

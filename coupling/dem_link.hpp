@@ -29,6 +29,11 @@ struct FluidAtParticle {
   std::array<double, 3> pressure_gradient{};
   std::array<double, 3> viscous_stress_divergence{};
   std::array<double, 3> vorticity{};
+  // The particle's own disturbance of these values (DemLink::correct_self_disturbance):
+  // the width sigma [m] of deposit and read-back kernels together (0: no correction) and the
+  // drag coefficient per volume of the other particles there [kg/m^3/s].
+  double disturbance_width = 0;
+  double disturbance_screening = 0;
 };
 
 // Particles as flat arrays: entries [0, local) are this rank's particles, entries
@@ -125,6 +130,11 @@ class DemLink {
   std::string output_directory_source() const;  // "file:line" of output.directory
   double snapshot_interval() const;
   std::string snapshot_interval_source() const;  // "file:line" of output.snapshot_interval
+
+  // From now on the drag sees the undisturbed velocity: the samples carry each particle's
+  // disturbance width and screening (FluidAtParticle), and the drag law is evaluated at the
+  // slip the particle would see without its own feedback (dem/fluid/self_disturbance.hpp).
+  void correct_self_disturbance(bool on);
 
   // Takes the processor grid of the fluid's decomposition (call before initialise());
   // the DEM then runs on a communicator ordered so that this rank owns exactly the box

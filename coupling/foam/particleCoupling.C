@@ -10,6 +10,7 @@
 
 #include "coupling/accuracy_table.hpp"
 #include "coupling/shared_decomposition.hpp"
+#include "dem/fluid/self_disturbance.hpp"  // lattice_cell_width (C++17-clean)
 #include "dem/io/output_directory.hpp"
 #include "zeroGradientFvPatchFields.H"
 #include "extrapolatedCalculatedFvPatchField.H"
@@ -82,7 +83,8 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
   // A misspelt key would silently fall back to its default: refuse unknown keys.
   {
     const wordList allowed{"scene", "voidFraction", "dividedResolution", "smoothingFactor",
-                           "sampling", "minVoidFraction", "ddtVoidFraction"};
+                           "sampling", "minVoidFraction", "ddtVoidFraction",
+                           "undisturbedVelocity"};
     for (const word& key : dict.toc())
       if (!allowed.found(key))
         FatalIOErrorInFunction(dict) << "unknown key '" << key << "'; allowed: " << allowed
@@ -132,11 +134,27 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
                                     "0.2)"
                                  << exit(FatalIOError);
   ddtVoidFraction_ = dict.lookupOrDefault<Switch>("ddtVoidFraction", true);
+  const word undisturbed = dict.lookupOrDefault<word>("undisturbedVelocity", "off");
+  if (undisturbed == "oseenBrinkman")
+    undisturbed_ = true;
+  else if (undisturbed != "off")
+    FatalIOErrorInFunction(dict) << "undisturbedVelocity " << undisturbed
+                                 << " is not one of: off (drag on the sampled velocity), "
+                                    "oseenBrinkman (drag on the sampled velocity minus the "
+                                    "particle's own disturbance, docs/models/"
+                                    "undisturbed-velocity.md)"
+                                 << exit(FatalIOError);
+  if (undisturbed_ && sampling_ != Sampling::cell)
+    FatalIOErrorInFunction(dict) << "undisturbedVelocity oseenBrinkman needs sampling cell "
+                                    "(the disturbance of the cellPoint interpolation is not "
+                                    "modelled yet); set sampling cell or undisturbedVelocity off"
+                                 << exit(FatalIOError);
 
   // --- the DEM ----------------------------------------------------------------------
   if (!sceneFile.isAbsolute()) sceneFile = cwd() / sceneFile;
   try {
     dem_ = std::make_unique<coupling::DemLink>(sceneFile, rho_, rho_ * nu_, MPI_COMM_WORLD);
+    dem_->correct_self_disturbance(undisturbed_);
   } catch (const std::exception& e) {
     FatalErrorInFunction << "\n" << e.what() << exit(FatalError);
   }
@@ -807,12 +825,19 @@ void ParticleCoupling::sample() {
       sampleCellPoint<10>();
     return;
   }
-  // Footprint-weighted cell values; ghosts' shares go back to their owners.
+  // Footprint-weighted cell values; ghosts' shares go back to their owners. With
+  // undisturbedVelocity, also the moments of the footprint's cells about the particle
+  // (offset, squared offset plus the cell's own variance V^(2/3)/4, summed over the axes),
+  // the other particles' drag per volume there and the particle's own share of it.
   dem_->begin_fluid();
-  constexpr std::size_t W = 14;
+  const std::size_t W = undisturbed_ ? 21 : 14;
   std::vector<double> acc(W * particles_.size(), 0.0);
+  const scalarField& V = mesh_.V().field();
+  const vectorField& C = mesh_.C().primitiveField();
+  std::vector<PointInCell> cellsOfParticle;  // a footprint's weight per cell
   for (std::size_t i = 0; i < particles_.size(); ++i) {
     double* a = &acc[W * i];
+    if (undisturbed_) cellsOfParticle.clear();
     for (std::size_t j = first_[i]; j < first_[i + 1]; ++j) {
       const label c = points_[j].cell;
       const double w = points_[j].weight;
@@ -824,7 +849,30 @@ void ParticleCoupling::sample() {
       }
       a[3] += w * voidFraction_[c];
       a[13] += w;
+      if (undisturbed_) {
+        const double* x = particles_.x(i);
+        double r2 = 0;
+        for (int d = 0; d < 3; ++d) {
+          const double o = C[c][d] - x[d];
+          a[14 + d] += w * o;
+          r2 += o * o;
+        }
+        a[17] += w * r2;
+        a[18] += w * Ksl_[c];
+        a[20] += w * std::cbrt(V[c] * V[c]);
+        bool found = false;
+        for (PointInCell& q : cellsOfParticle)
+          if (q.cell == c) {
+            q.weight += w;
+            found = true;
+            break;
+          }
+        if (!found) cellsOfParticle.push_back({c, w});
+      }
     }
+    // The particle's own share of the Ksl it read: K W_c^2 / V_c summed over its cells.
+    if (undisturbed_)
+      for (const PointInCell& q : cellsOfParticle) a[19] += q.weight * q.weight / V[q.cell];
   }
   const std::vector<double> sums = dem_->sum_onto_owners(acc, W);
   for (std::size_t i = 0; i < local; ++i) {
@@ -838,6 +886,20 @@ void ParticleCoupling::sample() {
       f.vorticity[d] = a[10 + d] * norm;
     }
     f.void_fraction = a[13] > 0 ? a[3] * norm : 1.0;
+    if (undisturbed_ && a[13] > 0) {
+      // Deposit and read-back share the footprint's cells: the disturbance read is that of
+      // the cells' weight autocorrelation, whose variance per axis is twice that of the
+      // cell centres, widened by the width at which a Gaussian's self-disturbance equals that
+      // of one cell of the mesh's discrete operator (self_disturbance.hpp).
+      double mean2 = 0;
+      for (int d = 0; d < 3; ++d) mean2 += a[14 + d] * norm * a[14 + d] * norm;
+      const double variance = std::max(0.0, a[17] * norm - mean2) / 3;
+      const double cell = lattice_cell_width * lattice_cell_width * a[20] * norm;
+      f.disturbance_width = std::sqrt(2 * variance + cell);
+      f.disturbance_screening =
+          std::max(0.0, (a[18] - particles_.drag_coefficient(i) * a[19]) * norm);
+
+    }
     dem_->add_fluid(f);
   }
 }
@@ -998,6 +1060,11 @@ void ParticleCoupling::write() {
              << cellPoint.c_str()
              << "grainFoam time split since the last write: " << split(interval).c_str() << "\n"
              << "grainFoam time split: " << split(times).c_str() << Foam::endl;
+  if (undisturbed_)
+    for (const std::string& line : dem_->reports())
+      if (line.rfind("undisturbed velocity", 0) == 0)
+        Foam::Info << "grainFoam " << line.c_str()
+                   << (Pstream::parRun() ? " (particles of rank 0)" : "") << Foam::endl;
 }
 
 std::string ParticleCoupling::cellPointLine() const {

@@ -32,6 +32,16 @@ struct CoupledSample {
   Vec3 viscous_stress_divergence = Vec3::Zero();  // ∇·τ [Pa/m]
 };
 
+// What the coupling knows of a particle's own disturbance of the fluid it samples, when the
+// drag is to see the undisturbed velocity (couplingProperties undisturbedVelocity;
+// self_disturbance.hpp): the width sigma of the deposit and read-back kernels together and
+// the drag coefficient per volume of the other particles around it (Brinkman screening).
+// sigma = 0: no correction for this particle.
+struct SelfDisturbance {
+  double width = 0;      // sigma [m]
+  double screening = 0;  // beta [kg/m^3/s]
+};
+
 class CoupledFluid {
  public:
   using Sampler = std::function<FluidSample(const Vec3& x)>;
@@ -40,6 +50,7 @@ class CoupledFluid {
   struct View {
     const CoupledSample* samples = nullptr;
     const Vec3* vorticity = nullptr;
+    const SelfDisturbance* disturbance = nullptr;  // null: no correction
     std::size_t size = 0;
   };
 
@@ -48,13 +59,15 @@ class CoupledFluid {
     viscosity_ = viscosity;
   }
   // Samples of the particles `ids` (any order), with their vorticity when `vorticity` is not
-  // empty (then one per id). Replaces the previous set.
+  // empty and their self-disturbance when `disturbance` is not empty (then one per id).
+  // Replaces the previous set.
   void set(std::vector<GlobalId> ids, std::vector<CoupledSample> samples,
-           std::vector<Vec3> vorticity = {});
+           std::vector<Vec3> vorticity = {}, std::vector<SelfDisturbance> disturbance = {});
   // The storage of the set before the last set() (its values stale), for the next set to
   // be written into without a new allocation each fluid step; empty if taken already.
   std::vector<CoupledSample> take_spare() { return std::move(spare_); }
   std::vector<Vec3> take_spare_vorticity() { return std::move(spare_vorticity_); }
+  std::vector<SelfDisturbance> take_spare_disturbance() { return std::move(spare_disturbance_); }
   void set_sampler(Sampler sampler) { sampler_ = std::move(sampler); }
   // The samples in the current order of `p` (cheap when the order has not changed).
   View at_particles(const Particles& p);
@@ -83,8 +96,10 @@ class CoupledFluid {
   std::vector<GlobalId> ids_;
   std::vector<CoupledSample> samples_;
   std::vector<Vec3> vorticity_;  // empty, or one per entry of samples_
+  std::vector<SelfDisturbance> disturbance_;  // empty, or one per entry of samples_
   std::vector<CoupledSample> spare_;  // the previous samples_ (take_spare)
   std::vector<Vec3> spare_vorticity_;
+  std::vector<SelfDisturbance> spare_disturbance_;
   std::unordered_map<GlobalId, std::size_t> index_;  // built on the first re-map after set()
   // After a re-sort, migration or late arrival: the samples in the particles' new order.
   // Until then the samples are served as set (no copy per fluid step).
@@ -92,6 +107,7 @@ class CoupledFluid {
   std::vector<GlobalId> mapped_ids_;                 // order of `mapped_`
   std::vector<CoupledSample> mapped_;
   std::vector<Vec3> mapped_vorticity_;
+  std::vector<SelfDisturbance> mapped_disturbance_;
   Sampler sampler_;
   long late_ = 0;
 };

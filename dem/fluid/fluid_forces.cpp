@@ -22,6 +22,7 @@
 #include "dem/fluid/rotational_drag.hpp"
 #include "dem/fluid/saffman_mei_lift.hpp"
 #include "dem/fluid/schiller_naumann.hpp"
+#include "dem/fluid/self_disturbance.hpp"
 #include "dem/fluid/tenneti_garg_subramaniam.hpp"
 #include "dem/fluid/void_fraction_grid.hpp"
 #include "dem/fluid/volume_forces.hpp"
@@ -54,7 +55,23 @@ class FluidForcesWith final : public ForceTerm {
   std::string name() const override { return "fluid forces (drag: " + s_.drag_law + ")"; }
 
   std::string report() const override {
-    if (!grid_) return {};
+    if (undisturbed_calls_ > 0) {
+      std::string out = "undisturbed velocity: the drag of " + std::to_string(undisturbed_calls_) +
+                        " particle-steps raised by a mean factor of " +
+                        significant(undisturbed_sum_ / undisturbed_calls_) + " (largest " +
+                        significant(undisturbed_max_) + ")";
+      if (undisturbed_limited_ > 0)
+        out += "; " + std::to_string(undisturbed_limited_) +
+               " particle-steps held at the largest factor 1/(1 - " + significant(max_km) +
+               ") (the particle's own disturbance as large as its slip: cells too small for "
+               "the particle, docs/models/undisturbed-velocity.md)";
+      if (!grid_) return out;
+      return out + "\n" + grid_report();
+    }
+    return grid_ ? grid_report() : std::string{};
+  }
+
+  std::string grid_report() const {
     return "void fraction: " + std::to_string(grid_->cells()[0]) + " x " +
            std::to_string(grid_->cells()[1]) + " x " + std::to_string(grid_->cells()[2]) +
            " cells; clamped to the minimum " + std::to_string(grid_->clamped_cells_total()) +
@@ -176,7 +193,9 @@ class FluidForcesWith final : public ForceTerm {
       const Vec3 slip = f.velocity - p.v[i];
       Vec3 force = Vec3::Zero(), carried = Vec3::Zero();
       if (on_.drag) {
-        const double k = Law({d, slip.norm(), f.void_fraction, f.density, f.viscosity});
+        double k = Law({d, slip.norm(), f.void_fraction, f.density, f.viscosity});
+        if (samples.disturbance && samples.disturbance[i].width > 0)
+          k *= undisturbed(samples.disturbance[i], d, slip.norm(), f);
         const double k_sum = drag.coefficient[i] + k;
         if (k_sum > 0)
           drag.fluid_velocity[i] =
@@ -226,6 +245,36 @@ class FluidForcesWith final : public ForceTerm {
   }
 
  private:
+  // The particle's own disturbance of the sampled velocity (self_disturbance.hpp): the factor
+  // 1/(1 - k m) by which the drag on the seen slip grows, so that the force is the drag law's
+  // at the undisturbed slip. The momentum equation of the disturbance has the viscosity
+  // c mu (c = eps in model A, 1 in model B) and the advecting density eps rho.
+  double undisturbed(const SelfDisturbance& sd, double d, double w_seen, const FluidSample& f) {
+    const double mu_e = (s_.model == VansModel::A ? f.void_fraction : 1.0) * f.viscosity;
+    const double rho_e = f.void_fraction * f.density;
+    const double sigma = sd.width;
+    const double b = sd.screening * sigma * sigma / mu_e;
+    const double eps = f.void_fraction;
+    const auto k = [&](double w) { return Law({d, w, eps, f.density, f.viscosity}); };
+    const auto m = [&](double w) { return self_disturbance_table()(rho_e * w * sigma / mu_e, b) / (mu_e * sigma); };
+    bool limited = false;
+    const double k0 = k(w_seen);
+    const double factor = undisturbed_factor(w_seen, k, m, max_km, limited);
+    // The law at the undisturbed slip, relative to the law at the seen slip (the caller's k).
+    const double w = w_seen * factor;
+    const double ratio = k0 > 0 ? k(w) * factor / k0 : factor;
+    ++undisturbed_calls_;
+    undisturbed_sum_ += ratio;
+    undisturbed_max_ = std::max(undisturbed_max_, ratio);
+    if (limited) ++undisturbed_limited_;
+    return ratio;
+  }
+  // Beyond k m = 0.8 the particle's own disturbance would be four times its seen slip: the
+  // estimate is then an extrapolation of the model far outside where it was checked.
+  static constexpr double max_km = 0.8;
+  long undisturbed_calls_ = 0, undisturbed_limited_ = 0;
+  double undisturbed_sum_ = 0, undisturbed_max_ = 0;
+
   FluidSettings s_;
   Vec3 gravity_;
   Enabled on_;

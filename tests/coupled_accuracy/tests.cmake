@@ -16,3 +16,16 @@ add_test(NAME accuracy_cost.coupled_short
 set_tests_properties(accuracy_cost.coupled_short PROPERTIES
   LABELS "foam;coupling;accuracy_cost"
   TIMEOUT 900)
+
+# coupling.undisturbed_settling: one sphere settling at Re_t = 0.1 in cells of 3 d with
+# undisturbedVelocity oseenBrinkman: the settling speed within 3 % of Schiller-Naumann's
+# terminal velocity (46 % too fast without the correction, docs/models/undisturbed-velocity.md)
+# and the momentum exchange balanced to 1e-12 at every write time.
+add_test(NAME coupling.undisturbed_settling
+         COMMAND ${GRAINFLOW_SWEEPS_PYTHON} ${PROJECT_SOURCE_DIR}/benchmarks/accuracy_cost/coupled/settling_cells.py
+                 --re 0.1 --cells 3 --courant 0.05 --width 10 --fall 30 --correction oseenBrinkman
+                 --check 3 --work ${CMAKE_CURRENT_BINARY_DIR}/undisturbed_settling
+                 --build ${PROJECT_BINARY_DIR})
+set_tests_properties(coupling.undisturbed_settling PROPERTIES
+  LABELS "foam;coupling;accuracy_cost"
+  TIMEOUT 600)

@@ -18,7 +18,7 @@ snapshots against references that do not come from the coupling itself:
                         fluid_force is the buoyancy -rho_f V g and its force zero;
   cellpoint_ranks       rank independence of cellPoint sampling: sinking beads next to the
                         processor patch end where the 1-rank run puts them, to round-off;
-  refuses_bad_setup     three set-ups grainFoam must refuse, with the message it must give;
+  refuses_bad_setup     set-ups grainFoam must refuse, with the message it must give;
   scene_output          the scene's output block and time.end: snapshots at the interval's
                         multiples in the given folder, the run ending at the earlier end
                         time, the keys grainFoam does not use refused where they are.
@@ -340,7 +340,7 @@ def staircase_decomposition(case):
 
 
 def refuses_bad_setup(runner, checks):
-    """Three set-ups grainFoam must stop on, each with a message that says what to do."""
+    """Set-ups grainFoam must stop on, each with a message that says what to do."""
     # 1. A decomposition that is not a grid of boxes. Debian's OpenFOAM v1912 ships
     # libscotchDecomp.so as the stub ("Attempted to use <scotch> without the scotchDecomp
     # library loaded"), and metis and kahip likewise, so a graph partitioner's layout is
@@ -375,6 +375,22 @@ def refuses_bad_setup(runner, checks):
     checks.expect(named is not None,
                   "fluid.density 1100 vs rho 1000: refused; the message names both values, "
                   "particles.yaml:32 (the density key) and constant/transportProperties")
+
+    # 4. undisturbedVelocity: an unknown model, and the model with cellPoint sampling.
+    case = runner.fresh_case("periodic_box", "undisturbed_unknown", [
+        ("constant/couplingProperties", "sampling        cell;",
+         "undisturbedVelocity oseen;\nsampling        cell;")])
+    runner.run(case, "blockMesh", "blockMesh")
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    checks.expect("undisturbedVelocity oseen is not one of: off" in log and "oseenBrinkman" in log,
+                  "undisturbedVelocity oseen: refused, naming off and oseenBrinkman")
+    case = runner.fresh_case("periodic_box", "undisturbed_cellpoint", [
+        ("constant/couplingProperties", "sampling        cell;",
+         "undisturbedVelocity oseenBrinkman;\nsampling        cellPoint;")])
+    runner.run(case, "blockMesh", "blockMesh")
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    checks.expect("undisturbedVelocity oseenBrinkman needs sampling cell" in log,
+                  "undisturbedVelocity oseenBrinkman with sampling cellPoint: refused")
 
 
 # --- coupling.restart -------------------------------------------------------------------

@@ -1,0 +1,123 @@
+#include "dem/fluid/self_disturbance.hpp"
+
+#include <array>
+#include <cmath>
+
+namespace grainflow {
+
+namespace {
+
+constexpr double pi = 3.14159265358979323846;
+
+// g(A) = 2 A (1 + A^2) atan(1/A) - 2 A^2 = A^2 [int_-1^1 (1 - c^2) / (A^2 + c^2) dc]; for
+// large A its series 4/3 - 4/(15 A^2) + 4/(35 A^4) - ..., whose terms are
+// (-1)^k 4 / ((2k + 1)(2k + 3)) A^(-2k), avoids the cancellation of the closed form.
+double g(double a) {
+  if (a > 8) {
+    const double x = 1 / (a * a);
+    double sum = 0, p = 1;
+    for (int k = 0; k < 14; ++k) {
+      sum += (k % 2 ? -4.0 : 4.0) / ((2 * k + 1) * (2 * k + 3)) * p;
+      p *= x;
+    }
+    return sum;
+  }
+  return 2 * a * (1 + a * a) * std::atan(1 / a) - 2 * a * a;
+}
+
+// 24-point Gauss-Legendre nodes and weights on [-1, 1] (positive half; symmetric).
+constexpr std::array<double, 12> gl_x = {
+    0.0640568928626056260850430826247450, 0.1911188674736163091586398207570696,
+    0.3150426796961633743867932913198103, 0.4337935076260451384870842319133497,
+    0.5454214713888395356583756172183723, 0.6480936519369755692524957869107476,
+    0.7401241915785543642438281030999785, 0.8200019859739029219539498726697453,
+    0.8864155270044010342131543419821968, 0.9382745520027327585236490017087215,
+    0.9747285559713094981983919930081691, 0.9951872199970213601799974097007368};
+constexpr std::array<double, 12> gl_w = {
+    0.1279381953467521569740561652246954, 0.1258374563468282961213753825111837,
+    0.1216704729278033912044631534762625, 0.1155056680537256013533444839067836,
+    0.1074442701159656347825773424466062, 0.0976186521041138882698806644642472,
+    0.0861901615319532759171852029837427, 0.0733464814110803057340336152531166,
+    0.0592985849154367807463677585001085, 0.0442774388174198061686027482113382,
+    0.0285313886289336631813078159518782, 0.0123412297999871995468056670700372};
+
+}  // namespace
+
+double self_disturbance_factor(double re_sigma, double screening) {
+  // The integrand s^2 e^(-s^2/2) g(A) / (s^2 + b): smooth, negligible beyond s = 12; a kink
+  // of scale min(Re, sqrt b) near s = 0 when Re or b is large is resolved by panels that
+  // grow geometrically from s = 1e-4.
+  const auto f = [&](double s) {
+    const double s2 = s * s;
+    const double a = re_sigma > 0 ? (s2 + screening) / (re_sigma * s) : INFINITY;
+    const double ga = std::isinf(a) ? 4.0 / 3.0 : g(a);
+    return s2 * std::exp(-0.5 * s2) * ga / (s2 + screening);
+  };
+  double sum = 0, lo = 0, hi = 1e-4;
+  while (lo < 12) {
+    const double c = 0.5 * (hi + lo), h = 0.5 * (hi - lo);
+    for (std::size_t k = 0; k < gl_x.size(); ++k)
+      sum += h * gl_w[k] * (f(c - h * gl_x[k]) + f(c + h * gl_x[k]));
+    lo = hi;
+    hi = std::min(12.0, hi < 0.25 ? 2 * hi : hi + 0.5);
+  }
+  return sum / (4 * pi * pi);
+}
+
+namespace {
+constexpr double re_lo = -5, re_hi = 6, b_lo = -10, b_hi = 8, per_decade = 8;
+}
+
+SelfDisturbanceTable::SelfDisturbanceTable()
+    : nr_(static_cast<int>((re_hi - re_lo) * per_decade) + 1),
+      nb_(static_cast<int>((b_hi - b_lo) * per_decade) + 1) {
+  log_phi_.resize(static_cast<std::size_t>(nr_) * nb_);
+  for (int i = 0; i < nr_; ++i)
+    for (int j = 0; j < nb_; ++j)
+      log_phi_[static_cast<std::size_t>(i) * nb_ + j] =
+          std::log(self_disturbance_factor(std::pow(10.0, re_lo + i / per_decade),
+                                           std::pow(10.0, b_lo + j / per_decade)));
+}
+
+double SelfDisturbanceTable::operator()(double re_sigma, double screening) const {
+  // Beyond the upper ends (Re_sigma > 1e6 or b > 1e8, far outside fluidised and packed
+  // beds): the quadrature itself. Below the lower ends phi is flat: within 1e-5 of its
+  // value at Re_sigma = 1e-5 (the Oseen term is linear in Re) and at b = 1e-10 (the Brinkman
+  // term grows as sqrt(b)).
+  double lr = std::log10(std::max(re_sigma, 1e-300));
+  double lb = std::log10(std::max(screening, 1e-300));
+  if (lr > re_hi || lb > b_hi) return self_disturbance_factor(re_sigma, screening);
+  lr = std::max(lr, re_lo);
+  lb = std::max(lb, b_lo);
+  const double x = (lr - re_lo) * per_decade, y = (lb - b_lo) * per_decade;
+  const int i = std::min(static_cast<int>(x), nr_ - 2), j = std::min(static_cast<int>(y), nb_ - 2);
+  const double tx = x - i, ty = y - j;
+  // Catmull-Rom weights; at the table's edges the missing neighbour is extrapolated linearly.
+  const auto w = [](double t) {
+    return std::array<double, 4>{0.5 * (-t + 2 * t * t - t * t * t), 0.5 * (2 - 5 * t * t + 3 * t * t * t),
+                                 0.5 * (t + 4 * t * t - 3 * t * t * t), 0.5 * (-t * t + t * t * t)};
+  };
+  const auto value = [&](int a, int c) {
+    // Linear extrapolation one point past an edge.
+    const auto col = [&](int aa) {
+      if (c < 0) return 2 * at(aa, 0) - at(aa, 1);
+      if (c >= nb_) return 2 * at(aa, nb_ - 1) - at(aa, nb_ - 2);
+      return at(aa, c);
+    };
+    if (a < 0) return 2 * col(0) - col(1);
+    if (a >= nr_) return 2 * col(nr_ - 1) - col(nr_ - 2);
+    return col(a);
+  };
+  const auto wx = w(tx), wy = w(ty);
+  double lp = 0;
+  for (int a = 0; a < 4; ++a)
+    for (int c = 0; c < 4; ++c) lp += wx[a] * wy[c] * value(i - 1 + a, j - 1 + c);
+  return std::exp(lp);
+}
+
+const SelfDisturbanceTable& self_disturbance_table() {
+  static const SelfDisturbanceTable table;
+  return table;
+}
+
+}  // namespace grainflow
