@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <string>
 
 #include "dem/engine/simulation.hpp"
 #include "dem/engine/time_step.hpp"
@@ -125,7 +126,12 @@ INSTANTIATE_TEST_SUITE_P(Laws, DampedImpactConvergence,
                                            Case{NormalModel::hooke, 0.5},
                                            Case{NormalModel::hooke, 0.1},
                                            Case{NormalModel::hertz, 0.5},
-                                           Case{NormalModel::hertz, 0.1}));
+                                           Case{NormalModel::hertz, 0.1}),
+                         [](const ::testing::TestParamInfo<Case>& info) {
+                           const Case& c = info.param;
+                           return std::string(c.model == NormalModel::hooke ? "Hooke" : "Hertz") +
+                                  "_e0" + std::to_string(static_cast<int>(c.e * 10 + 0.5));
+                         });
 
 }  // namespace
 }  // namespace grainflow
