@@ -127,8 +127,8 @@ INSTANTIATE_TEST_SUITE_P(Laws, DampedImpactConvergence,
                                            Case{NormalModel::hooke, 0.1},
                                            Case{NormalModel::hertz, 0.5},
                                            Case{NormalModel::hertz, 0.1}),
-                         [](const ::testing::TestParamInfo<Case>& info) {
-                           const Case& c = info.param;
+                         [](const ::testing::TestParamInfo<Case>& param_info) {
+                           const Case& c = param_info.param;
                            return std::string(c.model == NormalModel::hooke ? "Hooke" : "Hertz") +
                                   "_e0" + std::to_string(static_cast<int>(c.e * 10 + 0.5));
                          });
