@@ -9,12 +9,15 @@
 // (rank 0). benchmarks/strong_scaling/run.sh runs it on 1 and 2 ranks side by side.
 #include <mpi.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "dem/engine/simulation.hpp"
 
@@ -84,6 +87,39 @@ int main(int argc, char** argv) {
                 sim.load_imbalance());
   else
     sim.load_imbalance();
+  // Per rank: owned spheres, ghosts, pairs on the local neighbour list, and the pairs of an
+  // owned sphere with a ghost closer than the list's reach (2 r + skin), which this rank
+  // evaluates as well as the ghost's owner (inputs of benchmarks/scaling_model/model.py).
+  const Particles& p = sim.particles();
+  const Ghosts& gh = sim.ghosts();
+  const double reach = 2 * r + 0.4 * r;  // the scene's default skin: 0.4 r_max
+  std::map<std::array<long, 3>, std::vector<std::size_t>> bins;
+  auto key = [reach](const Vec3& x) {
+    return std::array<long, 3>{static_cast<long>(std::floor(x.x() / reach)),
+                               static_cast<long>(std::floor(x.y() / reach)),
+                               static_cast<long>(std::floor(x.z() / reach))};
+  };
+  for (std::size_t k = 0; k < p.size(); ++k) bins[key(p.x[k])].push_back(k);
+  long cross = 0;
+  for (std::size_t q = 0; q < gh.size(); ++q) {
+    const Vec3 xg = gh.position(q);
+    const auto c = key(xg);
+    for (long dx = -1; dx <= 1; ++dx)
+      for (long dy = -1; dy <= 1; ++dy)
+        for (long dz = -1; dz <= 1; ++dz) {
+          const auto it = bins.find({c[0] + dx, c[1] + dy, c[2] + dz});
+          if (it == bins.end()) continue;
+          for (const std::size_t k : it->second) cross += (p.x[k] - xg).norm() < reach;
+        }
+  }
+  const long mine[4] = {static_cast<long>(p.size()), static_cast<long>(gh.size()),
+                        static_cast<long>(sim.neighbour_list().pairs()), cross};
+  std::vector<long> all(4 * static_cast<std::size_t>(size));
+  MPI_Gather(mine, 4, MPI_LONG, all.data(), 4, MPI_LONG, 0, MPI_COMM_WORLD);
+  if (rank == 0)
+    for (int q = 0; q < size; ++q)
+      std::printf("rank=%d local=%ld ghosts=%ld list_pairs=%ld ghost_pairs=%ld\n", q, all[4 * q],
+                  all[4 * q + 1], all[4 * q + 2], all[4 * q + 3]);
   MPI_Finalize();
   return 0;
 }

@@ -1,0 +1,316 @@
+#!/usr/bin/env python3
+"""A model of how grain's DEM bed and grainFoam's coupled bed scale past this machine.
+
+    benchmarks/scaling_model/model.py --measure [--build DIR]   # counts on 1, 2, 4, 8 ranks
+    benchmarks/scaling_model/model.py                           # the model from the last counts
+    benchmarks/scaling_model/model.py --fluid                   # grainFoam's counts per fluid step
+
+--measure runs bench_strong_scaling (a dense FCC bed of 100 000 spheres) on 1, 2, 4 and 8 ranks
+(4 and 8 oversubscribed: the counts do not depend on the cores) with the MPI profiling layer
+mpi_count.c preloaded, and stores what every rank owns, holds as ghosts, evaluates as pairs,
+sends and reduces per step in DIR/scaling_model/measured.json. The model then
+
+  1. fits the ghost layer's width to the measured ghost counts and checks it on every run;
+  2. predicts the messages, bytes and reductions per step on 4 and 8 ranks from the 1- and
+     2-rank runs and prints them against the measured ones;
+  3. predicts the 1 -> 2 rank speed-up from the 1-rank time per particle-step and compares it
+     with docs/parallel-scaling.md's measurement;
+  4. extrapolates strong and weak scaling of the DEM bed and of a coupled bed to 64, 256 and
+     1024 ranks on the cluster network below, with the part that stops scaling first.
+
+The formulas, the network and the limits are explained in docs/scaling-model.md; this script
+prints its tables.
+"""
+import argparse
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+
+# ---- measured on this machine, quiet (sources in docs/scaling-model.md) -------------------
+T_PS_DENSE = 1 / 2.78e6    # s per particle-step, dense FCC bed, 1 rank (docs/parallel-scaling.md)
+SPEEDUP_DENSE_2 = 1.75     # its measured 1 -> 2 rank speed-up (same page)
+PAIR_SHARE = 0.75          # share of a step's time that scales with the pairs evaluated
+                           # (pair sweep 68 % + walls 7 % of the loop, docs/performance.md)
+# The coupled bed, from the fluidisedBed tutorial on 2 ranks (issue 22's measurement):
+# 12 000 beads, 4 800 cells, 20 DEM steps per fluid step; time split DEM 63 %, coupling
+# 12.1 %, fluid 24.9 %. The settled-bed rate of docs/performance.md, 1.48e7 particle-steps/s,
+# stands for its DEM.
+T_PS_BED = 1 / 1.48e7
+FB = dict(beads=12000, cells=4800, substeps=20, dem=0.63, coupling=0.121, fluid=0.249)
+
+# ---- the cluster the model assumes ------------------------------------------------------
+NET = dict(
+    alpha=1.5e-6,          # s, point-to-point latency of a small message between nodes
+    alpha_node=0.4e-6,     # s, the same within a node (shared memory)
+    node_bw=12.5e9,        # B/s, a node's injection bandwidth (InfiniBand HDR100, 100 Gb/s)
+    rank_bw_node=5e9,      # B/s, one rank's copy bandwidth within a node
+    ranks_per_node=64,     # 2 sockets x 32 cores
+    allreduce_level=1.5e-6,  # s per level of a small allreduce's tree (log2 P levels)
+)
+
+
+def mpirun(np_, args, env):
+    base = ["mpirun", "-np", str(np_), "--oversubscribe"]
+    for k in env:
+        base += ["-x", k]
+    e = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", **env)
+    return subprocess.run(base + args, env=e, check=True, capture_output=True, text=True).stdout
+
+
+def measure(build, particles, steps):
+    out_dir = os.path.join(build, "scaling_model")
+    os.makedirs(out_dir, exist_ok=True)
+    lib = os.path.join(out_dir, "libmpi_count.so")
+    subprocess.run(["mpicc", "-O2", "-shared", "-fPIC", "-o", lib, os.path.join(HERE, "mpi_count.c")],
+                   check=True)
+    runs = {}
+    for np_ in (1, 2, 4, 8):
+        counts = os.path.join(out_dir, f"counts_{np_}.txt")
+        if os.path.exists(counts):
+            os.remove(counts)
+        text = mpirun(np_, [os.path.join(build, "bin", "bench_strong_scaling"), "--particles",
+                            str(particles), "--steps", str(steps)],
+                      {"LD_PRELOAD": lib, "MPI_COUNT_OUT": counts})
+        print(text, end="")
+        head = dict(kv.split("=") for kv in text.splitlines()[0].split())
+        ranks = [{k: int(v) for k, v in (kv.split("=") for kv in line.split())}
+                 for line in text.splitlines() if line.startswith("rank=")]
+        traffic = {}
+        for line in open(counts):
+            d = dict(kv.split("=") for kv in line.split())
+            if d["epoch"] != "1":  # the timed loop (between the benchmark's two barriers)
+                continue
+            r = int(d["rank"])
+            traffic.setdefault(r, {})[d["kind"]] = dict(calls=int(d["calls"]) / steps,
+                                                         bytes=int(d["bytes"]) / steps)
+        for rk in ranks:
+            rk["per_step"] = traffic.get(rk["rank"], {})
+        runs[np_] = dict(particles=int(head["particles"]), contacts=int(head["contacts"]), ranks=ranks)
+    path = os.path.join(out_dir, "measured.json")
+    json.dump(dict(steps=steps, runs=runs), open(path, "w"), indent=1)
+    print("wrote", path)
+    return path
+
+
+def measure_fluid(build):
+    """grainFoam's messages and reductions per fluid step: fluidisedBed --short on 2 ranks, run
+    to 0.015 s and to 0.045 s (50 and 150 fluid steps) with mpi_count preloaded; the difference
+    of the two runs' totals over the 100 steps between them."""
+    import shutil
+    out_dir = os.path.join(build, "scaling_model")
+    os.makedirs(out_dir, exist_ok=True)
+    lib = os.path.join(out_dir, "libmpi_count.so")
+    subprocess.run(["mpicc", "-O2", "-shared", "-fPIC", "-o", lib, os.path.join(HERE, "mpi_count.c")],
+                   check=True)
+    case = os.path.join(out_dir, "fluidisedBed")
+    shutil.rmtree(case, ignore_errors=True)
+    shutil.copytree(os.path.join(ROOT, "tutorials", "cfd-dem", "fluidisedBed"), case)
+    tut = os.path.join(ROOT, "tutorials", "cfd-dem")
+    totals = {}
+    for end in ("0.015", "0.045"):
+        counts = os.path.join(out_dir, f"fluid_counts_{end}.txt")
+        if os.path.exists(counts):
+            os.remove(counts)
+        # The short scene of Allrun --short: 2000 beads poured from 2-20 mm.
+        import yaml
+        scene = yaml.safe_load(open(os.path.join(case, "particles.yaml")))
+        scene["insert"][0]["count"] = 2000
+        scene["insert"][0]["region"]["box"]["max"][2] = 0.02
+        yaml.safe_dump(scene, open(os.path.join(case, "particles_short.yaml"), "w"), sort_keys=False)
+        open(os.path.join(case, "system", "shortRun.coupling"), "w").write('scene "particles_short.yaml";\n')
+        open(os.path.join(case, "system", "shortRun"), "w").write(f"endTime {end};\n")
+        script = f"set -e; cd {case}; source {tut}/run_case.sh; run_case -np 2"
+        env = dict(os.environ, GRAINFLOW_SOURCE_DIR=ROOT, GRAINFLOW_BUILD_DIR=build,
+                   OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+                   OMPI_MCA_mca_base_env_list=f"LD_PRELOAD={lib};MPI_COUNT_OUT={counts}")
+        subprocess.run(["bash", "-c", script], env=env, check=True, stdout=subprocess.DEVNULL)
+        t = {}
+        for line in open(counts):
+            d = dict(kv.split("=") for kv in line.split())
+            if d["rank"] == "0":
+                t[d["kind"]] = t.get(d["kind"], 0) + int(d["calls"])
+        totals[end] = t
+    for kind in ("allreduce", "p2p"):
+        per = (totals["0.045"].get(kind, 0) - totals["0.015"].get(kind, 0)) / 100
+        print(f"grainFoam, fluidisedBed --short, 2 ranks: {per:.0f} {kind} calls per fluid step (rank 0)")
+
+
+# ---- the model ----------------------------------------------------------------------------
+R, SKIN = 1e-3, 0.4e-3
+PHI_DENSE = math.pi / (3 * math.sqrt(2))        # FCC
+RHO_DENSE = PHI_DENSE / (4 / 3 * math.pi * R ** 3)  # spheres per m^3
+
+
+def ghosts_cube(n, rho, w):
+    """Ghosts of a cubic box holding n spheres, a layer w deep on all six sides (3D cut)."""
+    L = (n / rho) ** (1 / 3)
+    return rho * ((L + 2 * w) ** 3 - L ** 3)
+
+
+def allreduce_time(p):
+    return 0.0 if p == 1 else NET["allreduce_level"] * math.ceil(math.log2(p))
+
+
+def comm_time(p, ghosts, bytes_per_ghost, messages, reductions):
+    """One step's communication of one rank on the cluster (latency + bandwidth + reductions)."""
+    if p == 1:
+        return 0.0
+    rpn = NET["ranks_per_node"]
+    # A node holds a cube of ranks; the share of a rank's faces that leave the node:
+    side = round(min(p, rpn) ** (1 / 3))
+    off = 0.0 if p <= rpn else 1.0 / side
+    lat = messages * ((1 - off) * NET["alpha_node"] + off * NET["alpha"])
+    b = ghosts * bytes_per_ghost
+    bw = (1 - off) * b / NET["rank_bw_node"] + off * b * rpn / NET["node_bw"]
+    return lat + bw + reductions * allreduce_time(p)
+
+
+def report(path):
+    m = json.load(open(path))
+    runs = {int(k): v for k, v in m["runs"].items()}
+    one = runs[1]["ranks"][0]
+    N = runs[1]["particles"]
+    print(f"## Measured per rank and step (dense FCC bed, {N} spheres; {m['steps']} timed steps)\n")
+    print("| ranks | owned | ghosts | ghosts / owned | pairs evaluated / ideal | p2p messages | bytes sent | bytes per ghost | allreduces |")
+    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    pairs1 = one["list_pairs"] + one["ghost_pairs"]
+    for p, run in sorted(runs.items()):
+        for rk in run["ranks"][:1] if p == 1 else run["ranks"]:
+            ps = rk["per_step"]
+            msg = ps.get("p2p", {}).get("calls", 0)
+            byt = ps.get("p2p", {}).get("bytes", 0)
+            ar = ps.get("allreduce", {}).get("calls", 0)
+            pe = (rk["list_pairs"] + rk["ghost_pairs"]) / (pairs1 / p)
+            print(f"| {p} (rank {rk['rank']}) | {rk['local']} | {rk['ghosts']} | {rk['ghosts']/rk['local']:.3f} | "
+                  f"{pe:.3f} | {msg:.0f} | {byt/1e6:.3f} MB | {byt/max(rk['ghosts'],1):.0f} | {ar:.0f} |")
+
+    # The ghost layer: fit its depth w to the 1-rank run (x and y periodic: four faces of the bed).
+    bed_h = one["local"] / (RHO_DENSE * (16 * math.sqrt(8) * R * 0.999) ** 2)
+    side = 16 * math.sqrt(8) * R * 0.999
+    w = one["ghosts"] / (RHO_DENSE * 4 * side * bed_h)
+    bpg = one["per_step"]["p2p"]["bytes"] / one["ghosts"]
+    lam_g = one["ghost_pairs"] / one["ghosts"]
+    print(f"\nghost layer depth fitted on 1 rank: w = {w*1e3:.2f} mm = {w/R:.2f} r "
+          f"(the list's reach 2 r + skin = {(2*R+SKIN)/R:.1f} r); pairs per ghost {lam_g:.2f}; "
+          f"{bpg:.0f} B per ghost and step\n")
+
+    # Check: messages and bytes of 4 and 8 ranks predicted from the geometry of their boxes.
+    print("| ranks | ghosts / rank, predicted (mean) | measured (mean) | messages / rank, predicted | measured | allreduces / step, predicted | measured |")
+    print("|---:|---:|---:|---:|---:|---:|---:|")
+    for p in (2, 4, 8):
+        run = runs[p]
+        rks = run["ranks"]
+        mean_g = sum(r["ghosts"] for r in rks) / len(rks)
+        # Predicted: the rank's box is the bed cut into p slabs along z (the grid the
+        # least-cut-area rule picks for a tall bed), plus the periodic x/y faces.
+        h = bed_h / p
+        g_pred = RHO_DENSE * w * (4 * side * h) + RHO_DENSE * w * side * side * (2 * (p - 1) / p)
+        mean_msg = sum(r["per_step"]["p2p"]["calls"] for r in rks) / len(rks)
+        mean_ar = sum(r["per_step"]["allreduce"]["calls"] for r in rks) / len(rks)
+        print(f"| {p} | {g_pred:.0f} | {mean_g:.0f} | 6 | {mean_msg:.1f} | 2 | {mean_ar:.1f} |")
+
+    # Check: the 1 -> 2 rank speed-up from the compute model.
+    def step_cost(n, pairs_eval, n1, pairs1_, t_ps):
+        per_particle = t_ps * (1 - PAIR_SHARE)
+        per_pair = t_ps * PAIR_SHARE * n1 / pairs1_
+        return per_particle * n + per_pair * pairs_eval
+    r2 = max(runs[2]["ranks"], key=lambda r: r["list_pairs"] + r["ghost_pairs"])
+    t1 = step_cost(N, pairs1, N, pairs1, T_PS_DENSE)
+    t2 = step_cost(r2["local"], r2["list_pairs"] + r2["ghost_pairs"], N, pairs1, T_PS_DENSE)
+    print(f"\n1 -> 2 ranks, compute only: predicted speed-up {t1/t2:.2f} (measured {SPEEDUP_DENSE_2}, "
+          "docs/parallel-scaling.md)\n")
+
+    # ---- extrapolation: DEM bed ------------------------------------------------------------
+    lam = pairs1 / N  # pairs per sphere in the bulk, as the 1-rank list holds them
+
+    def dem_step(n, p, rho=RHO_DENSE, t_ps=T_PS_DENSE):
+        g = 0 if p == 1 else ghosts_cube(n, rho, w)
+        pairs = lam * n + lam_g * g
+        tc = step_cost(n, pairs, 1, lam, t_ps)
+        tm = comm_time(p, g, bpg, 6, 2)
+        return tc, tm, g
+
+    print("## Strong scaling, dense DEM bed (per step; cluster network of the page)\n")
+    print("| spheres | ranks | spheres / rank | ghosts / owned | compute [ms] | communication [ms] | efficiency | limited by |")
+    print("|---:|---:|---:|---:|---:|---:|---:|---|")
+    for N_ in (10**6, 10**7, 10**8):
+        t_1 = step_cost(N_, lam * N_, 1, lam, T_PS_DENSE)
+        for p in (1, 2, 64, 256, 1024, 4096):
+            n = N_ / p
+            tc, tm, g = dem_step(n, p)
+            eff = t_1 / (p * (tc + tm))
+            lim = "-" if p == 1 else ("ghosts (pairs evaluated twice)" if (tc - t_1 / p) > tm else
+                                      "communication (latency, reductions)")
+            print(f"| {N_:.0e} | {p} | {n:,.0f} | {g/n:.2f} | {tc*1e3:.3f} | {tm*1e3:.4f} | {eff:.2f} | {lim} |")
+    print()
+    for N_ in (10**6, 10**7, 10**8):
+        t_1 = step_cost(N_, lam * N_, 1, lam, T_PS_DENSE)
+        p = 2
+        while p < 2 ** 20:
+            tc, tm, g = dem_step(N_ / p, p)
+            if t_1 / (p * (tc + tm)) < 0.5:
+                break
+            p *= 2
+        print(f"{N_:.0e} spheres: efficiency falls below 50 % at {p} ranks ({N_/p:,.0f} spheres per rank)")
+    print("\n## Weak scaling, dense DEM bed, spheres per rank fixed\n")
+    print("| spheres / rank | ranks | step [ms] | efficiency |")
+    print("|---:|---:|---:|---:|")
+    for n in (30000, 3000):
+        base = step_cost(n, lam * n, 1, lam, T_PS_DENSE)
+        for p in (1, 64, 256, 1024):
+            tc, tm, g = dem_step(n, p)
+            print(f"| {n} | {p} | {(tc+tm)*1e3:.3f} | {base/(tc+tm):.2f} |")
+
+    # ---- coupled bed -------------------------------------------------------------------------
+    t_cell = FB["fluid"] / FB["dem"] * FB["substeps"] * FB["beads"] * T_PS_BED / FB["cells"]
+    print(f"\nfluid cost per cell and fluid step (fluidisedBed split against the DEM's rate): {t_cell*1e6:.2f} us")
+    rho_bed = 0.6 / (4 / 3 * math.pi * R ** 3)
+    for Np, C in ((100000, 40000), (10**6, 400000)):
+        print(f"\n## Strong scaling, coupled bed ({Np:,} spheres, {C:,} cells, 20 DEM steps per fluid step)\n")
+        print("| ranks | spheres / rank | cells / rank | DEM [ms] | fluid + coupling compute [ms] | fluid reductions + halo [ms] | efficiency | limited by |")
+        print("|---:|---:|---:|---:|---:|---:|---:|---|")
+        t_one = None
+        for p in (1, 2, 16, 64, 256, 1024):
+            n, c = Np / p, C / p
+            tc, tm, g = dem_step(n, p, rho_bed, T_PS_BED)
+            t_dem = FB["substeps"] * (tc + tm)
+            t_fc = t_cell * c * (1 + FB["coupling"] / FB["fluid"])
+            nb = 0 if p == 1 else min(p - 1, 6)  # neighbours of a rank's part of the mesh
+            off = 0.0 if p <= NET["ranks_per_node"] else 0.25
+            lat = (1 - off) * NET["alpha_node"] + off * NET["alpha"]
+            t_fr = 0 if p == 1 else FLUID_REDUCTIONS * allreduce_time(p) + FLUID_HALO * nb * lat
+            total = t_dem + t_fc + t_fr
+            t_one = t_one or total
+            eff = t_one / (p * total)
+            lim = max((t_dem, "DEM"), (t_fc, "fluid compute"), (t_fr, "fluid reductions + halo"))[1]
+            print(f"| {p} | {n:,.0f} | {c:,.0f} | {t_dem*1e3:.3f} | {t_fc*1e3:.3f} | {t_fr*1e3:.3f} | {eff:.2f} | {lim} |")
+
+
+# Per fluid step of fluidisedBed --short on 2 ranks (model.py --fluid): 885 allreduces, of which
+# the 20 DEM steps make 40, and 828 point-to-point messages to the one neighbour rank, of which
+# the DEM makes 40; the rest is the PIMPLE loop (15.7 GAMG cycles for p, 8.4 sweeps for U) and
+# the coupling.
+FLUID_REDUCTIONS = 845  # allreduces per fluid step besides the DEM's
+FLUID_HALO = 788        # halo exchanges per fluid step besides the DEM's (a message per neighbour)
+
+if __name__ == "__main__":
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--measure", action="store_true")
+    ap.add_argument("--fluid", action="store_true")
+    ap.add_argument("--build", default=os.environ.get("GRAINFLOW_BUILD_DIR", os.path.join(ROOT, "build")))
+    ap.add_argument("--particles", type=int, default=100000)
+    ap.add_argument("--steps", type=int, default=50)
+    a = ap.parse_args()
+    if a.fluid:
+        measure_fluid(a.build)
+        sys.exit(0)
+    path = os.path.join(a.build, "scaling_model", "measured.json")
+    if a.measure or not os.path.exists(path):
+        path = measure(a.build, a.particles, a.steps)
+    report(path)
