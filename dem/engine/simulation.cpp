@@ -66,7 +66,8 @@ Simulation::Simulation(const Scene& scene, bool insert, MPI_Comm comm,
     throw SetupError(scene_.file + ": error: " + e.what() +
                      "; change `parallel.grid` or the number of MPI ranks");
   }
-  exchange_ = std::make_unique<Exchange>(*decomp_);
+  exchange_ = std::make_unique<Exchange>(
+      *decomp_, scene_.contact.dashpot_velocity == DashpotVelocity::predicted);
   constants_.hooke_characteristic_velocity =
       scene.contact.hooke_characteristic_velocity.value_or(0.0);
   constants_.hooke_kn = scene.contact.hooke_kn.value_or(0.0);
@@ -526,7 +527,8 @@ void Simulation::remake_decomposition(const std::array<int, 3>& dims) {
   if (dims == decomp_->dims()) return;
   exchange_.reset();
   decomp_ = std::make_unique<Decomposition>(comm_, scene_.domain, dims);
-  exchange_ = std::make_unique<Exchange>(*decomp_);
+  exchange_ = std::make_unique<Exchange>(
+      *decomp_, scene_.contact.dashpot_velocity == DashpotVelocity::predicted);
 }
 
 void Simulation::fit_grid_to_particles() {

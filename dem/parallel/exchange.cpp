@@ -106,8 +106,10 @@ void Exchange::migrate(Particles& p, CarriedState& carried) {
         w.put(Vec3(p.x[i] + shift));
         w.put(p.v[i]);
         w.put(p.omega[i]);
-        w.put(p.v_pred[i]);  // migration comes between the prediction and the forces
-        w.put(p.omega_pred[i]);
+        if (predicted_) {  // migration comes between the prediction and the forces
+          w.put(p.v_pred[i]);
+          w.put(p.omega_pred[i]);
+        }
         w.put(p.force[i]);  // the next half kick uses them (e.g. right after a checkpoint)
         w.put(p.torque[i]);
         w.put(p.radius[i]);
@@ -174,7 +176,7 @@ void Exchange::migrate(Particles& p, CarriedState& carried) {
       for (auto n = static_cast<std::size_t>(r.get()); n > 0; --n) {
         const GlobalId id = r.get_id();
         const Vec3 x = r.get_vec(), v = r.get_vec(), w_spin = r.get_vec();
-        const Vec3 v_pred = r.get_vec(), w_pred = r.get_vec();
+        const Vec3 v_pred = predicted_ ? r.get_vec() : v, w_pred = predicted_ ? r.get_vec() : w_spin;
         const Vec3 force = r.get_vec(), torque = r.get_vec();
         const double radius = r.get(), mass = r.get(), inertia = r.get();
         const int mat = static_cast<int>(r.get());
@@ -249,8 +251,10 @@ void Exchange::borders(const Particles& p, double cutoff, Ghosts& g) {
           w.put(Vec3((local ? Vec3::Zero() : g.shift[k]) + s.shift));
           w.put(local ? p.v[k] : g.v[k]);
           w.put(local ? p.omega[k] : g.omega[k]);
-          w.put(local ? p.v_pred[k] : g.v_pred[k]);
-          w.put(local ? p.omega_pred[k] : g.omega_pred[k]);
+          if (predicted_) {
+            w.put(local ? p.v_pred[k] : g.v_pred[k]);
+            w.put(local ? p.omega_pred[k] : g.omega_pred[k]);
+          }
           w.put(local ? p.radius[k] : g.radius[k]);
           w.put(local ? p.mass[k] : g.mass[k]);
           w.put(local ? p.inertia[k] : g.inertia[k]);
@@ -267,8 +271,10 @@ void Exchange::borders(const Particles& p, double cutoff, Ghosts& g) {
         g.shift.push_back(r.get_vec());
         g.v.push_back(r.get_vec());
         g.omega.push_back(r.get_vec());
-        g.v_pred.push_back(r.get_vec());
-        g.omega_pred.push_back(r.get_vec());
+        if (predicted_) {
+          g.v_pred.push_back(r.get_vec());
+          g.omega_pred.push_back(r.get_vec());
+        }
         g.radius.push_back(r.get());
         g.mass.push_back(r.get());
         g.inertia.push_back(r.get());
@@ -281,10 +287,19 @@ void Exchange::borders(const Particles& p, double cutoff, Ghosts& g) {
 }
 
 void Exchange::forward(const Particles& p, Ghosts& g) {
+  if (predicted_)
+    forward_fields<true>(p, g);
+  else
+    forward_fields<false>(p, g);
+}
+
+template <bool Predicted>
+void Exchange::forward_fields(const Particles& p, Ghosts& g) {
   // Every step, so one message per swap: the sizes are those of borders(). The two swaps of
   // an axis go at once (their lists hold particles and ghosts of earlier axes only), the
   // axes one after the other (the y swaps forward ghosts received along x).
-  constexpr int kWidth = 15;  // x, v, omega, v_pred, omega_pred
+  // x, v, omega, and with the predicted dashpot velocities also v_pred, omega_pred.
+  constexpr int kWidth = Predicted ? 15 : 9;
   buffers_.resize(2 * swaps_.size());
   for (std::size_t first = 0; first < swaps_.size(); first += 2) {
     MPI_Request requests[4];
@@ -302,10 +317,12 @@ void Exchange::forward(const Particles& p, Ghosts& g) {
         const bool local = static_cast<std::size_t>(idx) < nlocal_;
         const std::size_t k = local ? idx : idx - nlocal_;
         for (const Vec3* q : {local ? &p.x[k] : &g.x[k], local ? &p.v[k] : &g.v[k],
-                              local ? &p.omega[k] : &g.omega[k],
-                              local ? &p.v_pred[k] : &g.v_pred[k],
-                              local ? &p.omega_pred[k] : &g.omega_pred[k]})
+                              local ? &p.omega[k] : &g.omega[k]})
           for (int c = 0; c < 3; ++c) *o++ = (*q)[c];
+        if constexpr (Predicted)
+          for (const Vec3* q : {local ? &p.v_pred[k] : &g.v_pred[k],
+                                local ? &p.omega_pred[k] : &g.omega_pred[k]})
+            for (int c = 0; c < 3; ++c) *o++ = (*q)[c];
       }
       const int tag = 300 + 2 * s.axis + s.dir;
       MPI_Irecv(in.data(), static_cast<int>(in.size()), MPI_DOUBLE, from, tag, d_.comm(),
@@ -321,8 +338,10 @@ void Exchange::forward(const Particles& p, Ghosts& g) {
         g.x[k] = Vec3(q[0], q[1], q[2]);
         g.v[k] = Vec3(q[3], q[4], q[5]);
         g.omega[k] = Vec3(q[6], q[7], q[8]);
-        g.v_pred[k] = Vec3(q[9], q[10], q[11]);
-        g.omega_pred[k] = Vec3(q[12], q[13], q[14]);
+        if constexpr (Predicted) {
+          g.v_pred[k] = Vec3(q[9], q[10], q[11]);
+          g.omega_pred[k] = Vec3(q[12], q[13], q[14]);
+        }
       }
     }
   }

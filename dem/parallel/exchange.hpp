@@ -31,7 +31,12 @@ void agree_on_error(MPI_Comm comm, const std::string& local_message);
 
 class Exchange {
  public:
-  explicit Exchange(const Decomposition& d) : d_(d) {}
+  // predicted: the particles carry the dashpots' predicted velocities (Particles::v_pred,
+  // omega_pred; contact.dashpot_velocity: predicted), which then travel with every migrating
+  // particle and ghost. Without it they stay behind: ghosts have none, and a particle that
+  // arrives gets its v and omega in their place.
+  explicit Exchange(const Decomposition& d, bool predicted = false)
+      : d_(d), predicted_(predicted) {}
 
   // Wraps positions along periodic axes into the domain and sends every particle
   // to its owner. A particle that crossed more than one box since the last call is
@@ -41,7 +46,8 @@ class Exchange {
   // Rebuilds `ghosts` for interaction range `cutoff` and records the send lists.
   void borders(const Particles& p, double cutoff, Ghosts& ghosts);
 
-  // Refreshes ghost positions, velocities and spins along the recorded lists.
+  // Refreshes ghost positions, velocities and spins (and the predicted ones) along the
+  // recorded lists.
   void forward(const Particles& p, Ghosts& ghosts);
 
   // Sends `width` doubles per particle along the same lists as forward(): `local` holds
@@ -66,7 +72,11 @@ class Exchange {
     Vec3 shift;             // added to the image offset of what is sent
     std::size_t recv_first = 0, recv_count = 0;
   };
+  template <bool Predicted>
+  void forward_fields(const Particles& p, Ghosts& g);
+
   const Decomposition& d_;
+  bool predicted_;
   std::vector<Swap> swaps_;                   // per axis the swaps of dir 0 and 1, axis after axis
   std::vector<std::vector<double>> buffers_;  // forward(): per swap, what it receives and sends
   std::size_t nlocal_ = 0;

@@ -17,6 +17,7 @@ struct Ghosts {
   std::vector<GlobalId> id;
   std::vector<Vec3> x, shift, v, omega;
   std::vector<Vec3> v_pred, omega_pred;  // the owner's Particles::v_pred and omega_pred
+                                          // (empty unless the exchange carries them)
   std::vector<double> radius, mass, inertia;
   std::vector<int> material;
 
