@@ -15,8 +15,10 @@
 
 namespace grainflow {
 
-// PredictedDashpot: contact.dashpot_velocity: predicted (the sweeps then hand the dashpots the
-// predicted end-of-step velocities; with false, the half-step ones, as plain velocity Verlet).
+// PredictedDashpot: contact.dashpot_velocity: predicted (the sweeps then hand the law the
+// predicted end-of-step velocities as well as the half-step ones: the normal dashpot is
+// integrated over the step's cell, cell_dashpot(), the others see the predicted velocity; with
+// false, every dashpot sees the half-step velocity, as plain velocity Verlet).
 template <class Normal, class Tangential, class Rolling, class Cohesion,
           bool PredictedDashpot = false>
 struct ContactLaw {
@@ -40,7 +42,8 @@ struct ContactLaw {
   // which is the end-of-contact definition the restitution mappings assume. `tangential` and
   // `rolling` are the contact's springs (each touched only by a law that has it).
   // Springs advance with the half-step velocities (g.v_rel, g.w_rel), dashpots take
-  // g.v_pred, g.w_pred (contact.dashpot_velocity: half-step, or predicted at the step's end).
+  // g.v_pred, g.w_pred (contact.dashpot_velocity: half-step, or predicted at the step's end;
+  // with predicted, the normal dashpot is cell_dashpot()).
   template <class V, class PC>
   [[gnu::always_inline]] static ContactResultT<V> evaluate(const ContactGeometryT<V>& g,
                                                            const PC& pc, const ContactConstants& cc,
