@@ -516,6 +516,10 @@ void sweep_dt(const Settings& st, Checks& checks) {
     h.model = NormalModel::hooke;
     h.v_char = kV;
     cases.push_back({"hooke_vchar_1ms", h});
+    if (!st.short_run && (e == 0.9 || e == 0.5 || e == 0.1)) {
+      h.dashpot = DashpotVelocity::predicted;
+      cases.push_back({"hooke_predicted", h});
+    }
   }
   {
     // The damped reference integrator against the elastic closed form (b = 0):

@@ -100,16 +100,23 @@ def write_tables(results, path):
 # --- the table compiled into dem/engine (time_step_accuracy.hpp) -------------------------
 def write_header(impact, path):
     curves = []
-    for model in ("hertz", "hooke"):
-        es = sorted({r["restitution"] for r in impact if r["case"] in ("reference", "hooke_vchar_1ms")
-                     and r["model"] == model}, reverse=True)
-        for e in es:
-            pts = sorted((r for r in impact if r["model"] == model and r["restitution"] == e
-                          and r["case"] in ("reference", "hooke_vchar_1ms")),
-                         key=lambda r: r["steps_per_impact"])
-            curves.append((model, e, pts))
-    n = len(curves[0][2])
-    assert all(len(c[2]) == n for c in curves), "every curve needs the same number of points"
+    default_cases = ("reference", "hooke_vchar_1ms")
+    predicted_cases = {"hertz": "predicted", "hooke": "hooke_predicted"}
+    for predicted in (False, True):
+        for model in ("hertz", "hooke"):
+            cases = default_cases if not predicted else (predicted_cases[model],)
+            es = sorted({r["restitution"] for r in impact if r["case"] in cases
+                         and r["model"] == model}, reverse=True)
+            if predicted and es:
+                es = [1.0] + es  # elastic impacts: bit for bit the default's
+            for e in es:
+                cs = default_cases if (not predicted or e == 1.0) else cases
+                pts = sorted((r for r in impact if r["model"] == model and r["restitution"] == e
+                              and r["case"] in cs),
+                             key=lambda r: r["steps_per_impact"])
+                curves.append((model, predicted, e, pts))
+    n = len(curves[0][3])
+    assert all(len(c[3]) == n for c in curves), "every curve needs the same number of points"
 
     def arr(pts, key):
         return "{" + ", ".join(f"{p[key]:.4g}" for p in pts) + "}"
@@ -122,7 +129,7 @@ def write_header(impact, path):
         "// than editing. Hertz: elastic t_c / dt; Hooke: damped t_c / dt (as `grain check`).",
         "// Relative errors; restitution against the requested e, contact time against the",
         "// closed form (Hertz elastic: Johnson 1985; damped: the scaled impact integrated by RK4;",
-        "// Hooke: the damped oscillator).",
+        "// Hooke: the damped oscillator). `predicted`: contact.dashpot_velocity: predicted.",
         "// clang-format off",
         "namespace grainflow::measured {",
         "",
@@ -130,6 +137,7 @@ def write_header(impact, path):
         "",
         "struct ImpactCurve {",
         "  bool hooke;",
+        "  bool predicted;",
         "  double restitution;",
         "  double steps[kImpactPoints];  // ascending",
         "  double restitution_rms[kImpactPoints];",
@@ -140,8 +148,9 @@ def write_header(impact, path):
         "",
         "inline constexpr ImpactCurve kImpactCurves[] = {",
     ]
-    for model, e, pts in curves:
-        lines.append(f"    {{{'true' if model == 'hooke' else 'false'}, {e:g},")
+    for model, predicted, e, pts in curves:
+        lines.append(f"    {{{'true' if model == 'hooke' else 'false'}, "
+                     f"{'true' if predicted else 'false'}, {e:g},")
         for key in ("steps_per_impact", "restitution_error_rms", "restitution_error_max",
                     "contact_time_error_rms", "contact_time_error_max"):
             lines.append(f"     {arr(pts, key)},")
@@ -235,14 +244,20 @@ def write_doc(d, docs, meta):
       + ", ".join(f"{cell(0.15, e, 'restitution_error_rms')} % at e = {e:g}" for e in es) + ".\n")
     pred = [r for r in imp if r["case"] == "predicted"]
     if pred:
-        w("### The predicted dashpot velocity\n")
+        w("### The predicted dashpot velocity and the cell-integrated normal dashpot\n")
         pes = sorted({r["restitution"] for r in pred}, reverse=True)
         pby = {(r["restitution"], r["rayleigh_fraction"]): r for r in pred}
-        w("With `contact: {dashpot_velocity: predicted}` every dashpot sees the velocity predicted "
-          "at the end of the step, v(t + dt/2) + (v(t + dt/2) − v(t)) "
-          "(docs/models/contact-models.md, Integration). The same impacts as above, restitution "
-          "error as root mean square and as the mean over the 128 impacts (signed), against the "
-          "default's root mean square:\n")
+        w("With `contact: {dashpot_velocity: predicted}` the normal dashpot's force is its "
+          "impulse over the step's cell [t − dt/2, t + dt/2] divided by dt: the change over the "
+          "cell of Φ(δ) = ∫₀^δ γₙ, with the overlap at the cell's edges from velocity Verlet's "
+          "straight drifts (the next one predicted from v(t + dt/2) + (v(t + dt/2) − v(t)) and "
+          "corrected for the contact's own force), so a contact that begins or ends part-way "
+          "through a step gets the impulse of the part it lasts; the tangential and rolling "
+          "dashpots see the predicted velocity (docs/models/contact-models.md, Integration). "
+          "The same impacts as above (rows `predicted` and `hooke_predicted` of "
+          "`dem_tables.csv`; errors are deterministic), restitution error as root mean square "
+          "and as the mean over the 128 impacts (signed), against the default's root mean "
+          "square:\n")
         w("| dt / t_R | steps per impact | " + " | ".join(
             f"e = {e:g}: rms | mean | default rms" for e in pes) + " |")
         w("|---:|---:|" + "---:|---:|---:|" * len(pes))
@@ -256,27 +271,72 @@ def write_doc(d, docs, meta):
                  f"{cell(f, e, 'restitution_error_rms')} %") if r else "— | — | —"
                 for e, r in zip(pes, rows)) + " |")
         w("")
+        tes = [e for e in (0.9, 0.5, 0.1) if e in pes]
+        w("Contact time (rms of the relative error against the damped reference), `predicted` "
+          "against the default:\n")
+        w("| dt / t_R | steps per impact | " + " | ".join(
+            f"e = {e:g}: t_c rms | default" for e in tes) + " |")
+        w("|---:|---:|" + "---:|---:|" * len(tes))
+        for f in fr:
+            rows = [pby.get((e, f)) for e in tes]
+            if not any(rows):
+                continue
+            n = next(r for r in rows if r)["steps_per_impact"]
+            w(f"| {f:g} | {n:.3g} | " + " | ".join(
+                (f"{pct(r['contact_time_error_rms'])} % | {cell(f, e, 'contact_time_error_rms')} %")
+                if r else "— | —" for e, r in zip(tes, rows)) + " |")
+        w("")
+        hp = [r for r in imp if r["case"] == "hooke_predicted"]
+        hd = {(r["restitution"], r["rayleigh_fraction"]): r for r in imp
+              if r["case"] == "hooke_vchar_1ms"}
+        if hp:
+            hes = sorted({r["restitution"] for r in hp}, reverse=True)
+            hby = {(r["restitution"], r["rayleigh_fraction"]): r for r in hp}
+            w("Hooke (v_char = 1 m/s), restitution and contact-time rms, `predicted` against the "
+              "default:\n")
+            w("| dt / t_R | steps per impact | " + " | ".join(
+                f"e = {e:g}: e rms | default | t_c rms | default" for e in hes) + " |")
+            w("|---:|---:|" + "---:|---:|---:|---:|" * len(hes))
+            for f in fr:
+                rows = [hby.get((e, f)) for e in hes]
+                if not any(rows):
+                    continue
+                n = next(r for r in rows if r)["steps_per_impact"]
+                cells = []
+                for e, r in zip(hes, rows):
+                    d0 = hd.get((e, f))
+                    cells.append(
+                        f"{pct(r['restitution_error_rms'])} % | "
+                        f"{pct(d0['restitution_error_rms']) if d0 else '—'} % | "
+                        f"{pct(r['contact_time_error_rms'])} % | "
+                        f"{pct(d0['contact_time_error_rms']) if d0 else '—'} %" if r else "— | — | — | —")
+                w(f"| {f:g} | {n:.3g} | " + " | ".join(cells) + " |")
+            w("")
         po = convergence_orders(pred)
-        w("**The predicted velocity makes the systematic error second order; the rms keeps the "
-          "error of the first and last step in contact.** Slopes of the rms: " + ", ".join(
-              f"e = {e:g}: {o[0]:.1f}" for e, o in po) + "; of the mean: " + ", ".join(
-              f"e = {e:g}: {o[2]:.1f}" for e, o in po) +
-          ". A Hertz dashpot grows as δ^{1/4} from first touch, a non-smooth start that a step "
-          "sampling it at an arbitrary offset misses by an amount that changes sign with the "
-          "offset and falls only as about N^{-5/4}, whatever velocity the dashpot is given (an "
-          "exactly implicit dashpot, tried on the scaled impact in Python, leaves 0.87 % rms at "
-          "e = 0.5 and N = 22). Over many impacts at random offsets — the dissipation of a flow "
-          "— the mean is what counts. **Choose `predicted` for strongly damped materials "
-          "(e ≤ 0.5)**: at e = 0.1 it cuts the error four- to sevenfold from 20 steps per impact "
-          "up (2.5-fold at 11). **Keep the default for e ≥ 0.7**: there the half-step velocity's lag "
-          "happens to be small (its mean error at e = 0.9 is a tenth of its rms), and the "
-          "prediction's larger constant makes it up to 1.6× worse at 10–30 steps per impact. "
-          "Below 3 steps per impact (beyond the refusal limit of `grain check`) a strongly damped "
-          "contact with the predicted velocity is not even stable; those points are not "
-          "measured. `predicted` costs more per step (the first half kick writes the predicted "
-          "velocities, laws with torques read two velocities per body; measured side by side "
-          "with `benchmarks/peers/build_cost.py`, docs/models/contact-models.md); the default "
-          "runs plain velocity Verlet's loop. `grain check` quotes the default's table.\n")
+        ho = convergence_orders(hp) if hp else []
+        w("**Impact by impact second order.** Slopes (log error / log N between the two finest "
+          "points) of the rms, Hertz: " + ", ".join(
+              f"e = {e:g}: restitution {o[0]:.1f}, contact time {o[1]:.1f}" for e, o in po) +
+          (("; Hooke: " + ", ".join(
+              f"e = {e:g}: restitution {o[0]:.1f}, contact time {o[1]:.1f}" for e, o in ho))
+           if ho else "") +
+          ". The rms now follows the mean: the start and end of contact within a step no longer "
+          "scatter the error with the offset. At 0.15 t_R (22 steps per impact) the Hertz "
+          "restitution error is " + ", ".join(
+              f"{pct(pby[(e, 0.15)]['restitution_error_rms'])} % at e = {e:g}"
+              for e in pes if (e, 0.15) in pby) +
+          " (the default: " + ", ".join(f"{cell(0.15, e, 'restitution_error_rms')} %" for e in pes) +
+          "). **Choose `predicted` for any damped material**: from 5 steps per impact up its "
+          "restitution error is below the default's at every restitution measured, and from 11 "
+          "up its contact-time error too (at e = 0.1 and 5–8 steps the default's contact time is "
+          "slightly better). At 3–4 steps per impact (beyond the refusal limit of `grain check`, "
+          "5) neither scheme resolves a contact and `predicted` is not better; below 3 a strongly "
+          "damped contact with it is not even stable (not measured). Elastic contacts (e = 1) are bit for bit the default's. "
+          "`predicted` costs more per step (the cell dashpot evaluates its potential at four "
+          "overlaps per contact, the first half kick writes the predicted velocities, and ghosts "
+          "carry them; measured side by side with `benchmarks/peers/build_cost.py`, "
+          "docs/models/contact-models.md); the default runs plain velocity Verlet's loop. "
+          "`grain check` quotes the table of the scene's `dashpot_velocity`.\n")
 
     # --- 2. Hooke -------------------------------------------------------------------------
     w("## 2. Hooke versus Hertz, and Hooke's characteristic velocity\n")
@@ -362,15 +422,24 @@ def write_doc(d, docs, meta):
     w("## Where `grain check` uses this\n")
     w("`grain check` (and the start-up report of `grain run`) prints where the scene's time step "
       "sits on the measured curve, for the material pair with the largest restitution error "
-      "at `time.expected_max_speed`:\n")
+      "at `time.expected_max_speed`, from the table of the scene's `contact.dashpot_velocity`; "
+      "with the default and a damped pair it also quotes what `predicted` would give at the "
+      "same dt:\n")
     ex = example_line(imp)
     if ex:
-        w("```\n$ grain check tests/data/scenes/minimal.yaml\n...\n" + ex + "\n```\n")
+        w("```\n$ grain check tests/data/scenes/minimal.yaml\n...\n" + ex + "\n" + HINT + "\n```\n")
     w("The numbers come from `dem/engine/time_step_accuracy_table.hpp` (written by "
       "`report.py` from the dt sweep), interpolated linearly in log N and log error, and "
-      "linearly in e between the measured restitutions (1, 0.9, 0.7, 0.5, 0.3, 0.1).\n")
+      "linearly in e between the measured restitutions (1, 0.9, 0.7, 0.5, 0.3, 0.1; for Hooke "
+      "with `predicted` 1, 0.9, 0.5, 0.1).\n")
     open(os.path.join(docs, "accuracy-vs-cost.md"), "w").write("\n".join(md))
     plots(imp, bed, hk, sk, ef, docs)
+
+
+# The second line `grain check` prints for minimal.yaml (its default dashpots, e = 0.9).
+HINT = ("with `contact: {dashpot_velocity: predicted}` (second order for damped contacts, about "
+        "1.8x the cost per step) the restitution error at this dt would be ≈ 0.011 % and the "
+        "contact-time error ≈ 0.052 % (docs/accuracy-vs-cost.md)")
 
 
 def example_line(imp):
@@ -431,8 +500,9 @@ def how_to_choose(imp, bed, hk, sk, ef):
             f"{e_err(0.5, 0.05)} % at 0.05 t_R (N ≈ 65) — for {cost(0.3):.3g}, {cost(0.15):.3g} "
             f"and {cost(0.05):.3g} CPU s per simulated second of the 2048-sphere bed. Halving "
             f"the error costs 1.5–2× the time (less than 2× at coarse steps, where list rebuilds "
-            f"weigh more per step). For e ≤ 0.5, `contact: {{dashpot_velocity: predicted}}` "
-            f"gives the same error for far fewer steps (§1). Elastic contacts are cheap to "
+            f"weigh more per step). With `contact: {{dashpot_velocity: predicted}}` damped "
+            f"impacts converge at second order: the same error for a fifth of the steps or "
+            f"fewer (§1). Elastic contacts are cheap to "
             f"resolve: at 0.3 t_R "
             f"e = 1 is kept to {e_err(1.0, 0.3)} % and energy to "
             f"{pct(bedby[0.3]['energy_error_max'])} %.")
@@ -443,7 +513,8 @@ def how_to_choose(imp, bed, hk, sk, ef):
             f"can use 0.3 t_R; fast impacts, stiff materials (t_c/t_R grows as (√(Y/ρ)/v)^{{1/5}}) "
             f"and low restitution need a smaller fraction: aim for N ≥ 20 for ~1 % at e ≥ 0.5, "
             f"N ≥ 50 for ~0.5 %; at e = 0.1 even N = 160 leaves {e_err(0.1, 0.02)} % by default, "
-            f"while `dashpot_velocity: predicted` gives ~3 % at N = 22 and ~0.5 % at N = 65.")
+            f"while `dashpot_velocity: predicted` keeps every restitution to ~1.5 % at N = 11 and "
+            f"~0.15 % at N = 22 (§1).")
     if hk:
         h1 = [r for r in hk if r["model"] == "hooke" and r["v_char"] == 1.0 and r["impact_speed"] == 1.0]
         hz = [r for r in hk if r["model"] == "hertz" and r["impact_speed"] == 1.0]

@@ -15,8 +15,10 @@
 
 namespace grainflow {
 
-// PredictedDashpot: contact.dashpot_velocity: predicted (the sweeps then hand the dashpots the
-// predicted end-of-step velocities; with false, the half-step ones, as plain velocity Verlet).
+// PredictedDashpot: contact.dashpot_velocity: predicted (the sweeps then hand the law the
+// predicted end-of-step velocities as well as the half-step ones: the normal dashpot is
+// integrated over the step's cell, cell_dashpot(), the others see the predicted velocity; with
+// false, every dashpot sees the half-step velocity, as plain velocity Verlet).
 template <class Normal, class Tangential, class Rolling, class Cohesion,
           bool PredictedDashpot = false>
 struct ContactLaw {
@@ -40,7 +42,8 @@ struct ContactLaw {
   // which is the end-of-contact definition the restitution mappings assume. `tangential` and
   // `rolling` are the contact's springs (each touched only by a law that has it).
   // Springs advance with the half-step velocities (g.v_rel, g.w_rel), dashpots take
-  // g.v_pred, g.w_pred (contact.dashpot_velocity: half-step, or predicted at the step's end).
+  // g.v_pred, g.w_pred (contact.dashpot_velocity: half-step, or predicted at the step's end;
+  // with predicted, the normal dashpot is cell_dashpot()).
   template <class V, class PC>
   [[gnu::always_inline]] static ContactResultT<V> evaluate(const ContactGeometryT<V>& g,
                                                            const PC& pc, const ContactConstants& cc,
@@ -48,7 +51,11 @@ struct ContactLaw {
                                                            double dt) {
     const SpringDashpotT<V> s = Normal::coefficients(pc, cc, g.r_star, g.m_star, g.overlap);
     const V vn = dot(g.v_pred, g.n);
-    const V fn = s.kn * g.overlap - s.gn * vn;
+    V fn;
+    if constexpr (PredictedDashpot)
+      fn = s.kn * g.overlap + cell_dashpot(g, s, dt);
+    else
+      fn = s.kn * g.overlap - s.gn * vn;
     const V fn_pos = max0(fn);
     V fn_total = fn;
     if constexpr (Cohesion::enabled) fn_total -= Cohesion::force(g, pc.cohesion_energy_density);
@@ -71,6 +78,55 @@ struct ContactLaw {
       r.torque_j -= m;
     }
     return r;
+  }
+
+  // The normal dashpot force of contact.dashpot_velocity: predicted: its impulse over the
+  // step's cell [t - dt/2, t + dt/2] divided by dt (docs/models/contact-models.md,
+  // "Integration"). The dashpot force gamma_n(delta) d(delta)/dt is the time derivative of
+  // Phi(delta) = int_0^delta gamma_n (Normal::dashpot_potential), so its impulse over the cell
+  // is Phi(delta(t + dt/2)) - Phi(delta(t - dt/2)), with Phi = 0 out of contact. Velocity
+  // Verlet drifts in straight lines, so the overlap at the cell's edges follows from the
+  // approach rates u = -v.n: the half-step one u_h of the drift just made (exact), and the
+  // next drift's, predicted from the predicted end-of-step velocity (u_s) and corrected once
+  // for the change of this contact's own force since the last step. Where the contact began
+  // during the last drift the cell's impulse counts from first touch (Phi(0)); where the
+  // half-step velocity lets it end during the next drift, to the last touch, and the step
+  // after, if the contact still holds, counts on from zero (both sides reconstruct the
+  // decision from the half-step and predicted velocities alone: no state is kept). The
+  // impulses then telescope: over a contact they sum to Phi's change, to the prediction's
+  // third-order error per step, and a contact that starts or ends part-way through a step
+  // gets the impulse of the part it lasts.
+  template <class V>
+  [[gnu::always_inline]] static V cell_dashpot(const ContactGeometryT<V>& g,
+                                               const SpringDashpotT<V>& s, double dt) {
+    const double h = 0.5 * dt;
+    const V d = g.overlap;
+    const auto phi = [&](V x) { return Normal::dashpot_potential(s, d, max0(x)); };
+    const V uh = -dot(g.v_rel, g.n);   // over the last drift
+    const V us = -dot(g.v_pred, g.n);  // predicted at the step's end
+    const V up = 3.0 * uh - 2.0 * us;  // over the drift before (u_h - dt du/dt)
+    const V d_prev = d - dt * uh;      // the overlap one step ago
+    const auto in_prev = d_prev > 0.0;
+    // The step before decided the contact ends within its next drift (then it took the
+    // dashpot's impulse down to zero overlap, and this cell counts from zero).
+    const auto ended_prev = 0.0 > d_prev + dt * up;
+    const V phi_left = phi(d - h * uh);  // Phi at the cell's left edge
+    const V lo = select(in_prev, select(ended_prev, V{}, phi_left), V{});
+    // The previous step's own force (spring and cell dashpot), for the correction.
+    const V lo_prev = select(d_prev - dt * up > 0.0, phi(d_prev - h * up), V{});
+    const V f_prev = select(in_prev,
+                            Normal::spring_force(s, d, max0(d_prev)) +
+                                (select(ended_prev, V{}, phi_left) - lo_prev) * (1.0 / dt),
+                            V{});
+    const auto ends = 0.0 > d + dt * uh;  // ends within the next drift
+    // The next drift's approach rate: predicted, then corrected once for the change of this
+    // contact's force (du/dt = that of the last step minus the change over m*).
+    const V accel = (us - uh) * (1.0 / h);
+    const V u0 = 2.0 * us - uh;
+    const V f0 = s.kn * d + (select(ends, V{}, phi(d + h * u0)) - lo) * (1.0 / dt);
+    const V u1 = uh + dt * (accel - (f0 - f_prev) / g.m_star);
+    const V hi = select(ends, V{}, phi(d + h * u1));
+    return (hi - lo) * (1.0 / dt);
   }
 
   // The normal part of evaluate()'s force on i, as its component along g.n (the same

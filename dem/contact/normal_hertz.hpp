@@ -27,6 +27,18 @@ struct HertzNormal {
     const V gn = two_sqrt_5_6 * pc.hertz_beta * lane_sqrt(sn * m_star);
     return {(2.0 / 3.0) * sn, gn, st, gn * pc.hertz_gt_per_gn};
   }
+  // For the cell-integrated dashpot (contact_law.hpp), from the coefficients `s` at `overlap`:
+  // the spring force k_n(x) x = (4/3) Y* sqrt(R*) x^{3/2} at overlap x >= 0, and the
+  // dashpot's potential Phi(x) = int_0^x gamma_n(y) dy = (4/5) gamma_n(x) x (gamma_n grows as
+  // y^{1/4}), whose change over an interval is the dashpot's impulse over it.
+  template <class V>
+  [[gnu::always_inline]] static V spring_force(const SpringDashpotT<V>& s, V overlap, V x) {
+    return s.kn * x * lane_sqrt(x / overlap);
+  }
+  template <class V>
+  [[gnu::always_inline]] static V dashpot_potential(const SpringDashpotT<V>& s, V overlap, V x) {
+    return 0.8 * s.gn * x * lane_sqrt(lane_sqrt(x / overlap));
+  }
 };
 
 }  // namespace grainflow

@@ -32,6 +32,14 @@ struct HookeNormal {
     const double gt = kt == kn ? gn : std::sqrt(4 * m_star * kt) * pc.hooke_damping;
     return {kn, gn, kt, gt};
   }
+  // For the cell-integrated dashpot (contact_law.hpp): the spring force at overlap x >= 0 and
+  // the dashpot's potential Phi(x) = gamma_n x.
+  static double spring_force(const SpringDashpot& s, double /*overlap*/, double x) {
+    return s.kn * x;
+  }
+  static double dashpot_potential(const SpringDashpot& s, double /*overlap*/, double x) {
+    return s.gn * x;
+  }
 };
 
 }  // namespace grainflow

@@ -121,7 +121,8 @@ template <class Law, class V>
       g.v_pred = g.v_rel;
       g.w_pred = g.w_rel;
     }
-  } else if constexpr (Law::predicted_dashpot) {  // no spring: only the dashpot's velocity
+  } else if constexpr (Law::predicted_dashpot) {  // no spring: the normal dashpot's two
+    g.v_rel = a.v - b.v;
     g.v_pred = a.vp - b.vp;
   } else {
     g.v_pred = a.v - b.v;
@@ -253,7 +254,7 @@ void local_pair_sweep(ContactSweep& s, int a_first, int a_end) {
         a.vp = gather3<V>([&](int l) -> const Vec3& { return vp[group[l].a]; });
         b.vp = gather3<V>([&](int l) -> const Vec3& { return vp[group[l].b]; });
       }
-      if constexpr (Law::needs_spin || !Law::predicted_dashpot) {
+      {  // the half-step velocities: springs, and the cell dashpot's drift (predicted)
         a.v = gather3<V>([&](int l) -> const Vec3& { return v[group[l].a]; });
         b.v = gather3<V>([&](int l) -> const Vec3& { return v[group[l].b]; });
       }
@@ -427,7 +428,7 @@ void ghost_pair_sweep(ContactSweep& s, int a_first, int a_end) {
           a.vp = gather3<V>([&](int l) -> const Vec3& { return group[l].first.vp; });
           b.vp = gather3<V>([&](int l) -> const Vec3& { return group[l].second.vp; });
         }
-        if constexpr (Law::needs_spin || !Law::predicted_dashpot) {
+        {  // the half-step velocities: springs, and the cell dashpot's drift (predicted)
           a.v = gather3<V>([&](int l) -> const Vec3& { return group[l].first.v; });
           b.v = gather3<V>([&](int l) -> const Vec3& { return group[l].second.v; });
         }

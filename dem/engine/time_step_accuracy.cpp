@@ -41,10 +41,12 @@ ImpactAccuracy on_curve(const measured::ImpactCurve& c, double n) {
   return a;
 }
 
-std::vector<const measured::ImpactCurve*> curves_of(NormalModel model) {
+std::vector<const measured::ImpactCurve*> curves_of(NormalModel model, DashpotVelocity dashpot) {
   std::vector<const measured::ImpactCurve*> out;
   for (const measured::ImpactCurve& c : measured::kImpactCurves)
-    if (c.hooke == (model == NormalModel::hooke)) out.push_back(&c);
+    if (c.hooke == (model == NormalModel::hooke) &&
+        c.predicted == (dashpot == DashpotVelocity::predicted))
+      out.push_back(&c);
   std::sort(out.begin(), out.end(),
             [](auto* a, auto* b) { return a->restitution < b->restitution; });
   return out;
@@ -54,15 +56,16 @@ std::vector<const measured::ImpactCurve*> curves_of(NormalModel model) {
 
 std::pair<double, double> measured_steps_per_impact(NormalModel model) {
   double lo = 1e300, hi = 0;
-  for (const measured::ImpactCurve* c : curves_of(model)) {
+  for (const measured::ImpactCurve* c : curves_of(model, DashpotVelocity::half_step)) {
     lo = std::min(lo, c->steps[0]);
     hi = std::max(hi, c->steps[measured::kImpactPoints - 1]);
   }
   return {lo, hi};
 }
 
-ImpactAccuracy impact_accuracy(NormalModel model, double restitution, double steps_per_impact) {
-  const std::vector<const measured::ImpactCurve*> curves = curves_of(model);
+ImpactAccuracy impact_accuracy(NormalModel model, double restitution, double steps_per_impact,
+                               DashpotVelocity dashpot) {
+  const std::vector<const measured::ImpactCurve*> curves = curves_of(model, dashpot);
   if (curves.empty()) throw std::logic_error("no measured impact curve for this normal model");
   if (restitution <= curves.front()->restitution) {
     ImpactAccuracy a = on_curve(*curves.front(), steps_per_impact);

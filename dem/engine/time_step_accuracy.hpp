@@ -31,8 +31,10 @@ struct ImpactAccuracy {
   bool extrapolated = false;
 };
 
-// Errors of an impact of the given model and restitution resolved by `steps_per_impact` steps.
-ImpactAccuracy impact_accuracy(NormalModel model, double restitution, double steps_per_impact);
+// Errors of an impact of the given model and restitution resolved by `steps_per_impact` steps,
+// with the dashpots of contact.dashpot_velocity (both measured over the same steps).
+ImpactAccuracy impact_accuracy(NormalModel model, double restitution, double steps_per_impact,
+                               DashpotVelocity dashpot = DashpotVelocity::half_step);
 
 // Measured range of steps per impact (smallest, largest) for the model.
 std::pair<double, double> measured_steps_per_impact(NormalModel model);

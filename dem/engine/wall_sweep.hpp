@@ -41,8 +41,11 @@ inline ContactGeometry wall_geometry(const Particles& p, std::size_t i, const Wa
       g.v_pred = g.v_rel;
       g.w_pred = g.w_rel;
     }
+  } else if constexpr (Law::predicted_dashpot) {
+    g.v_rel = p.v[i] - t.surface_velocity;  // the cell dashpot's last drift
+    g.v_pred = p.v_pred[i] - t.surface_velocity;
   } else {
-    g.v_pred = (Law::predicted_dashpot ? p.v_pred[i] : p.v[i]) - t.surface_velocity;
+    g.v_pred = p.v[i] - t.surface_velocity;
   }
   if constexpr (Law::needs_roll_inertia)
     g.roll_inertia = p.inertia[i] + p.mass[i] * p.radius[i] * p.radius[i];

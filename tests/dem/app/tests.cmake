@@ -43,10 +43,11 @@ grain_cli_test(check_warns_travel_limit 0
                "above 116.[78] m/s for the smallest.*; warning: that is below time.expected_max_speed = 150 m/s"
                CMD ${_grain} check ${_scenes}/fast_impacts.yaml)
 # The time step placed on the measured accuracy curve (docs/accuracy-vs-cost.md):
-# minimal.yaml runs at 0.07 t_R with e = 0.9 between its glass beads. (';' separates the
+# minimal.yaml runs at 0.07 t_R with e = 0.9 between its glass beads, with the default dashpots:
+# the check also quotes the table of contact.dashpot_velocity: predicted. (';' separates the
 # regexes that must all match.)
 grain_cli_test(check_reports_accuracy 0
-               "dt = 0.07 t_R, [0-9.]+ steps per impact: restitution error .+ [0-9.e-]+ % \\(worst .+ [0-9.e-]+ %\\), contact-time error .+ [0-9.e-]+ % \\(glass-glass at 1 m/s, e = 0.9;measured, docs/accuracy-vs-cost.md\\)"
+               "dt = 0.07 t_R, [0-9.]+ steps per impact: restitution error .+ [0-9.e-]+ % \\(worst .+ [0-9.e-]+ %\\), contact-time error .+ [0-9.e-]+ % \\(glass-glass at 1 m/s, e = 0.9;measured, docs/accuracy-vs-cost.md\\);with `contact: {dashpot_velocity: predicted}` .+ the restitution error at this dt would be .+ [0-9.e-]+ % and the contact-time error .+ [0-9.e-]+ %"
                CMD ${_grain} check ${_scenes}/minimal.yaml)
 grain_cli_test(bad_restitution 2 "bad/restitution.yaml:13:[0-9]+: error: .*restitution.*value 1.2 is out of range.*\\(0, 1\\]"
                CMD ${_grain} check ${_scenes}/bad/restitution.yaml)

@@ -23,6 +23,10 @@ namespace grainflow {
 namespace {
 
 using Law = ContactLaw<HertzNormal, HistoryTangential, NoRolling, NoCohesion>;
+// contact.dashpot_velocity: predicted (the cell-integrated normal dashpot, with its branches for
+// a contact that began in the last drift or ends in the next: the random overlaps reach below
+// dt |v|).
+using PredictedLaw = ContactLaw<HertzNormal, HistoryTangential, NoRolling, NoCohesion, true>;
 
 // The material-pair constants the law reads, as lanes (what the sweeps gather).
 template <class V>
@@ -91,15 +95,16 @@ struct Scalar {
   Vec3 spring;
 };
 
+template <class L = Law>
 Scalar evaluate_alone(const Case& c, const PairCoefficients& pc, double dt) {
   Scalar s{ContactResult{}, c.spring};
   Vec3 rolling = Vec3::Zero();
-  s.r = Law::evaluate(c.g, pc, ContactConstants{}, s.spring, rolling, dt);
+  s.r = L::evaluate(c.g, pc, ContactConstants{}, s.spring, rolling, dt);
   return s;
 }
 
 // Evaluates the cases `pick[0..W)` in the lanes of V and checks each against its alone result.
-template <class V>
+template <class V, class L = Law>
 void check_lanes(const std::vector<Case>& cases, const std::vector<Scalar>& alone,
                  const std::vector<int>& pick, const PairCoefficients& pc, double dt) {
   constexpr int W = lane_count<V>;
@@ -125,7 +130,7 @@ void check_lanes(const std::vector<Case>& cases, const std::vector<Scalar>& alon
                                  all(pc.hertz_gt_per_gn), all(pc.friction)};
   V3<V> spring = gather3<V>([&](int l) -> const Vec3& { return cases[pick[l]].spring; });
   V3<V> rolling = zero3<V>();
-  const ContactResultT<V> r = Law::evaluate(g, lanes_pc, ContactConstants{}, spring, rolling, dt);
+  const ContactResultT<V> r = L::evaluate(g, lanes_pc, ContactConstants{}, spring, rolling, dt);
   for (int l = 0; l < W; ++l) {
     const Scalar& a = alone[pick[l]];
     EXPECT_TRUE(same(lane(r.force, l), a.r.force)) << "case " << pick[l] << " lane " << l;
@@ -160,6 +165,30 @@ TEST(ContactLanes, EveryLaneGivesTheScalarResultToTheLastBit) {
     check_lanes<Lanes2x2>(cases, alone, {k, (k + 3) % n, (k + 5) % n, (k + 11) % n}, pc, dt);
     check_lanes<Lanes2x2>(cases, alone, {(k + 2) % n, (k + 9) % n, k, (k + 4) % n}, pc, dt);
     check_lanes<Lanes2x2>(cases, alone, {k, k, k, k}, pc, dt);
+  }
+}
+
+TEST(ContactLanes, PredictedDashpotGivesTheScalarResultToTheLastBit) {
+  const PairCoefficients pc = material();
+  const double dt = 2e-4;  // dt |v| spans the overlaps: contacts start and end in the step
+  const std::vector<Case> cases = random_cases(60);
+  std::vector<Scalar> alone;
+  int starts = 0, ends = 0;
+  for (const Case& c : cases) {
+    alone.push_back(evaluate_alone<PredictedLaw>(c, pc, dt));
+    const double vn = c.g.v_rel.dot(c.g.n);  // > 0: separating
+    starts += c.g.overlap + dt * vn <= 0;    // began within the last drift
+    ends += c.g.overlap - dt * vn < 0;       // ends within the next
+    EXPECT_TRUE(std::isfinite(alone.back().r.force.norm()));
+  }
+  ASSERT_GT(starts, 2) << "the cases must include contacts that began within the step";
+  ASSERT_GT(ends, 2) << "the cases must include contacts that end within the next step";
+  const int n = static_cast<int>(cases.size());
+  for (int k = 0; k < n; ++k) {
+    check_lanes<Lanes2, PredictedLaw>(cases, alone, {k, (k + 1) % n}, pc, dt);
+    check_lanes<Lanes2x2, PredictedLaw>(cases, alone, {k, (k + 3) % n, (k + 5) % n, (k + 11) % n},
+                                        pc, dt);
+    check_lanes<Lanes2x2, PredictedLaw>(cases, alone, {k, k, k, k}, pc, dt);
   }
 }
 

@@ -1,21 +1,22 @@
-// Damped impacts converge at second order in dt with `contact.dashpot_velocity: predicted`:
-// the dashpots see the predicted end-of-step velocity (docs/models/contact-models.md,
-// "Integration").
+// Damped impacts converge at second order in dt with `contact.dashpot_velocity: predicted`,
+// impact by impact: the normal dashpot's impulse is that of the step's cell [t - dt/2,
+// t + dt/2], so a contact that begins or ends part-way through a step gets the impulse of the
+// part it lasts (docs/models/contact-models.md, "Integration").
 //
 // Reference: a Hooke sphere-wall impact is a damped linear oscillator whose contact ends
-// when the overlap returns to zero; its restitution is the closed form
-//   e = exp(-zeta pi / sqrt(1 - zeta^2)),  zeta = gamma_n / (2 sqrt(m k_n)),
-// which the damping gamma_n = sqrt(4 m k_n / (1 + (pi/ln e)^2)) of normal_hooke.hpp makes
-// equal to the requested e. A Hertz impact's reference is the requested e as well: the
-// restitution mapping (restitution_mapping.hpp) integrates the scaled impact to 1e-9.
+// when the overlap returns to zero; its restitution and contact time are the closed forms
+//   e = exp(-zeta pi / sqrt(1 - zeta^2)),  t_c = pi / sqrt(k_n/m - (gamma_n/2m)^2),
+// zeta = gamma_n / (2 sqrt(m k_n)), which the damping gamma_n = sqrt(4 m k_n / (1 +
+// (pi/ln e)^2)) of normal_hooke.hpp makes the requested e. A Hertz impact's reference is the
+// requested e as well: the restitution mapping (restitution_mapping.hpp) integrates the scaled
+// impact to 1e-9.
 //
-// Each point is the mean signed error over 16 first-touch offsets spread evenly within a
-// step. Where contact begins and ends between two steps, a single impact has an error that
-// depends on the offset (the force jumps at first touch; for Hooke also at separation, where
-// the dashpot still pulls); over evenly spread offsets that part averages out, and what
-// remains is the scheme's own error, which the test follows from N to 2N steps per impact.
-// With the dashpot at the half-step velocity (the default, half_step) the ratio is 2 (first
-// order); second order gives 4.
+// Each point is the root mean square of the relative error over 32 impacts: 8 first-touch
+// offsets spread evenly within a step x 4 contact lengths spread over N - 1/2 ... N + 1/2 steps
+// (where contact begins and ends between two steps is random in a flow). The test follows it
+// from N = 20 to 40 steps per impact: second order quarters it (slope 2); with the dashpot at
+// the half-step velocity (the default, half_step) or at the predicted velocity alone (the
+// start and end of contact sampled at an arbitrary offset) the rms falls as 1/N to N^-1.3.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -41,9 +42,12 @@ class Rig {
     sim_.set_dt(1e-6);
     sim_.initialise();
   }
-  // Rebound speed / approach speed of an impact whose first touch falls `phase` into the
-  // second step after the reset.
-  double restitution(double dt, double phase) {
+  struct Impact {
+    double restitution, contact_time;
+  };
+  // Rebound speed / approach speed and contact time of an impact whose first touch falls
+  // `phase` into the second step after the reset.
+  Impact impact(double dt, double phase) {
     Particles& p = sim_.particles();
     const double t0 = (1.0 + phase) * dt;
     p.x[0] = Vec3(kR + kV * t0, 0, 0);
@@ -56,11 +60,11 @@ class Rig {
       const double d = kR - p.x[0][0];
       if (d > 0)
         touched = true;
-      else if (touched)
-        return p.v[0][0] / kV;
+      else if (touched)  // free flight since the last drift: it crossed d = 0 at t + d/v
+        return {p.v[0][0] / kV, (n + 1) * dt + d / p.v[0][0] - t0};
     }
     ADD_FAILURE() << "contact did not end";
-    return 0;
+    return {0, 0};
   }
 
  private:
@@ -91,42 +95,66 @@ double contact_time(NormalModel model, double e) {
   return std::numbers::pi / std::sqrt(k / m * (1 - zeta * zeta));
 }
 
-double mean_error(Rig& rig, NormalModel model, double e, double steps) {
-  constexpr int kPhases = 16;
-  const double dt = contact_time(model, e) / steps;
-  double sum = 0;
-  for (int k = 0; k < kPhases; ++k) sum += rig.restitution(dt, (k + 0.5) / kPhases) / e - 1;
-  return sum / kPhases;
-}
-
 struct Case {
   NormalModel model;
   double e;
+  double max_rms_at_22;  // restitution error allowed at 22 steps per impact
 };
+
+struct Errors {
+  double restitution, contact_time;  // rms of the relative errors
+};
+
+Errors rms_errors(Rig& rig, const Case& c, double steps) {
+  constexpr int kPhases = 8, kLengths = 4;
+  const double tc = contact_time(c.model, c.e);
+  double se = 0, st = 0;
+  for (int j = 0; j < kLengths; ++j) {
+    const double dt = tc / (steps + (j + 0.5) / kLengths - 0.5);
+    for (int k = 0; k < kPhases; ++k) {
+      const Rig::Impact r = rig.impact(dt, (k + 0.5) / kPhases);
+      se += std::pow(r.restitution / c.e - 1, 2);
+      st += std::pow(r.contact_time / tc - 1, 2);
+    }
+  }
+  return {std::sqrt(se / (kPhases * kLengths)), std::sqrt(st / (kPhases * kLengths))};
+}
 
 class DampedImpactConvergence : public ::testing::TestWithParam<Case> {};
 
-TEST_P(DampedImpactConvergence, RestitutionErrorFallsAtSecondOrder) {
+TEST_P(DampedImpactConvergence, ImpactErrorsFallAtSecondOrder) {
   const Case c = GetParam();
   Rig rig(c.model, c.e);
-  const double coarse = mean_error(rig, c.model, c.e, 20);
-  const double fine = mean_error(rig, c.model, c.e, 40);
-  std::printf("%s e = %.1f: mean restitution error %.3e at 20 steps per impact, %.3e at 40: "
-              "ratio %.2f\n",
-              c.model == NormalModel::hooke ? "hooke" : "hertz", c.e, coarse, fine,
-              coarse / fine);
-  // Second order quarters the error per halving of dt (ratio 4); 3.5 leaves room for the
-  // third-order remainder at 20 steps (measured 3.8-4.3). First order (ratio 2, the dashpot at
-  // the half-step velocity) fails.
-  EXPECT_GE(coarse / fine, 3.5);
+  const Errors at22 = rms_errors(rig, c, 22), coarse = rms_errors(rig, c, 20),
+               fine = rms_errors(rig, c, 40);
+  const double slope_e = std::log2(coarse.restitution / fine.restitution);
+  const double slope_t = std::log2(coarse.contact_time / fine.contact_time);
+  std::printf("%s e = %.1f: rms restitution error %.3e at 22 steps per impact; %.3e at 20, "
+              "%.3e at 40: slope %.2f\n",
+              c.model == NormalModel::hooke ? "hooke" : "hertz", c.e, at22.restitution,
+              coarse.restitution, fine.restitution, slope_e);
+  if (c.model == NormalModel::hooke)
+    std::printf("hooke e = %.1f: rms contact-time error %.3e at 20, %.3e at 40: slope %.2f\n", c.e,
+                coarse.contact_time, fine.contact_time, slope_t);
+  EXPECT_GE(slope_e, 1.8);
+  EXPECT_LE(at22.restitution, c.max_rms_at_22);
+  // The contact time's closed form is the damped oscillator's (Hooke); for Hertz the elastic
+  // closed form only sets N (the damped one needs an integration: accuracy_cost).
+  if (c.model == NormalModel::hooke) {
+    EXPECT_GE(slope_t, 1.8);
+  }
 }
 
+// The bounds at 22 steps per impact: Hertz e = 0.5 and 0.1 at the targets of issue 24 (0.1 %
+// and 1 %); Hooke, whose force jumps at first touch and separation, at about 1.5x its measured
+// error.
 INSTANTIATE_TEST_SUITE_P(Laws, DampedImpactConvergence,
-                         ::testing::Values(Case{NormalModel::hooke, 0.9},
-                                           Case{NormalModel::hooke, 0.5},
-                                           Case{NormalModel::hooke, 0.1},
-                                           Case{NormalModel::hertz, 0.5},
-                                           Case{NormalModel::hertz, 0.1}),
+                         ::testing::Values(Case{NormalModel::hooke, 0.9, 2e-3},
+                                           Case{NormalModel::hooke, 0.5, 2.5e-3},
+                                           Case{NormalModel::hooke, 0.1, 8e-3},
+                                           Case{NormalModel::hertz, 0.9, 1e-3},
+                                           Case{NormalModel::hertz, 0.5, 1e-3},
+                                           Case{NormalModel::hertz, 0.1, 1e-2}),
                          [](const ::testing::TestParamInfo<Case>& param_info) {
                            const Case& c = param_info.param;
                            return std::string(c.model == NormalModel::hooke ? "Hooke" : "Hertz") +
