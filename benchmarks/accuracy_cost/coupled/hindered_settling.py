@@ -17,15 +17,19 @@ fluid phase average minus particle average, against
      sphere's terminal velocity from Schiller & Naumann (1933).
 
 Particles: spheres of d = 2 mm, rho_p = 2500 kg/m^3 in a liquid of rho_f = 1000 kg/m^3 with the
-viscosity that gives Re_t (default 0.1: the Stokes regime, n = 4.65); placed at random without
-overlap (Poisson points pushed apart, periodic), elastic (e = 0.9) and nearly frictionless
-(mu = 0.05) so that the suspension stays homogeneous. The box is `--cells` cubic cells of
-`--h` diameters per side; the particle count sets eps. The fluid and the particles start at
-rest; the slip is averaged over the log's write times after `--skip` of the run.
+viscosity that gives Re_t (default 0.1: the Stokes regime, n = 4.65), elastic (e = 0.9) and
+nearly frictionless (mu = 0.05). `--arrangement random` (default): a box of `--cells` cubic
+cells of `--h` diameters per side, the particle count set by eps, positions at random without
+overlap (Poisson points pushed apart, periodic; `--seed`); `crystal`: a simple cubic lattice of
+8 particles per cell, every cell alike (a uniform suspension; the box sized by eps);
+`lattice`: a jittered simple cubic lattice. The fluid and the particles start at rest; the
+slip is averaged over the log's write times after `--skip` of the run. The results and what
+they show: docs/models/undisturbed-velocity.md, "hindered settling".
 
-Usage: hindered_settling.py [--eps 0.6,0.7,0.8,0.9] [--cells 4] [--h 3] [--re 0.1]
-                            [--drag di_felice] [--model B] [--footprint divided]
-                            [--end 0.1] [--skip 0.04] [--ranks 1] [--check PCT_DRAG,PCT_RZ]
+Usage: hindered_settling.py [--eps 0.6,0.7,0.8,0.9] [--arrangement random] [--cells 4] [--h 3]
+                            [--re 0.1] [--drag di_felice] [--model B] [--footprint divided]
+                            [--correction oseenBrinkman] [--end 0.1] [--skip 0.04] [--ranks 1]
+                            [--seed 11] [--series] [--check PCT_DRAG,PCT_RZ]
                             [--work DIR] [--build DIR]
 Prints one line per eps and appends to <work>/hindered_settling.csv; with --check, exit 1
 unless every slip is within PCT_DRAG % of the drag law and PCT_RZ % of Richardson-Zaki, the
@@ -178,11 +182,11 @@ def make_case(case, eps, a, mu):
         m = int(round(((1 - eps) * (n_cells * a.h * D) ** 3 / VP) ** (1 / 3)))
         n = m**3
         L = (n * VP / (1 - eps)) ** (1 / 3)
-        x = jittered_lattice(m, L, seed=11)
+        x = jittered_lattice(m, L, seed=a.seed)
     else:
         L = n_cells * a.h * D
         n = int(round((1 - eps) * L**3 / VP))
-        x = random_suspension(n, L, seed=11)
+        x = random_suspension(n, L, seed=a.seed)
     h = L / n_cells
     eps_box = 1 - n * VP / L**3
     dt_f = a.dt
@@ -352,6 +356,7 @@ def main():
     ap.add_argument("--skip", type=float, default=0.04, help="transient left out of the mean [s]")
     ap.add_argument("--write", type=float, default=2e-3, help="log interval (write times) [s]")
     ap.add_argument("--ranks", type=int, default=1)
+    ap.add_argument("--seed", type=int, default=11, help="of the random positions")
     ap.add_argument("--arrangement", default="random", choices=["random", "lattice", "crystal"],
                     help="random: non-overlapping, Poisson-like counts per cell; lattice: "
                          "jittered simple cubic; crystal: simple cubic, 8 per cell")
@@ -366,7 +371,7 @@ def main():
     n_rz = rz_exponent(a.re)
     rows = []
     for eps in (float(e) for e in a.eps.split(",")):
-        name = f"eps{eps:g}_{a.drag}_{a.model}_{a.footprint}_{a.sampling}_h{a.h:g}_c{a.cells}_re{a.re:g}_r{a.ranks}_{a.correction or 'off'}_{a.arrangement}"
+        name = f"eps{eps:g}_{a.drag}_{a.model}_{a.footprint}_{a.sampling}_h{a.h:g}_c{a.cells}_re{a.re:g}_r{a.ranks}_{a.correction or 'off'}_{a.arrangement}_s{a.seed}"
         case = os.path.join(a.work, name)
         subprocess.call(["rm", "-rf", case])
         info = make_case(case, eps, a, mu)
