@@ -534,6 +534,25 @@ DemSummary DemLink::summary() const {
   return s;
 }
 
+std::array<double, 3> DemLink::buoyant_weight() const {
+  const Particles& p = impl_->simulation().particles();
+  double excess = 0;  // sum m - rho_f V
+  for (std::size_t i = 0; i < p.size(); ++i)
+    excess += p.mass[i] - impl_->fluid_density * sphere_volume(p.radius[i]);
+  MPI_Allreduce(MPI_IN_PLACE, &excess, 1, MPI_DOUBLE, MPI_SUM, impl_->dem_comm);
+  const Vec3& g = impl_->scene.gravity;
+  return {excess * g[0], excess * g[1], excess * g[2]};
+}
+
+std::array<double, 3> DemLink::momentum() const {
+  const Particles& p = impl_->simulation().particles();
+  double sum[3] = {0, 0, 0};
+  for (std::size_t i = 0; i < p.size(); ++i)
+    for (int d = 0; d < 3; ++d) sum[d] += p.mass[i] * p.v[i][d];
+  MPI_Allreduce(MPI_IN_PLACE, sum, 3, MPI_DOUBLE, MPI_SUM, impl_->dem_comm);
+  return {sum[0], sum[1], sum[2]};
+}
+
 void DemLink::write_snapshot(const std::string& directory, long step, long continue_after) {
   Impl& m = *impl_;
   try {

@@ -193,6 +193,11 @@ class DemLink {
   void advance(int steps, const std::string& diagnostic_directory);
 
   DemSummary summary() const;  // collective
+  // Sums over every rank's particles (collective): the buoyant weight sum (m - rho_f V) g [N]
+  // (the weight a mean pressure gradient must carry in a box periodic along g), and the
+  // momentum sum m v [kg m/s].
+  std::array<double, 3> buoyant_weight() const;
+  std::array<double, 3> momentum() const;
   // Writes a particle snapshot (HDF5 + XDMF index) into `directory` (created if missing).
   // After restore(), the first call continues the series there: snapshots with step <=
   // `continue_after` are kept, later ones (of the stopped run) are overwritten. The files hold

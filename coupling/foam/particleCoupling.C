@@ -84,7 +84,7 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
   {
     const wordList allowed{"scene", "voidFraction", "dividedResolution", "smoothingFactor",
                            "sampling", "minVoidFraction", "ddtVoidFraction",
-                           "undisturbedVelocity"};
+                           "undisturbedVelocity", "meanPressureGradient"};
     for (const word& key : dict.toc())
       if (!allowed.found(key))
         FatalIOErrorInFunction(dict) << "unknown key '" << key << "'; allowed: " << allowed
@@ -150,6 +150,17 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
                                     "modelled yet); set sampling cell or undisturbedVelocity off"
                                  << exit(FatalIOError);
 
+  const word meanGradP = dict.lookupOrDefault<word>("meanPressureGradient", "off");
+  if (meanGradP == "suspensionWeight")
+    meanGradPOn_ = true;
+  else if (meanGradP != "off")
+    FatalIOErrorInFunction(dict) << "meanPressureGradient " << meanGradP
+                                 << " is not one of: off (the pressure gradient is the "
+                                    "solved one), suspensionWeight (a uniform pressure "
+                                    "gradient carries the particles' buoyant weight, for a "
+                                    "domain periodic along gravity; docs/coupling.md)"
+                                 << exit(FatalIOError);
+
   // --- the DEM ----------------------------------------------------------------------
   if (!sceneFile.isAbsolute()) sceneFile = cwd() / sceneFile;
   try {
@@ -161,6 +172,37 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
   model_ = dem_->vans_model();
   domain_ = dem_->domain();
   periodic_ = dem_->periodic();
+  domainVolume_ = (domain_.hi[0] - domain_.lo[0]) * (domain_.hi[1] - domain_.lo[1]) *
+                  (domain_.hi[2] - domain_.lo[2]);
+  if (meanGradPOn_) {
+    // Only a box periodic along gravity needs (and can hold) the uniform part: elsewhere a
+    // wall or an outlet carries the weight through the solved pressure.
+    const std::array<double, 3> g = dem_->gravity();
+    const double gMag = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+    static const char* axis = "xyz";
+    for (int a = 0; a < 3; ++a)
+      if (g[a] != 0 && !periodic_[a])
+        FatalIOErrorInFunction(dict)
+            << "meanPressureGradient suspensionWeight: gravity has a component along "
+            << axis[a] << " but the scene's domain is not periodic along " << axis[a]
+            << " (domain.periodic); there the walls carry the weight through the solved "
+               "pressure. Set meanPressureGradient off, or make the domain and the mesh "
+               "periodic along every axis gravity has a component on"
+            << exit(FatalIOError);
+    forAll(mesh.boundary(), patch) {
+      const fvPatch& fp = mesh.boundary()[patch];
+      if (fp.coupled() || fp.size() == 0 || gMag == 0) continue;
+      const vectorField n(fp.nf());
+      for (const vector& v : n)
+        if (std::abs(v[0] * g[0] + v[1] * g[1] + v[2] * g[2]) > 1e-6 * gMag)
+          FatalIOErrorInFunction(dict)
+              << "meanPressureGradient suspensionWeight: patch " << fp.name() << " (type "
+              << fp.type() << ") has faces across gravity; the uniform pressure gradient "
+                 "needs a mesh periodic (cyclic) along gravity. Set meanPressureGradient off, "
+                 "or make that patch cyclic"
+              << exit(FatalIOError);
+    }
+  }
 
   // --- the shared decomposition -----------------------------------------------------
   boundBox local(mesh.points(), false);
@@ -243,6 +285,13 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
   for (const std::string& note : dem_->force_limit_notes()) {
     if (note.rfind("error:", 0) == 0) FatalErrorInFunction << "\n" << note << exit(FatalError);
     Info << "grainFoam coupling: " << note.c_str() << endl;
+  }
+
+  if (meanGradPOn_) {
+    updateMeanPressureGradient();
+    Info << "grainFoam coupling: meanPressureGradient suspensionWeight: G = " << meanGradP_
+         << " Pa/m, the particles' buoyant weight sum (m - rho_f V) g over the domain's "
+         << domainVolume_ << " m^3 (the fluid gets -c G, the particles -V_p G)" << endl;
   }
 
   // --- the time-step ratio ----------------------------------------------------------
@@ -742,6 +791,8 @@ void ParticleCoupling::sample() {
   const dimensionedScalar rho("rho", dimless, rho_);
   volVectorField& gradP = pressureGradient();
   gradP *= rho;
+  // rho grad p keeps p's kinematic dimensions (rho is dimensionless here): G [Pa/m] by value.
+  if (meanGradPOn_) gradP += dimensionedVector("meanGradP", gradP.dimensions(), meanGradP_);
   volVectorField& divTau = viscousLaplacian();
   divTau *= rho;
   const bool curl = dem_->needs_vorticity();
@@ -911,6 +962,7 @@ coupling::FluidAtParticle ParticleCoupling::sampleAt(const std::array<double, 3>
   if (c < 0) return f;
   f.velocity = toArray(U_[c]);
   f.void_fraction = voidFraction_[c];
+  if (meanGradPOn_) f.pressure_gradient = toArray(meanGradP_);
   return f;
 }
 
@@ -955,6 +1007,23 @@ void ParticleCoupling::checkBalance() {
        << ") N, relative imbalance " << balanceError_ << endl;
 }
 
+void ParticleCoupling::updateMeanPressureGradient() {
+  const std::array<double, 3> w = dem_->buoyant_weight();
+  for (int d = 0; d < 3; ++d) meanGradP_[d] = w[d] / domainVolume_;
+}
+
+void ParticleCoupling::reportMixtureMomentum() {
+  using namespace Foam;
+  // The mixture's momentum: with G carrying the buoyant weight the net force on it is zero,
+  // so it stays what it was (zero from rest) up to the discretisation's lag.
+  vector fluid = rho_ * gSum(voidFraction_.primitiveField() * mesh_.V().field() *
+                             U_.primitiveField());
+  const std::array<double, 3> particles = dem_->momentum();
+  Info << "grainFoam mean pressure gradient: G = " << meanGradP_ << " Pa/m; momentum: fluid ("
+       << fluid[0] << " " << fluid[1] << " " << fluid[2] << ") kg m/s, particles ("
+       << particles[0] << " " << particles[1] << " " << particles[2] << ") kg m/s" << endl;
+}
+
 void ParticleCoupling::evolve() {
   auto t0 = Clock::now();
   sample();  // straight into the DEM (DemLink::fluid_samples or add_fluid)
@@ -975,7 +1044,11 @@ void ParticleCoupling::evolve() {
   t0 = Clock::now();
   buildFootprints();
   deposit();
-  if (mesh_.time().writeTime() || mesh_.time().timeIndex() == 1) checkBalance();
+  if (meanGradPOn_) updateMeanPressureGradient();
+  if (mesh_.time().writeTime() || mesh_.time().timeIndex() == 1) {
+    checkBalance();
+    if (meanGradPOn_) reportMixtureMomentum();
+  }
   couplingSeconds_ += seconds_since(t0);
 }
 

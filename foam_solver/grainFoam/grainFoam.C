@@ -14,6 +14,12 @@
 // Gravity is absent from both models: in model A, -eps grad(P) + eps rho g = -eps grad(p)
 // for P = p + rho g.x; in model B the remaining -(1-eps) rho g is cancelled exactly by the
 // particles' buoyancy returned through the exchange, so neither is applied.
+// With couplingProperties meanPressureGradient suspensionWeight (a box periodic along g),
+// the pressure gradient is grad p + G/rho with a uniform G [Pa/m] carrying the particles'
+// buoyant weight (ParticleCoupling::meanPressureGradient): periodic p cannot hold a mean
+// slope, so without G nothing would stop the suspension from falling. G is a cell source
+// -c G/rho of the momentum equation (in H, hence in the flux), whose volume integral is
+// exactly the force the particles' weight needs; the particles sample grad p + G.
 // Ksl = sum K / V_cell goes on the matrix diagonal (implicit), Ksl Us = sum K v / V_cell
 // and f (explicit forces the model returns to the fluid) are explicit sources.
 // Pressure–velocity coupling: U = HbyA - rAU c grad p inserted into continuity gives
@@ -58,6 +64,7 @@ void solve(const Foam::argList& args) {
   grainflow::foam::ParticleCoupling particles(mesh, U, p, rho.value(), nu.value());
   const volScalarField& eps = particles.voidFraction();
   const bool modelA = particles.model() == 'A';
+  const bool meanGradP = particles.meanPressureGradientOn();
 
   // The superficial flux, from the initial U and eps.
   surfaceScalarField phi(IOobject("phi", runTime.timeName(), mesh, IOobject::READ_IF_PRESENT,
@@ -118,6 +125,9 @@ void solve(const Foam::argList& args) {
           == -fvm::Sp(particles.Ksl() / rho, U) + particles.KslUs() / rho +
                  particles.fExplicit() / rho);
       UEqn.relax();
+      // The uniform part G of the pressure gradient: a cell source (its volume integral is
+      // exactly -c G V, so the mixture's net force stays zero); zero when off.
+      if (meanGradP) UEqn -= -c * particles.meanPressureGradient() / rho;
       if (pimple.momentumPredictor()) solve(UEqn == -c * fvc::grad(p));
 
       while (pimple.correct()) {

@@ -29,3 +29,24 @@ add_test(NAME coupling.undisturbed_settling
 set_tests_properties(coupling.undisturbed_settling PROPERTIES
   LABELS "foam;coupling;accuracy_cost"
   TIMEOUT 600)
+
+# coupling.hindered_settling: a suspension in a fully periodic box (x, y, z; mesh cyclic on
+# all faces) held by meanPressureGradient suspensionWeight, eps = 0.7, drag di_felice, a
+# simple cubic crystal of 8 particles per cell (cells 2.4 d, 1 rank): the mean slip (fluid
+# phase average minus particle average) within 2 % of the drag law's own uniform-suspension
+# slip, F_drag(eps, slip) = eps (rho_p - rho_f) g V_p, solved in Python from Di Felice (1994)
+# (measured -0.00 %), within 10 % of Richardson-Zaki with n = 4.65 (Re_t = 0.1; measured
+# +1.9 %), the exchange balanced to 1e-12 and the mixture's momentum constant within 1 %
+# over the averaging window. About 5 s CPU (the same run on 2 ranks agrees to 1e-12
+# relative, measured once: it waits on the loaded machine). The random arrangements are
+# not within 2 % (docs/models/undisturbed-velocity.md, "Hindered settling").
+grainflow_find_python(GRAINFLOW_HINDERED_PYTHON "h5py,numpy,scipy" "coupling.hindered_settling is")
+if(GRAINFLOW_HINDERED_PYTHON)
+  add_test(NAME coupling.hindered_settling
+           COMMAND ${GRAINFLOW_HINDERED_PYTHON} ${PROJECT_SOURCE_DIR}/benchmarks/accuracy_cost/coupled/hindered_settling.py
+                   --eps 0.7 --arrangement crystal --end 0.03 --skip 0.015 --ranks 1 --check 2,10
+                   --work ${CMAKE_CURRENT_BINARY_DIR}/hindered_settling --build ${PROJECT_BINARY_DIR})
+  set_tests_properties(coupling.hindered_settling PROPERTIES
+    LABELS "foam;coupling;accuracy_cost"
+    TIMEOUT 300)
+endif()

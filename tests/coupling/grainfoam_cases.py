@@ -392,6 +392,26 @@ def refuses_bad_setup(runner, checks):
     checks.expect("undisturbedVelocity oseenBrinkman needs sampling cell" in log,
                   "undisturbedVelocity oseenBrinkman with sampling cellPoint: refused")
 
+    # 5. meanPressureGradient: an unknown value, and suspensionWeight in a box with walls
+    # across gravity (periodic_box is periodic along x and y only, gravity along -z).
+    case = runner.fresh_case("periodic_box", "mean_gradient_unknown", [
+        ("constant/couplingProperties", "sampling        cell;",
+         "meanPressureGradient weight;\nsampling        cell;")])
+    runner.run(case, "blockMesh", "blockMesh")
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    checks.expect("meanPressureGradient weight is not one of: off" in log
+                  and "suspensionWeight" in log,
+                  "meanPressureGradient weight: refused, naming off and suspensionWeight")
+    case = runner.fresh_case("periodic_box", "mean_gradient_walls", [
+        ("constant/couplingProperties", "sampling        cell;",
+         "meanPressureGradient suspensionWeight;\nsampling        cell;")])
+    runner.run(case, "blockMesh", "blockMesh")
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    checks.expect("meanPressureGradient suspensionWeight: gravity has a component along z but "
+                  "the scene's domain is not periodic along z" in log,
+                  "meanPressureGradient suspensionWeight with walls across gravity: refused, "
+                  "naming the axis z")
+
 
 # --- coupling.restart -------------------------------------------------------------------
 

@@ -17,7 +17,9 @@
 #       its snapshot's fluid_force (output.fields) is the buoyancy and its force zero; with
 #       output.start between the two write times only the second has a snapshot.
 #   coupling.refuses_bad_setup     processor meshes that are not boxes (2 ranks), deltaT not
-#       a whole number of DEM steps, fluid.density != rho: each stops with its message.
+#       a whole number of DEM steps, fluid.density != rho, undisturbedVelocity unknown or with
+#       cellPoint, meanPressureGradient unknown or with walls across gravity: each stops with
+#       its message.
 #   coupling.restart               cases/periodic_box under 10 g in a flow: 400 fluid steps vs
 #       200 + restart (startFrom latestTime) + 200, on 1 and on 2 ranks: every particle and
 #       U, p, phi, voidfraction bit-identical; a 1-rank checkpoint restarted on 2 ranks
