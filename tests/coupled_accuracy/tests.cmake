@@ -37,7 +37,7 @@ set_tests_properties(coupling.undisturbed_settling PROPERTIES
 # the momentum exchange balanced to 1e-12 (docs/models/bed-surface.md).
 add_test(NAME coupling.bed_surface
          COMMAND ${GRAINFLOW_SWEEPS_PYTHON} ${PROJECT_SOURCE_DIR}/benchmarks/accuracy_cost/coupled/bed_surface.py
-                 --laws koch_hill,gidaspow --cells 6 --surface sharpInterface --check 3
+                 --laws koch_hill,gidaspow --cells 6 --surface sharpInterface --check 3 --end 0.02
                  --work ${CMAKE_CURRENT_BINARY_DIR}/bed_surface
                  --build ${PROJECT_BINARY_DIR})
 set_tests_properties(coupling.bed_surface PROPERTIES
