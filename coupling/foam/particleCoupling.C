@@ -461,6 +461,7 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
       settings.sampling = sampling;
       settings.cell_over_d = std::cbrt(sums[2] / cells) / (sums[0] / sums[1]);
       settings.steps_per_fluid = subSteps_;
+      settings.drag_void_fraction = sharpInterface_ ? "sharpInterface" : "cell";
       Info << "  " << coupling::describe_coupled_accuracy(settings).c_str() << endl;
     }
   }
