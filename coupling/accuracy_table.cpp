@@ -125,6 +125,12 @@ std::string describe_coupled_accuracy(const CoupledSettings& s) {
                                         "schiller_naumann)";
     return out.str();
   }
+  if (s.drag_void_fraction != "cell") {
+    out << "dragVoidFraction " << s.drag_void_fraction
+        << ": no measured table here (the tables are for dragVoidFraction cell); its fixed-bed "
+           "measurements are in docs/models/bed-surface.md";
+    return out.str();
+  }
   out << footprint_line(s) << "\n  " << interval_line(s);
   return out.str();
 }

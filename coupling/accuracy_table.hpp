@@ -100,6 +100,7 @@ struct CoupledSettings {
   std::string sampling;  // cell or cellPoint
   double cell_over_d = 0;
   int steps_per_fluid = 1;
+  std::string drag_void_fraction = "cell";  // couplingProperties dragVoidFraction
 };
 
 // Lines (the first without indentation, the others indented by two spaces) saying what the

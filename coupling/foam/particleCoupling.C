@@ -16,6 +16,7 @@
 #include "extrapolatedCalculatedFvPatchField.H"
 #include "coupling/foam/gaussLinearGrad.H"
 #include "volPointInterpolation.H"
+#include "wallFvPatch.H"
 
 namespace grainflow::foam {
 namespace {
@@ -74,7 +75,9 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
              derivedPatchTypes(mesh)),
       fExplicit_(derivedField(mesh, "fParticles", false), mesh,
                  Foam::dimensionedVector("zero", Foam::dimensionSet(1, -2, -2, 0, 0), Foam::Zero),
-                 derivedPatchTypes(mesh)) {
+                 derivedPatchTypes(mesh)),
+      dragVoidFraction_(derivedField(mesh, "dragVoidFraction", false), mesh,
+                        Foam::dimensionedScalar("one", Foam::dimless, 1), derivedPatchTypes(mesh)) {
   using namespace Foam;
   IOdictionary dict(IOobject("couplingProperties", mesh.time().constant(), mesh,
                              IOobject::MUST_READ_IF_MODIFIED, IOobject::NO_WRITE));
@@ -84,7 +87,7 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
   {
     const wordList allowed{"scene", "voidFraction", "dividedResolution", "smoothingFactor",
                            "sampling", "minVoidFraction", "ddtVoidFraction",
-                           "undisturbedVelocity", "meanPressureGradient"};
+                           "undisturbedVelocity", "meanPressureGradient", "dragVoidFraction"};
     for (const word& key : dict.toc())
       if (!allowed.found(key))
         FatalIOErrorInFunction(dict) << "unknown key '" << key << "'; allowed: " << allowed
@@ -159,6 +162,29 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
                                     "solved one), suspensionWeight (a uniform pressure "
                                     "gradient carries the particles' buoyant weight, for a "
                                     "domain periodic along gravity; docs/coupling.md)"
+                                 << exit(FatalIOError);
+
+  const word dragEps = dict.lookupOrDefault<word>("dragVoidFraction", "cell");
+  if (dragEps == "sharpInterface")
+    sharpInterface_ = true;
+  else if (dragEps != "cell")
+    FatalIOErrorInFunction(dict) << "dragVoidFraction " << dragEps
+                                 << " is not one of: cell (the drag sees the cell's void "
+                                    "fraction and velocity), sharpInterface (a cell between a "
+                                    "denser and a more dilute neighbour is read as two layers "
+                                    "of their states: the drag sees the layers' solid-weighted "
+                                    "void fraction and the velocity at the cell's superficial "
+                                    "velocity, docs/models/bed-surface.md)"
+                                 << exit(FatalIOError);
+  if (sharpInterface_ && sampling_ != Sampling::cell)
+    FatalIOErrorInFunction(dict) << "dragVoidFraction sharpInterface needs sampling cell (it "
+                                    "scales the cells' velocities before the footprint-weighted "
+                                    "average); set sampling cell or dragVoidFraction cell"
+                                 << exit(FatalIOError);
+  if (sharpInterface_ && undisturbed_)
+    FatalIOErrorInFunction(dict) << "dragVoidFraction sharpInterface and undisturbedVelocity "
+                                    "oseenBrinkman are not combined (the disturbance model "
+                                    "reads the cells' unscaled Ksl); switch one of them off"
                                  << exit(FatalIOError);
 
   // --- the DEM ----------------------------------------------------------------------
@@ -439,7 +465,8 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
        << "  VANS model " << model_ << ", drag " << dem_->drag_law().c_str() << ", void fraction "
        << coupling::void_fraction_method_name(vf) << " (" << label(footprint_.size())
        << " points per particle), sampling " << sampling << ", minVoidFraction " << minVoidFraction_
-       << ", ddt(voidfraction) " << (ddtVoidFraction_ ? "on" : "off") << "\n"
+       << ", ddt(voidfraction) " << (ddtVoidFraction_ ? "on" : "off") << ", dragVoidFraction "
+       << (sharpInterface_ ? "sharpInterface" : "cell") << "\n"
        << "  viscous term at the particles: "
        << (orthogonal ? "Gauss linear uncorrected (the mesh is orthogonal: largest "
                         "non-orthogonal correction vector "
@@ -483,6 +510,7 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
       settings.sampling = sampling;
       settings.cell_over_d = std::cbrt(sums[2] / cells) / (sums[0] / sums[1]);
       settings.steps_per_fluid = subSteps_;
+      settings.drag_void_fraction = sharpInterface_ ? "sharpInterface" : "cell";
       Info << "  " << coupling::describe_coupled_accuracy(settings).c_str() << endl;
     }
   }
@@ -663,6 +691,12 @@ void ParticleCoupling::deposit() {
     meshSolidVolume += (1 - eps[c]) * V[c];
   }
   voidFraction_.correctBoundaryConditions();
+  if (sharpInterface_) {
+    // The particles read velocityScale U (sample()): the fluid's implicit coefficient is
+    // scaled alike, so that their forces and the exchange source still balance.
+    reconstructLayers();
+    forAll(Ksl, c) Ksl[c] *= velocityScale_[c];
+  }
   Ksl_.correctBoundaryConditions();  // written at write times: every patch
   // KslUs and fParticles are read on a boundary only by grainFoam's fixedFluxPressure
   // patches (the drag balance there), which are never constraint patches, and are not
@@ -682,6 +716,80 @@ void ParticleCoupling::deposit() {
   particleVolume_ = sums[0];
   meshSolidVolume_ = sums[2];
   stepClampedVolume_ = sums[3];
+}
+
+void ParticleCoupling::reconstructLayers() {
+  // Along each axis a cell has a neighbour on either side (area-weighted over that side's
+  // faces; across processor and cyclic patches the neighbour's value; particle-free fluid
+  // beyond an inlet or outlet; none at a wall). A cell whose solid fraction phi lies strictly between its two neighbours' phi_L <
+  // phi < phi_D is read as a sharp interface between their states (a one-dimensional VOF
+  // reconstruction): a fraction f = (phi - phi_L)/(phi_D - phi_L) of it at phi_D, the rest at
+  // phi_L. The drag sees the solid-weighted solid fraction of the two layers,
+  //   phi_s = (f phi_D^2 + (1 - f) phi_L^2) / phi   (>= phi; = phi_D when phi_L = 0),
+  // along the axis with the largest jump phi_D - phi_L, and the interstitial velocity of
+  // the cell's superficial velocity in it, (eps / eps_s) U: the layers are crossed in series.
+  // The pressure then drops across the dense layer alone: the particles read grad p / f =
+  // (phi_s / phi) grad p, and model A's fluid carries eps_s grad p (grainFoam's c), so that
+  // the cell's pressure drop is its drag over eps_s, as in a bed of eps_s, not over eps.
+  // A cell without such an axis keeps its own eps, U and grad p.
+  using namespace Foam;
+  const label n = mesh_.nCells();
+  const scalarField& eps = voidFraction_.primitiveField();
+  sides_.assign(12 * static_cast<std::size_t>(n), 0.0);
+  const auto add = [this](label c, const vector& outward, double phi) {
+    int a = 0;
+    for (int b = 1; b < 3; ++b)
+      if (std::abs(outward[b]) > std::abs(outward[a])) a = b;
+    const double area = mag(outward);
+    double* s = &sides_[12 * static_cast<std::size_t>(c) + 4 * a + (outward[a] > 0 ? 2 : 0)];
+    s[0] += area * phi;
+    s[1] += area;
+  };
+  const vectorField& Sf = mesh_.Sf().primitiveField();
+  const labelUList& owner = mesh_.owner();
+  const labelUList& neighbour = mesh_.neighbour();
+  forAll(neighbour, f) {
+    add(owner[f], Sf[f], 1 - eps[neighbour[f]]);
+    add(neighbour[f], -Sf[f], 1 - eps[owner[f]]);
+  }
+  // Beyond an inlet or outlet (a patch the fluid crosses) lies particle-free fluid: the
+  // bed resting on a distributor is read like its surface. A wall or a constraint patch
+  // that is not coupled (empty, symmetry, ...) is a side without a neighbour.
+  forAll(voidFraction_.boundaryField(), patch) {
+    const fvPatchScalarField& pe = voidFraction_.boundaryField()[patch];
+    const fvPatch& fp = mesh_.boundary()[patch];
+    const vectorField& S = mesh_.Sf().boundaryField()[patch];
+    const labelUList& cells = fp.faceCells();
+    if (pe.coupled()) {
+      const tmp<scalarField> other = pe.patchNeighbourField();
+      forAll(cells, i) add(cells[i], S[i], 1 - other()[i]);
+    } else if (!isA<wallFvPatch>(fp) && !polyPatch::constraintType(fp.type())) {
+      forAll(cells, i) add(cells[i], S[i], 0.0);
+    }
+  }
+  scalarField& dragEps = dragVoidFraction_.primitiveFieldRef();
+  velocityScale_.setSize(n);
+  gradScale_.setSize(n);
+  for (label c = 0; c < n; ++c) {
+    const double phi = 1 - eps[c];
+    double phiS = phi, jump = 0;
+    const double* s = &sides_[12 * static_cast<std::size_t>(c)];
+    for (int a = 0; a < 3; ++a) {
+      const double* lo = s + 4 * a;
+      const double* hi = lo + 2;
+      if (!(lo[1] > 0 && hi[1] > 0)) continue;  // a bounded side: no neighbour
+      const double p0 = lo[0] / lo[1], p1 = hi[0] / hi[1];
+      const double dense = std::max(p0, p1), dilute = std::min(p0, p1);
+      if (!(phi > dilute && phi < dense) || dense - dilute <= jump) continue;
+      const double f = (phi - dilute) / (dense - dilute);
+      phiS = (f * dense * dense + (1 - f) * dilute * dilute) / phi;
+      jump = dense - dilute;
+    }
+    dragEps[c] = 1 - phiS;
+    velocityScale_[c] = eps[c] / dragEps[c];
+    gradScale_[c] = phi > 0 ? phiS / phi : 1.0;
+  }
+  dragVoidFraction_.correctBoundaryConditions();
 }
 
 Foam::volVectorField& ParticleCoupling::pressureGradient() {
@@ -892,13 +1000,24 @@ void ParticleCoupling::sample() {
     for (std::size_t j = first_[i]; j < first_[i + 1]; ++j) {
       const label c = points_[j].cell;
       const double w = points_[j].weight;
+      if (sharpInterface_) {
+        const double wu = w * velocityScale_[c], wg = w * gradScale_[c];
+        for (int d = 0; d < 3; ++d) {
+          a[d] += wu * U_[c][d];
+          a[4 + d] += wg * gradP[c][d];
+        }
+        a[3] += w * dragVoidFraction_[c];
+      } else {
+        for (int d = 0; d < 3; ++d) {
+          a[d] += w * U_[c][d];
+          a[4 + d] += w * gradP[c][d];
+        }
+        a[3] += w * voidFraction_[c];
+      }
       for (int d = 0; d < 3; ++d) {
-        a[d] += w * U_[c][d];
-        a[4 + d] += w * gradP[c][d];
         a[7 + d] += w * divTau[c][d];
         if (curl) a[10 + d] += w * tCurlU()[c][d];
       }
-      a[3] += w * voidFraction_[c];
       a[13] += w;
       if (undisturbed_) {
         const double* x = particles_.x(i);
@@ -963,6 +1082,10 @@ coupling::FluidAtParticle ParticleCoupling::sampleAt(const std::array<double, 3>
   f.velocity = toArray(U_[c]);
   f.void_fraction = voidFraction_[c];
   if (meanGradPOn_) f.pressure_gradient = toArray(meanGradP_);
+  if (sharpInterface_) {
+    for (double& u : f.velocity) u *= velocityScale_[c];
+    f.void_fraction = dragVoidFraction_[c];
+  }
   return f;
 }
 
@@ -975,7 +1098,8 @@ void ParticleCoupling::checkBalance() {
     for (std::size_t j = first_[i]; j < first_[i + 1]; ++j) {
       const label c = points_[j].cell;
       const double w = points_[j].weight;
-      for (int d = 0; d < 3; ++d) acc[W * i + d] += w * U_[c][d];
+      const double ws = sharpInterface_ ? w * velocityScale_[c] : w;
+      for (int d = 0; d < 3; ++d) acc[W * i + d] += ws * U_[c][d];
       acc[W * i + 3] += w;
     }
   const std::vector<double> u = dem_->sum_onto_owners(acc, W);

@@ -108,8 +108,11 @@ void solve(const Foam::argList& args) {
     const auto fluidStart = std::chrono::steady_clock::now();
 
     const surfaceScalarField epsf(fvc::interpolate(eps));
-    volScalarField c("c", eps);    // coefficient of grad p (and of the viscous term)
+    // Coefficient of grad p (and of the viscous term); with dragVoidFraction sharpInterface
+    // the void fraction of the layer that carries a two-layer cell's pressure drop.
+    volScalarField c("c", particles.sharpInterface() ? particles.dragVoidFraction() : eps);
     surfaceScalarField cf("cf", epsf);
+    if (particles.sharpInterface()) cf = fvc::interpolate(c);
     if (!modelA) {
       c = dimensionedScalar("one", dimless, 1);
       cf = dimensionedScalar("one", dimless, 1);

@@ -134,6 +134,17 @@ TEST(AccuracyTable, DescribesMeasuredPointsAndRefusesToExtrapolate) {
             std::string::npos);
 }
 
+// dragVoidFraction sharpInterface changes the packed bed's error: the default's tables are
+// not quoted for it.
+TEST(AccuracyTable, SharpInterfaceIsNotQuotedTheDefaultsTable) {
+  CoupledSettings s = bed("divided", "cell", 2, 20);
+  s.drag_void_fraction = "sharpInterface";
+  const std::string text = describe_coupled_accuracy(s);
+  EXPECT_EQ(text.find("-7.3 %"), std::string::npos) << text;
+  EXPECT_NE(text.find("dragVoidFraction sharpInterface: no measured table here"), std::string::npos)
+      << text;
+}
+
 // (a) A single settling sphere in cells of 3 d was quoted the packed bed's -12.6 % (its
 // error is +18 %): it gets no packed-bed figure, and the settling table only where that was
 // measured (divided, cell, 10 d cells: +1.10 % at N = 1 ... +1.14 % at N = 100).
