@@ -35,6 +35,7 @@ with open(sys.argv[2], "w") as f:
         f.write(f"| {k} | {med[k]:.3g} | {', '.join(f'{x:.3g}' for x in by[k])} | {med[k]/med[1]:.2f} |\n")
     f.write("\nThe 2-rank grid is chosen automatically (least cut area); pairs that straddle the "
             "cut are computed on both ranks (see docs/parallel.md), which is the price of exact "
-            "force symmetry without a reverse communication.\n")
+            "force symmetry without a reverse communication. Past two ranks: "
+            "[scaling-model.md](scaling-model.md).\n")
 print(open(sys.argv[2]).read())
 PY
