@@ -7,11 +7,13 @@
 //    within 0.5 %;
 //  - two equal spheres exchanging heat between adiabatic walls conserve sum m c T to
 //    round-off;
+//  - a restart from a checkpoint continues the temperatures bit for bit;
 //  - the parser refuses what is not built and thermal keys without `heat:`.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <numbers>
 #include <string>
 
@@ -177,6 +179,35 @@ TEST(HeatTransfer, TwoSpheresConserveEnergyToRoundOff) {
   EXPECT_LT(std::abs(p.temperature[0] - p.temperature[1]), 1e-3);  // equilibrated
   EXPECT_NEAR(0.5 * (p.temperature[0] + p.temperature[1]), 350, 1e-9);
   EXPECT_LT(worst, 1e-14);  // round-off: 20 000 steps of ~1e-16 each, mostly cancelling
+}
+
+// Reference: the uninterrupted run (Simulation::write_checkpoint rebuilds the lists as a
+// restart from the file does, so both continue from the same state, bit for bit).
+TEST(HeatTransfer, RestartContinuesTemperaturesExactly) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "heat_transfer_test";
+  fs::create_directories(dir);
+  const std::string file = (dir / "checkpoint.h5").string();
+  const double r = 1e-3, delta0 = 5e-7;
+  const Scene s = parse_scene(chain_scene(3, r, delta0, ", temperature: 400", ", heat_flux: -5e3"),
+                              "restart.yaml");
+  Simulation whole(s, false);
+  add_chain(whole, 3, r, delta0, {300, 320, 340});
+  whole.advance_to(2e-3);
+  whole.write_checkpoint(file);
+  whole.advance_to(4e-3);
+  Simulation resumed(s, false);
+  resumed.restore(read_checkpoint(file));
+  resumed.advance_to(4e-3);
+  ASSERT_EQ(whole.counters().steps, resumed.counters().steps);
+  const Particles &a = whole.particles(), &b = resumed.particles();
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a.id[i], b.id[i]);
+    EXPECT_EQ(a.temperature[i], b.temperature[i]) << "particle " << a.id[i];
+    EXPECT_EQ(a.x[i], b.x[i]) << "particle " << a.id[i];
+  }
+  EXPECT_NE(a.temperature[0], 300);  // heat flowed
 }
 
 std::string error_of(const std::string& yaml) {
