@@ -108,6 +108,13 @@ DemLink::DemLink(const std::string& scene_file, double fluid_density, double flu
         << ": error: grainFoam's pressure excludes the hydrostatic part (rho_f g.x); add "
            "`pressure: {hydrostatic: false}` to the fluid block and list buoyancy in "
            "fluid.forces\n";
+  // Heat transfer is built for grain (DEM and one-way fluid) only.
+  if (m.scene.heat)
+    why << m.scene.heat->source
+        << ": error: heat transfer in a coupled run needs grainFoam's fluid energy equation, "
+           "which is not built yet (docs/models/heat-transfer.md, \"Not yet built\"); remove "
+           "the `heat:` block (and the thermal keys) to run the isothermal coupled case, or run "
+           "the scene with `grain` and a prescribed fluid temperature\n";
   // The output keys that belong to grain's own run loop: grainFoam's write times replace them.
   for (const auto& [key, where] : m.scene.output.given) {
     const char* instead = nullptr;

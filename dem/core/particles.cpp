@@ -15,6 +15,7 @@ void Particles::reserve(std::size_t n) {
   mass.reserve(n);
   inertia.reserve(n);
   material.reserve(n);
+  temperature.reserve(n);
 }
 
 std::size_t Particles::add(GlobalId gid, const Vec3& position, const Vec3& velocity,
@@ -37,6 +38,7 @@ std::size_t Particles::add_raw(GlobalId gid, const Vec3& position, const Vec3& v
   mass.push_back(m);
   inertia.push_back(moment);
   material.push_back(mat);
+  temperature.push_back(0.0);
   return id.size() - 1;
 }
 
@@ -71,6 +73,7 @@ void Particles::permute(const std::vector<std::size_t>& perm) {
   apply_permutation(mass, perm);
   apply_permutation(inertia, perm);
   apply_permutation(material, perm);
+  apply_permutation(temperature, perm);
 }
 
 void Particles::remove_if(const std::vector<char>& remove) {
@@ -86,6 +89,7 @@ void Particles::remove_if(const std::vector<char>& remove) {
   compact(mass, remove);
   compact(inertia, remove);
   compact(material, remove);
+  compact(temperature, remove);
 }
 
 }  // namespace grainflow

@@ -28,6 +28,9 @@ struct Particles {
   std::vector<double> mass;      // [kg]
   std::vector<double> inertia;   // moment of inertia of a solid sphere, 2/5 m r^2 [kg m^2]
   std::vector<int> material;     // index into the scene's material table
+  // [K]; integrated only when the scene switches heat transfer on (0 otherwise). Touched
+  // at rebuilds (re-sort, migration), never by the force loop or the kicks.
+  std::vector<double> temperature;
 
   std::size_t size() const { return id.size(); }
 

@@ -80,6 +80,7 @@ Simulation::Simulation(const Scene& scene, bool insert, MPI_Comm comm,
     throw SetupError(e.what());
   }
   streams_ = StreamInsertion(scene_);
+  if (scene_.heat) heat_ = std::make_unique<HeatTransfer>(scene_);
   if (insert) insert_particles(scene_, p_, next_id_, &walls_);
 }
 
@@ -606,6 +607,11 @@ void Simulation::restore(const CheckpointData& checkpoint) {
   for (std::size_t k = 0; k < streams_.size(); ++k) delivered.push_back(streams_.count_inserted(k));
   check_checkpoint(checkpoint, scene_, walls_.history_columns(), streams_.max_radius(), delivered);
 
+  if (heat_ && !checkpoint.has_temperature)
+    throw SetupError(scene_.file + ": error: heat is on, but " + where +
+                     " holds no particle temperatures (it was written by a run without heat "
+                     "transfer); run the scene from the start, or restart with a scene whose "
+                     "heat settings match the checkpoint's run");
   p_ = checkpoint.particles;
   restored_drag_.clear();
   for (std::size_t i = 0; i < checkpoint.drag_coefficient.size(); ++i)
@@ -628,6 +634,7 @@ void Simulation::write_checkpoint(const std::string& path) {
   d.step = counters_.steps;
   d.next_id = next_id_;
   d.particles = p_;
+  d.has_temperature = heat_ != nullptr;
   if (!terms_.empty()) {
     d.drag_coefficient = drag_.coefficient;
     d.drag_fluid_velocity = drag_.fluid_velocity;
@@ -1329,6 +1336,7 @@ void Simulation::step() {
   time_ += dt_;
   walls_.move_to(time_);
   const ContactGuards guards = compute_forces();
+  if (heat_) advance_temperatures();
   state_finite_ = half_kick<true>();
   finite_everywhere_ = check_contacts(guards, state_finite_);
   ++counters_.steps;
@@ -1337,6 +1345,12 @@ void Simulation::step() {
 void Simulation::advance_to(double t_end) {
   if (!initialised_) initialise();
   while (time_ < t_end - 0.5 * dt_) step();
+}
+
+void Simulation::advance_temperatures() {
+  exchange_->forward_values(p_.temperature, 1, ghost_temperature_);
+  heat_->step(p_, ghosts_, ghost_temperature_, local_list_, ghost_list_, walls_, wall_neighbours_,
+              dt_);
 }
 
 double Simulation::kinetic_energy_translational() const {

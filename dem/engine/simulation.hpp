@@ -21,6 +21,7 @@
 #include "dem/engine/force_term.hpp"
 #include "dem/engine/overload.hpp"
 #include "dem/engine/time_step.hpp"
+#include "dem/heat/heat_transfer.hpp"
 #include "dem/insert/stream_insertion.hpp"
 #include "dem/io/checkpoint.hpp"
 #include "dem/io/snapshot_writer.hpp"
@@ -147,6 +148,8 @@ class Simulation {
                         std::vector<double> ghost) const {
     exchange_->reverse_values(local, width, ghost);
   }
+  // Heat transfer (scene key `heat:`), or nullptr when it is off.
+  const HeatTransfer* heat() const { return heat_.get(); }
   double time() const { return time_; }
   double dt() const { return dt_; }
   void set_dt(double dt) { dt_ = dt; }
@@ -217,6 +220,8 @@ class Simulation {
   void remake_decomposition(const std::array<int, 3>& dims);  // uniform planes
   ContactGuards compute_forces();  // gravity, contacts, then the force terms
   void apply_force_terms();  // non-contact terms only
+  // Heat on: the ghosts' temperatures from their owners, then HeatTransfer::step (collective).
+  void advance_temperatures();
   void restore_implicit_drag();  // initialise() after restore()
   // The terms' implicit spin drag at the present state, in the present order (after a
   // checkpoint's rebuild, or a restore); forces, torques and drag unchanged.
@@ -286,6 +291,8 @@ class Simulation {
   std::vector<Vec3> x_at_build_;
   std::vector<char> leaving_;
   std::vector<std::unique_ptr<ForceTerm>> terms_;
+  std::unique_ptr<HeatTransfer> heat_;       // scene.heat; null: no thermal code runs
+  std::vector<double> ghost_temperature_;    // each ghost's, at the step's start (heat on)
   ImplicitDrag drag_;
   std::vector<TermLimit> force_limits_;
   std::vector<std::string> force_limit_notes_;

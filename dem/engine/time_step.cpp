@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "dem/contact/normal_hooke.hpp"
+#include "dem/heat/thermal_limits.hpp"
 
 namespace grainflow {
 
@@ -216,6 +217,7 @@ TimeStepReport check_time_step(const Scene& scene, const Particles& p, const Pai
       rep.notes.push_back(o.str());
     }
   }
+  if (scene.heat) check_thermal_limits(scene, p, rep);
   return rep;
 }
 

@@ -47,6 +47,16 @@ struct VoidFractionGridSettings {
   double minimum = 0.2;  // eps_min in [kLowestVoidFraction, 1)
 };
 
+// Particle-fluid convection with a prescribed fluid temperature (heat on;
+// dem/heat/convection.hpp).
+enum class NusseltLaw { ranz_marshall, gunn };
+struct FluidThermal {
+  double temperature = 0;    // T_f [K]
+  double heat_capacity = 0;  // c_p,f [J/(kg K)] > 0
+  double conductivity = 0;   // k_f [W/(m K)] > 0
+  NusseltLaw nusselt = NusseltLaw::ranz_marshall;
+};
+
 struct FluidSettings {
   PrescribedFluid field;
   // When set, eps comes from the particles (void_fraction_grid.hpp), not field.void_fraction.
@@ -56,6 +66,7 @@ struct FluidSettings {
   VansModel model = VansModel::B;
   double virtual_mass_coefficient = kSphereVirtualMassCoefficient;
   std::string source;                         // "file:line" of the block, for messages
+  std::optional<FluidThermal> thermal;        // `temperature:` given (heat on)
 };
 
 }  // namespace grainflow

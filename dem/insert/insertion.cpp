@@ -248,6 +248,7 @@ void fill_region(const Scene& scene, const WallSet* walls, const Insertion& ins,
       continue;
     grid.add(x, r);
     p.add(next_id++, x, ins.velocity, Vec3::Zero(), r, ins.material, density);
+    p.temperature.back() = ins.temperature.value_or(0.0);
     ++placed;
     volume += sphere_volume(r);
   }
@@ -298,8 +299,8 @@ std::string outside_domain_reason(const Domain& d, const Vec3& x, double r) {
 
 // The columns a particle file may have; x, y, z and radius are required, vx, vy, vz
 // come together, and so do wx, wy, wz.
-const std::vector<std::string> kCsvColumns = {"x",  "y",  "z",  "radius", "vx",      "vy",
-                                              "vz", "wx", "wy", "wz",     "material"};
+const std::vector<std::string> kCsvColumns = {"x",  "y",  "z",  "radius",   "vx", "vy",
+                                              "vz", "wx", "wy", "wz", "material", "T"};
 
 void read_csv(const Scene& scene, const WallSet* walls, const Insertion& ins, Particles& p,
               GlobalId& next_id, OverlapGrid& grid) {
@@ -316,7 +317,8 @@ void read_csv(const Scene& scene, const WallSet* walls, const Insertion& ins, Pa
                          ins.source + ")");
   };
   const std::string allowed =
-      "columns: x,y,z,radius (required), vx,vy,vz, wx,wy,wz, material (optional)";
+      "columns: x,y,z,radius (required), vx,vy,vz, wx,wy,wz, material, T (optional; T needs "
+      "heat on)";
   std::string line;
   long lineno = 0, header_line = 0;
   std::vector<std::string> header;
@@ -350,6 +352,14 @@ void read_csv(const Scene& scene, const WallSet* walls, const Insertion& ins, Pa
     fail(header_line, "the header has only " + std::to_string(spin_columns) +
                           " of the angular velocity columns wx,wy,wz; give all three or none");
   const bool has_w = spin_columns == 3;
+  // The temperature column T [K]: with heat on, it or the entry's `temperature` is needed.
+  const bool has_t = col.count("T") > 0;
+  if (has_t && !scene.heat)
+    fail(header_line, "column 'T' (temperature) is given, but heat transfer is off; add a "
+                      "top-level `heat: {}` block to the scene, or remove the column");
+  if (scene.heat && !has_t && !ins.temperature)
+    fail(header_line, "heat is on, but the file has no column 'T' and the insertion entry no "
+                      "`temperature: <K>`; give one of them");
   long particles = 0;
   while (std::getline(in, line)) {
     ++lineno;
@@ -395,6 +405,13 @@ void read_csv(const Scene& scene, const WallSet* walls, const Insertion& ins, Pa
                        "; particles must not overlap at insertion (move one or shrink it)");
     grid.add(x, r);
     p.add(next_id++, x, v, w, r, mat, scene.materials[mat].density);
+    if (has_t) {
+      const double t = number("T");
+      if (!(t > 0)) fail(lineno, "temperature T must be > 0 K, got " + cells[col["T"]]);
+      p.temperature.back() = t;
+    } else {
+      p.temperature.back() = ins.temperature.value_or(0.0);
+    }
     ++particles;
   }
   if (particles == 0)
@@ -446,6 +463,22 @@ void read_snapshot_entry(const Scene& scene, const WallSet* walls, const Inserti
   // inside, and is moved there. Farther out (a snapshot of another domain) is an error.
   Particles& q = snap.particles;
   check_snapshot_records(scene, ins, q);
+  // Temperatures: the entry's `temperature` for all, else the file's (heat on).
+  if (scene.heat) {
+    if (ins.temperature)
+      q.temperature.assign(q.size(), *ins.temperature);
+    else if (!snap.has_temperature)
+      throw InsertionError(ins.source + ": error: heat is on, but snapshot '" + ins.snapshot_file +
+                           "' holds no temperatures (dataset '/temperature'); give the entry "
+                           "`temperature: <K>`");
+    for (std::size_t i = 0; i < q.size(); ++i)
+      if (!(q.temperature[i] > 0) || !std::isfinite(q.temperature[i]))
+        throw StateError(ins.snapshot_file + ": error: dataset '/temperature', index " +
+                         std::to_string(i) + ": temperature " + std::to_string(q.temperature[i]) +
+                         " K is not a finite positive number");
+  } else {
+    q.temperature.assign(q.size(), 0.0);
+  }
   const Domain& dom = scene.domain;
   const double drift = scene.neighbour.skin ? 0.5 * *scene.neighbour.skin : 0.0;
   for (std::size_t i = 0; i < q.size(); ++i)
@@ -497,6 +530,7 @@ void read_snapshot_entry(const Scene& scene, const WallSet* walls, const Inserti
     const Vec3 v = ins.keep_velocity ? q.v[i] : Vec3::Zero();
     const Vec3 w = ins.keep_velocity ? q.omega[i] : Vec3::Zero();
     p.add_raw(next_id++, q.x[i], v, w, q.radius[i], q.mass[i], q.inertia[i], q.material[i]);
+    p.temperature.back() = q.temperature[i];
   }
 }
 

@@ -129,7 +129,10 @@ long StreamInsertion::insert(double t, Particles& p, const Ghosts& ghosts, const
       }
       if (found < 0) break;
       const Vec3 x = cand[static_cast<std::size_t>(j) * kAttempts + found];
-      if (decomp.owns(x)) p.add(next_id, x, s.entry.velocity, Vec3::Zero(), r, s.entry.material, s.density);
+      if (decomp.owns(x)) {
+        p.add(next_id, x, s.entry.velocity, Vec3::Zero(), r, s.entry.material, s.density);
+        p.temperature.back() = s.entry.temperature.value_or(0.0);
+      }
       ++next_id;
       placed_x.push_back(x);
       placed_r.push_back(r);

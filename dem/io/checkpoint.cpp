@@ -22,13 +22,14 @@ std::vector<double> pack(const CheckpointData& d) {
   std::vector<double> b;
   const bool drag = !d.drag_coefficient.empty();
   b.push_back(static_cast<double>(d.particles.size()));
-  b.push_back(drag ? 1.0 : 0.0);
+  b.push_back((drag ? 1.0 : 0.0) + (d.has_temperature ? 2.0 : 0.0));  // flags
   for (std::size_t i = 0; i < d.particles.size(); ++i) {
     const Particles& p = d.particles;
     b.push_back(std::bit_cast<double>(p.id[i]));
     for (const Vec3* v : {&p.x[i], &p.v[i], &p.omega[i], &p.force[i], &p.torque[i]})
       b.insert(b.end(), v->data(), v->data() + 3);
     b.insert(b.end(), {p.radius[i], p.mass[i], p.inertia[i], static_cast<double>(p.material[i])});
+    if (d.has_temperature) b.push_back(p.temperature[i]);
     if (drag) {
       b.push_back(d.drag_coefficient[i]);
       b.insert(b.end(), d.drag_fluid_velocity[i].data(), d.drag_fluid_velocity[i].data() + 3);
@@ -47,7 +48,8 @@ std::vector<double> pack(const CheckpointData& d) {
 // (measured: 4000 particles without springs take 658 758 bytes, 624 000 of them data).
 std::uintmax_t expected_bytes(const CheckpointData& d) {
   const std::uintmax_t n = d.particles.size(), per_particle = 8 + 5 * 24 + 3 * 8 + 4;
-  const std::uintmax_t drag = d.drag_coefficient.empty() ? 0 : 32;
+  const std::uintmax_t drag =
+      (d.drag_coefficient.empty() ? 0 : 32) + (d.has_temperature ? 8 : 0);
   const std::uintmax_t streams = d.streams ? d.streams->size() : 0;
   std::uintmax_t grid = 0;
   if (d.grid)
@@ -60,7 +62,9 @@ std::uintmax_t expected_bytes(const CheckpointData& d) {
 void unpack(const double* b, std::size_t n, CheckpointData& out) {
   std::size_t k = 0;
   const auto count = static_cast<std::size_t>(b[k++]);
-  const bool drag = b[k++] != 0;
+  const int flags = static_cast<int>(b[k++]);
+  const bool drag = (flags & 1) != 0, temperature = (flags & 2) != 0;
+  if (temperature) out.has_temperature = true;
   auto vec = [&] {
     const Vec3 v(b[k], b[k + 1], b[k + 2]);
     k += 3;
@@ -75,6 +79,7 @@ void unpack(const double* b, std::size_t n, CheckpointData& out) {
     out.particles.add_raw(id, x, v, w, r, m, inertia, mat);
     out.particles.force.back() = f;
     out.particles.torque.back() = t;
+    if (temperature) out.particles.temperature.back() = b[k++];
     if (drag) {
       out.drag_coefficient.push_back(b[k++]);
       out.drag_fluid_velocity.push_back(vec());
@@ -208,6 +213,10 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
                    write_array(fail, g, "inertia", H5T_NATIVE_DOUBLE, n, 1, p.inertia.data()) &&
                    write_array(fail, g, "material", H5T_NATIVE_INT, n, 1, mats.data()),
                "writing the group 'particles'");
+    if (d.has_temperature)
+      fail.check(g >= 0 && write_array(fail, g, "temperature", H5T_NATIVE_DOUBLE, n, 1,
+                                       p.temperature.data()),
+                 "writing the temperatures in group 'particles'");
     if (!d.drag_coefficient.empty())
       fail.check(g >= 0 &&
                      write_array(fail, g, "drag_coefficient", H5T_NATIVE_DOUBLE, n, 1,
@@ -385,6 +394,13 @@ CheckpointData read_checkpoint(const std::string& path) {
     // Optional: present when the run had fluid forces.
     const bool has_drag =
         error.empty() && H5Lexists(f, "/particles/drag_coefficient", H5P_DEFAULT) > 0;
+    // Optional: present when the run had heat transfer.
+    d.has_temperature =
+        error.empty() && H5Lexists(f, "/particles/temperature", H5P_DEFAULT) > 0;
+    std::vector<double> temperature;
+    if (d.has_temperature)
+      temperature =
+          read_array<double>(f, "/particles/temperature", H5T_NATIVE_DOUBLE, 1, n, error);
     std::vector<double> drag_k, drag_u;
     if (has_drag) {
       drag_k = read_array<double>(f, "/particles/drag_coefficient", H5T_NATIVE_DOUBLE, 1, n, error);
@@ -429,6 +445,7 @@ CheckpointData read_checkpoint(const std::string& path) {
                             mat[i]);
         d.particles.force.back() = Vec3(force[3 * i], force[3 * i + 1], force[3 * i + 2]);
         d.particles.torque.back() = Vec3(torque[3 * i], torque[3 * i + 1], torque[3 * i + 2]);
+        if (d.has_temperature) d.particles.temperature.back() = temperature[i];
         if (has_drag) {
           d.drag_coefficient.push_back(drag_k[i]);
           d.drag_fluid_velocity.emplace_back(drag_u[3 * i], drag_u[3 * i + 1], drag_u[3 * i + 2]);

@@ -15,6 +15,7 @@
 // /particles/{id, position, velocity, angular_velocity, force, torque, radius, mass,
 // inertia, material} — force and torque are those of the step's end, which the next
 // velocity-Verlet half kick uses (recomputing them would advance the springs twice);
+// with heat transfer /particles/temperature;
 // with fluid forces also /particles/{drag_coefficient, drag_fluid_velocity}, the
 // implicit drag K and u of the step's end, which that half kick uses too (a coupled
 // run cannot recompute them: they come from the fluid of the step before);
@@ -64,6 +65,9 @@ struct CheckpointData {
   std::vector<double> drag_coefficient;
   std::vector<Vec3> drag_fluid_velocity;
   std::vector<CheckpointSpring> springs;
+  // Whether particles.temperature is part of the state (the run had heat on): written as
+  // /particles/temperature, read back when present.
+  bool has_temperature = false;
   // The stream insertions' progress (taken from rank 0 when writing); absent in a format 1
   // file, which cannot continue a scene with streams.
   std::optional<std::string> streams;

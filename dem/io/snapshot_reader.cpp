@@ -100,6 +100,15 @@ Snapshot read_snapshot(const std::string& path) {
   p.omega_pred = p.omega;
   p.force.assign(n, Vec3::Zero());
   p.torque.assign(n, Vec3::Zero());
+  // Optional (written when heat was on): the particles' temperatures.
+  s.has_temperature = H5Lexists(f.id, "/temperature", H5P_DEFAULT) > 0;
+  if (s.has_temperature) {
+    if (read(f.id, path, "/temperature", 1, H5T_NATIVE_DOUBLE, p.temperature) != n)
+      throw SnapshotReadError(path + ": error: dataset '/temperature' has a different particle "
+                              "count than '/id'");
+  } else {
+    p.temperature.assign(n, 0.0);
+  }
   return s;
 }
 

@@ -23,6 +23,7 @@ class SnapshotDamagedError : public SnapshotReadError {
 struct Snapshot {
   Particles particles;  // id, x, v, omega, radius, mass, material; inertia = 2/5 m r^2
   double time = 0;
+  bool has_temperature = false;  // the file holds temperatures (else particles' are 0)
 };
 
 Snapshot read_snapshot(const std::string& path);

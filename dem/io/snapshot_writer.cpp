@@ -401,7 +401,8 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step,
     optional("coordination", extras.coordination.data());
     optional("fluid_force", vectors(extras.fluid_force));
     optional("overlap_max", extras.overlap_max.data());
-    static_assert(snapshot_fields.size() == 13, "a new snapshot field needs its write above");
+    optional("temperature", p.temperature.data());
+    static_assert(snapshot_fields.size() == 14, "a new snapshot field needs its write above");
 
     if (contacts) {
       static_assert(sizeof(std::array<GlobalId, 2>) == 2 * sizeof(std::int64_t));

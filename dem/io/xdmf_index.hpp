@@ -25,9 +25,9 @@ struct SnapshotField {
   const char* units;  // stored as the dataset's "units" attribute
 };
 
-// The first eight are the default set; the others are written when the scene's
-// `output.fields` asks for them (docs/scene-reference.md).
-inline constexpr std::array<SnapshotField, 13> snapshot_fields{{
+// The first eight are the default set (and temperature when heat is on); the others are
+// written when the scene's `output.fields` asks for them (docs/scene-reference.md).
+inline constexpr std::array<SnapshotField, 14> snapshot_fields{{
     {"id", 1, SnapshotField::Type::Int64, "1"},
     {"position", 3, SnapshotField::Type::Float64, "m"},
     {"velocity", 3, SnapshotField::Type::Float64, "m/s"},
@@ -41,6 +41,7 @@ inline constexpr std::array<SnapshotField, 13> snapshot_fields{{
     {"coordination", 1, SnapshotField::Type::Int32, "1"},
     {"fluid_force", 3, SnapshotField::Type::Float64, "N"},
     {"overlap_max", 1, SnapshotField::Type::Float64, "1"},
+    {"temperature", 1, SnapshotField::Type::Float64, "K"},  // heat on (written by default then)
 }};
 
 // A set of snapshot fields: bit k stands for snapshot_fields[k].

@@ -116,6 +116,7 @@ void Exchange::migrate(Particles& p, CarriedState& carried) {
         w.put(p.mass[i]);
         w.put(p.inertia[i]);
         w.put(static_cast<double>(p.material[i]));
+        w.put(p.temperature[i]);
         if (carried.carries_drag)
           for (double x : carried.drag[i]) w.put(x);
       }
@@ -180,7 +181,9 @@ void Exchange::migrate(Particles& p, CarriedState& carried) {
         const Vec3 force = r.get_vec(), torque = r.get_vec();
         const double radius = r.get(), mass = r.get(), inertia = r.get();
         const int mat = static_cast<int>(r.get());
+        const double temperature = r.get();
         p.add_raw(id, x, v, w_spin, radius, mass, inertia, mat);
+        p.temperature.back() = temperature;
         p.v_pred.back() = v_pred;
         p.omega_pred.back() = w_pred;
         p.force.back() = force;

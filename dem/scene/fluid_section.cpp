@@ -40,11 +40,47 @@ std::vector<FluidForce> parse_forces(const Field& f) {
   return out;
 }
 
+// The prescribed fluid temperature and what convection needs (heat on): `temperature`,
+// `heat_capacity`, `conductivity` (for the Prandtl number), `convection` (Nusselt law).
+std::optional<FluidThermal> parse_thermal(const Map& m, const FluidSettings& s,
+                                          const std::optional<HeatSettings>& heat) {
+  const std::optional<Field> t = m.find("temperature");
+  if (!t) {
+    for (const char* key : {"heat_capacity", "conductivity", "convection"})
+      if (const auto k = m.find(key))
+        k->fail_at_key(std::string("`") + key +
+                       "` is a convection setting, which needs the fluid's `temperature: <K>`; "
+                       "add it, or remove this key");
+    return std::nullopt;
+  }
+  if (!heat)
+    t->fail_at_key("a fluid temperature is given, but heat transfer is off; add a top-level "
+                   "`heat: {}` block to switch it on, or remove this key");
+  if (s.computed_void_fraction)
+    t->fail_at_key("convection with a void fraction computed from the particles is not built "
+                   "yet; give a uniform `void_fraction: <eps>` or remove `temperature`");
+  FluidThermal th;
+  th.temperature = t->number(kPositive);
+  th.heat_capacity = m.get("heat_capacity", "add the fluid's `heat_capacity: <J/(kg K)>` (the "
+                                            "Prandtl number of convection needs it)")
+                         .number(kPositive);
+  th.conductivity = m.get("conductivity", "add the fluid's `conductivity: <W/(m K)>` (Nusselt "
+                                          "number and Prandtl number need it)")
+                        .number(kPositive);
+  if (const auto c = m.find("convection"))
+    th.nusselt = c->choice<NusseltLaw>(
+        "convection (Nusselt) law",
+        {{"ranz_marshall", NusseltLaw::ranz_marshall}, {"gunn", NusseltLaw::gunn}});
+  return th;
+}
+
 }  // namespace
 
-FluidSettings parse_fluid_section(const Field& f, const Vec3& gravity) {
+FluidSettings parse_fluid_section(const Field& f, const Vec3& gravity,
+                                  const std::optional<HeatSettings>& heat) {
   const Map m = f.map({"density", "viscosity", "velocity", "shear", "void_fraction", "pressure",
-                       "drag", "forces", "model", "virtual_mass_coefficient"});
+                       "drag", "forces", "model", "virtual_mass_coefficient", "temperature",
+                       "heat_capacity", "conductivity", "convection"});
   FluidSettings s;
   s.source = f.source().label + ":" + std::to_string(f.line());
   PrescribedFluid& field = s.field;
@@ -85,6 +121,7 @@ FluidSettings parse_fluid_section(const Field& f, const Vec3& gravity) {
     forces.fail(*problem);
   s.virtual_mass_coefficient = m.number_or("virtual_mass_coefficient",
                                            kSphereVirtualMassCoefficient, kNonNegative);
+  s.thermal = parse_thermal(m, s, heat);
   return s;
 }
 

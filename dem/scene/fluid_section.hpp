@@ -2,11 +2,17 @@
 // The scene's `fluid:` block (one-way mode, docs/scene-reference.md): a prescribed fluid
 // field and the fluid forces to apply. Validated here — drag-law name, force list against
 // model A/B (dem/fluid/vans_model.hpp) — so errors point at file:line:column.
+#include <optional>
+
 #include "dem/fluid/prescribed_fluid.hpp"
+#include "dem/scene/scene.hpp"
 #include "dem/scene/yaml_reader.hpp"
 
 namespace grainflow {
 
-FluidSettings parse_fluid_section(const scene_yaml::Field& f, const Vec3& gravity);
+// `heat`: the scene's heat settings; the fluid's `temperature` (with heat_capacity,
+// conductivity, convection) needs heat on.
+FluidSettings parse_fluid_section(const scene_yaml::Field& f, const Vec3& gravity,
+                                  const std::optional<HeatSettings>& heat);
 
 }  // namespace grainflow

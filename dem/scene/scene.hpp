@@ -21,6 +21,11 @@ struct Material {
   double youngs_modulus = 0;
   double poisson_ratio = 0;
   double density = 0;         // > 0 [kg/m^3]
+  // Heat transfer (Scene::heat; docs/models/heat-transfer.md): given for every material when
+  // heat is on, else 0.
+  double heat_capacity = 0;  // c_p > 0 [J/(kg K)]
+  double conductivity = 0;   // k > 0 [W/(m K)]
+  double heat_source = 0;    // q [W/kg], any sign (0: none)
 };
 
 // Properties of a pair of materials (symmetric). Pairs not listed use the
@@ -111,8 +116,16 @@ struct WallMotion {
   Vec3 axis = Vec3::UnitZ();       // unit
 };
 
+// A wall's thermal condition (heat on; docs/models/heat-transfer.md): no heat through it, a
+// fixed temperature across contacts, or a fixed heat flux density through the contact areas.
+struct WallThermal {
+  enum class Kind { adiabatic, temperature, flux } kind = Kind::adiabatic;
+  double value = 0;  // temperature [K] or flux density into the particle [W/m^2]
+};
+
 struct Wall {
   enum class Kind { plane, cylinder, mesh } kind = Kind::plane;
+  WallThermal thermal;
   std::string name;
   int material = 0;
   PlaneWall plane;
@@ -171,6 +184,9 @@ struct Insertion {
   // csv: columns x,y,z,radius and optionally vx,vy,vz, wx,wy,wz, material (material by name)
   std::string csv_file;  // resolved relative to the scene file's folder
   std::string source;    // "file:line" of this entry, for messages
+  // Heat on: the particles' initial temperature [K] (fill, stream; csv rows without a `T`
+  // column; snapshots without a temperature dataset). Absent when heat is off.
+  std::optional<double> temperature;
 };
 
 struct OutputSettings {
@@ -207,6 +223,14 @@ struct ParallelSettings {
   bool reproducible = false;
 };
 
+// Heat transfer (docs/models/heat-transfer.md): present when the scene switches it on
+// (`heat:`); absent, no thermal code runs.
+struct HeatSettings {
+  // Contact conduction law (Batchelor & O'Brien 1977, Q = 2 k* a dT) on or off.
+  bool conduction = true;
+  std::string source;  // "file:line" of the block, for messages
+};
+
 struct Scene {
   std::string file;  // path it was read from
   Domain domain;
@@ -221,6 +245,7 @@ struct Scene {
   OutputSettings output;
   ParallelSettings parallel;
   std::optional<FluidSettings> fluid;  // one-way fluid (docs/scene-reference.md, `fluid:`)
+  std::optional<HeatSettings> heat;    // heat transfer on (docs/models/heat-transfer.md)
   // False when nothing in the scene can touch: no walls, and one particle (a fill entry of
   // count 1 or a CSV file of one row; no stream or snapshot). Then `contact`, `interactions`
   // and the materials' elastic constants may be left out.

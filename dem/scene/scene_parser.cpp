@@ -119,7 +119,25 @@ void defer(Deferred& later, F&& check) {
   }
 }
 
-std::vector<Material> parse_materials(const Field& f, Deferred& later) {
+// The thermal properties of a material: required with heat on, refused without it.
+void read_material_heat(const Map& m, const std::optional<HeatSettings>& heat, Material& mat) {
+  if (!heat) {
+    for (const char* key : {"heat_capacity", "conductivity", "heat_source"})
+      if (const auto f = m.find(key))
+        f->fail_at_key(std::string("`") + key +
+                       "` is a heat-transfer property, but heat transfer is off; add a top-level "
+                       "`heat: {}` block to switch it on, or remove this key");
+    return;
+  }
+  const std::string hint = " (heat is on, " + heat->source + ")";
+  mat.heat_capacity =
+      m.get("heat_capacity", "add `heat_capacity: <J/(kg K)>`" + hint).number(kPositive);
+  mat.conductivity = m.get("conductivity", "add `conductivity: <W/(m K)>`" + hint).number(kPositive);
+  mat.heat_source = m.number_or("heat_source", 0.0, kAny);
+}
+
+std::vector<Material> parse_materials(const Field& f, Deferred& later,
+                                      const std::optional<HeatSettings>& heat) {
   std::vector<Material> out;
   std::map<std::string, int> first_line;
   const std::vector<Field> items = f.non_empty_items("define at least one material");
@@ -129,7 +147,8 @@ std::vector<Material> parse_materials(const Field& f, Deferred& later) {
                   std::to_string(kMaxMaterials) +
                   " are allowed (every pair of materials gets its own contact properties)");
   for (const Field& item : items) {
-    const Map m = item.map({"name", "youngs_modulus", "poisson_ratio", "density"});
+    const Map m = item.map({"name", "youngs_modulus", "poisson_ratio", "density", "heat_capacity",
+                            "conductivity", "heat_source"});
     const Field name = m.get("name", "add `name: <material name>`");
     Material mat;
     mat.name = name.text();
@@ -146,6 +165,7 @@ std::vector<Material> parse_materials(const Field& f, Deferred& later) {
     else
       defer(later, [&] { m.number("poisson_ratio", Range{-1, 0.5, false, false}); });
     mat.density = m.number("density", kPositive);
+    read_material_heat(m, heat, mat);
     out.push_back(mat);
   }
   return out;
@@ -328,9 +348,32 @@ WallMotion parse_wall_motion(const Field& f) {
   return w;
 }
 
+// A wall's `temperature: <K>` or `heat_flux: <W/m^2>` (neither: adiabatic); only with heat on.
+WallThermal parse_wall_thermal(const Map& m, const std::optional<HeatSettings>& heat) {
+  WallThermal t;
+  const auto temperature = m.find("temperature"), flux = m.find("heat_flux");
+  if (!heat) {
+    if (const auto f = temperature ? temperature : flux)
+      f->fail_at_key("a wall's thermal condition is given, but heat transfer is off; add a "
+                     "top-level `heat: {}` block to switch it on, or remove this key");
+    return t;
+  }
+  if (temperature && flux)
+    flux->fail_at_key("a wall has either a fixed `temperature` or a fixed `heat_flux`, not both; "
+                      "leave both out for an adiabatic wall");
+  if (temperature) {
+    t.kind = WallThermal::Kind::temperature;
+    t.value = temperature->number(kPositive);
+  } else if (flux) {
+    t.kind = WallThermal::Kind::flux;
+    t.value = flux->number(kAny);
+  }
+  return t;
+}
+
 // `names` are the names of the walls already read, to keep them unique.
 Wall parse_wall(const Field& item, const std::unordered_set<std::string>& names,
-                const std::vector<Material>& materials) {
+                const std::vector<Material>& materials, const std::optional<HeatSettings>& heat) {
   const Map m = item.map();
   Wall w;
   w.kind = m.get("type", "add `type: plane`, `type: cylinder` or `type: mesh`")
@@ -340,7 +383,7 @@ Wall parse_wall(const Field& item, const std::unordered_set<std::string>& names,
   if (const auto motion = m.find("motion")) w.motion = parse_wall_motion(*motion);
   if (w.kind == Wall::Kind::mesh) {
     m.allow_only({"type", "name", "file", "scale", "rotate", "translate", "surface_velocity",
-                  "weld_tolerance", "material", "motion"},
+                  "weld_tolerance", "material", "motion", "temperature", "heat_flux"},
                  " (a mesh wall)");
     w.mesh.file = existing_file(m.get("file", "add `file: <mesh.stl>`"), "STL file");
     w.mesh.scale = m.number_or("scale", 1.0, kPositive);
@@ -354,13 +397,15 @@ Wall parse_wall(const Field& item, const std::unordered_set<std::string>& names,
     w.mesh.weld_tolerance =
         m.number_or("weld_tolerance", w.mesh.weld_tolerance, Range{0, 0.01, true, true});
   } else if (w.kind == Wall::Kind::plane) {
-    m.allow_only({"type", "name", "point", "normal", "material", "motion"}, " (a plane wall)");
+    m.allow_only({"type", "name", "point", "normal", "material", "motion", "temperature",
+                  "heat_flux"},
+                 " (a plane wall)");
     w.plane.point = m.vec3("point");
     w.plane.normal = m.direction("normal");
   } else {
     m.allow_only(
         {"type", "name", "axis_point", "axis", "radius", "side", "angular_velocity", "material",
-         "motion"},
+         "motion", "temperature", "heat_flux"},
         " (a cylinder wall)");
     CylinderWall& c = w.cylinder;
     c.axis_point = m.vec3("axis_point");
@@ -375,14 +420,16 @@ Wall parse_wall(const Field& item, const std::unordered_set<std::string>& names,
   if (names.count(w.name) > 0)
     (name ? *name : item).fail("duplicate wall name '" + w.name + "'; give each wall a unique name");
   w.material = material_ref(m, "material", materials);
+  w.thermal = parse_wall_thermal(m, heat);
   return w;
 }
 
-std::vector<Wall> parse_walls(const Field& f, const std::vector<Material>& materials) {
+std::vector<Wall> parse_walls(const Field& f, const std::vector<Material>& materials,
+                              const std::optional<HeatSettings>& heat) {
   std::vector<Wall> walls;
   std::unordered_set<std::string> names;  // a set: many walls cost linear, not quadratic, time
   for (const Field& item : f.items()) {
-    walls.push_back(parse_wall(item, names, materials));
+    walls.push_back(parse_wall(item, names, materials, heat));
     names.insert(walls.back().name);
   }
   return walls;
@@ -527,7 +574,8 @@ double region_volume(const Region& r) {
 
 void parse_fill(const Map& m, const Scene& scene, Insertion& ins) {
   m.allow_only(
-      {"type", "region", "count", "volume_fraction", "material", "radius", "velocity", "seed"},
+      {"type", "region", "count", "volume_fraction", "material", "radius", "velocity", "seed",
+       "temperature"},
       " (a fill insertion)");
   ins.region =
       parse_region(m.get("region", "add `region: {box: {min: [..], max: [..]}}`"), scene.domain);
@@ -558,7 +606,7 @@ void parse_fill(const Map& m, const Scene& scene, Insertion& ins) {
 }
 
 void parse_csv(const Map& m, const Scene& scene, Insertion& ins) {
-  m.allow_only({"type", "file", "material"}, " (a csv insertion)");
+  m.allow_only({"type", "file", "material", "temperature"}, " (a csv insertion)");
   ins.csv_file = existing_file(m.get("file", "add `file: <particles.csv>`"), "particle file");
   ins.material = material_ref(m, "material", scene.materials);
 }
@@ -597,7 +645,7 @@ InsertionFace parse_face(const Field& f) {
 
 void parse_stream(const Map& m, const Scene& scene, Insertion& ins) {
   m.allow_only({"type", "face", "mass_rate", "count_rate", "start", "stop", "material", "radius",
-                "velocity", "seed"},
+                "velocity", "seed", "temperature"},
                " (a stream insertion)");
   const Field face = m.get("face", "add `face: {disc: {centre, normal, radius}}`");
   ins.face = parse_face(face);
@@ -621,10 +669,28 @@ void parse_stream(const Map& m, const Scene& scene, Insertion& ins) {
 }
 
 void parse_snapshot(const Map& m, Insertion& ins) {
-  m.allow_only({"type", "file", "keep_velocity"}, " (a snapshot insertion)");
+  m.allow_only({"type", "file", "keep_velocity", "temperature"}, " (a snapshot insertion)");
   ins.snapshot_file =
       existing_file(m.get("file", "add `file: <particles_000020.h5>`"), "snapshot file");
   if (const auto k = m.find("keep_velocity")) ins.keep_velocity = k->boolean();
+}
+
+// The initial temperature of an insertion's particles: required with heat on for fill and
+// stream (a csv file may give a `T` column, a snapshot a temperature dataset instead: checked
+// when they are read), refused with heat off.
+void parse_insertion_temperature(const Map& m, const Scene& scene, Insertion& ins) {
+  const auto t = m.find("temperature");
+  if (!scene.heat) {
+    if (t)
+      t->fail_at_key("an initial temperature is given, but heat transfer is off; add a top-level "
+                     "`heat: {}` block to switch it on, or remove this key");
+    return;
+  }
+  if (t)
+    ins.temperature = t->number(kPositive);
+  else if (ins.kind == Insertion::Kind::fill || ins.kind == Insertion::Kind::stream)
+    m.get("temperature", "add `temperature: <K>`, the particles' initial temperature (heat is on, " +
+                             scene.heat->source + ")");
 }
 
 std::vector<Insertion> parse_insertions(const Field& f, const Scene& scene) {
@@ -645,12 +711,13 @@ std::vector<Insertion> parse_insertions(const Field& f, const Scene& scene) {
       case Insertion::Kind::stream: parse_stream(m, scene, ins); break;
       case Insertion::Kind::snapshot: parse_snapshot(m, ins); break;
     }
+    parse_insertion_temperature(m, scene, ins);
     out.push_back(std::move(ins));
   }
   return out;
 }
 
-OutputSettings parse_output(const Field& f, const TimeSettings& time) {
+OutputSettings parse_output(const Field& f, const TimeSettings& time, bool heat) {
   const Map m =
       f.map({"directory", "snapshot_interval", "log_interval", "progress", "checkpoint_interval",
              "checkpoint_keep", "fields", "start", "stop", "contacts"});
@@ -681,8 +748,13 @@ OutputSettings parse_output(const Field& f, const TimeSettings& time) {
       if (bit == 0)
         item.fail("unknown snapshot field '" + name + "'; allowed: " + join(names) +
                   suggestion(name, names));
+      if (bit == snapshot_field_bit("temperature") && !heat)
+        item.fail("the field 'temperature' needs heat transfer, which is off; add a top-level "
+                  "`heat: {}` block or remove 'temperature' from the list");
       o.fields |= bit;
     }
+  } else if (heat) {
+    o.fields |= snapshot_field_bit("temperature");  // the default set, and the temperature
   }
   o.start = m.maybe_number("start", kNonNegative);
   o.stop = m.maybe_number("stop", kPositive);
@@ -695,6 +767,23 @@ OutputSettings parse_output(const Field& f, const TimeSettings& time) {
                         " s) is after time.end (" + format_number(time.end) +
                         " s): no snapshot would be written; give a start <= time.end");
   return o;
+}
+
+// `heat: {conduction: batchelor_obrien | none, contact_radius: geometric}`
+// (docs/models/heat-transfer.md). What is not built is refused here, by name.
+HeatSettings parse_heat(const Field& f) {
+  HeatSettings h;
+  h.source = f.source().label + ":" + std::to_string(f.line());
+  if (f.node().IsNull()) return h;  // `heat:` alone, as `heat: {}`
+  const Map m = f.map({"conduction", "contact_radius"});
+  if (const auto c = m.find("conduction"))
+    h.conduction = c->choice<bool>("contact conduction law",
+                                   {{"batchelor_obrien", true}, {"none", false}});
+  if (const auto a = m.find("contact_radius"))
+    a->choice<bool>("contact radius for conduction (the soft-particle corrections of Morris et al. "
+                    "2016 and Lu et al. 2017 are not built yet)",
+                    {{"geometric", true}});
+  return h;
 }
 
 // Whether any two bodies of the scene can touch (Scene::contacts_possible).
@@ -728,7 +817,7 @@ bool contacts_possible(const Scene& s) {
 
 const std::vector<std::string> kTopLevelKeys = {
     "domain",  "gravity",   "time",  "materials", "interactions", "interaction_defaults",
-    "contact", "neighbour", "walls", "insert",    "output", "parallel", "fluid"};
+    "contact", "neighbour", "walls", "insert",    "output", "parallel", "fluid", "heat"};
 
 Scene build_scene(const Field& root) {
   if (!root.node().IsDefined() || root.node().IsNull())
@@ -742,19 +831,24 @@ Scene build_scene(const Field& root) {
   s.domain = parse_domain(top.get("domain", "add `domain: {min: [x, y, z], max: [x, y, z]}`"));
   s.gravity = top.vec3_or("gravity", Vec3::Zero());
   s.time = parse_time(top.get("time", "add `time: {step: <s>, end: <s>}`"));
+  if (const auto h = top.find("heat")) s.heat = parse_heat(*h);
   Deferred for_contacts;  // errors that stand only if contacts can happen
-  s.materials = parse_materials(top.get("materials", "add a list of materials"), for_contacts);
+  s.materials =
+      parse_materials(top.get("materials", "add a list of materials"), for_contacts, s.heat);
   s.pairs = parse_pairs(top, s.materials, for_contacts);
   if (const auto c = top.find("contact"))
     s.contact = parse_contact(*c);
   else
     defer(for_contacts, [&] { top.get("contact", "add `contact: {normal: hertz}`"); });
   if (const auto n = top.find("neighbour")) s.neighbour = parse_neighbour(*n);
-  if (const auto w = top.find("walls")) s.walls = parse_walls(*w, s.materials);
+  if (const auto w = top.find("walls")) s.walls = parse_walls(*w, s.materials, s.heat);
   if (const auto i = top.find("insert")) s.insertions = parse_insertions(*i, s);
-  if (const auto o = top.find("output")) s.output = parse_output(*o, s.time);
+  if (const auto o = top.find("output"))
+    s.output = parse_output(*o, s.time, s.heat.has_value());
+  else if (s.heat)
+    s.output.fields |= snapshot_field_bit("temperature");
   if (const auto p = top.find("parallel")) s.parallel = parse_parallel(*p);
-  if (const auto f = top.find("fluid")) s.fluid = parse_fluid_section(*f, s.gravity);
+  if (const auto f = top.find("fluid")) s.fluid = parse_fluid_section(*f, s.gravity, s.heat);
   s.contacts_possible = contacts_possible(s);
   if (s.contacts_possible && !for_contacts.empty()) std::rethrow_exception(for_contacts.front());
   // The Rayleigh time needs the elastic constants of every material a particle uses.

@@ -247,7 +247,7 @@ TEST_F(BrokenCsv, EmptyOrHeaderOnly) {
 TEST_F(BrokenCsv, MissingUnknownRepeatedAndPartialColumns) {
   EXPECT_THAT(error_of("x,y,radius\n0,0,0.1\n"),
               HasSubstr(at(1) + "header lacks column 'z'; columns: x,y,z,radius (required), "
-                                "vx,vy,vz, wx,wy,wz, material (optional)"));
+                                "vx,vy,vz, wx,wy,wz, material, T (optional; T needs heat on)"));
   // A misspelt column would otherwise be ignored with its values.
   EXPECT_THAT(error_of("x,y,z,radius,vX,vy,vz\n0,0,0,0.1,1,0,0\n"),
               HasSubstr(at(1) + "unknown column 'vX' in the header; allowed columns: x,y,z,radius"));

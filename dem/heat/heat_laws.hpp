@@ -1,0 +1,64 @@
+#pragma once
+// The laws of particle heat transfer (docs/models/heat-transfer.md), as pure functions.
+//
+// Contact conduction, Batchelor & O'Brien (1977): two bodies touching over a circle of
+// radius a conduct Q = 2 k* a (T_j - T_i) when the solids conduct far better than the gap
+// fluid. Each body is a half-space to the constriction at the circle, of resistance
+// 1/(4 k a) (Holm); in series 1/(4 k_i a) + 1/(4 k_j a) = 1/(2 k* a) with the harmonic
+// k* = 2 k_i k_j / (k_i + k_j), which is k for like materials.
+// The contact radius is that of Hertz theory, a = sqrt(R* delta), for Hertz and Hooke
+// contacts alike (a Hooke spring has no contact area of its own; the geometric radius of
+// the overlap is the common choice).
+//
+// Convection: h = Nu k_f / d on the area pi d^2, with Re = eps rho_f d |u - v| / mu and
+// Pr = c_p,f mu / k_f:
+//   Ranz & Marshall (1952), a single sphere:  Nu = 2 + 0.6 Re^(1/2) Pr^(1/3);
+//   Gunn (1978, eq. 21), fixed and fluidised beds, 0.35 <= eps <= 1:
+//     Nu = (7 - 10 eps + 5 eps^2)(1 + 0.7 Re^0.2 Pr^(1/3))
+//          + (1.33 - 2.4 eps + 1.2 eps^2) Re^0.7 Pr^(1/3).
+#include <cmath>
+#include <numbers>
+
+#include "dem/fluid/prescribed_fluid.hpp"
+
+namespace grainflow {
+
+// Harmonic effective conductivity of a contact [W/(m K)].
+inline double effective_conductivity(double k_i, double k_j) {
+  return 2 * k_i * k_j / (k_i + k_j);
+}
+
+// Contact radius a = sqrt(R* delta) [m] (Hertz; used for Hooke contacts too).
+inline double contact_radius(double r_star, double overlap) { return std::sqrt(r_star * overlap); }
+
+// Batchelor & O'Brien's conductance 2 k* a [W/K].
+inline double contact_conductance(double k_star, double a) { return 2 * k_star * a; }
+
+inline double prandtl_number(double heat_capacity, double viscosity, double conductivity) {
+  return heat_capacity * viscosity / conductivity;
+}
+
+inline double nusselt_ranz_marshall(double re, double pr) {
+  return 2 + 0.6 * std::sqrt(re) * std::cbrt(pr);
+}
+
+inline double nusselt_gunn(double eps, double re, double pr) {
+  const double pr3 = std::cbrt(pr);
+  return (7 - 10 * eps + 5 * eps * eps) * (1 + 0.7 * std::pow(re, 0.2) * pr3) +
+         (1.33 - 2.4 * eps + 1.2 * eps * eps) * std::pow(re, 0.7) * pr3;
+}
+
+inline double nusselt_number(NusseltLaw law, double eps, double re, double pr) {
+  return law == NusseltLaw::gunn ? nusselt_gunn(eps, re, pr) : nusselt_ranz_marshall(re, pr);
+}
+
+// h A = Nu k_f pi d [W/K] of a sphere of diameter d at slip speed `slip`.
+inline double convective_conductance(const FluidThermal& th, const PrescribedFluid& f, double d,
+                                     double slip) {
+  const double eps = f.void_fraction;
+  const double re = eps * f.density * d * slip / f.viscosity;
+  const double pr = prandtl_number(th.heat_capacity, f.viscosity, th.conductivity);
+  return nusselt_number(th.nusselt, eps, re, pr) * th.conductivity * std::numbers::pi * d;
+}
+
+}  // namespace grainflow
