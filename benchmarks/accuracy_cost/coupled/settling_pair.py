@@ -84,6 +84,10 @@ def main():
             f.write("x,y,z,radius\n")
             for x in xs:
                 f.write(f"{x:.12g},{y0:.12g},{z0:.12g},{r}\n")
+        if n == 2:  # two particles need contact properties (they never touch: l > d)
+            with open(os.path.join(case, "particles.yaml"), "a") as f:
+                f.write("contact: {normal: hertz}\n"
+                        "interaction_defaults: {restitution: 0.5, friction: 0.5}\n")
         cpu, imbalance = sc.run(case, a.build)
         worst = max(worst, imbalance)
         speeds[n] = mean_speed(case, info, n)
