@@ -468,7 +468,8 @@ void DemLink::add_fluid(const FluidAtParticle& f) {
   m.pending.push_back(CoupledSample{vec(f.velocity), f.void_fraction, vec(f.pressure_gradient),
                                     vec(f.viscous_stress_divergence)});
   if (m.curl) m.pending_vorticity.push_back(vec(f.vorticity));
-  if (m.self) m.pending_disturbance.push_back({f.disturbance_width, f.disturbance_screening});
+  if (m.self) m.pending_disturbance.push_back(
+        {f.disturbance_cell, f.disturbance_spread, f.disturbance_screening});
 }
 
 void DemLink::end_fluid(std::function<FluidAtParticle(const std::array<double, 3>&)> late) {

@@ -30,9 +30,11 @@ struct FluidAtParticle {
   std::array<double, 3> viscous_stress_divergence{};
   std::array<double, 3> vorticity{};
   // The particle's own disturbance of these values (DemLink::correct_self_disturbance):
-  // the width sigma [m] of deposit and read-back kernels together (0: no correction) and the
-  // drag coefficient per volume of the other particles there [kg/m^3/s].
-  double disturbance_width = 0;
+  // the size h [m] of the cells its footprint covers (0: no correction), the footprint's own
+  // spread s [m] (standard deviation per axis of its points) and the drag coefficient per
+  // volume of the other particles there [kg/m^3/s].
+  double disturbance_cell = 0;
+  double disturbance_spread = 0;
   double disturbance_screening = 0;
 };
 

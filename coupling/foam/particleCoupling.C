@@ -10,7 +10,6 @@
 
 #include "coupling/accuracy_table.hpp"
 #include "coupling/shared_decomposition.hpp"
-#include "dem/fluid/self_disturbance.hpp"  // lattice_cell_width (C++17-clean)
 #include "dem/io/output_directory.hpp"
 #include "zeroGradientFvPatchFields.H"
 #include "extrapolatedCalculatedFvPatchField.H"
@@ -118,6 +117,15 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
                                     "the ghost range covers at most 2 radii)"
                                  << exit(FatalIOError);
   footprint_ = coupling::Footprint(vf, static_cast<int>(resolution), smoothing);
+  {
+    // The footprint's spread per axis in particle radii: its points' standard deviation.
+    double m2 = 0, w = 0;
+    for (const coupling::FootprintPoint& q : footprint_.unit_points()) {
+      for (int a = 0; a < 3; ++a) m2 += q.weight * q.offset[a] * q.offset[a];
+      w += q.weight;
+    }
+    footprintSpread_ = w > 0 ? std::sqrt(m2 / (3 * w)) : 0;
+  }
 
   const word sampling = dict.lookupOrDefault<word>("sampling", "cell");
   if (sampling == "cell")
@@ -985,14 +993,12 @@ void ParticleCoupling::sample() {
     return;
   }
   // Footprint-weighted cell values; ghosts' shares go back to their owners. With
-  // undisturbedVelocity, also the moments of the footprint's cells about the particle
-  // (offset, squared offset plus the cell's own variance V^(2/3)/4, summed over the axes),
-  // the other particles' drag per volume there and the particle's own share of it.
+  // undisturbedVelocity, also the cells' size (V^(2/3)), the other particles' drag per volume
+  // there and the particle's own share of it.
   dem_->begin_fluid();
-  const std::size_t W = undisturbed_ ? 21 : 14;
+  const std::size_t W = undisturbed_ ? 17 : 14;
   std::vector<double> acc(W * particles_.size(), 0.0);
   const scalarField& V = mesh_.V().field();
-  const vectorField& C = mesh_.C().primitiveField();
   std::vector<PointInCell> cellsOfParticle;  // a footprint's weight per cell
   for (std::size_t i = 0; i < particles_.size(); ++i) {
     double* a = &acc[W * i];
@@ -1020,16 +1026,8 @@ void ParticleCoupling::sample() {
       }
       a[13] += w;
       if (undisturbed_) {
-        const double* x = particles_.x(i);
-        double r2 = 0;
-        for (int d = 0; d < 3; ++d) {
-          const double o = C[c][d] - x[d];
-          a[14 + d] += w * o;
-          r2 += o * o;
-        }
-        a[17] += w * r2;
-        a[18] += w * Ksl_[c];
-        a[20] += w * std::cbrt(V[c] * V[c]);
+        a[14] += w * Ksl_[c];
+        a[16] += w * std::cbrt(V[c] * V[c]);
         bool found = false;
         for (PointInCell& q : cellsOfParticle)
           if (q.cell == c) {
@@ -1042,7 +1040,7 @@ void ParticleCoupling::sample() {
     }
     // The particle's own share of the Ksl it read: K W_c^2 / V_c summed over its cells.
     if (undisturbed_)
-      for (const PointInCell& q : cellsOfParticle) a[19] += q.weight * q.weight / V[q.cell];
+      for (const PointInCell& q : cellsOfParticle) a[15] += q.weight * q.weight / V[q.cell];
   }
   const std::vector<double> sums = dem_->sum_onto_owners(acc, W);
   for (std::size_t i = 0; i < local; ++i) {
@@ -1057,18 +1055,14 @@ void ParticleCoupling::sample() {
     }
     f.void_fraction = a[13] > 0 ? a[3] * norm : 1.0;
     if (undisturbed_ && a[13] > 0) {
-      // Deposit and read-back share the footprint's cells: the disturbance read is that of
-      // the cells' weight autocorrelation, whose variance per axis is twice that of the
-      // cell centres, widened by the width at which a Gaussian's self-disturbance equals that
-      // of one cell of the mesh's discrete operator (self_disturbance.hpp).
-      double mean2 = 0;
-      for (int d = 0; d < 3; ++d) mean2 += a[14 + d] * norm * a[14 + d] * norm;
-      const double variance = std::max(0.0, a[17] * norm - mean2) / 3;
-      const double cell = lattice_cell_width * lattice_cell_width * a[20] * norm;
-      f.disturbance_width = std::sqrt(2 * variance + cell);
+      // The disturbance read is that of the mesh's lattice (self_disturbance.hpp,
+      // lattice_self_disturbance): cells of size h = <V^(2/3)>^(1/2) over the footprint,
+      // the footprint's own spread (its points' standard deviation per axis) and the
+      // other particles' drag per volume.
+      f.disturbance_cell = std::sqrt(a[16] * norm);
+      f.disturbance_spread = footprintSpread_ * particles_.radius(i);
       f.disturbance_screening =
-          std::max(0.0, (a[18] - particles_.drag_coefficient(i) * a[19]) * norm);
-
+          std::max(0.0, (a[14] - particles_.drag_coefficient(i) * a[15]) * norm);
     }
     dem_->add_fluid(f);
   }

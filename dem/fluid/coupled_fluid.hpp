@@ -34,11 +34,12 @@ struct CoupledSample {
 
 // What the coupling knows of a particle's own disturbance of the fluid it samples, when the
 // drag is to see the undisturbed velocity (couplingProperties undisturbedVelocity;
-// self_disturbance.hpp): the width sigma of the deposit and read-back kernels together and
-// the drag coefficient per volume of the other particles around it (Brinkman screening).
-// sigma = 0: no correction for this particle.
+// self_disturbance.hpp): the size of the cells the footprint covers, the footprint's own
+// spread and the drag coefficient per volume of the other particles around it (Brinkman
+// screening). cell = 0: no correction for this particle.
 struct SelfDisturbance {
-  double width = 0;      // sigma [m]
+  double cell = 0;       // h [m]
+  double spread = 0;     // s [m], standard deviation per axis of the footprint's points
   double screening = 0;  // beta [kg/m^3/s]
 };
 

@@ -194,7 +194,7 @@ class FluidForcesWith final : public ForceTerm {
       Vec3 force = Vec3::Zero(), carried = Vec3::Zero();
       if (on_.drag) {
         double k = Law({d, slip.norm(), f.void_fraction, f.density, f.viscosity});
-        if (samples.disturbance && samples.disturbance[i].width > 0)
+        if (samples.disturbance && samples.disturbance[i].cell > 0)
           k *= undisturbed(samples.disturbance[i], d, slip.norm(), f);
         const double k_sum = drag.coefficient[i] + k;
         if (k_sum > 0)
@@ -247,16 +247,17 @@ class FluidForcesWith final : public ForceTerm {
  private:
   // The particle's own disturbance of the sampled velocity (self_disturbance.hpp): the factor
   // 1/(1 - k m) by which the drag on the seen slip grows, so that the force is the drag law's
-  // at the undisturbed slip. The momentum equation of the disturbance has the viscosity
-  // c mu (c = eps in model A, 1 in model B) and the advecting density eps rho.
+  // at the undisturbed slip, with m the mobility of the particle's disturbance on its cells'
+  // lattice. The momentum equation of the disturbance has the viscosity c mu (c = eps in
+  // model A, 1 in model B) and the advecting density eps rho.
   double undisturbed(const SelfDisturbance& sd, double d, double w_seen, const FluidSample& f) {
     const double mu_e = (s_.model == VansModel::A ? f.void_fraction : 1.0) * f.viscosity;
     const double rho_e = f.void_fraction * f.density;
-    const double sigma = sd.width;
-    const double b = sd.screening * sigma * sigma / mu_e;
     const double eps = f.void_fraction;
     const auto k = [&](double w) { return Law({d, w, eps, f.density, f.viscosity}); };
-    const auto m = [&](double w) { return self_disturbance_table()(rho_e * w * sigma / mu_e, b) / (mu_e * sigma); };
+    const auto m = [&](double w) {
+      return lattice_self_mobility(sd.cell, sd.spread, w, rho_e, mu_e, sd.screening);
+    };
     bool limited = false;
     const double k0 = k(w_seen);
     const double factor = undisturbed_factor(w_seen, k, m, max_km, limited);

@@ -1,5 +1,8 @@
 #include "dem/fluid/self_disturbance.hpp"
 
+#include "dem/fluid/lattice_self_disturbance_table.hpp"
+
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -112,6 +115,70 @@ double SelfDisturbanceTable::operator()(double re_sigma, double screening) const
   double lp = 0;
   for (int a = 0; a < 4; ++a)
     for (int c = 0; c < 4; ++c) lp += wx[a] * wy[c] * value(i - 1 + a, j - 1 + c);
+  return std::exp(lp);
+}
+
+double lattice_self_disturbance(double re_h, double screening, double spread_over_h) {
+  namespace t = lattice_table;
+  // Fractional indices along the three axes; outside the table the end cells are used (held
+  // below Re_h and b, extrapolated linearly above: there the Catmull-Rom weights at t > 1
+  // reduce to the linear continuation of the last interval).
+  const double x = (std::log10(std::max(re_h, 1e-300)) - t::log_re_lo) * t::log_re_per_decade;
+  const double y = (std::log10(std::max(screening, 1e-300)) - t::log_b_lo) * t::log_b_per_decade;
+  const double z = (std::min(std::max(spread_over_h, 0.0), 0.5) - t::spread_lo) * t::spread_per_unit;
+  const auto split = [](double u, int n, bool hold_low, int& i, double& f) {
+    if (u < 0 && hold_low) u = 0;
+    i = std::clamp(static_cast<int>(std::floor(u)), 0, n - 2);
+    f = u - i;
+  };
+  int i, j, k;
+  double fx, fy, fz;
+  split(x, t::n_re, true, i, fx);
+  split(y, t::n_b, true, j, fy);
+  split(z, t::n_spread, true, k, fz);
+  const auto at = [&](int kk, int ii, int jj) {
+    return t::log_phi[(static_cast<std::size_t>(kk) * t::n_re + ii) * t::n_b + jj];
+  };
+  // Outside [0, 1] in a coordinate (extrapolation above the table): linear in that one.
+  const auto weights = [](double f, int m, int n, std::array<int, 4>& idx, std::array<double, 4>& w) {
+    if (f > 1 || f < 0) {
+      idx = {m, m + 1, m + 1, m + 1};
+      w = {1 - f, f, 0, 0};
+      return;
+    }
+    // Catmull-Rom; a missing neighbour at an edge is the linear extrapolation of the two
+    // nearest, folded into the weights.
+    std::array<double, 4> c = {0.5 * (-f + 2 * f * f - f * f * f), 0.5 * (2 - 5 * f * f + 3 * f * f * f),
+                               0.5 * (f + 4 * f * f - 3 * f * f * f), 0.5 * (-f * f + f * f * f)};
+    idx = {m - 1, m, m + 1, m + 2};
+    w = c;
+    if (m - 1 < 0) {  // v(-1) = 2 v(0) - v(1)
+      idx[0] = m;
+      w[1] += 2 * c[0];
+      w[2] -= c[0];
+      w[0] = 0;
+    }
+    if (m + 2 > n - 1) {  // v(n) = 2 v(n-1) - v(n-2)
+      idx[3] = m + 1;
+      w[2] += 2 * c[3];
+      w[1] -= c[3];
+      w[3] = 0;
+    }
+  };
+  std::array<int, 4> ix, iy, iz;
+  std::array<double, 4> wx, wy, wz;
+  weights(fx, i, t::n_re, ix, wx);
+  weights(fy, j, t::n_b, iy, wy);
+  weights(fz, k, t::n_spread, iz, wz);
+  double lp = 0;
+  for (int c = 0; c < 4; ++c) {
+    if (wz[c] == 0) continue;
+    for (int a = 0; a < 4; ++a) {
+      if (wx[a] == 0) continue;
+      for (int e = 0; e < 4; ++e)
+        if (wy[e] != 0) lp += wz[c] * wx[a] * wy[e] * at(iz[c], ix[a], iy[e]);
+    }
+  }
   return std::exp(lp);
 }
 

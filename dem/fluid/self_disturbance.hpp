@@ -22,23 +22,20 @@
 // sqrt(pi/2) / (3 pi^2) (Stokes), phi -> 1 / (4 pi Re_sigma) as Re_sigma grows (Oseen: the
 // force carried off by advection), phi(0, b) = (sqrt(pi/2) - (pi/2) sqrt(b) e^(b/2)
 // erfc(sqrt(b/2))) / (3 pi^2) (Brinkman).
+//
+// That continuous form is the model's continuum reference. The coupling uses its lattice
+// form (lattice_self_disturbance below): the same equation discretised as grainFoam
+// discretises it, whose response at the scale of a cell differs from the continuous one
+// (softer in Stokes flow, and carrying the force off through a whole cell's section at high
+// cell Reynolds number).
 #include <cmath>
 #include <vector>
 
 namespace grainflow {
 
-// The width sigma = c h at which the regularised Stokeslet's self-disturbance equals that of
-// a force deposited into one cube cell of side h and read back from the same cell, for the
-// finite-volume Stokes operator with the 7-point Laplacian (OpenFOAM's Gauss linear on a
-// uniform hexahedral mesh): u' = (2/3) W F / (mu h) with Watson's lattice integral
-// W = (2 pi)^-3 int_[-pi,pi]^3 d^3q / sum_a 4 sin^2(q_a/2) = 0.2527310098 (Watson 1939,
-// Q. J. Math. 10:266; the 2/3 is the isotropic mean of the divergence-free projection), so
-// c = phi(0, 0) / ((2/3) W) = sqrt(pi/2) / (2 pi^2 W). Continuous cell averaging alone
-// would give u' = 0.0999 F / (mu h): the discrete operator is 1.69 times softer at the
-// scale of a cell.
+// Watson's lattice integral (2 pi)^-3 int_[-pi,pi]^3 d^3q / sum_a 4 sin^2(q_a/2) (Watson 1939,
+// Q. J. Math. 10:266): the 7-point Laplacian's Green's function at the origin.
 inline constexpr double watson_integral = 0.2527310098;
-inline constexpr double lattice_cell_width =
-    1.2533141373155003 / (2 * 9.8696044010893586 * watson_integral);
 
 // phi(Re_sigma, b) by Gauss-Legendre quadrature (about 1e-12 relative).
 double self_disturbance_factor(double re_sigma, double screening);
@@ -62,6 +59,38 @@ class SelfDisturbanceTable {
 
 // The one table of the process, built on first use (thread-safe).
 const SelfDisturbanceTable& self_disturbance_table();
+
+// The self-disturbance on the finite-volume lattice grainFoam solves (what the coupling uses):
+// a particle moving at the slip W along a mesh axis through fluid at rest, on a uniform cubic
+// mesh of cell size h, deposits -F with its footprint weights and reads the velocity back with
+// the same weights (sampling cell); averaged over its passage through the cells the
+// disturbance it reads, along F, is u' = -F phi_lat / (mu_e h) with
+//     phi_lat = (2 pi)^-3 int_BZ A(q_x) A(q_y) P_zz(q)
+//               sum_G |g(q_z + 2 pi G)|^2 Re 1 / (Lambda(q) + b + i Re_h (q_z + 2 pi G)) d^3q,
+// Lambda = sum_a 4 sin^2(q_a/2) (7-point Laplacian), P_zz = 1 - sin^2 q_z / sum_a sin^2 q_a
+// (collocated projection with the Gauss linear pressure gradient), |g(k)|^2 = sinc^2(k/2) /
+// (1 + s^2 k^2) the deposit-read autocorrelation of a cell widened by the footprint's spread
+// s, A(q) = sum_G |g(q + 2 pi G)|^2, Re_h = rho_e W h / mu_e, b = beta h^2 / mu_e, h = 1.
+// The Oseen term is the source moving through fixed cells: each lattice wavenumber q_z is
+// forced at the frequencies W (q_z + 2 pi G) of its images. Limits: phi_lat(0, 0, 0) =
+// (2/3) Watson's integral; phi_lat -> 1 / (2 Re_h) at s = 0 as Re_h grows (the force
+// carried off through one cell's section, read half-way). Tabulated by
+// scripts/lattice_self_disturbance.py in lattice_self_disturbance_table.hpp over
+// 1e-3 <= Re_h <= 1e4, 1e-6 <= b <= 1e4, 0 <= s/h <= 1/2 and interpolated (tricubic
+// Catmull-Rom in log phi, log Re_h, log b, s/h); below the lower ends of Re_h and b it is
+// held, above the upper ends extrapolated linearly in log-log (phi ~ 1/Re_h, 1/b). For
+// s/h > 1/2 (cells finer than about half the particle) the cell size is taken as 2 s, where
+// the lattice's own scale has stopped mattering: u' = -F phi_lat(Re_2s, b_2s, 1/2) / (2 mu_e s).
+double lattice_self_disturbance(double re_h, double screening, double spread_over_h);
+
+// The mobility m = u' / F [s/kg] of a particle's self-disturbance on cells of size h [m]
+// with footprint spread s [m], at slip w [m/s], for the momentum equation with density rho_e,
+// viscosity mu_e and Brinkman coefficient beta [kg/m^3/s].
+inline double lattice_self_mobility(double h, double s, double w, double rho_e, double mu_e,
+                                    double beta) {
+  const double l = 2 * s > h ? 2 * s : h;
+  return lattice_self_disturbance(rho_e * w * l / mu_e, beta * l * l / mu_e, s / l) / (mu_e * l);
+}
 
 // The undisturbed slip for drag: given the slip the particle sees (sampled fluid minus
 // particle velocity, |w_seen|), the drag coefficient law k(|w|) [kg/s] and the disturbance

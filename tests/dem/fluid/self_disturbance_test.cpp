@@ -82,6 +82,50 @@ TEST(SelfDisturbance, TableFollowsTheQuadrature) {
   EXPECT_EQ(table(1e7, 1.0), self_disturbance_factor(1e7, 1.0));
 }
 
+// The lattice form (lattice_self_disturbance): its table against the quadrature of
+// scripts/lattice_self_disturbance.py (a finer one than the table's: 24 Gauss points on 12
+// graded panels per transverse axis, 64 along q_z) at points between the table's nodes, and
+// its two closed-form limits. Tolerance 2e-3 at the nodes' limits (the table's quadrature
+// agrees with the finer one to 2.5e-4; b = 0 is read at the table's lowest b, 1e-6, where
+// the Brinkman term's sqrt(b) changes phi by about 1e-3); 6e-3 between nodes, the tricubic
+// interpolation at 3 (Re_h), 1.5 (b) points per decade and steps of 1/8 in s/h (measured up
+// to 4.8e-3; it changes a settling speed by k m times that, below 0.3 %).
+TEST(SelfDisturbance, LatticeStokesLimitIsTwoThirdsOfWatsonsIntegral) {
+  // A force in one cell read back from it: (2/3) W (the 2/3 is the projection's mean).
+  EXPECT_NEAR(lattice_self_disturbance(0, 0, 0) / (2 * watson_integral / 3), 1, 2e-3);
+  EXPECT_NEAR(lattice_self_disturbance(1e-5, 1e-9, 0) / (2 * watson_integral / 3), 1, 2e-3);
+}
+
+TEST(SelfDisturbance, LatticeOseenLimitIsTheForceCarriedThroughOneCell) {
+  // u' = F / (2 rho W h^2): the momentum flux rho W h^2 u' through one cell's section carries
+  // F downstream; the cell reads the mean of upstream (0) and downstream. Above the table's
+  // end (Re_h = 1e4) by its log-log extrapolation.
+  for (double re : {3e3, 1e4, 1e5, 1e6})
+    EXPECT_NEAR(2 * re * lattice_self_disturbance(re, 0, 0), 1, 3e-3) << "Re_h " << re;
+}
+
+TEST(SelfDisturbance, LatticeTableFollowsTheQuadrature) {
+  struct Case {
+    double re, b, s, phi;
+  };
+  // scripts/lattice_self_disturbance.py, Quadrature(24, 64, 12).phi(re, b, s).
+  for (const Case& c : {Case{0.37, 0.0, 0.07, 0.13630020083944536},
+                        Case{5.3, 0.02, 0.11, 0.05021511008694206},
+                        Case{42.0, 0.0, 0.19, 0.007293548842465539},
+                        Case{260.0, 3.0, 0.3, 0.0009458418154526701},
+                        Case{0.05, 50.0, 0.45, 0.0026446387912598037}})
+    EXPECT_NEAR(lattice_self_disturbance(c.re, c.b, c.s) / c.phi, 1, 6e-3)
+        << "Re_h " << c.re << ", b " << c.b << ", s/h " << c.s;
+}
+
+TEST(SelfDisturbance, LatticeMobilityIsContinuousWhereTheFootprintOutgrowsTheCell) {
+  // For s > h/2 twice the footprint's spread takes the place of the cell size.
+  const double h = 1e-3, rho = 1000, mu = 0.01, w = 0.02, beta = 50;
+  const double below = lattice_self_mobility(h, 0.5 * h * (1 - 1e-9), w, rho, mu, beta);
+  const double above = lattice_self_mobility(h, 0.5 * h * (1 + 1e-9), w, rho, mu, beta);
+  EXPECT_NEAR(above / below, 1, 1e-6);
+}
+
 TEST(SelfDisturbance, UndisturbedFactorSolvesTheFixedPoint) {
   bool limited = true;
   // Constant k and m: 1 / (1 - k m).
