@@ -348,22 +348,44 @@ double oblique_error(ObliqueRig& rig, const ObliqueReference& ref, double steps)
 
 class ObliqueStickingConvergence : public ::testing::TestWithParam<SchemeCase> {};
 
-TEST_P(ObliqueStickingConvergence, ReboundSpinFollowsTheLinearOde) {
+// The tangential force of an impact jumps where the contact begins (the dashpot's
+// -gamma_t v_t) and where F_n reaches zero (the spring's -k_t xi, cut by the Coulomb limit),
+// and the spring's first increment counts the whole drift in which the contact began: errors
+// of O(dt) in the impulse, impact by impact, with either scheme (the normal dashpot's cell
+// integration has no tangential counterpart). The rms error therefore falls at first order
+// only; the test fits the slope over N = 20 ... 80 (the single impacts' errors change sign
+// with the offsets, so two points scatter; measured 0.73-1.0) and requires >= 0.6, and the
+// error at N = 40 below 0.2 of the change of v_t (measured 0.004-0.11). Below 20 steps per
+// impact the e = 0.1 case with predicted is unstable at N = 10-14: the tangential oscillator
+// (m_eff = 2/7 m, gamma_t = gamma_n) is over-damped and faster than the normal one, and the
+// extrapolated velocity makes the explicit dashpot less stable than the half-step one.
+TEST_P(ObliqueStickingConvergence, ReboundConvergesAtFirstOrder) {
   const SchemeCase c = GetParam();
   const ObliqueReference ref = oblique_reference(c.e);
   ObliqueRig rig(c.scheme, c.e);
-  const double coarse = oblique_error(rig, ref, 20), fine = oblique_error(rig, ref, 40);
-  const double slope = std::log2(coarse / fine);
-  std::printf("oblique sticking %s e = %.1f: v_t after %.4f v_t before; rms error of its change "
-              "%.3e at 20 steps, %.3e at 40: slope %.2f\n",
-              scheme_name(c.scheme), c.e, ref.vt / kVt, coarse, fine, slope);
-  EXPECT_GE(slope, 0.8);
-  if (c.scheme == DashpotVelocity::predicted)
-    print_sweep(("oblique sticking e=" + std::to_string(c.e)).c_str(),
-                [&](DashpotVelocity d, double n) {
-                  ObliqueRig r(d, c.e);
-                  return oblique_error(r, ref, n);
-                });
+  double sx = 0, sy = 0, sxx = 0, sxy = 0, at40 = 0;
+  const std::array<double, 5> ns{20, 28, 40, 57, 80};
+  if (sweep_requested())  // below 20: e = 0.1 is unstable at 10-14 steps with predicted
+    for (double n : {10.0, 14.0})
+      std::printf("oblique sticking %s e = %.1f: N=%g %.2e\n", scheme_name(c.scheme), c.e, n,
+                  oblique_error(rig, ref, n));
+  std::printf("oblique sticking %s e = %.1f (v_t after %.4f v_t before): rms error of its change",
+              scheme_name(c.scheme), c.e, ref.vt / kVt);
+  for (double n : ns) {
+    const double err = oblique_error(rig, ref, n);
+    if (n == 40) at40 = err;
+    std::printf(" N=%g %.2e", n, err);
+    const double x = std::log(n), y = std::log(err);
+    sx += x;
+    sy += y;
+    sxx += x * x;
+    sxy += x * y;
+  }
+  const double k = ns.size();
+  const double slope = -(k * sxy - sx * sy) / (k * sxx - sx * sx);
+  std::printf(": fitted slope %.2f\n", slope);
+  EXPECT_GE(slope, 0.6);
+  EXPECT_LE(at40, 0.2);
 }
 
 INSTANTIATE_TEST_SUITE_P(Schemes, ObliqueStickingConvergence, kSchemeCases, scheme_case_name);
@@ -463,9 +485,11 @@ TEST_P(PairImpactConvergence, RestitutionErrorFallsAtSecondOrder) {
   const double slope_e = std::log2(coarse[0] / fine[0]);
   const double slope_t = std::log2(coarse[1] / fine[1]);
   const char* law = c.model == NormalModel::hooke ? "hooke" : "hertz";
-  std::printf("pair %s e = %.1f: rms restitution error %.3e at 20, %.3e at 40: slope %.2f; "
-              "contact time slope %.2f\n",
-              law, c.e, coarse[0], fine[0], slope_e, slope_t);
+  std::printf("pair %s e = %.1f: rms restitution error %.3e at 20, %.3e at 40: slope %.2f\n", law,
+              c.e, coarse[0], fine[0], slope_e);
+  if (c.model == NormalModel::hooke)
+    std::printf("pair hooke e = %.1f: rms contact-time error %.3e at 20, %.3e at 40: slope %.2f\n",
+                c.e, coarse[1], fine[1], slope_t);
   EXPECT_GE(slope_e, 1.8);
   if (c.model == NormalModel::hooke) {
     EXPECT_GE(slope_t, 1.8);
