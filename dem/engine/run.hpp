@@ -36,6 +36,12 @@ struct RunSummary {
   long rebuilds = 0;
   double wall_seconds = 0;
   double particle_steps_per_second = 0;
+  // Start-up: from run_scene's entry to the time loop (insertion or restore, first neighbour
+  // lists and forces) plus the first snapshot of a fresh run. Snapshots: all files written by
+  // this run, their bytes on disk and the seconds spent writing them (rank 0's clock).
+  double startup_seconds = 0;
+  double snapshot_seconds = 0, snapshot_bytes = 0;
+  long snapshot_files = 0;
   std::string stop_checkpoint;  // set when a SIGTERM/SIGINT stopped the run early
   struct StreamTotal {
     long count = 0;   // particles delivered since t = 0 (a restart continues the count)

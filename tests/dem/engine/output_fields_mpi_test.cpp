@@ -490,10 +490,20 @@ TEST(OutputFields, WindowWritesEveryStepBetweenStartAndStopOnly) {
   options.handle_stop_signals = false;
   options.output_directory = (dir / "out").string();
   std::ostringstream log;
-  run_scene(scene, options, MPI_COMM_WORLD, log);
+  const RunSummary sum = run_scene(scene, options, MPI_COMM_WORLD, log);
   if (world_rank() == 0) {
     const auto files = snapshots_in(dir / "out");
     ASSERT_EQ(files.size(), 11u);  // steps 35 ... 45, both ends included
+    // The summary counts what is on disk: the files and their bytes.
+    EXPECT_EQ(sum.snapshot_files, 11);
+    double bytes = 0;
+    for (const auto& f : files) bytes += static_cast<double>(fs::file_size(f));
+    EXPECT_EQ(sum.snapshot_bytes, bytes);
+    EXPECT_GT(sum.snapshot_seconds, 0);
+    EXPECT_GT(sum.startup_seconds, 0);
+    EXPECT_NE(log.str().find("; 11 snapshot(s), "), std::string::npos) << log.str();
+    // No snapshot before the window: the start-up has none to include.
+    EXPECT_EQ(log.str().find("first snapshot"), std::string::npos) << log.str();
     for (std::size_t k = 0; k < files.size(); ++k) {
       const SnapshotFile s = read_file(files[k]);
       EXPECT_EQ(s.step, 35 + static_cast<long>(k));
