@@ -1353,7 +1353,7 @@ void Simulation::advance_to(double t_end) {
 void Simulation::advance_temperatures() {
   exchange_->forward_values(p_.temperature, 1, ghost_temperature_);
   heat_->step(p_, ghosts_, ghost_temperature_, local_list_, ghost_list_, walls_, wall_neighbours_,
-              dt_);
+              dt_, scene_.parallel.reproducible ? &canonical_ : nullptr);
 }
 
 double Simulation::kinetic_energy_translational() const {
