@@ -8,6 +8,10 @@
 //  - two equal spheres exchanging heat between adiabatic walls conserve sum m c T to
 //    round-off;
 //  - a restart from a checkpoint continues the temperatures bit for bit;
+//  - a material heat source: T0 + q t / c alone, T_f + q m / (h A) with convection;
+//  - a fixed-flux wall: q'' pi a^2 at Hertz's static overlap, and a chain from a flux wall to
+//    a fixed-temperature wall in the steady state of the series resistances;
+//  - Gunn's (1978) convection in a bed of uniform void fraction: the lumped exponential;
 //  - the parser refuses what is not built and thermal keys without `heat:`.
 #include <gtest/gtest.h>
 
