@@ -829,7 +829,8 @@ void report_contacts(const ContactSweep& s, ContactNetwork& out) {
                             ContactHistory h) {
     const ContactGeometry geo = wall_geometry<Law>(p, i, t);
     const PairCoefficients& pc = s.table(p.material[i], material);
-    const ContactResult r = Law::evaluate(geo, pc, s.constants, h.tangential, h.rolling, s.dt, s.spring_dt);
+    const ContactResult r =
+        Law::evaluate(geo, pc, s.constants, h.tangential, h.rolling, s.dt, s.spring_dt);
     const double fn = Law::normal_force(geo, pc, s.constants);
     const Vec3 normal = fn * geo.n;
     const Vec3 point = p.x[i] - geo.arm_i * geo.n;

@@ -30,8 +30,8 @@ constexpr double kKn = 1e3, kKt = 8e2, kRollingFriction = 0.1;
 constexpr int kSteps = 10;
 
 struct Springs {
-  double pair_force = 0;    // y force on a [N]
-  double wall_force = 0;    // y force on c [N]
+  double pair_force = 0;      // y force on a [N]
+  double wall_force = 0;      // y force on c [N]
   double rolling_torque = 0;  // z torque on d [N m]
 };
 
@@ -51,10 +51,10 @@ class InitialSprings : public ::testing::TestWithParam<DashpotVelocity> {
     sim_ = std::make_unique<Simulation>(s, false);
     Particles& p = sim_->particles();
     const double half = kR - 0.5 * kOverlap;
-    p.add(1, Vec3(-half, 0, 0.5), Vec3::Zero(), Vec3(0, 0, kSpin), kR, 0, 1e12);    // a
-    p.add(2, Vec3(half, 0, 0.5), Vec3::Zero(), Vec3::Zero(), kR, 0, 1e12);          // b
+    p.add(1, Vec3(-half, 0, 0.5), Vec3::Zero(), Vec3(0, 0, kSpin), kR, 0, 1e12);  // a
+    p.add(2, Vec3(half, 0, 0.5), Vec3::Zero(), Vec3::Zero(), kR, 0, 1e12);        // b
     p.add(3, Vec3(0, -0.5, -0.5 + kR - kOverlap), Vec3::Zero(), Vec3(kSpin, 0, 0), kR, 0,
-          1e12);                                                                   // c
+          1e12);                                                                    // c
     p.add(4, Vec3(-half, 0.5, 0.5), Vec3::Zero(), Vec3(0, 0, kSpin), kR, 0, 1e12);  // d
     p.add(5, Vec3(half, 0.5, 0.5), Vec3::Zero(), Vec3(0, 0, -kSpin), kR, 0, 1e12);  // e
     sim_->set_dt(kDt);
@@ -102,8 +102,7 @@ TEST_P(InitialSprings, StartFromZeroAndHoldTheStepsDisplacement) {
 INSTANTIATE_TEST_SUITE_P(DashpotVelocities, InitialSprings,
                          ::testing::Values(DashpotVelocity::half_step, DashpotVelocity::predicted),
                          [](const ::testing::TestParamInfo<DashpotVelocity>& p) {
-                           return p.param == DashpotVelocity::half_step ? "half_step"
-                                                                        : "predicted";
+                           return p.param == DashpotVelocity::half_step ? "half_step" : "predicted";
                          });
 
 }  // namespace

@@ -254,7 +254,8 @@ TEST(HeatTransfer, HeatSourceWithConvectionReachesItsSteadyExcess) {
   const double tau = m * c / ha, t_inf = tf + q * m / ha;
   const double dt = tau / 1000;
   const std::string yaml = R"(domain: {min: [-0.01, -0.01, -0.01], max: [0.01, 0.01, 0.01]}
-time: {step: )" + std::to_string(dt) + R"(, end: 100}
+time: {step: )" + std::to_string(dt) +
+                           R"(, end: 100}
 heat: {}
 materials:
   - {name: glass, youngs_modulus: 1e7, poisson_ratio: 0.3, density: 2500, heat_capacity: 840,
@@ -284,13 +285,14 @@ fluid:
   for (int k = 1; k <= 6; ++k) {
     sim.advance_to(0.5 * k * tau);
     const double expected = t_inf + (t0 - t_inf) * std::exp(-sim.time() / tau);
-    worst = std::max(worst, std::abs((sim.particles().temperature[0] - expected) /
-                                     (expected - t_inf)));
+    worst =
+        std::max(worst, std::abs((sim.particles().temperature[0] - expected) / (expected - t_inf)));
   }
   sim.advance_to(40 * tau);
-  std::printf("tau = %.4f s, T_inf = %.6f K; largest error of T - T_inf over 3 tau %.3e; "
-              "T(40 tau) = %.9f K\n",
-              tau, t_inf, worst, sim.particles().temperature[0]);
+  std::printf(
+      "tau = %.4f s, T_inf = %.6f K; largest error of T - T_inf over 3 tau %.3e; "
+      "T(40 tau) = %.9f K\n",
+      tau, t_inf, worst, sim.particles().temperature[0]);
   EXPECT_LT(worst, 5e-3);
   EXPECT_NEAR(sim.particles().temperature[0], t_inf, 1e-9);
   EXPECT_EQ(sim.particles().v[0].norm(), 0.0);  // at rest in still fluid, gravity off
@@ -332,9 +334,10 @@ walls:
   sim.advance_to(0.02);
   const double expected = t0 + rate * sim.time() / (m * c);
   const Particles& p = sim.particles();
-  std::printf("delta = %.6e m (Hertz), %.6e m (run); wall heat %.9e W, q'' pi r delta %.9e W; "
-              "T = %.12f K, closed form %.12f K\n",
-              delta, r - p.x[0][2], sim.heat()->wall_heat()[0], rate, p.temperature[0], expected);
+  std::printf(
+      "delta = %.6e m (Hertz), %.6e m (run); wall heat %.9e W, q'' pi r delta %.9e W; "
+      "T = %.12f K, closed form %.12f K\n",
+      delta, r - p.x[0][2], sim.heat()->wall_heat()[0], rate, p.temperature[0], expected);
   EXPECT_NEAR(sim.heat()->wall_heat()[0], rate, 1e-9 * rate);
   const double steps = static_cast<double>(sim.counters().steps);
   EXPECT_NEAR(p.temperature[0], expected, steps * 0x1p-53 * expected);
@@ -366,9 +369,9 @@ TEST(HeatTransfer, SteadyChainFromAFixedFluxToAFixedTemperature) {
   for (int k = 0; k + 1 < n; ++k)
     resistance += 1 / (2 * k_glass * std::sqrt(0.5 * r * (2 * r - (x[k + 1] - x[k]))));
   const std::vector<double>& q = sim.heat()->wall_heat();
-  std::printf("in %.6e W (q'' pi a^2 %.6e W), out %.6e W; T1 - T_w = %.6f K, Q R = %.6f K\n",
-              q[0], q_in, -q[1], t[0] - cold, q_in * resistance);
-  EXPECT_NEAR(q[0] / q_in, 1, 1e-9);  // the flux wall's definition, at the run's overlap
+  std::printf("in %.6e W (q'' pi a^2 %.6e W), out %.6e W; T1 - T_w = %.6f K, Q R = %.6f K\n", q[0],
+              q_in, -q[1], t[0] - cold, q_in * resistance);
+  EXPECT_NEAR(q[0] / q_in, 1, 1e-9);   // the flux wall's definition, at the run's overlap
   EXPECT_NEAR(-q[1] / q_in, 1, 5e-3);  // steady: all of it leaves through the cold wall
   EXPECT_NEAR((t[0] - cold) / (q_in * resistance), 1, 5e-3);
 }
@@ -383,18 +386,19 @@ TEST(HeatTransfer, GunnConvectionInABedMatchesTheLumpedExponential) {
   const double d = 1e-3, rho = 1e9, eps = 0.5, u = 1, rho_f = 1.2, mu = 1.8e-5, cf = 1005,
                kf = 0.026, t0 = 400, tf = 300;
   const double re = eps * rho_f * d * u / mu, pr = cf * mu / kf;
-  const double nu_gunn = (7 - 10 * eps + 5 * eps * eps) *
-                             (1 + 0.7 * std::pow(re, 0.2) * std::pow(pr, 1.0 / 3.0)) +
-                         (1.33 - 2.4 * eps + 1.2 * eps * eps) * std::pow(re, 0.7) *
-                             std::pow(pr, 1.0 / 3.0);
+  const double nu_gunn =
+      (7 - 10 * eps + 5 * eps * eps) * (1 + 0.7 * std::pow(re, 0.2) * std::pow(pr, 1.0 / 3.0)) +
+      (1.33 - 2.4 * eps + 1.2 * eps * eps) * std::pow(re, 0.7) * std::pow(pr, 1.0 / 3.0);
   const double h = nu_gunn * kf / d;
   const double c = 0.1 * 6 * h / (rho * d);  // tau = 0.1 s
   const double tau = rho * c * d / (6 * h), dt = tau / 2000;
   char material[256];
   std::snprintf(material, sizeof material,
                 "  - {name: heavy, youngs_modulus: 1e7, poisson_ratio: 0.3, density: 1e9, "
-                "heat_capacity: %.17g, conductivity: 1}\n", c);
-  const std::string yaml = std::string(R"(domain: {min: [-0.01, -0.01, -0.01], max: [0.01, 0.01, 0.01]}
+                "heat_capacity: %.17g, conductivity: 1}\n",
+                c);
+  const std::string yaml = std::string(
+                               R"(domain: {min: [-0.01, -0.01, -0.01], max: [0.01, 0.01, 0.01]}
 time: {step: 1e-4, end: 1}
 heat: {}
 materials:
@@ -426,13 +430,14 @@ fluid:
   for (int k = 1; k <= 6; ++k) {
     sim.advance_to(0.5 * k * tau);
     const double expected = tf + (t0 - tf) * std::exp(-sim.time() / tau);
-    worst = std::max(worst,
-                     std::abs((sim.particles().temperature[0] - expected) / (expected - tf)));
+    worst =
+        std::max(worst, std::abs((sim.particles().temperature[0] - expected) / (expected - tf)));
   }
   const double slip_change = sim.particles().v[0].norm() / u;
-  std::printf("Re = %.3f, Pr = %.4f, Nu (Gunn) = %.5f, h = %.3f W/m^2/K; largest error of "
-              "T - T_f over 3 tau %.3e; slip change %.1e\n",
-              re, pr, nu_gunn, h, worst, slip_change);
+  std::printf(
+      "Re = %.3f, Pr = %.4f, Nu (Gunn) = %.5f, h = %.3f W/m^2/K; largest error of "
+      "T - T_f over 3 tau %.3e; slip change %.1e\n",
+      re, pr, nu_gunn, h, worst, slip_change);
   EXPECT_LT(slip_change, 1e-5);
   EXPECT_LT(worst, 5e-3);
 }
