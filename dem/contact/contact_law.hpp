@@ -43,12 +43,14 @@ struct ContactLaw {
   // `rolling` are the contact's springs (each touched only by a law that has it).
   // Springs advance with the half-step velocities (g.v_rel, g.w_rel), dashpots take
   // g.v_pred, g.w_pred (contact.dashpot_velocity: half-step, or predicted at the step's end;
-  // with predicted, the normal dashpot is cell_dashpot()).
+  // with predicted, the normal dashpot is cell_dashpot()). The springs advance over
+  // `spring_dt`: dt in a step, 0 in the evaluation of the initial state, whose springs have
+  // not moved yet (Simulation::initialise); dt alone sizes the dashpot's cell.
   template <class V, class PC>
   [[gnu::always_inline]] static ContactResultT<V> evaluate(const ContactGeometryT<V>& g,
                                                            const PC& pc, const ContactConstants& cc,
                                                            V3<V>& tangential, V3<V>& rolling,
-                                                           double dt) {
+                                                           double dt, double spring_dt) {
     const SpringDashpotT<V> s = Normal::coefficients(pc, cc, g.r_star, g.m_star, g.overlap);
     const V vn = dot(g.v_pred, g.n);
     V fn;
@@ -65,7 +67,7 @@ struct ContactLaw {
       const V3<V> vt = g.v_rel - dot(g.v_rel, g.n) * g.n;
       const V3<V> vt_pred = g.v_pred - vn * g.n;
       const V3<V> ft = Tangential::template force<V>(vt, vt_pred, s.kt, s.gt, pc.friction * fn_pos,
-                                                     g.n, tangential, dt);
+                                                     g.n, tangential, spring_dt);
       r.force += ft;
       const V3<V> n_x_ft = cross(g.n, ft);
       r.torque_i = -g.arm_i * n_x_ft;
@@ -73,11 +75,19 @@ struct ContactLaw {
     }
     if constexpr (Rolling::enabled) {
       const double m_max = pc.rolling_friction * g.r_star * fn_pos;
-      const Vec3 m = Rolling::torque(g, m_max, s.kn, pc.rolling_friction, cc, rolling, dt);
+      const Vec3 m = Rolling::torque(g, m_max, s.kn, pc.rolling_friction, cc, rolling, spring_dt);
       r.torque_i += m;
       r.torque_j -= m;
     }
     return r;
+  }
+  // A step's evaluation: the springs advance over dt.
+  template <class V, class PC>
+  [[gnu::always_inline]] static ContactResultT<V> evaluate(const ContactGeometryT<V>& g,
+                                                           const PC& pc, const ContactConstants& cc,
+                                                           V3<V>& tangential, V3<V>& rolling,
+                                                           double dt) {
+    return evaluate(g, pc, cc, tangential, rolling, dt, dt);
   }
 
   // The normal dashpot force of contact.dashpot_velocity: predicted: its impulse over the

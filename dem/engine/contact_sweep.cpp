@@ -139,7 +139,7 @@ template <class Law, class V, class PC>
                                                            V3<V>& tangential, V3<V>& rolling,
                                                            V& overlap) {
   const ContactGeometryT<V> g = pair_geometry<Law>(d, a, b, r_star, m_star, overlap);
-  return Law::evaluate(g, pc, s.constants, tangential, rolling, s.dt);
+  return Law::evaluate(g, pc, s.constants, tangential, rolling, s.dt, s.spring_dt);
 }
 
 // The overlap guard keeps the largest overlap / min(r_a, r_b) of the sweep, R. A contact
@@ -767,7 +767,7 @@ void report_contacts(const ContactSweep& s, ContactNetwork& out) {
     double overlap = 0;
     const ContactGeometry geo =
         pair_geometry<Law>(d, a, b, reduced_radius(a, b), reduced_mass(a, b), overlap);
-    const ContactResult r = Law::evaluate(geo, pc, s.constants, ht, hr, s.dt);
+    const ContactResult r = Law::evaluate(geo, pc, s.constants, ht, hr, s.dt, s.spring_dt);
     const double fn = Law::normal_force(geo, pc, s.constants);
     const Vec3 normal = fn * geo.n;
     pairs.id.push_back({ia, ib});
@@ -829,7 +829,8 @@ void report_contacts(const ContactSweep& s, ContactNetwork& out) {
                             ContactHistory h) {
     const ContactGeometry geo = wall_geometry<Law>(p, i, t);
     const PairCoefficients& pc = s.table(p.material[i], material);
-    const ContactResult r = Law::evaluate(geo, pc, s.constants, h.tangential, h.rolling, s.dt);
+    const ContactResult r =
+        Law::evaluate(geo, pc, s.constants, h.tangential, h.rolling, s.dt, s.spring_dt);
     const double fn = Law::normal_force(geo, pc, s.constants);
     const Vec3 normal = fn * geo.n;
     const Vec3 point = p.x[i] - geo.arm_i * geo.n;

@@ -94,6 +94,9 @@ struct ContactSweep {
   const PairTable& table;
   const ContactConstants& constants;
   double dt;
+  // The time over which the springs advance: dt, or 0 in the evaluation of the initial state
+  // (Simulation::initialise), where the contacts present have not moved yet.
+  double spring_dt;
   const UniformPairs& uniform;
   // results of the sweep
   long contacts = 0;             // each contact once over all ranks

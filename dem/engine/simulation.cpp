@@ -165,11 +165,13 @@ void Simulation::initialise() {
   rebuild();
   // A restored run keeps the checkpoint's forces: evaluating the contacts again
   // would advance every spring a second time for the same step, and the force terms
-  // are already in them. Only the implicit drag is set, from the checkpoint.
+  // are already in them. Only the implicit drag is set, from the checkpoint. A fresh run
+  // evaluates its initial state: the contacts present start with springs that have not
+  // moved, so this evaluation advances none (the first step advances them by v(dt/2) dt).
   if (restoring)
     restore_implicit_drag();
   else
-    check_contacts(compute_forces(), true);
+    check_contacts(compute_forces(false), true);
   check_force_limits();
   initialised_ = true;
 }
@@ -754,7 +756,7 @@ void Simulation::rebuild(bool keep_drag) {
   ++counters_.rebuilds;
 }
 
-ContactGuards Simulation::compute_forces() {
+ContactGuards Simulation::compute_forces(bool advance_springs) {
   if (!fresh_from_kick_) {  // else kick_and_drift() has set them
     const Vec3 g = scene_.gravity;
     for (std::size_t i = 0; i < p_.size(); ++i) {
@@ -766,6 +768,7 @@ ContactGuards Simulation::compute_forces() {
   ContactSweep s{
       p_,       ghosts_,       local_list_,      ghost_list_, local_springs_, ghost_springs_,
       walls_,   wall_history_, wall_neighbours_, table_,      constants_,     dt_,
+      advance_springs ? dt_ : 0.0,
       uniform_, 0,             0.0,              WorstContact{}, UnresolvedContact{}};
   // clang-format on
   s.canonical = &canonical_;
@@ -1350,7 +1353,7 @@ void Simulation::advance_to(double t_end) {
 void Simulation::advance_temperatures() {
   exchange_->forward_values(p_.temperature, 1, ghost_temperature_);
   heat_->step(p_, ghosts_, ghost_temperature_, local_list_, ghost_list_, walls_, wall_neighbours_,
-              dt_);
+              dt_, scene_.parallel.reproducible ? &canonical_ : nullptr);
 }
 
 double Simulation::kinetic_energy_translational() const {

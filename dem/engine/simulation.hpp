@@ -218,7 +218,9 @@ class Simulation {
   // The checkpoint's grid and planes (restore(), written on as many ranks).
   void take_restored_grid(const CheckpointGrid& grid);
   void remake_decomposition(const std::array<int, 3>& dims);  // uniform planes
-  ContactGuards compute_forces();  // gravity, contacts, then the force terms
+  // Gravity, contacts, then the force terms. `advance_springs` false: the forces of the
+  // initial state, whose contact springs have not moved (initialise()).
+  ContactGuards compute_forces(bool advance_springs = true);
   void apply_force_terms();  // non-contact terms only
   // Heat on: the ghosts' temperatures from their owners, then HeatTransfer::step (collective).
   void advance_temperatures();

@@ -59,7 +59,7 @@ void apply_wall_contact(ContactSweep& s, std::size_t i, const WallTouch& t, int 
   Particles& p = s.p;
   const ContactGeometry g = wall_geometry<Law>(p, i, t);
   const ContactResult r = Law::evaluate(g, s.table(p.material[i], material), s.constants,
-                                        h.tangential, h.rolling, s.dt);
+                                        h.tangential, h.rolling, s.dt, s.spring_dt);
   p.force[i] += r.force;
   if constexpr (Law::needs_spin) p.torque[i] += r.torque_i;
   ++s.contacts;

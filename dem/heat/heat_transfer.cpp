@@ -78,17 +78,18 @@ void HeatTransfer::walls_pass(const Particles& p, const WallSet& walls, const Wa
 
 void HeatTransfer::step(Particles& p, const Ghosts& g, const std::vector<double>& ghost_temperature,
                         const NeighbourList& local, const NeighbourList& ghost,
-                        const WallSet& walls, const WallNeighbours& wall_neighbours, double dt) {
+                        const WallSet& walls, const WallNeighbours& wall_neighbours, double dt,
+                        const CanonicalOrder* canonical) {
   const std::size_t n = p.size();
   q_.assign(n, 0.0);
   const double* T = p.temperature.data();
   if (conduction_) {
-    // Local pairs, each once: +q to i, -q to j.
-    for (std::size_t e = 0; e < local.j.size(); ++e) {
+    // A local pair (list entry e), once: +q to i, -q to j.
+    const auto local_pair = [&](std::size_t e) {
       const std::size_t i = local.owner[e], j = local.j[e];
       const double sum = p.radius[i] + p.radius[j];
       const double d2 = (p.x[i] - p.x[j]).squaredNorm();
-      if (d2 >= sum * sum) continue;
+      if (d2 >= sum * sum) return;
       const double overlap = sum - std::sqrt(d2);
       const double r_star = p.radius[i] * p.radius[j] / sum;
       const double q = contact_conductance(k_star_[p.material[i] * materials_ + p.material[j]],
@@ -96,21 +97,35 @@ void HeatTransfer::step(Particles& p, const Ghosts& g, const std::vector<double>
                        (T[j] - T[i]);
       q_[i] += q;
       q_[j] -= q;
-    }
-    // Local-ghost pairs: the ghost's owner computes the same pair from its side. The
+    };
+    // A local-ghost pair: the ghost's owner computes the same pair from its side. The
     // operands are the same bits in the other order, and each operation gives the same
     // result in either order (a - b = -(b - a), squares, sums and products commute), so
-    // the two ranks' q are exact opposites.
-    for (std::size_t e = 0; e < ghost.j.size(); ++e) {
+    // the two ranks' q are exact opposites, and equal to the q of the same pair held by one
+    // rank as a local pair.
+    const auto ghost_pair = [&](std::size_t e) {
       const std::size_t i = ghost.owner[e], k = ghost.j[e];
       const double sum = p.radius[i] + g.radius[k];
       const double d2 = ((p.x[i] - g.x[k]) - g.shift[k]).squaredNorm();
-      if (d2 >= sum * sum) continue;
+      if (d2 >= sum * sum) return;
       const double overlap = sum - std::sqrt(d2);
       const double r_star = p.radius[i] * g.radius[k] / sum;
       q_[i] += contact_conductance(k_star_[p.material[i] * materials_ + g.material[k]],
                                    contact_radius(r_star, overlap)) *
                (ghost_temperature[k] - T[i]);
+    };
+    if (canonical != nullptr) {
+      // parallel.reproducible: the contact sweep's order, so that each particle adds its
+      // pairs' heat by ascending partner key on every decomposition (canonical_order.hpp).
+      std::size_t e = 0, t = 0;
+      for (const CanonicalOrder::Run& run : canonical->runs) {
+        for (; e < static_cast<std::size_t>(run.local_end); ++e) local_pair(e);
+        for (; t < static_cast<std::size_t>(run.ghost_end); ++t)
+          ghost_pair(static_cast<std::size_t>(canonical->ghost_entries[t]));
+      }
+    } else {
+      for (std::size_t e = 0; e < local.j.size(); ++e) local_pair(e);
+      for (std::size_t e = 0; e < ghost.j.size(); ++e) ghost_pair(e);
     }
   }
   walls_pass(p, walls, wall_neighbours);

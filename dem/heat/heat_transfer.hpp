@@ -8,12 +8,14 @@
 //   T_i' = (T_i + dt/C_i (Q_i + m_i q_i + H_i T_f)) / (1 + dt H_i / C_i),  C = m c, H = h A.
 // A pair's heat is computed once per rank that holds it, from the same bits on both ranks,
 // and added to one partner and subtracted from the other: what one gains the other loses
-// exactly, within a rank and across a cut. The Simulation owns one only when heat is on;
+// exactly, within a rank and across a cut. With parallel.reproducible the pairs are visited
+// in the contact sweep's canonical order. The Simulation owns one only when heat is on;
 // off, no thermal code runs.
 #include <optional>
 #include <vector>
 
 #include "dem/core/particles.hpp"
+#include "dem/engine/canonical_order.hpp"
 #include "dem/neighbour/verlet_list.hpp"
 #include "dem/neighbour/wall_neighbours.hpp"
 #include "dem/parallel/ghosts.hpp"
@@ -27,10 +29,14 @@ class HeatTransfer {
   explicit HeatTransfer(const Scene& scene);
 
   // Advances the local particles' temperatures by dt. `ghost_temperature`: each ghost's
-  // owner's temperature at the step's start (Exchange::forward_values).
+  // owner's temperature at the step's start (Exchange::forward_values). `canonical`
+  // (parallel.reproducible): the pairs' order of the contact sweep, built for these lists,
+  // so that temperatures are the same bit for bit on every decomposition; nullptr: the
+  // local list, then the ghost list.
   void step(Particles& p, const Ghosts& g, const std::vector<double>& ghost_temperature,
             const NeighbourList& local, const NeighbourList& ghost, const WallSet& walls,
-            const WallNeighbours& wall_neighbours, double dt);
+            const WallNeighbours& wall_neighbours, double dt,
+            const CanonicalOrder* canonical = nullptr);
 
   // Heat that entered this rank's particles through each wall in the last step [W]
   // (negative: left through it), in WallSet order.

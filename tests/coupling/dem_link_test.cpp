@@ -172,5 +172,40 @@ TEST(DemLink, SampleRecordsActLikeAddFluid) {
   EXPECT_EQ(differ_from_still, a.local);
 }
 
+// grainFoam has no fluid energy equation: a coupled scene with `heat:` is refused when the
+// link reads it, with the heat block's file:line, the reason and the two ways on
+// (docs/models/heat-transfer.md, "Not yet built"), rather than running without the fluid's
+// side of the heat exchange.
+TEST(DemLink, RefusesASceneWithHeatTransfer) {
+  const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "dem_link_heat";
+  fs::create_directories(dir);
+  const std::string scene = (dir / "scene.yaml").string();
+  std::ofstream(scene) << "domain: {min: [0, 0, 0], max: [0.016, 0.016, 0.016]}\n"
+                          "time: {step: 1.0e-6, end: 1.0}\n"
+                          "heat: {}\n"
+                          "materials: [{name: glass, youngs_modulus: 1.0e8, poisson_ratio: 0.3, "
+                          "density: 2500, heat_capacity: 840, conductivity: 1}]\n"
+                          "interaction_defaults: {restitution: 0.5, friction: 0.3}\n"
+                          "contact: {normal: hertz}\n"
+                          "fluid: {density: 1.2, viscosity: 1.8e-5, drag: di_felice, model: A, "
+                          "pressure: {hydrostatic: false}, forces: [drag, pressure_gradient, "
+                          "viscous]}\n";
+  std::string message = "no error";
+  try {
+    DemLink link(scene, 1.2, 1.8e-5, MPI_COMM_WORLD);
+  } catch (const std::runtime_error& e) {
+    message = e.what();
+  }
+  EXPECT_NE(message.find(scene + ":3"), std::string::npos) << message;
+  EXPECT_NE(message.find("heat transfer in a coupled run needs grainFoam's fluid energy "
+                         "equation, which is not built yet"),
+            std::string::npos)
+      << message;
+  EXPECT_NE(message.find("remove the `heat:` block"), std::string::npos) << message;
+  EXPECT_NE(message.find("run the scene with `grain` and a prescribed fluid temperature"),
+            std::string::npos)
+      << message;
+}
+
 }  // namespace
 }  // namespace grainflow::coupling

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """`parallel: {reproducible: true}` through the command line: the same scene run by
 `grain run` on 1, 2 and 3 ranks writes snapshots that are equal bit for bit (every snapshot,
-sorted by id: ids, positions, velocities, spins), and the 1-rank run's first checkpoint
+sorted by id: ids, positions, velocities, spins, and temperatures when the scene has heat
+transfer), and the 1-rank run's first checkpoint
 continued with `grain run --restart` on 3 ranks writes the same last snapshot.
 
     reproducible_snapshots.py GRAIN SCENE WORKDIR MPIEXEC
@@ -18,6 +19,7 @@ import h5py
 import numpy as np
 
 FIELDS = ("id", "position", "velocity", "angular_velocity")
+OPTIONAL = ("temperature",)  # compared when the snapshots hold it
 
 
 def run(grain, scene, out, mpiexec, ranks, extra=()):
@@ -32,12 +34,14 @@ def run(grain, scene, out, mpiexec, ranks, extra=()):
 def snapshot(path):
     with h5py.File(path, "r") as f:
         order = np.argsort(f["id"][...], kind="stable")
-        return {k: f[k][...][order] for k in FIELDS}
+        return {k: f[k][...][order] for k in FIELDS + OPTIONAL if k in f}
 
 
 def compare(a_path, b_path):
     a, b = snapshot(a_path), snapshot(b_path)
-    for k in FIELDS:
+    if a.keys() != b.keys():
+        sys.exit(f"error: {b_path} holds {sorted(b)}, {a_path} {sorted(a)}")
+    for k in a:
         if a[k].shape != b[k].shape or a[k].tobytes() != b[k].tobytes():
             diff = np.max(np.abs(a[k] - b[k])) if a[k].shape == b[k].shape else "shape"
             sys.exit(f"error: {b_path} differs from {a_path} in '{k}' (largest difference {diff})")
@@ -56,6 +60,14 @@ def main():
     snaps = sorted(p.name for p in outs[1].glob("particles_*.h5"))
     if len(snaps) < 5:
         sys.exit(f"error: only {len(snaps)} snapshots in {outs[1]}")
+    heat = any(line.startswith("heat:") for line in pathlib.Path(scene).read_text().splitlines())
+    if heat:
+        first = snapshot(outs[1] / snaps[0])
+        if "temperature" not in first:
+            sys.exit(f"error: the scene has heat transfer but {snaps[0]} holds no temperature")
+        last = snapshot(outs[1] / snaps[-1])["temperature"]
+        if np.all(last == first["temperature"]):
+            sys.exit("error: no heat flowed: the temperature comparison would prove nothing")
     for n in (2, 3):
         for s in snaps:
             compare(outs[1] / s, outs[n] / s)

@@ -211,4 +211,12 @@ if(GRAINFLOW_PYTHON3)
                    ${_work}/reproducible_snapshots_predicted ${MPIEXEC_EXECUTABLE})
   set_tests_properties(grain.reproducible_snapshots_predicted
                        PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}" TIMEOUT 300 PROCESSORS 2)
+  # With heat transfer: the heat flows are summed in the same canonical order, so the
+  # temperatures are equal bit for bit too.
+  add_test(NAME grain.reproducible_snapshots_heat
+           COMMAND ${GRAINFLOW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/reproducible_snapshots.py
+                   ${_grain} ${_scenes}/periodic_bed_reproducible_heat.yaml
+                   ${_work}/reproducible_snapshots_heat ${MPIEXEC_EXECUTABLE})
+  set_tests_properties(grain.reproducible_snapshots_heat
+                       PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}" TIMEOUT 300 PROCESSORS 2)
 endif()

@@ -8,6 +8,10 @@
 //  - two equal spheres exchanging heat between adiabatic walls conserve sum m c T to
 //    round-off;
 //  - a restart from a checkpoint continues the temperatures bit for bit;
+//  - a material heat source: T0 + q t / c alone, T_f + q m / (h A) with convection;
+//  - a fixed-flux wall: q'' pi a^2 at Hertz's static overlap, and a chain from a flux wall to
+//    a fixed-temperature wall in the steady state of the series resistances;
+//  - Gunn's (1978) convection in a bed of uniform void fraction: the lumped exponential;
 //  - the parser refuses what is not built and thermal keys without `heat:`.
 #include <gtest/gtest.h>
 
@@ -208,6 +212,234 @@ TEST(HeatTransfer, RestartContinuesTemperaturesExactly) {
     EXPECT_EQ(a.x[i], b.x[i]) << "particle " << a.id[i];
   }
   EXPECT_NE(a.temperature[0], 300);  // heat flowed
+}
+
+// One sphere alone, away from walls, gravity off: m c dT/dt = m q, so T(t) = T0 + q t / c.
+// Explicit Euler integrates a constant rate exactly; the tolerance is the round-off of the
+// 1000 additions to T and to the clock (a few times 1000 x 2^-53 of T).
+TEST(HeatTransfer, HeatSourceRaisesAnIsolatedSphereLinearly) {
+  const double q = 1e3, c = 500, t0 = 300;
+  const Scene s = parse_scene(R"(domain: {min: [-0.01, -0.01, -0.01], max: [0.01, 0.01, 0.01]}
+time: {step: 1e-3, end: 1}
+heat: {}
+materials:
+  - {name: glass, youngs_modulus: 1e7, poisson_ratio: 0.3, density: 2500, heat_capacity: 500,
+     conductivity: 1, heat_source: 1000}
+interaction_defaults: {restitution: 0.5, friction: 0.3}
+contact: {normal: hertz}
+)",
+                              "source.yaml");
+  Simulation sim(s, false);
+  sim.particles().add(1, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), 5e-4, 0, 2500);
+  sim.particles().temperature.back() = t0;
+  sim.next_id() = 2;
+  sim.initialise();
+  sim.advance_to(1.0);
+  ASSERT_EQ(sim.counters().steps, 1000);
+  const double expected = t0 + q * sim.time() / c;
+  std::printf("T(1 s) = %.15f K, T0 + q t / c = %.15f K\n", sim.particles().temperature[0],
+              expected);
+  EXPECT_NEAR(sim.particles().temperature[0], expected, 4 * 1000 * 0x1p-53 * expected);
+  EXPECT_DOUBLE_EQ(sim.heat()->source_heat(), q * sim.particles().mass[0]);
+}
+
+// The same sphere at rest in still water at T_f (Re = 0: Ranz-Marshall Nu = 2, h A = 2 k_f pi d)
+// with its source on: T -> T_inf = T_f + q m / (h A), approached as
+// T_inf + (T0 - T_inf) exp(-t / tau), tau = m c / (h A). Tolerances: 0.5 % of T - T_inf over
+// 3 tau (implicit Euler lags by dt / (2 tau) = 5e-4 per tau), and the fixed point of the
+// implicit step is T_inf exactly, reached to 1e-9 K after 40 tau.
+TEST(HeatTransfer, HeatSourceWithConvectionReachesItsSteadyExcess) {
+  const double d = 1e-3, rho = 2500, c = 840, q = 1e4, kf = 0.6, t0 = 300, tf = 290;
+  const double m = rho * kPi * d * d * d / 6, ha = 2 * kf * kPi * d;
+  const double tau = m * c / ha, t_inf = tf + q * m / ha;
+  const double dt = tau / 1000;
+  const std::string yaml = R"(domain: {min: [-0.01, -0.01, -0.01], max: [0.01, 0.01, 0.01]}
+time: {step: )" + std::to_string(dt) +
+                           R"(, end: 100}
+heat: {}
+materials:
+  - {name: glass, youngs_modulus: 1e7, poisson_ratio: 0.3, density: 2500, heat_capacity: 840,
+     conductivity: 1, heat_source: 1e4}
+interaction_defaults: {restitution: 0.5, friction: 0.3}
+contact: {normal: hertz}
+fluid:
+  density: 1000
+  viscosity: 1e-3
+  drag: schiller_naumann
+  model: B
+  forces: [drag, pressure_gradient, viscous]
+  temperature: 290
+  heat_capacity: 4180
+  conductivity: 0.6
+)";
+  Scene s = parse_scene(yaml, "source_convection.yaml");
+  s.time.step = dt;  // to the last bit
+  Simulation sim(s, false);
+  sim.add_force_term(make_fluid_forces(*s.fluid, s.gravity, s.domain, MPI_COMM_WORLD));
+  sim.particles().add(1, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), 0.5 * d, 0, rho);
+  sim.particles().temperature.back() = t0;
+  sim.next_id() = 2;
+  sim.set_dt(dt);
+  sim.initialise();
+  double worst = 0;
+  for (int k = 1; k <= 6; ++k) {
+    sim.advance_to(0.5 * k * tau);
+    const double expected = t_inf + (t0 - t_inf) * std::exp(-sim.time() / tau);
+    worst =
+        std::max(worst, std::abs((sim.particles().temperature[0] - expected) / (expected - t_inf)));
+  }
+  sim.advance_to(40 * tau);
+  std::printf(
+      "tau = %.4f s, T_inf = %.6f K; largest error of T - T_inf over 3 tau %.3e; "
+      "T(40 tau) = %.9f K\n",
+      tau, t_inf, worst, sim.particles().temperature[0]);
+  EXPECT_LT(worst, 5e-3);
+  EXPECT_NEAR(sim.particles().temperature[0], t_inf, 1e-9);
+  EXPECT_EQ(sim.particles().v[0].norm(), 0.0);  // at rest in still fluid, gravity off
+}
+
+// A sphere resting on a floor that feeds a fixed heat flux density q'' [W/m^2] through its
+// contact area pi a^2 (docs/models/heat-transfer.md, "Walls"). It is placed at Hertz's static
+// overlap, m g = (4/3) Y* sqrt(r) delta^(3/2) with 1/Y* = 2 (1 - nu^2) / Y (sphere and floor
+// of one material), a^2 = r delta, and stays there; no other exchange (adiabatic elsewhere, no
+// fluid): T(t) = T0 + q'' pi r delta t / (m c). Tolerances: 1e-9 relative for the rate (the
+// sphere's drift from the computed equilibrium, round-off, changes delta at that level); for T
+// the round-off of adding the same small increment to T = 300 K in each of the N steps, which
+// rounds the same way every time: N ulp(T) / 2.
+TEST(HeatTransfer, FixedFluxWallFeedsItsFluxThroughTheContactArea) {
+  const double r = 1e-3, rho = 2500, c = 800, y = 1e7, nu = 0.3, g = 9.81, flux = 2e5, t0 = 300;
+  const double m = rho * 4.0 / 3.0 * kPi * r * r * r;
+  const double y_star = y / (2 * (1 - nu * nu));
+  const double delta = std::pow(3 * m * g / (4 * y_star * std::sqrt(r)), 2.0 / 3.0);
+  const double rate = flux * kPi * r * delta;
+  const Scene s = parse_scene(R"(domain: {min: [-0.01, -0.01, 0], max: [0.01, 0.01, 0.01]}
+gravity: [0, 0, -9.81]
+time: {step: 1e-6, end: 1}
+heat: {}
+materials:
+  - {name: glass, youngs_modulus: 1e7, poisson_ratio: 0.3, density: 2500, heat_capacity: 800,
+     conductivity: 1}
+interaction_defaults: {restitution: 0.5, friction: 0.3}
+contact: {normal: hertz}
+walls:
+  - {type: plane, name: floor, point: [0, 0, 0], normal: [0, 0, 1], material: glass,
+     heat_flux: 2e5}
+)",
+                              "flux.yaml");
+  Simulation sim(s, false);
+  sim.particles().add(1, Vec3(0, 0, r - delta), Vec3::Zero(), Vec3::Zero(), r, 0, rho);
+  sim.particles().temperature.back() = t0;
+  sim.next_id() = 2;
+  sim.initialise();
+  sim.advance_to(0.02);
+  const double expected = t0 + rate * sim.time() / (m * c);
+  const Particles& p = sim.particles();
+  std::printf(
+      "delta = %.6e m (Hertz), %.6e m (run); wall heat %.9e W, q'' pi r delta %.9e W; "
+      "T = %.12f K, closed form %.12f K\n",
+      delta, r - p.x[0][2], sim.heat()->wall_heat()[0], rate, p.temperature[0], expected);
+  EXPECT_NEAR(sim.heat()->wall_heat()[0], rate, 1e-9 * rate);
+  const double steps = static_cast<double>(sim.counters().steps);
+  EXPECT_NEAR(p.temperature[0], expected, steps * 0x1p-53 * expected);
+}
+
+// The chain of SteadyChainMatchesSeriesResistances between a wall feeding q'' and a wall at
+// 300 K: in the steady state all that enters, Q = q'' pi r delta_in, leaves through the cold
+// wall, and the sphere at the flux wall is Q sum 1/(2 k* a) above 300 K (the contacts
+// between it and the cold wall in series; a from the measured overlaps). Tolerance 0.5 %.
+TEST(HeatTransfer, SteadyChainFromAFixedFluxToAFixedTemperature) {
+  const int n = 3;
+  const double r = 1e-3, delta0 = 5e-7, k_glass = 1.2, k_steel = 16, flux = 1e6, cold = 300;
+  const Scene s = parse_scene(chain_scene(n, r, delta0, ", heat_flux: 1e6", ", temperature: 300"),
+                              "flux_chain.yaml");
+  Simulation sim(s, false);
+  add_chain(sim, n, r, delta0, {300, 300, 300});
+  sim.initialise();
+  sim.advance_to(0.08);
+  const Particles& p = sim.particles();
+  std::vector<double> x(n), t(n);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    x[p.id[i] - 1] = p.x[i][0];
+    t[p.id[i] - 1] = p.temperature[i];
+  }
+  const double length = s.walls[1].plane.point[0];
+  const double k_wall = 2 * k_glass * k_steel / (k_glass + k_steel);
+  const double q_in = flux * kPi * r * (r - x[0]);
+  double resistance = 1 / (2 * k_wall * std::sqrt(r * (r - (length - x[n - 1]))));
+  for (int k = 0; k + 1 < n; ++k)
+    resistance += 1 / (2 * k_glass * std::sqrt(0.5 * r * (2 * r - (x[k + 1] - x[k]))));
+  const std::vector<double>& q = sim.heat()->wall_heat();
+  std::printf("in %.6e W (q'' pi a^2 %.6e W), out %.6e W; T1 - T_w = %.6f K, Q R = %.6f K\n", q[0],
+              q_in, -q[1], t[0] - cold, q_in * resistance);
+  EXPECT_NEAR(q[0] / q_in, 1, 1e-9);   // the flux wall's definition, at the run's overlap
+  EXPECT_NEAR(-q[1] / q_in, 1, 5e-3);  // steady: all of it leaves through the cold wall
+  EXPECT_NEAR((t[0] - cold) / (q_in * resistance), 1, 5e-3);
+}
+
+// Gunn (1978, eq. 21) in a run: a sphere in air flowing through a bed of uniform void
+// fraction eps = 0.5 at u = 1 m/s. The sphere is so dense (1e9 kg/m^3) that drag changes its
+// slip by < 1e-5 over the run, and its heat capacity so small that tau = rho c d / (6 h) is
+// 0.1 s. Reference: Nu written out here from Gunn's paper, Re = eps rho_f d |u| / mu (his
+// superficial Reynolds number), h = Nu k_f / d; T_f + (T0 - T_f) exp(-t / tau) within 0.5 % of
+// T - T_f over 3 tau (dt = tau / 2000: the implicit step's lag is 2.5e-4 per tau).
+TEST(HeatTransfer, GunnConvectionInABedMatchesTheLumpedExponential) {
+  const double d = 1e-3, rho = 1e9, eps = 0.5, u = 1, rho_f = 1.2, mu = 1.8e-5, cf = 1005,
+               kf = 0.026, t0 = 400, tf = 300;
+  const double re = eps * rho_f * d * u / mu, pr = cf * mu / kf;
+  const double nu_gunn =
+      (7 - 10 * eps + 5 * eps * eps) * (1 + 0.7 * std::pow(re, 0.2) * std::pow(pr, 1.0 / 3.0)) +
+      (1.33 - 2.4 * eps + 1.2 * eps * eps) * std::pow(re, 0.7) * std::pow(pr, 1.0 / 3.0);
+  const double h = nu_gunn * kf / d;
+  const double c = 0.1 * 6 * h / (rho * d);  // tau = 0.1 s
+  const double tau = rho * c * d / (6 * h), dt = tau / 2000;
+  char material[256];
+  std::snprintf(material, sizeof material,
+                "  - {name: heavy, youngs_modulus: 1e7, poisson_ratio: 0.3, density: 1e9, "
+                "heat_capacity: %.17g, conductivity: 1}\n",
+                c);
+  const std::string yaml = std::string(
+                               R"(domain: {min: [-0.01, -0.01, -0.01], max: [0.01, 0.01, 0.01]}
+time: {step: 1e-4, end: 1}
+heat: {}
+materials:
+)") + material + R"(interaction_defaults: {restitution: 0.5, friction: 0.3}
+contact: {normal: hertz}
+fluid:
+  density: 1.2
+  viscosity: 1.8e-5
+  velocity: [1, 0, 0]
+  void_fraction: 0.5
+  drag: di_felice
+  model: B
+  forces: [drag, pressure_gradient, viscous]
+  temperature: 300
+  heat_capacity: 1005
+  conductivity: 0.026
+  convection: gunn
+)";
+  Scene s = parse_scene(yaml, "gunn.yaml");
+  s.time.step = dt;
+  Simulation sim(s, false);
+  sim.add_force_term(make_fluid_forces(*s.fluid, s.gravity, s.domain, MPI_COMM_WORLD));
+  sim.particles().add(1, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), 0.5 * d, 0, rho);
+  sim.particles().temperature.back() = t0;
+  sim.next_id() = 2;
+  sim.set_dt(dt);
+  sim.initialise();
+  double worst = 0;
+  for (int k = 1; k <= 6; ++k) {
+    sim.advance_to(0.5 * k * tau);
+    const double expected = tf + (t0 - tf) * std::exp(-sim.time() / tau);
+    worst =
+        std::max(worst, std::abs((sim.particles().temperature[0] - expected) / (expected - tf)));
+  }
+  const double slip_change = sim.particles().v[0].norm() / u;
+  std::printf(
+      "Re = %.3f, Pr = %.4f, Nu (Gunn) = %.5f, h = %.3f W/m^2/K; largest error of "
+      "T - T_f over 3 tau %.3e; slip change %.1e\n",
+      re, pr, nu_gunn, h, worst, slip_change);
+  EXPECT_LT(slip_change, 1e-5);
+  EXPECT_LT(worst, 5e-3);
 }
 
 std::string error_of(const std::string& yaml) {
