@@ -13,13 +13,13 @@
 //   horizontal axis at w0: the rolling spring M_k' = -k_r w and M = M_k - C_r w give
 //   I theta'' + C_r theta' + k_r theta = 0, w = theta', with k_r, C_r of rolling.hpp
 //   (Ai et al. 2011, model C); the spring stays below M_max = mu_r R m g.
-// - Oblique impact that sticks: Hooke normal (the overlap d(t) of the damped oscillator in
-//   closed form), tangential spring-dashpot with a friction coefficient so large that the
-//   Coulomb limit acts only where F_n <= 0 (the attractive end of a damped contact, from the
-//   root t* of k_n d + gamma_n d' = 0 on: there F_t = 0). Up to t* the state (xi, v_x, w_y)
-//   obeys the linear ODE xi' = v_t = v_x - (R - d(t)) w_y, m v_x' = F_t,
-//   I w_y' = -(R - d(t)) F_t, F_t = -k_t xi - gamma_t v_t, integrated here with RK4 (20000
-//   steps, error < 1e-12); after t*, v_t is constant. The rebound's v_t is compared.
+// - Oblique impacts that stick (Hooke and Hertz, sphere-wall and pair): a friction
+//   coefficient so large that the Coulomb limit acts only where F_n <= 0 (the attractive end
+//   of a damped contact: there F_t = 0 from then on). The normal and tangential motion
+//   (spring xi' = v_t, F_t = -k_t xi - gamma_t v_t, the lever arms R - d or R - d/2) are
+//   integrated here with RK4 (40000 steps per contact time, the cut located by bisection); for
+//   the pair in the plane of the motion, since the line of centres turns. The rebound's v_t is
+//   compared (oblique_reference, oblique_pair_reference).
 // - Pair impacts: two equal spheres head-on, Hooke and Hertz, the references of
 //   damped_impact_convergence_test.cpp with m* = m/2 and R* = R/2.
 //
