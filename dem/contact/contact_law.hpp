@@ -54,8 +54,9 @@ struct ContactLaw {
     const SpringDashpotT<V> s = Normal::coefficients(pc, cc, g.r_star, g.m_star, g.overlap);
     const V vn = dot(g.v_pred, g.n);
     V fn;
+    [[maybe_unused]] V fn_prev{};  // predicted: the previous step's normal force (cell_dashpot)
     if constexpr (PredictedDashpot)
-      fn = s.kn * g.overlap + cell_dashpot(g, s, dt);
+      fn = s.kn * g.overlap + cell_dashpot(g, s, dt, fn_prev);
     else
       fn = s.kn * g.overlap - s.gn * vn;
     const V fn_pos = max0(fn);
@@ -66,8 +67,16 @@ struct ContactLaw {
     if constexpr (Tangential::enabled) {
       const V3<V> vt = g.v_rel - dot(g.v_rel, g.n) * g.n;
       const V3<V> vt_pred = g.v_pred - vn * g.n;
-      const V3<V> ft = Tangential::template force<V>(vt, vt_pred, s.kt, s.gt, pc.friction * fn_pos,
-                                                     g.n, tangential, spring_dt);
+      V3<V> ft;
+      if constexpr (PredictedDashpot) {
+        TangentialCell<V> cell = tangential_cell(g, fn, fn_prev, pc.friction, dt);
+        if (spring_dt == 0.0) cell.spring_time = V{};  // the initial state: springs unmoved
+        ft = Tangential::template cell_force<V>(vt, vt_pred, s.kt, s.gt, cell, g.n, tangential,
+                                                dt);
+      } else {
+        ft = Tangential::template force<V>(vt, vt_pred, s.kt, s.gt, pc.friction * fn_pos, g.n,
+                                           tangential, spring_dt);
+      }
       r.force += ft;
       const V3<V> n_x_ft = cross(g.n, ft);
       r.torque_i = -g.arm_i * n_x_ft;
@@ -106,9 +115,11 @@ struct ContactLaw {
   // impulses then telescope: over a contact they sum to Phi's change, to the prediction's
   // third-order error per step, and a contact that starts or ends part-way through a step
   // gets the impulse of the part it lasts.
+  // `f_prev` receives the previous step's force of this contact (spring and cell dashpot; 0
+  // if the contact began during the last drift), for tangential_cell().
   template <class V>
   [[gnu::always_inline]] static V cell_dashpot(const ContactGeometryT<V>& g,
-                                               const SpringDashpotT<V>& s, double dt) {
+                                               const SpringDashpotT<V>& s, double dt, V& f_prev) {
     const double h = 0.5 * dt;
     const V d = g.overlap;
     const auto phi = [&](V x) { return Normal::dashpot_potential(s, d, max0(x)); };
@@ -124,7 +135,7 @@ struct ContactLaw {
     const V lo = select(in_prev, select(ended_prev, V{}, phi_left), V{});
     // The previous step's own force (spring and cell dashpot), for the correction.
     const V lo_prev = select(d_prev - dt * up > 0.0, phi(d_prev - h * up), V{});
-    const V f_prev = select(in_prev,
+    f_prev = select(in_prev,
                             Normal::spring_force(s, d, max0(d_prev)) +
                                 (select(ended_prev, V{}, phi_left) - lo_prev) * (1.0 / dt),
                             V{});
@@ -137,6 +148,52 @@ struct ContactLaw {
     const V u1 = uh + dt * (accel - (f0 - f_prev) / g.m_star);
     const V hi = select(ends, V{}, phi(d + h * u1));
     return (hi - lo) * (1.0 / dt);
+  }
+
+  // What the tangential spring-dashpot of contact.dashpot_velocity: predicted needs to
+  // integrate its impulse over the step's cell [t - dt/2, t + dt/2] (docs/models/
+  // contact-models.md, "Integration"; TangentialCell, tangential.hpp). The contact began
+  // during the last drift if the overlap one step ago, delta - dt u_h, was <= 0: then it has
+  // lasted delta / u_h (the drift is straight), the spring's first increment and the left part
+  // of the cell. Where F_n > 0 within the cell follows from the line through the previous
+  // step's normal force and this one's (both cell averages, so the line's zero, where the
+  // Coulomb limit cuts the tangential force, is placed to O(dt^2)); the Coulomb limit is mu
+  // times the cell average of max(F_n, 0) along that line.
+  template <class V, class F>
+  [[gnu::always_inline]] static TangentialCell<V> tangential_cell(const ContactGeometryT<V>& g,
+                                                                  V fn, V fn_prev, F friction,
+                                                                  double dt) {
+    const double h = 0.5 * dt;
+    const V zero{}, one = V{} + 1.0;
+    const V uh = -dot(g.v_rel, g.n);
+    const auto in_prev = g.overlap - dt * uh > 0.0;
+    // Since first touch (u_h >= delta / dt > 0 where the contact is new).
+    const V since = select(in_prev, V{} + dt, g.overlap / select(in_prev, one, uh));
+    // F_n at the cell's edges on the line (t - dt, fn_prev), (t, fn); where the contact is
+    // new, fn_prev = 0 and the left part counts from first touch, where F_n > 0.
+    const V fa = 0.5 * (fn + fn_prev), fb = 1.5 * fn - 0.5 * fn_prev;
+    // The fraction of a segment from a to b on which the line is positive, and the mean of
+    // max(line, 0) over it.
+    const auto positive = [&](V a, V b) {
+      return select(a > 0.0, select(b > 0.0, one, a / (a - b)),
+                    select(b > 0.0, b / (b - a), zero));
+    };
+    const auto mean_positive = [&](V a, V b) {
+      return select(a > 0.0, select(b > 0.0, 0.5 * (a + b), a * a / (2.0 * (a - b))),
+                    select(b > 0.0, b * b / (2.0 * (b - a)), zero));
+    };
+    TangentialCell<V> c;
+    c.in_prev = select(in_prev, one, zero);
+    c.spring_time = since;
+    c.left = select(in_prev, h * positive(fa, fn), select(fn > 0.0, since, zero));
+    c.right = h * positive(fn, fb);
+    const V mean_left = select(in_prev, mean_positive(fa, fn), max0(fn));
+    c.limit = friction * 0.5 * (mean_left + mean_positive(fn, fb));
+    c.limit_now = friction * max0(fn);
+    // Tangential effective mass of solid spheres touching at their surface: 1/m_t =
+    // 1/m* + a_i^2/I_i + a_j^2/I_j ~ (1 + 5/2)/m* (I = 2 m r^2 / 5, arms ~ radii).
+    c.inv_mass = 3.5 / g.m_star;
+    return c;
   }
 
   // The normal part of evaluate()'s force on i, as its component along g.n (the same

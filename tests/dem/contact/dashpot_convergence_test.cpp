@@ -13,13 +13,13 @@
 //   horizontal axis at w0: the rolling spring M_k' = -k_r w and M = M_k - C_r w give
 //   I theta'' + C_r theta' + k_r theta = 0, w = theta', with k_r, C_r of rolling.hpp
 //   (Ai et al. 2011, model C); the spring stays below M_max = mu_r R m g.
-// - Oblique impact that sticks: Hooke normal (the overlap d(t) of the damped oscillator in
-//   closed form), tangential spring-dashpot with a friction coefficient so large that the
-//   Coulomb limit acts only where F_n <= 0 (the attractive end of a damped contact, from the
-//   root t* of k_n d + gamma_n d' = 0 on: there F_t = 0). Up to t* the state (xi, v_x, w_y)
-//   obeys the linear ODE xi' = v_t = v_x - (R - d(t)) w_y, m v_x' = F_t,
-//   I w_y' = -(R - d(t)) F_t, F_t = -k_t xi - gamma_t v_t, integrated here with RK4 (20000
-//   steps, error < 1e-12); after t*, v_t is constant. The rebound's v_t is compared.
+// - Oblique impacts that stick (Hooke and Hertz, sphere-wall and pair): a friction
+//   coefficient so large that the Coulomb limit acts only where F_n <= 0 (the attractive end
+//   of a damped contact: there F_t = 0 from then on). The normal and tangential motion
+//   (spring xi' = v_t, F_t = -k_t xi - gamma_t v_t, the lever arms R - d or R - d/2) are
+//   integrated here with RK4 (40000 steps per contact time, the cut located by bisection); for
+//   the pair in the plane of the motion, since the line of centres turns. The rebound's v_t is
+//   compared (oblique_reference, oblique_pair_reference).
 // - Pair impacts: two equal spheres head-on, Hooke and Hertz, the references of
 //   damped_impact_convergence_test.cpp with m* = m/2 and R* = R/2.
 //
@@ -39,8 +39,10 @@
 #include <functional>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "dem/engine/simulation.hpp"
+#include "dem/contact/restitution_mapping.hpp"
 #include "dem/engine/time_step.hpp"
 #include "tests/dem/support/test_scene.hpp"
 
@@ -241,94 +243,256 @@ TEST_P(RollingDashpotConvergence, EpsdFollowsTheDampedOscillator) {
 INSTANTIATE_TEST_SUITE_P(Schemes, RollingDashpotConvergence, kSchemeCases, scheme_case_name);
 
 // ---------------------------------------------------------------------------------------
-// Oblique impact that sticks.
+// Oblique impacts that stick: sphere-wall and pair (two equal spheres), Hooke and Hertz.
 constexpr double kVn = 1.0, kVt = 0.3;
 
-struct ObliqueReference {
-  double kn, gn, contact_time, vt;  // vt: the contact point's tangential velocity after
+struct ObliqueCase {
+  DashpotVelocity scheme;
+  NormalModel model;
+  bool pair;
+  double e;
 };
 
-ObliqueReference oblique_reference(double e) {
-  const double y_star = kY / (2 * (1 - kNu * kNu));
-  const double sr = std::sqrt(kR);
-  const double kn = (16.0 / 15.0) * sr * y_star *
-                    std::pow(15.0 * kMass * kVn * kVn / (16.0 * sr * y_star), 0.2);
-  const double beta = zeta_of(e);
-  const double gn = std::sqrt(4 * kMass * kn) * beta;
-  const double kt = kn, gt = gn;  // normal_hooke.hpp: k_t = k_n, gamma_t = gamma_n
-  const Oscillator normal(kMass, gn, kn, kVn);
-  // t*: k_n d + gamma_n d' = 0, i.e. tan(omega_d t) = -gamma_n omega_d / (k_n - gamma_n alpha).
-  const double w = normal.omega_d;
-  const double t_star = (kPi - std::atan2(gn * w, kn - gn * normal.alpha)) / w;
-  // RK4 on (xi, v_x, w_y) from first touch to t*.
-  const auto rhs = [&](double t, const std::array<double, 3>& y) {
-    const double arm = kR - normal.position(t);
-    const double vt = y[1] - arm * y[2];
-    const double ft = -kt * y[0] - gt * vt;
-    return std::array<double, 3>{vt, ft / kMass, -arm * ft / kInertia};
-  };
-  std::array<double, 3> y{0, kVt, 0};
-  const int steps = 20000;
-  const double h = t_star / steps;
-  for (int i = 0; i < steps; ++i) {
-    const double t = i * h;
-    std::array<double, 3> k1 = rhs(t, y), y2, y3, y4;
-    for (int j = 0; j < 3; ++j) y2[j] = y[j] + 0.5 * h * k1[j];
-    const std::array<double, 3> k2 = rhs(t + 0.5 * h, y2);
-    for (int j = 0; j < 3; ++j) y3[j] = y[j] + 0.5 * h * k2[j];
-    const std::array<double, 3> k3 = rhs(t + 0.5 * h, y3);
-    for (int j = 0; j < 3; ++j) y4[j] = y[j] + h * k3[j];
-    const std::array<double, 3> k4 = rhs(t + h, y4);
-    for (int j = 0; j < 3; ++j) y[j] += h / 6 * (k1[j] + 2 * k2[j] + 2 * k3[j] + k4[j]);
+struct ObliqueReference {
+  double contact_time, vt;  // vt: the contact point's tangential velocity after
+};
+
+// The normal and tangential coefficients of the contact at overlap d (normal_hooke.hpp,
+// normal_hertz.hpp with the pair coefficients of one material).
+struct ObliqueLaw {
+  NormalModel model;
+  double m_star, r_star, y_star, g_star, hooke_kn, hooke_gn, hertz_beta;
+  ObliqueLaw(NormalModel law, bool pair, double e) : model(law) {
+    m_star = pair ? 0.5 * kMass : kMass;
+    r_star = pair ? 0.5 * kR : kR;
+    y_star = kY / (2 * (1 - kNu * kNu));
+    g_star = kY / (4 * (2 - kNu) * (1 + kNu));
+    const double sr = std::sqrt(r_star);
+    hooke_kn = (16.0 / 15.0) * sr * y_star *
+               std::pow(15.0 * m_star * kVn * kVn / (16.0 * sr * y_star), 0.2);
+    hooke_gn = std::sqrt(4 * m_star * hooke_kn) * zeta_of(e);
+    hertz_beta = hertz_damping_for_restitution(e);
   }
-  // After separation the arm is R.
-  return {kn, gn, normal.half_period(), y[1] - kR * y[2]};
+  // k_n d (the spring force), gamma_n, k_t, gamma_t at overlap d >= 0.
+  std::array<double, 4> at(double d) const {
+    if (model == NormalModel::hooke) return {hooke_kn * d, hooke_gn, hooke_kn, hooke_gn};
+    const double a = std::sqrt(r_star * d), sn = 2 * y_star * a;
+    const double gn = 1.8257418583505538 * hertz_beta * std::sqrt(sn * m_star);
+    return {(2.0 / 3.0) * sn * d, gn, 8 * g_star * a, gn * std::sqrt(4 * g_star / y_star)};
+  }
+};
+
+// RK4 on (d, d', xi, w, omega) from first touch: m* d'' = -F_n, F_n = k_n d + gamma_n d';
+// the tangential force F_t = -k_t xi - gamma_t v_t while F_n > 0 and 0 from the first time
+// F_n reaches 0 on (located by bisection of the step), with v_t = w - c a omega, w' = F_t/m_w,
+// omega' = -a F_t / I: for the wall c = 1, m_w = m, a = R - d; for the pair w = v_i - v_j,
+// omega each sphere's spin, c = 2, m_w = m/2, a = R - d/2. After F_n = 0 only the normal
+// motion continues, to the end of contact (d = 0), which gives the contact time.
+ObliqueReference oblique_reference(const ObliqueLaw& law, bool pair) {
+  using State = std::array<double, 5>;
+  const double c = pair ? 2 : 1, m_w = pair ? 0.5 * kMass : kMass;
+  bool sticking = true;
+  const auto normal_force = [&](const State& y) {
+    const auto k = law.at(std::max(y[0], 0.0));
+    return k[0] + k[1] * y[1];
+  };
+  const auto rhs = [&](const State& y) {
+    const auto k = law.at(std::max(y[0], 0.0));
+    const double fn = k[0] + k[1] * y[1];
+    const double arm = kR - (pair ? 0.5 : 1.0) * y[0];
+    const double vt = y[3] - c * arm * y[4];
+    const double ft = sticking ? -k[2] * y[2] - k[3] * vt : 0.0;
+    return State{y[1], -fn / law.m_star, vt, ft / m_w, -arm * ft / kInertia};
+  };
+  const auto rk4 = [&](const State& y, double h) {
+    const State k1 = rhs(y);
+    State y2, y3, y4, r = y;
+    for (int j = 0; j < 5; ++j) y2[j] = y[j] + 0.5 * h * k1[j];
+    const State k2 = rhs(y2);
+    for (int j = 0; j < 5; ++j) y3[j] = y[j] + 0.5 * h * k2[j];
+    const State k3 = rhs(y3);
+    for (int j = 0; j < 5; ++j) y4[j] = y[j] + h * k3[j];
+    const State k4 = rhs(y4);
+    for (int j = 0; j < 5; ++j) r[j] += h / 6 * (k1[j] + 2 * k2[j] + 2 * k3[j] + k4[j]);
+    return r;
+  };
+  // The step: 1/40000 of the elastic Hertz contact time (or Hooke's undamped half period).
+  const double t_scale = law.model == NormalModel::hooke
+                             ? kPi * std::sqrt(law.m_star / law.hooke_kn)
+                             : hertz_contact_time(law.y_star, law.r_star, law.m_star, kVn);
+  const double h = t_scale / 40000;
+  State y{0, kVn, 0, kVt, 0};
+  double t = 0;
+  for (long n = 0; n < 10'000'000; ++n) {
+    const State next = rk4(y, h);
+    if (sticking && n > 0 && normal_force(next) <= 0) {
+      double lo = 0, hi = h;  // F_n > 0 after lo, <= 0 after hi
+      for (int k = 0; k < 60; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        (normal_force(rk4(y, mid)) > 0 ? lo : hi) = mid;
+      }
+      y = rk4(y, hi);
+      t += hi;
+      sticking = false;
+      continue;
+    }
+    if (next[0] <= 0) {  // the end of contact, by linear interpolation of d
+      t += h * y[0] / (y[0] - next[0]);
+      return {t, next[3] - c * kR * next[4]};
+    }
+    y = next;
+    t += h;
+  }
+  ADD_FAILURE() << "the reference contact did not end";
+  return {0, 0};
+}
+
+// The pair in the plane of its motion (the line of centres turns as the tangential forces
+// move the spheres apart sideways, so the wall's one-dimensional reference does not apply):
+// RK4 on the relative position r = x_i - x_j, the relative velocity u = v_i - v_j, each
+// sphere's spin omega (equal by symmetry) and the spring's length s along the tangent
+// t = z x n (n = r / |r|; the law keeps the spring in the tangent plane at its length). With
+// d = 2R - |r|, a = R - d/2 and the contact point's velocity v_c = u - 2 a omega t:
+// F_n = k_n d + gamma_n (-u.n), F_t = -k_t s - gamma_t v_c.t while F_n > 0 (0 from the first
+// time F_n reaches 0 on), s' = v_c.t, u' = 2 (F_n n + F_t t) / m, omega' = -a F_t / I.
+// First touch at r = (2R, 0), u = (-v_n, v_t); the rebound's u_y - 2 R omega is compared
+// (the lab-frame tangential velocity of the contact point, constant after separation).
+ObliqueReference oblique_pair_reference(const ObliqueLaw& law) {
+  using State = std::array<double, 6>;  // r_x, r_y, u_x, u_y, omega, s
+  bool sticking = true;
+  const auto forces = [&](const State& y) {  // F_n, F_t, n, t, arm
+    const double dist = std::hypot(y[0], y[1]);
+    const double d = 2 * kR - dist;
+    const double nx = y[0] / dist, ny = y[1] / dist;
+    const double arm = kR - 0.5 * d;
+    const double vn = y[2] * nx + y[3] * ny;
+    const double vt = -y[2] * ny + y[3] * nx - 2 * arm * y[4];
+    if (d <= 0) return std::array<double, 6>{0, 0, nx, ny, arm, vt};
+    const auto k = law.at(d);
+    const double fn = k[0] - k[1] * vn;
+    const double ft = sticking && fn > 0 ? -k[2] * y[5] - k[3] * vt : 0.0;
+    return std::array<double, 6>{fn, ft, nx, ny, arm, vt};
+  };
+  const auto rhs = [&](const State& y) {
+    const auto f = forces(y);
+    const double fx = f[0] * f[2] - f[1] * f[3], fy = f[0] * f[3] + f[1] * f[2];
+    return State{y[2], y[3], 2 * fx / kMass, 2 * fy / kMass, -f[4] * f[1] / kInertia, f[5]};
+  };
+  const auto rk4 = [&](const State& y, double h) {
+    const State k1 = rhs(y);
+    State y2, y3, y4, r = y;
+    for (int j = 0; j < 6; ++j) y2[j] = y[j] + 0.5 * h * k1[j];
+    const State k2 = rhs(y2);
+    for (int j = 0; j < 6; ++j) y3[j] = y[j] + 0.5 * h * k2[j];
+    const State k3 = rhs(y3);
+    for (int j = 0; j < 6; ++j) y4[j] = y[j] + h * k3[j];
+    const State k4 = rhs(y4);
+    for (int j = 0; j < 6; ++j) r[j] += h / 6 * (k1[j] + 2 * k2[j] + 2 * k3[j] + k4[j]);
+    return r;
+  };
+  const double t_scale = law.model == NormalModel::hooke
+                             ? kPi * std::sqrt(law.m_star / law.hooke_kn)
+                             : hertz_contact_time(law.y_star, law.r_star, law.m_star, kVn);
+  const double h = t_scale / 40000;
+  State y{2 * kR, 0, -kVn, kVt, 0, 0};
+  double t = 0;
+  const auto normal_force = [&](const State& z) { return forces(z)[0]; };
+  const auto overlap = [&](const State& z) { return 2 * kR - std::hypot(z[0], z[1]); };
+  for (long n = 0; n < 10'000'000; ++n) {
+    const State next = rk4(y, h);
+    if (sticking && n > 0 && normal_force(next) <= 0) {
+      double lo = 0, hi = h;
+      for (int k = 0; k < 60; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        (normal_force(rk4(y, mid)) > 0 ? lo : hi) = mid;
+      }
+      y = rk4(y, hi);
+      t += hi;
+      sticking = false;
+      continue;
+    }
+    if (n > 0 && overlap(next) <= 0) {
+      t += h * overlap(y) / (overlap(y) - overlap(next));
+      return {t, next[3] - 2 * kR * next[4]};
+    }
+    y = next;
+    t += h;
+  }
+  ADD_FAILURE() << "the reference contact did not end";
+  return {0, 0};
 }
 
 class ObliqueRig {
  public:
-  ObliqueRig(DashpotVelocity d, double e) : sim_(scene(d, e), false) {
-    sim_.particles().add(1, Vec3(0, 0, kR + 1e-3), Vec3(kVt, 0, -kVn), Vec3::Zero(), kR, 0, kRho);
+  explicit ObliqueRig(const ObliqueCase& c) : pair_(c.pair), sim_(scene(c), false) {
+    if (pair_) {
+      sim_.particles().add(1, Vec3(kR + 1e-3, 0, 0), Vec3::Zero(), Vec3::Zero(), kR, 0, kRho);
+      sim_.particles().add(2, Vec3(-kR - 1e-3, 0, 0), Vec3::Zero(), Vec3::Zero(), kR, 0, kRho);
+    } else {
+      sim_.particles().add(1, Vec3(0, 0, kR + 1e-3), Vec3::Zero(), Vec3::Zero(), kR, 0, kRho);
+    }
     sim_.set_dt(1e-7);
     sim_.initialise();
   }
   // The contact point's tangential velocity after an impact whose first touch falls `phase`
-  // into the second step.
+  // into the second step. The wall: normal z, tangential x. The pair: normal x at first
+  // touch (from particle 2 to particle 1), relative velocity (-v_n, v_t, 0); the rebound's
+  // u_y - R (omega_i + omega_j)_z in the lab frame (oblique_pair_reference).
   double impact(double dt, double phase) {
     Particles& p = sim_.particles();
     const double t0 = (1.0 + phase) * dt;
-    p.x[0] = Vec3(0, 0, kR + kVn * t0);
-    p.v[0] = Vec3(kVt, 0, -kVn);
-    p.omega[0].setZero();
-    p.force[0].setZero();
-    p.torque[0].setZero();
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      p.omega[i].setZero();
+      p.force[i].setZero();
+      p.torque[i].setZero();
+      if (!pair_) {
+        p.x[i] = Vec3(0, 0, kR + kVn * t0);
+        p.v[i] = Vec3(kVt, 0, -kVn);
+      } else {
+        // The particles may have been re-sorted: place them by id, so that the line of
+        // centres is along x at first touch.
+        const double sign = p.id[i] == 1 ? 1.0 : -1.0;
+        p.x[i] = sign * Vec3(kR + 0.5 * kVn * t0, -0.5 * kVt * t0, 0);
+        p.v[i] = sign * Vec3(-0.5 * kVn, 0.5 * kVt, 0);
+      }
+    }
     sim_.set_dt(dt);
     bool touched = false;
     for (long n = 0; n < 1'000'000; ++n) {
       sim_.step();
-      const double d = kR - p.x[0][2];
-      if (d > 0)
-        touched = true;
-      else if (touched)
-        return p.v[0][0] - kR * p.omega[0][1];
+      if (!pair_) {
+        const double d = kR - p.x[0][2];
+        if (d > 0)
+          touched = true;
+        else if (touched)
+          return p.v[0][0] - kR * p.omega[0][1];
+      } else {
+        const std::size_t i = p.id[0] == 1 ? 0 : 1, j = 1 - i;
+        const double d = 2 * kR - (p.x[i] - p.x[j]).norm();
+        if (d > 0)
+          touched = true;
+        else if (touched)
+          return p.v[i][1] - p.v[j][1] - kR * (p.omega[i][2] + p.omega[j][2]);
+      }
     }
     ADD_FAILURE() << "contact did not end";
     return 0;
   }
 
  private:
-  static Scene scene(DashpotVelocity d, double e) {
-    Scene s = test::one_material_scene(kY, kNu, kRho, e, 1e6);
-    s.contact.normal = NormalModel::hooke;
+  static Scene scene(const ObliqueCase& c) {
+    Scene s = test::one_material_scene(kY, kNu, kRho, c.e, 1e6);
+    s.contact.normal = c.model;
     s.contact.tangential = TangentialModel::history;
-    s.contact.hooke_characteristic_velocity = kVn;
-    s.contact.dashpot_velocity = d;
-    s.domain.lo = Vec3(-0.1, -0.01, -0.01);
-    s.domain.hi = Vec3(0.1, 0.01, 0.03);
+    if (c.model == NormalModel::hooke) s.contact.hooke_characteristic_velocity = kVn;
+    s.contact.dashpot_velocity = c.scheme;
+    s.domain.lo = Vec3(-0.1, -0.1, -0.01);
+    s.domain.hi = Vec3(0.1, 0.1, 0.03);
     s.time.max_overlap = 1;
-    s.walls.push_back(test::plane(Vec3::Zero(), Vec3::UnitZ()));
+    if (!c.pair) s.walls.push_back(test::plane(Vec3::Zero(), Vec3::UnitZ()));
     return s;
   }
+  bool pair_;
   Simulation sim_;
 };
 
@@ -346,31 +510,65 @@ double oblique_error(ObliqueRig& rig, const ObliqueReference& ref, double steps)
   return std::sqrt(se / (kPhases * kLengths));
 }
 
-class ObliqueStickingConvergence : public ::testing::TestWithParam<SchemeCase> {};
+std::string oblique_case_name(const ::testing::TestParamInfo<ObliqueCase>& info) {
+  const ObliqueCase& c = info.param;
+  return std::string(c.scheme == DashpotVelocity::predicted ? "Predicted" : "HalfStep") +
+         (c.model == NormalModel::hooke ? "_Hooke" : "_Hertz") + (c.pair ? "_Pair" : "_Wall") +
+         "_e0" + std::to_string(static_cast<int>(c.e * 10 + 0.5));
+}
 
-// The tangential force of an impact jumps where the contact begins (the dashpot's
-// -gamma_t v_t) and where F_n reaches zero (the spring's -k_t xi, cut by the Coulomb limit),
-// and the spring's first increment counts the whole drift in which the contact began: errors
-// of O(dt) in the impulse, impact by impact, with either scheme (the normal dashpot's cell
-// integration has no tangential counterpart). The rms error therefore falls at first order
-// only; the test fits the slope over N = 20 ... 80 (the single impacts' errors change sign
-// with the offsets, so two points scatter; measured 0.73-1.0) and requires >= 0.6, and the
-// error at N = 40 below 0.2 of the change of v_t (measured 0.004-0.11). Below 20 steps per
-// impact the e = 0.1 case with predicted is unstable at N = 10-14: the tangential oscillator
-// (m_eff = 2/7 m, gamma_t = gamma_n) is over-damped and faster than the normal one, and the
-// extrapolated velocity makes the explicit dashpot less stable than the half-step one.
-TEST_P(ObliqueStickingConvergence, ReboundConvergesAtFirstOrder) {
-  const SchemeCase c = GetParam();
-  const ObliqueReference ref = oblique_reference(c.e);
-  ObliqueRig rig(c.scheme, c.e);
+std::vector<ObliqueCase> oblique_cases() {
+  std::vector<ObliqueCase> cases;
+  for (DashpotVelocity d : {DashpotVelocity::predicted, DashpotVelocity::half_step})
+    for (NormalModel m : {NormalModel::hooke, NormalModel::hertz})
+      for (bool pair : {false, true})
+        for (double e : {0.9, 0.5, 0.1}) {
+          // half_step: the Hooke wall only, unless GRAINFLOW_DASHPOT_SWEEP is set.
+          if (d == DashpotVelocity::half_step && (pair || m == NormalModel::hertz) &&
+              !sweep_requested())
+            continue;
+          cases.push_back({d, m, pair, e});
+        }
+  return cases;
+}
+
+class ObliqueStickingConvergence : public ::testing::TestWithParam<ObliqueCase> {};
+
+// With `predicted` the tangential spring-dashpot's impulse is integrated over the step's cell
+// (contact start inside the step, the Coulomb cut where F_n reaches zero inside the step,
+// the spring's first increment over the time in contact), and the dashpot sees the
+// end-of-step velocity implicit in its own force: second order, impact by impact, and stable
+// at 10 steps per impact where the explicit predicted dashpot was not (at e = 0.1). The test
+// fits the slope of the rms error over N = 20 ... 80 and requires >= 1.8, and checks that
+// N = 10 stays bounded (error <= 10 %). With half_step the tangential force still jumps at
+// contact start (the dashpot) and at F_n = 0 (the spring, cut by the Coulomb limit), and the
+// spring's first increment counts the whole drift of first touch: O(dt) impulse errors, first
+// order (the slope >= 0.6 is asserted and the error at N = 40 below 0.2).
+TEST_P(ObliqueStickingConvergence, ReboundConverges) {
+  const ObliqueCase c = GetParam();
+  const ObliqueLaw law(c.model, c.pair, c.e);
+  const ObliqueReference ref = c.pair ? oblique_pair_reference(law) : oblique_reference(law, c.pair);
+  ObliqueRig rig(c);
   double sx = 0, sy = 0, sxx = 0, sxy = 0, at40 = 0;
   const std::array<double, 5> ns{20, 28, 40, 57, 80};
-  if (sweep_requested())  // below 20: e = 0.1 is unstable at 10-14 steps with predicted
-    for (double n : {10.0, 14.0})
-      std::printf("oblique sticking %s e = %.1f: N=%g %.2e\n", scheme_name(c.scheme), c.e, n,
-                  oblique_error(rig, ref, n));
-  std::printf("oblique sticking %s e = %.1f (v_t after %.4f v_t before): rms error of its change",
-              scheme_name(c.scheme), c.e, ref.vt / kVt);
+  const char* name = scheme_name(c.scheme);
+  const char* model = c.model == NormalModel::hooke ? "hooke" : "hertz";
+  const char* geometry = c.pair ? "pair" : "wall";
+  if (c.scheme == DashpotVelocity::predicted || sweep_requested()) {
+    std::printf("oblique sticking %s %s %s e = %.1f:", name, model, geometry, c.e);
+    for (double n : {7.0, 10.0, 14.0}) {
+      if (c.model == NormalModel::hertz && n < 10) continue;  // refused: < 5 elastic contact times
+      const double err = oblique_error(rig, ref, n);
+      std::printf(" N=%g %.2e", n, err);
+      if (c.scheme == DashpotVelocity::predicted && n >= 10) {
+        EXPECT_LE(err, 0.2) << "N = " << n;
+      }
+    }
+    std::printf("\n");
+  }
+  std::printf("oblique sticking %s %s %s e = %.1f (v_t after %.4f v_t before): rms error of its "
+              "change",
+              name, model, geometry, c.e, ref.vt / kVt);
   for (double n : ns) {
     const double err = oblique_error(rig, ref, n);
     if (n == 40) at40 = err;
@@ -384,11 +582,16 @@ TEST_P(ObliqueStickingConvergence, ReboundConvergesAtFirstOrder) {
   const double k = ns.size();
   const double slope = -(k * sxy - sx * sy) / (k * sxx - sx * sx);
   std::printf(": fitted slope %.2f\n", slope);
-  EXPECT_GE(slope, 0.6);
-  EXPECT_LE(at40, 0.2);
+  if (c.scheme == DashpotVelocity::predicted) {
+    EXPECT_GE(slope, 1.8);
+  } else {
+    EXPECT_GE(slope, 0.6);
+    EXPECT_LE(at40, 0.2);
+  }
 }
 
-INSTANTIATE_TEST_SUITE_P(Schemes, ObliqueStickingConvergence, kSchemeCases, scheme_case_name);
+INSTANTIATE_TEST_SUITE_P(Schemes, ObliqueStickingConvergence, ::testing::ValuesIn(oblique_cases()),
+                         oblique_case_name);
 
 // ---------------------------------------------------------------------------------------
 // Pair impacts, head-on.
