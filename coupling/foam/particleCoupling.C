@@ -1191,10 +1191,13 @@ void ParticleCoupling::depositHeat() {
       responseCell_[points_[j].cell] += points_[j].weight * g;
     }
   }
-  // Particles that left this rank during the advance: their heat where they last took it.
+  // Particles that left this rank during the advance: their heat where they last took it,
+  // or, when that position already lies beyond this rank's cells (the step that took them
+  // across a processor plane or a periodic face), in this rank's nearest cell.
   for (std::size_t k = 0; k < heatExchange_.orphan_heat.size(); ++k) {
     const std::array<double, 3>& x = heatExchange_.orphan_position[k];
-    const label c = locate(point(x[0], x[1], x[2]));
+    label c = locate(point(x[0], x[1], x[2]));
+    if (c < 0 && n > 0) c = mesh_.findNearestCell(point(x[0], x[1], x[2]));
     if (c >= 0)
       heatCell_[c] += heatExchange_.orphan_heat[k];
     else
