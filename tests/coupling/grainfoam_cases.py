@@ -844,6 +844,25 @@ def heat_equilibrium(runner, checks):
     checks.expect(worst < 5e-3, f"mean temperatures against T_eq + (T_0 - T_eq) exp(-t/tau), "
                                 f"T_eq = {t_eq:.4f} K, tau = {tau * 1e3:.3f} ms: largest error "
                                 f"{100 * worst:.3f} % of the initial difference < 0.5 %")
+    # Set-ups refused: transportProperties without kappa, Cp unlike the scene's, a scene with
+    # heat but no convection keys in its fluid block.
+    for name, edits, pattern in (
+            ("no_kappa", [("constant/transportProperties", "kappa   0.026;\n", "")],
+             r"transportProperties\"? needs `kappa  <W/\(m K\)>;`"),
+            ("cp_differs", [("constant/transportProperties", "Cp      1000;", "Cp      1005;")],
+             r"particles\.yaml:\d+: error: fluid\.heat_capacity is 1000 J/\(kg K\) but .*"
+             r"transportProperties has Cp 1005"),
+            ("no_convection", [("particles.yaml", "  temperature: 300 ", "  # temperature: 300 "),
+                               ("particles.yaml", "  heat_capacity: 1000\n", ""),
+                               ("particles.yaml", "  conductivity: 0.026\n", ""),
+                               ("particles.yaml", "  convection: ranz_marshall\n", "")],
+             r"particles\.yaml:\d+: error: heat is on .*the fluid block has no convection "
+             r"settings")):
+        bad = runner.fresh_case("heated_box", name, edits)
+        runner.run(bad, "blockMesh", "blockMesh")
+        out = runner.run(bad, "grainFoam", runner.solver, expect_failure=True)
+        checks.expect(re.search(pattern, out, re.DOTALL) is not None,
+                      f"{name}: refused with /{pattern}/")
     # Restart: stop at 0.05 s, continue to 0.1 s.
     part = runner.fresh_case("heated_box", "equilibrium_restart", [
         ("system/controlDict", "endTime         0.1;", "endTime         0.05;")])

@@ -38,7 +38,8 @@
 #       air at 300 K (heat on): the mixture's thermal energy conserved to 1e-12, the mean
 #       temperatures against the two-body closed form (T_eq, tau with Nu = 2) within 0.5 %,
 #       the exchange balanced to round-off at every write time; a restart at half time ends
-#       with the same T. About 10 s.
+#       with the same T; missing kappa, Cp unlike the scene, heat without convection keys
+#       refused with their messages. About 10 s.
 #   coupling.heat_balance          cases/periodic_box with heat (Gunn), beads at 350 K raining
 #       through water at 300 K, on 1 and 2 ranks: heat taken by the particles = heat lost by
 #       the fluid to 1e-12 relative at every write time, mixture energy conserved to 1e-12,
