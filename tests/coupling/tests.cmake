@@ -43,7 +43,7 @@
 #   coupling.heat_balance          cases/periodic_box with heat (Gunn), beads at 350 K raining
 #       through water at 300 K, on 1 and 2 ranks: heat taken by the particles = heat lost by
 #       the fluid to 1e-12 relative at every write time, mixture energy conserved to 1e-12,
-#       the two rank counts agree within 1 %. About 40 s.
+#       the two rank counts agree within 1 %. About 10 s.
 if(NOT TARGET grainFoam)
   return()
 endif()
