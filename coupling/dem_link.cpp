@@ -8,6 +8,7 @@
 #include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <unordered_map>
 
 #include "dem/engine/checkpoint_series.hpp"
 #include "dem/engine/finite_guard.hpp"
@@ -47,6 +48,8 @@ struct DemLink::Impl {
   bool curl = false;                    // needs_vorticity()
   std::vector<SelfDisturbance> pending_disturbance;  // when `self`
   bool self = false;                                  // correct_self_disturbance()
+  bool heat = false;                     // heat_on()
+  std::vector<double> pending_temperature;  // set_fluid_temperatures()
   // The coupling's sampler of late arrivals (end_fluid), and whether the CoupledFluid's
   // sampler calls it already.
   std::function<FluidAtParticle(const std::array<double, 3>&)> late;
@@ -71,6 +74,7 @@ struct DemLink::Impl {
     s.vorticity = vec(f.vorticity);
     s.density = fluid_density;
     s.viscosity = fluid_viscosity;
+    s.temperature = f.temperature;
     return s;
   }
 };
@@ -108,13 +112,16 @@ DemLink::DemLink(const std::string& scene_file, double fluid_density, double flu
         << ": error: grainFoam's pressure excludes the hydrostatic part (rho_f g.x); add "
            "`pressure: {hydrostatic: false}` to the fluid block and list buoyancy in "
            "fluid.forces\n";
-  // Heat transfer is built for grain (DEM and one-way fluid) only.
-  if (m.scene.heat)
-    why << m.scene.heat->source
-        << ": error: heat transfer in a coupled run needs grainFoam's fluid energy equation, "
-           "which is not built yet (docs/models/heat-transfer.md, \"Not yet built\"); remove "
-           "the `heat:` block (and the thermal keys) to run the isothermal coupled case, or run "
-           "the scene with `grain` and a prescribed fluid temperature\n";
+  // Heat in a coupled run: grainFoam's energy equation exchanges heat with the particles by
+  // convection, which needs the fluid's c_p, k_f and Nusselt law from the fluid block.
+  if (m.scene.heat && !f.thermal)
+    why << f.source
+        << ": error: heat is on (" << m.scene.heat->source
+        << "), but the fluid block has no convection settings; a coupled run with heat needs "
+           "`temperature: <K>`, `heat_capacity: <J/(kg K)>` and `conductivity: <W/(m K)>` in "
+           "the fluid block (the fluid temperature itself comes from grainFoam's 0/T; "
+           "docs/models/heat-transfer.md, \"Coupled to grainFoam\")\n";
+  m.heat = m.scene.heat && f.thermal;
   // The output keys that belong to grain's own run loop: grainFoam's write times replace them.
   for (const auto& [key, where] : m.scene.output.given) {
     const char* instead = nullptr;
@@ -159,6 +166,14 @@ bool DemLink::needs_vorticity() const {
   return false;
 }
 std::string DemLink::drag_law() const { return impl_->scene.fluid->drag_law; }
+bool DemLink::heat_on() const { return impl_->heat; }
+double DemLink::fluid_heat_capacity() const {
+  return impl_->heat ? impl_->scene.fluid->thermal->heat_capacity : 0.0;
+}
+double DemLink::fluid_conductivity() const {
+  return impl_->heat ? impl_->scene.fluid->thermal->conductivity : 0.0;
+}
+std::string DemLink::fluid_source() const { return impl_->scene.fluid->source; }
 double DemLink::end_time() const { return impl_->scene.time.end; }
 std::string DemLink::end_time_source() const { return impl_->scene.time.end_source; }
 
@@ -241,6 +256,7 @@ void DemLink::initialise() {
     // The first force evaluation, before the fluid is sampled, sees fluid at rest, eps = 1.
     Impl* self = &m;
     m.fluid->set_sampler([self](const Vec3&) { return self->to_sample(FluidAtParticle{}); });
+    if (m.heat) m.sim->heat()->couple(m.fluid.get());
     m.sim->record_fluid_force((m.scene.output.fields & snapshot_field_bit("fluid_force")) != 0);
     m.sim->record_contacts(m.scene.output.contacts);
     m.sim->initialise();
@@ -463,6 +479,83 @@ DemLink::SampleRecords DemLink::fluid_samples() {
                        m.curl ? m.pending_vorticity.data()->data() : nullptr};
 }
 
+void DemLink::set_fluid_temperatures(std::vector<double> temperatures) {
+  impl_->pending_temperature = std::move(temperatures);
+}
+
+void DemLink::heat_exchange(int steps, HeatExchange& out) const {
+  const Impl& m = *impl_;
+  const Simulation& sim = m.simulation();
+  const Particles& p = sim.particles();
+  const HeatTransfer& heat = *sim.heat();
+  const CoupledFluid& fluid = *m.fluid;
+  const std::vector<GlobalId>& ids = fluid.entry_ids();
+  const std::vector<double>& taken = fluid.entry_heat();
+  const std::vector<double>& conductance = fluid.entry_conductance();
+  const std::vector<Vec3>& where = fluid.entry_heat_position();
+  std::unordered_map<GlobalId, std::size_t> entry;
+  entry.reserve(ids.size());
+  for (std::size_t k = 0; k < ids.size() && k < taken.size(); ++k) entry.emplace(ids[k], k);
+  std::vector<char> used(taken.size(), 0);
+  const std::size_t local = p.size();
+  const Ghosts& g = sim.ghosts();
+  out.heat.assign(local + g.size(), 0.0);
+  out.response.assign(local + g.size(), 0.0);
+  const double dt = sim.dt();
+  for (std::size_t i = 0; i < local; ++i) {
+    const auto it = entry.find(p.id[i]);
+    if (it == entry.end()) continue;  // came after the last heat pass: nothing taken
+    const std::size_t k = it->second;
+    used[k] = 1;
+    const double c = p.mass[i] * heat.heat_capacity(p.material[i]);
+    out.heat[i] = taken[k];
+    // N implicit steps at fixed T_f: a change dT_f of the fluid temperature changes T_i
+    // by (1 - (1 + dt H / C)^-N) dT_f.
+    out.response[i] = -c * std::expm1(-steps * std::log1p(dt * conductance[k] / c));
+  }
+  out.orphan_position.clear();
+  out.orphan_heat.clear();
+  for (std::size_t k = 0; k < taken.size(); ++k)
+    if (!used[k] && taken[k] != 0) {
+      out.orphan_position.push_back(arr(where[k]));
+      out.orphan_heat.push_back(taken[k]);
+    }
+  if (g.size() == 0 && sim.decomposition().dims() == std::array<int, 3>{1, 1, 1}) return;
+  std::vector<double> values(2 * local);
+  for (std::size_t i = 0; i < local; ++i) {
+    values[2 * i] = out.heat[i];
+    values[2 * i + 1] = out.response[i];
+  }
+  const std::vector<double> ghost_values = sim.ghost_values(values, 2);
+  for (std::size_t k = 0; k < g.size(); ++k) {
+    out.heat[local + k] = ghost_values[2 * k];
+    out.response[local + k] = ghost_values[2 * k + 1];
+  }
+}
+
+void DemLink::add_heat(const std::vector<double>& joules) {
+  Simulation& sim = impl_->simulation();
+  Particles& p = sim.particles();
+  const HeatTransfer& heat = *sim.heat();
+  if (joules.size() != p.size())
+    throw std::logic_error("DemLink::add_heat: " + std::to_string(joules.size()) +
+                           " values for " + std::to_string(p.size()) + " particles");
+  for (std::size_t i = 0; i < p.size(); ++i)
+    p.temperature[i] += joules[i] / (p.mass[i] * heat.heat_capacity(p.material[i]));
+}
+
+std::array<double, 2> DemLink::thermal_energy() const {
+  const Simulation& sim = impl_->simulation();
+  const Particles& p = sim.particles();
+  double sums[2] = {0, 0};
+  if (const HeatTransfer* heat = sim.heat()) {
+    sums[0] = heat->thermal_energy(p);
+    for (std::size_t i = 0; i < p.size(); ++i) sums[1] += p.mass[i] * heat->heat_capacity(p.material[i]);
+  }
+  MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE, MPI_SUM, impl_->dem_comm);
+  return {sums[0], sums[1]};
+}
+
 void DemLink::add_fluid(const FluidAtParticle& f) {
   Impl& m = *impl_;
   m.pending.push_back(CoupledSample{vec(f.velocity), f.void_fraction, vec(f.pressure_gradient),
@@ -492,9 +585,14 @@ void DemLink::end_fluid() {
     throw std::logic_error("DemLink: " + std::to_string(m.pending_disturbance.size()) +
                            " self-disturbance samples for " + std::to_string(p.size()) +
                            " particles");
+  if (m.heat && m.pending_temperature.size() != p.size())
+    throw std::logic_error("DemLink: " + std::to_string(m.pending_temperature.size()) +
+                           " fluid temperatures for " + std::to_string(p.size()) + " particles");
   m.fluid->set(p.id, std::move(m.pending),
                m.curl ? std::move(m.pending_vorticity) : std::vector<Vec3>{},
-               m.self ? std::move(m.pending_disturbance) : std::vector<SelfDisturbance>{});
+               m.self ? std::move(m.pending_disturbance) : std::vector<SelfDisturbance>{},
+               m.heat ? std::move(m.pending_temperature) : std::vector<double>{});
+  m.pending_temperature = {};
   m.pending = {};  // moved from: empty
   m.pending_vorticity = {};
   m.pending_disturbance = {};

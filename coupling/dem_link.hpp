@@ -36,6 +36,20 @@ struct FluidAtParticle {
   double disturbance_cell = 0;
   double disturbance_spread = 0;
   double disturbance_screening = 0;
+  double temperature = 0;  // T_f [K] (coupled heat; see DemLink::heat_on)
+};
+
+// The particles' convective heat exchange with the fluid over the last advance()
+// (DemLink::heat_exchange; docs/models/heat-transfer.md, "Coupled"). Entries [0, local) are
+// this rank's particles, [local, size) the ghosts, in the order of DemLink::view().
+struct HeatExchange {
+  std::vector<double> heat;      // taken from the fluid during the advance [J]
+  std::vector<double> response;  // G = C (1 - (1 + dt H / C)^-N) [J/K]: the heat the
+                                 // particle would have taken more per kelvin of fluid
+  // Heat taken on this rank by particles that are no longer local (they left during the
+  // advance): where each last took it [m] and how much [J].
+  std::vector<std::array<double, 3>> orphan_position;
+  std::vector<double> orphan_heat;
 };
 
 // Particles as flat arrays: entries [0, local) are this rank's particles, entries
@@ -122,6 +136,13 @@ class DemLink {
   char vans_model() const;  // 'A' or 'B'
   bool needs_vorticity() const;
   std::string drag_law() const;
+  // Heat transfer coupled to the fluid: the scene has `heat:` (and then, necessarily, the
+  // fluid block's convection keys). The fluid's c_p [J/(kg K)] and k_f [W/(m K)] as the
+  // scene gives them, and "file:line" of the fluid block.
+  bool heat_on() const;
+  double fluid_heat_capacity() const;
+  double fluid_conductivity() const;
+  std::string fluid_source() const;
   double end_time() const;           // the scene's time.end [s]
   std::string end_time_source() const;  // "file:line" of time.end
   // The scene's output block as a coupled run honours it: the folder for particle snapshots
@@ -188,6 +209,17 @@ class DemLink {
     double* vorticity;  // 3 per particle, or null: no force reads it
   };
   SampleRecords fluid_samples();
+  // Heat on: the fluid temperature at each local particle, in the order of the samples;
+  // given before each end_fluid().
+  void set_fluid_temperatures(std::vector<double> temperatures);
+  // Heat on, after advance(steps): each particle's convective heat of the advance and its
+  // response to the fluid temperature (HeatExchange). Collective.
+  void heat_exchange(int steps, HeatExchange& out) const;
+  // Heat on: adds joules[i] [J] to local particle i (the order of view()); the total is
+  // added to the particle side of the heat balance by the caller.
+  void add_heat(const std::vector<double>& joules);
+  // Heat on: sums over every rank's particles (collective) of m c T [J] and m c [J/K].
+  std::array<double, 2> thermal_energy() const;
   // `steps` DEM steps (collective). After each, the NaN / Inf guard: the first non-finite
   // particle state stops the run with the particle, its forces and a diagnostic snapshot
   // of every particle in `diagnostic_directory`. Throws std::runtime_error with the DEM's

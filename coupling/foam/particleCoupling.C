@@ -1075,6 +1075,7 @@ coupling::FluidAtParticle ParticleCoupling::sampleAt(const std::array<double, 3>
   if (c < 0) return f;
   f.velocity = toArray(U_[c]);
   f.void_fraction = voidFraction_[c];
+  if (T_) f.temperature = (*T_)[c];
   if (meanGradPOn_) f.pressure_gradient = toArray(meanGradP_);
   if (sharpInterface_) {
     for (double& u : f.velocity) u *= velocityScale_[c];
@@ -1125,6 +1126,139 @@ void ParticleCoupling::checkBalance() {
        << ") N, relative imbalance " << balanceError_ << endl;
 }
 
+void ParticleCoupling::setTemperature(const Foam::volScalarField& T, double rhoCp,
+                                      double conductivity, const Foam::fileName& propertiesFile) {
+  using namespace Foam;
+  const auto differ = [](double a, double b) {
+    return std::abs(a - b) > 1e-9 * std::max(std::abs(a), std::abs(b));
+  };
+  const double cp = rhoCp / rho_;
+  std::ostringstream why;
+  if (differ(cp, dem_->fluid_heat_capacity()))
+    why << "\n" << dem_->fluid_source() << ": error: fluid.heat_capacity is "
+        << dem_->fluid_heat_capacity() << " J/(kg K) but " << propertiesFile << " has Cp " << cp
+        << " J/(kg K); make them equal";
+  if (differ(conductivity, dem_->fluid_conductivity()))
+    why << "\n" << dem_->fluid_source() << ": error: fluid.conductivity is "
+        << dem_->fluid_conductivity() << " W/(m K) but " << propertiesFile << " has kappa "
+        << conductivity << " W/(m K); make them equal";
+  if (!why.str().empty()) FatalErrorInFunction << why.str().c_str() << exit(FatalError);
+  T_ = &T;
+  rhoCp_ = rhoCp;
+  heatResponse_.reset(new volScalarField(
+      derivedField(mesh_, "heatResponse", false), mesh_,
+      dimensionedScalar("zero", dimensionSet(1, -1, -3, -1, 0), 0), derivedPatchTypes(mesh_)));
+  heatSource_.reset(new volScalarField(derivedField(mesh_, "heatSource", false), mesh_,
+                                       dimensionedScalar("zero", dimensionSet(1, -1, -3, 0, 0), 0),
+                                       derivedPatchTypes(mesh_)));
+  Info << "grainFoam heat: fluid energy equation on, rho c_p " << rhoCp << " J/(m^3 K), k_f "
+       << conductivity << " W/(m K) (" << propertiesFile << "); convection law of "
+       << dem_->fluid_source().c_str() << endl;
+}
+
+void ParticleCoupling::sampleTemperature() {
+  using namespace Foam;
+  const volScalarField& T = *T_;
+  // The footprint weights of the deposit (as `cell` sampling), ghosts' shares to owners.
+  constexpr std::size_t W = 2;
+  std::vector<double> acc(W * particles_.size(), 0.0);
+  for (std::size_t i = 0; i < particles_.size(); ++i)
+    for (std::size_t j = first_[i]; j < first_[i + 1]; ++j) {
+      acc[W * i] += points_[j].weight * T[points_[j].cell];
+      acc[W * i + 1] += points_[j].weight;
+    }
+  const std::vector<double> sums = dem_->sum_onto_owners(acc, W);
+  const double fallback = gAverage(T.primitiveField());
+  std::vector<double> t(particles_.local());
+  for (std::size_t i = 0; i < t.size(); ++i)
+    t[i] = sums[W * i + 1] > 0 ? sums[W * i] / sums[W * i + 1]
+                               : (centreCell_[i] >= 0 ? T[centreCell_[i]] : fallback);
+  dem_->set_fluid_temperatures(std::move(t));
+}
+
+void ParticleCoupling::depositHeat() {
+  using namespace Foam;
+  dem_->heat_exchange(subSteps_, heatExchange_);
+  const label n = mesh_.nCells();
+  heatCell_.setSize(n);
+  responseCell_.setSize(n);
+  heatCell_ = 0.0;
+  responseCell_ = 0.0;
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    const double e = heatExchange_.heat[i], g = heatExchange_.response[i];
+    for (std::size_t j = first_[i]; j < first_[i + 1]; ++j) {
+      heatCell_[points_[j].cell] += points_[j].weight * e;
+      responseCell_[points_[j].cell] += points_[j].weight * g;
+    }
+  }
+  // Particles that left this rank during the advance: their heat where they last took it,
+  // or, when that position already lies beyond this rank's cells (the step that took them
+  // across a processor plane or a periodic face), in this rank's nearest cell.
+  for (std::size_t k = 0; k < heatExchange_.orphan_heat.size(); ++k) {
+    const std::array<double, 3>& x = heatExchange_.orphan_position[k];
+    label c = locate(point(x[0], x[1], x[2]));
+    if (c < 0 && n > 0) c = mesh_.findNearestCell(point(x[0], x[1], x[2]));
+    if (c >= 0)
+      heatCell_[c] += heatExchange_.orphan_heat[k];
+    else
+      lostHeat_ += heatExchange_.orphan_heat[k];
+  }
+  const scalarField& V = mesh_.V().field();
+  const double dt = mesh_.time().deltaTValue();
+  scalarField& KT = heatResponse_->primitiveFieldRef();
+  scalarField& Q = heatSource_->primitiveFieldRef();
+  forAll(V, c) {
+    KT[c] = responseCell_[c] / (V[c] * dt);
+    Q[c] = heatCell_[c] / (V[c] * dt);
+  }
+}
+
+void ParticleCoupling::exchangeHeat(const Foam::volScalarField& T, const Foam::volScalarField& T0) {
+  using namespace Foam;
+  auto t0 = Clock::now();
+  std::vector<double> acc(particles_.size(), 0.0);
+  for (std::size_t i = 0; i < particles_.size(); ++i)
+    for (std::size_t j = first_[i]; j < first_[i + 1]; ++j)
+      acc[i] += points_[j].weight * (T[points_[j].cell] - T0[points_[j].cell]);
+  const std::vector<double> change = dem_->sum_onto_owners(acc, 1);
+  std::vector<double> joules(particles_.local());
+  // particle side, fluid side, scale, heat lost (orphans outside every cell)
+  double sums[4] = {0, 0, 0, lostHeat_};
+  for (std::size_t i = 0; i < joules.size(); ++i) {
+    joules[i] = heatExchange_.response[i] * change[i];
+    sums[0] += heatExchange_.heat[i] + joules[i];
+    sums[2] += std::abs(heatExchange_.heat[i]) + std::abs(joules[i]);
+  }
+  for (const double e : heatExchange_.orphan_heat) {
+    sums[0] += e;
+    sums[2] += std::abs(e);
+  }
+  try {
+    dem_->add_heat(joules);
+  } catch (const std::exception& e) {
+    FatalErrorInFunction << "\n" << e.what() << exit(FatalError);
+  }
+  forAll(heatCell_, c) sums[1] -= heatCell_[c] + responseCell_[c] * (T[c] - T0[c]);
+  MPI_Allreduce(MPI_IN_PLACE, sums, 4, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  particleHeatTotal_ += sums[0];
+  fluidHeatTotal_ += sums[1];
+  couplingSeconds_ += seconds_since(t0);
+  const Time& time = mesh_.time();
+  if (!time.writeTime() && time.timeIndex() != restartIndex_ + 1) return;
+  const double imbalance = sums[2] > 0 ? std::abs(sums[0] + sums[1]) / sums[2] : 0.0;
+  const std::array<double, 2> particles = dem_->thermal_energy();
+  const scalarField epsV(voidFraction_.primitiveField() * mesh_.V().field());
+  const double fluidEnergy = rhoCp_ * gSum(epsV * T.primitiveField());
+  const double fluidCapacity = rhoCp_ * gSum(epsV);
+  Info << "grainFoam heat exchange: particles took " << sums[0] << " J from the fluid in the "
+       << "last step, the fluid " << sums[1] << " J from the particles, relative imbalance "
+       << imbalance << "; since the run's start: particles " << particleHeatTotal_ << " J, fluid "
+       << fluidHeatTotal_ << " J; lost (outside the mesh) " << sums[3] << " J" << endl;
+  Info << "grainFoam thermal energy: particles " << particles[0] << " J (m c " << particles[1]
+       << " J/K), fluid " << fluidEnergy << " J (eps rho c_p V " << fluidCapacity
+       << " J/K), sum " << particles[0] + fluidEnergy << " J" << endl;
+}
+
 void ParticleCoupling::updateMeanPressureGradient() {
   const std::array<double, 3> w = dem_->buoyant_weight();
   for (int d = 0; d < 3; ++d) meanGradP_[d] = w[d] / domainVolume_;
@@ -1145,6 +1279,7 @@ void ParticleCoupling::reportMixtureMomentum() {
 void ParticleCoupling::evolve() {
   auto t0 = Clock::now();
   sample();  // straight into the DEM (DemLink::fluid_samples or add_fluid)
+  if (T_) sampleTemperature();
   if (lateSamplerSet_) {
     dem_->end_fluid();  // the sampler of late arrivals stays sampleAt
   } else {
@@ -1162,6 +1297,7 @@ void ParticleCoupling::evolve() {
   t0 = Clock::now();
   buildFootprints();
   deposit();
+  if (T_) depositHeat();
   if (meanGradPOn_) updateMeanPressureGradient();
   if (mesh_.time().writeTime() || mesh_.time().timeIndex() == 1) {
     checkBalance();

@@ -150,6 +150,7 @@ class Simulation {
   }
   // Heat transfer (scene key `heat:`), or nullptr when it is off.
   const HeatTransfer* heat() const { return heat_.get(); }
+  HeatTransfer* heat() { return heat_.get(); }
   double time() const { return time_; }
   double dt() const { return dt_; }
   void set_dt(double dt) { dt_ = dt; }

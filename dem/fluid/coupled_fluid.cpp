@@ -6,7 +6,8 @@
 namespace grainflow {
 
 void CoupledFluid::set(std::vector<GlobalId> ids, std::vector<CoupledSample> samples,
-                       std::vector<Vec3> vorticity, std::vector<SelfDisturbance> disturbance) {
+                       std::vector<Vec3> vorticity, std::vector<SelfDisturbance> disturbance,
+                       std::vector<double> temperature) {
   if (ids.size() != samples.size())
     throw std::invalid_argument("CoupledFluid::set: " + std::to_string(ids.size()) + " ids but " +
                                 std::to_string(samples.size()) + " samples");
@@ -18,6 +19,10 @@ void CoupledFluid::set(std::vector<GlobalId> ids, std::vector<CoupledSample> sam
     throw std::invalid_argument("CoupledFluid::set: " + std::to_string(samples.size()) +
                                 " samples but " + std::to_string(disturbance.size()) +
                                 " self-disturbances");
+  if (!temperature.empty() && temperature.size() != samples.size())
+    throw std::invalid_argument("CoupledFluid::set: " + std::to_string(samples.size()) +
+                                " samples but " + std::to_string(temperature.size()) +
+                                " temperatures");
   ids_ = std::move(ids);
   spare_ = std::move(samples_);
   samples_ = std::move(samples);
@@ -25,19 +30,32 @@ void CoupledFluid::set(std::vector<GlobalId> ids, std::vector<CoupledSample> sam
   vorticity_ = std::move(vorticity);
   spare_disturbance_ = std::move(disturbance_);
   disturbance_ = std::move(disturbance);
+  spare_temperature_ = std::move(temperature_);
+  temperature_ = std::move(temperature);
+  if (!temperature_.empty()) {
+    heat_.assign(temperature_.size(), 0.0);
+    heat_conductance_.assign(temperature_.size(), 0.0);
+    heat_x_.assign(temperature_.size(), Vec3::Zero());
+  }
   index_.clear();
   remapped_ = false;  // the samples themselves serve the particles while their order holds
 }
 
 CoupledFluid::View CoupledFluid::at_particles(const Particles& p) {
   const bool curl = !vorticity_.empty(), self = !disturbance_.empty();
-  const auto view = [curl, self](const std::vector<CoupledSample>& s, const std::vector<Vec3>& w,
-                                 const std::vector<SelfDisturbance>& d) {
-    return View{s.data(), curl ? w.data() : nullptr, self ? d.data() : nullptr, s.size()};
+  const bool heat = !temperature_.empty();
+  const auto view = [curl, self, heat](const std::vector<CoupledSample>& s,
+                                       const std::vector<Vec3>& w,
+                                       const std::vector<SelfDisturbance>& d,
+                                       const std::vector<double>& t, const std::size_t* entry) {
+    return View{s.data(), curl ? w.data() : nullptr, self ? d.data() : nullptr,
+                heat ? t.data() : nullptr, entry, s.size()};
   };
-  if (!remapped_ && p.id == ids_) return view(samples_, vorticity_, disturbance_);
+  if (!remapped_ && p.id == ids_)
+    return view(samples_, vorticity_, disturbance_, temperature_, nullptr);
   if (remapped_ && p.id == mapped_ids_)
-    return view(mapped_, mapped_vorticity_, mapped_disturbance_);
+    return view(mapped_, mapped_vorticity_, mapped_disturbance_, mapped_temperature_,
+                heat ? mapped_entry_.data() : nullptr);
   if (index_.empty()) {
     index_.reserve(ids_.size());
     for (std::size_t k = 0; k < ids_.size(); ++k) index_.emplace(ids_[k], k);
@@ -45,12 +63,20 @@ CoupledFluid::View CoupledFluid::at_particles(const Particles& p) {
   mapped_.resize(p.size());
   if (curl) mapped_vorticity_.resize(p.size());
   if (self) mapped_disturbance_.resize(p.size());
+  if (heat) {
+    mapped_temperature_.resize(p.size());
+    mapped_entry_.resize(p.size());
+  }
   for (std::size_t i = 0; i < p.size(); ++i) {
     const auto it = index_.find(p.id[i]);
     if (it != index_.end()) {
       mapped_[i] = samples_[it->second];
       if (curl) mapped_vorticity_[i] = vorticity_[it->second];
       if (self) mapped_disturbance_[i] = disturbance_[it->second];
+      if (heat) {
+        mapped_temperature_[i] = temperature_[it->second];
+        mapped_entry_[i] = it->second;
+      }
       continue;
     }
     if (!sampler_)
@@ -72,11 +98,20 @@ CoupledFluid::View CoupledFluid::at_particles(const Particles& p) {
       mapped_disturbance_[i] = SelfDisturbance{};
       disturbance_.push_back(SelfDisturbance{});
     }
+    if (heat) {
+      mapped_temperature_[i] = f.temperature;
+      mapped_entry_[i] = temperature_.size();
+      temperature_.push_back(f.temperature);
+      heat_.push_back(0.0);
+      heat_conductance_.push_back(0.0);
+      heat_x_.push_back(p.x[i]);
+    }
     ++late_;
   }
   mapped_ids_ = p.id;
   remapped_ = true;
-  return view(mapped_, mapped_vorticity_, mapped_disturbance_);
+  return view(mapped_, mapped_vorticity_, mapped_disturbance_, mapped_temperature_,
+              heat ? mapped_entry_.data() : nullptr);
 }
 
 }  // namespace grainflow

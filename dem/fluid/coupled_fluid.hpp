@@ -52,6 +52,10 @@ class CoupledFluid {
     const CoupledSample* samples = nullptr;
     const Vec3* vorticity = nullptr;
     const SelfDisturbance* disturbance = nullptr;  // null: no correction
+    // Coupled heat (set with temperatures): the fluid temperature T_f [K] at each particle,
+    // and each particle's entry in the set (for add_heat); null entry: entry i is particle i.
+    const double* temperature = nullptr;
+    const std::size_t* entry = nullptr;
     std::size_t size = 0;
   };
 
@@ -62,8 +66,12 @@ class CoupledFluid {
   // Samples of the particles `ids` (any order), with their vorticity when `vorticity` is not
   // empty and their self-disturbance when `disturbance` is not empty (then one per id).
   // Replaces the previous set.
+  // With `temperature` (one per id; coupled heat), the set also keeps, per entry, the
+  // convective heat the particle took from the fluid during the DEM steps until the next
+  // set (add_heat), where it last took it, and its last conductance h A.
   void set(std::vector<GlobalId> ids, std::vector<CoupledSample> samples,
-           std::vector<Vec3> vorticity = {}, std::vector<SelfDisturbance> disturbance = {});
+           std::vector<Vec3> vorticity = {}, std::vector<SelfDisturbance> disturbance = {},
+           std::vector<double> temperature = {});
   // The storage of the set before the last set() (its values stale), for the next set to
   // be written into without a new allocation each fluid step; empty if taken already.
   std::vector<CoupledSample> take_spare() { return std::move(spare_); }
@@ -86,6 +94,21 @@ class CoupledFluid {
     return f;
   }
   long late_samples() const { return late_; }
+
+  // Coupled heat: particle `entry` (View::entry) took `joules` from the fluid at x in a DEM
+  // step, with conductance h A = `conductance` [W/K].
+  void add_heat(std::size_t entry, double joules, const Vec3& x, double conductance) {
+    heat_[entry] += joules;
+    heat_x_[entry] = x;
+    heat_conductance_[entry] = conductance;
+  }
+  // Per entry of the set (ids in the set's order, late arrivals appended): the heat taken
+  // since set() [J], the position of its last exchange and the last conductance [W/K].
+  const std::vector<GlobalId>& entry_ids() const { return ids_; }
+  const std::vector<double>& entry_heat() const { return heat_; }
+  const std::vector<Vec3>& entry_heat_position() const { return heat_x_; }
+  const std::vector<double>& entry_conductance() const { return heat_conductance_; }
+  std::vector<double> take_spare_temperature() { return std::move(spare_temperature_); }
   void reset_late_samples() { late_ = 0; }
 
   // Per particle of the last step, in its order: the explicit force on the particle
@@ -101,6 +124,9 @@ class CoupledFluid {
   std::vector<CoupledSample> spare_;  // the previous samples_ (take_spare)
   std::vector<Vec3> spare_vorticity_;
   std::vector<SelfDisturbance> spare_disturbance_;
+  std::vector<double> temperature_, spare_temperature_;  // empty, or one per entry
+  std::vector<double> heat_, heat_conductance_;         // coupled heat, per entry
+  std::vector<Vec3> heat_x_;
   std::unordered_map<GlobalId, std::size_t> index_;  // built on the first re-map after set()
   // After a re-sort, migration or late arrival: the samples in the particles' new order.
   // Until then the samples are served as set (no copy per fluid step).
@@ -109,6 +135,8 @@ class CoupledFluid {
   std::vector<CoupledSample> mapped_;
   std::vector<Vec3> mapped_vorticity_;
   std::vector<SelfDisturbance> mapped_disturbance_;
+  std::vector<double> mapped_temperature_;
+  std::vector<std::size_t> mapped_entry_;
   Sampler sampler_;
   long late_ = 0;
 };

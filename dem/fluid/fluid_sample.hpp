@@ -15,6 +15,7 @@ struct FluidSample {
   double viscosity = 0;                            // dynamic viscosity μ [Pa s]
   Vec3 vorticity = Vec3::Zero();                   // ∇×u_f [1/s]
   Vec3 material_derivative = Vec3::Zero();         // Du_f/Dt = ∂u/∂t + (u·∇)u [m/s^2]
+  double temperature = 0;  // T_f [K], read by coupled convection only (CoupledFluid)
 };
 
 }  // namespace grainflow

@@ -53,12 +53,17 @@ inline double nusselt_number(NusseltLaw law, double eps, double re, double pr) {
 }
 
 // h A = Nu k_f pi d [W/K] of a sphere of diameter d at slip speed `slip`.
+// At void fraction eps, fluid density and viscosity given (the coupled fluid's samples).
+inline double convective_conductance(const FluidThermal& th, double eps, double density,
+                                     double viscosity, double d, double slip) {
+  const double re = eps * density * d * slip / viscosity;
+  const double pr = prandtl_number(th.heat_capacity, viscosity, th.conductivity);
+  return nusselt_number(th.nusselt, eps, re, pr) * th.conductivity * std::numbers::pi * d;
+}
+
 inline double convective_conductance(const FluidThermal& th, const PrescribedFluid& f, double d,
                                      double slip) {
-  const double eps = f.void_fraction;
-  const double re = eps * f.density * d * slip / f.viscosity;
-  const double pr = prandtl_number(th.heat_capacity, f.viscosity, th.conductivity);
-  return nusselt_number(th.nusselt, eps, re, pr) * th.conductivity * std::numbers::pi * d;
+  return convective_conductance(th, f.void_fraction, f.density, f.viscosity, d, slip);
 }
 
 }  // namespace grainflow

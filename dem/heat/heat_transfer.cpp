@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
 
 #include "dem/heat/heat_laws.hpp"
 #include "dem/walls/wall_contact.hpp"
@@ -133,6 +134,10 @@ void HeatTransfer::step(Particles& p, const Ghosts& g, const std::vector<double>
   source_heat_ = 0;
   double* Tw = p.temperature.data();
   const bool convection = fluid_thermal_.has_value();
+  if (convection && coupled_) {
+    coupled_step(p, dt);
+    return;
+  }
   for (std::size_t i = 0; i < n; ++i) {
     const double c = p.mass[i] * cp_[p.material[i]];
     const double s = p.mass[i] * source_[p.material[i]];
@@ -147,6 +152,27 @@ void HeatTransfer::step(Particles& p, const Ghosts& g, const std::vector<double>
     const double t_f = fluid_thermal_->temperature;
     Tw[i] = (Tw[i] + dt * (q_[i] + s + h * t_f) / c) / (1 + dt * h / c);
     fluid_heat_ += h * (t_f - Tw[i]);
+  }
+}
+
+void HeatTransfer::coupled_step(Particles& p, double dt) {
+  const CoupledFluid::View view = coupled_->at_particles(p);
+  if (!view.temperature)
+    throw std::logic_error("HeatTransfer: the coupled fluid samples carry no temperatures");
+  double* T = p.temperature.data();
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double c = p.mass[i] * cp_[p.material[i]];
+    const double s = p.mass[i] * source_[p.material[i]];
+    source_heat_ += s;
+    const CoupledSample& f = view.samples[i];
+    const double h = convective_conductance(*fluid_thermal_, f.void_fraction, field_.density,
+                                            field_.viscosity, 2 * p.radius[i],
+                                            (f.velocity - p.v[i]).norm());
+    const double t_f = view.temperature[i];
+    T[i] = (T[i] + dt * (q_[i] + s + h * t_f) / c) / (1 + dt * h / c);
+    const double q = h * (t_f - T[i]);
+    fluid_heat_ += q;
+    coupled_->add_heat(view.entry ? view.entry[i] : i, dt * q, p.x[i], h);
   }
 }
 

@@ -16,6 +16,7 @@
 
 #include "dem/core/particles.hpp"
 #include "dem/engine/canonical_order.hpp"
+#include "dem/fluid/coupled_fluid.hpp"
 #include "dem/neighbour/verlet_list.hpp"
 #include "dem/neighbour/wall_neighbours.hpp"
 #include "dem/parallel/ghosts.hpp"
@@ -47,10 +48,18 @@ class HeatTransfer {
   double source_heat() const { return source_heat_; }
 
   double heat_capacity(int material) const { return cp_[material]; }
+
+  // Two-way coupling (grainFoam): convection reads the fluid temperature, velocity and void
+  // fraction of each particle from `fluid`'s samples (set with temperatures) instead of the
+  // prescribed fluid, and records each particle's heat into the set (CoupledFluid::add_heat)
+  // for the fluid's energy equation. Needs the scene's fluid `temperature:` block (the
+  // convection law, c_p and k_f); `fluid` must outlive this object.
+  void couple(CoupledFluid* fluid) { coupled_ = fluid; }
   // Thermal energy sum m c T of this rank's particles [J].
   double thermal_energy(const Particles& p) const;
 
  private:
+  void coupled_step(Particles& p, double dt);  // the particles' pass with couple()
   void walls_pass(const Particles& p, const WallSet& walls, const WallNeighbours& wn);
 
   int materials_ = 0;
@@ -60,6 +69,7 @@ class HeatTransfer {
   std::vector<WallThermal> wall_thermal_;  // per scene wall (= WallSet entry)
   std::optional<FluidThermal> fluid_thermal_;
   PrescribedFluid field_;
+  CoupledFluid* coupled_ = nullptr;
   Vec3 gravity_ = Vec3::Zero();
   std::vector<double> q_;  // heat flow into each local particle in this step [W]
   std::vector<double> wall_heat_;

@@ -27,6 +27,8 @@
 #include <mpi.h>
 
 #include <chrono>
+#include <memory>
+#include <string>
 #include <sstream>
 
 #include "coupling/foam/particleCoupling.H"
@@ -63,6 +65,29 @@ void solve(const Foam::argList& args) {
 
   grainflow::foam::ParticleCoupling particles(mesh, U, p, rho.value(), nu.value());
   const volScalarField& eps = particles.voidFraction();
+
+  // Heat (the DEM scene has `heat:`): the fluid temperature T [K] and the fluid's c_p and
+  // k_f from transportProperties; without heat neither is read nor anything solved.
+  std::unique_ptr<volScalarField> temperature;
+  dimensionedScalar rhoCp("rhoCp", dimensionSet(1, -1, -2, -1, 0), 0);
+  dimensionedScalar alpha("alpha", dimViscosity, 0);  // k_f / (rho c_p)
+  if (particles.heatOn()) {
+    for (const char* key : {"Cp", "kappa"})
+      if (!transport.found(key))
+        FatalIOErrorInFunction(transport)
+            << "the DEM scene has heat on: " << transport.objectPath() << " needs `" << key
+            << (std::string(key) == "Cp" ? "  <J/(kg K)>;` (the fluid's heat capacity c_p)"
+                                          : "  <W/(m K)>;` (the fluid's conductivity k_f)")
+            << exit(FatalIOError);
+    const dimensionedScalar Cp("Cp", dimensionSet(0, 2, -2, -1, 0), transport);
+    const dimensionedScalar kappa("kappa", dimensionSet(1, 1, -3, -1, 0), transport);
+    rhoCp = rho * Cp;
+    alpha = kappa / rhoCp;
+    temperature.reset(new volScalarField(IOobject("T", runTime.timeName(), mesh,
+                                                  IOobject::MUST_READ, IOobject::AUTO_WRITE),
+                                         mesh));
+    particles.setTemperature(*temperature, rhoCp.value(), kappa.value(), transport.objectPath());
+  }
   const bool modelA = particles.model() == 'A';
   const bool meanGradP = particles.meanPressureGradientOn();
 
@@ -182,8 +207,26 @@ void solve(const Foam::argList& args) {
              << endl;
       }
     }
+    // The fluid's energy equation, volume-averaged, divided by rho c_p, in conservative form:
+    //   d(eps T)/dt + div(phi T) - div(eps alpha grad T) = -(KT (T - T0) + Q) / (rho c_p)
+    // with the particles' exchange (ParticleCoupling::heatResponse, heatSource): Q the heat
+    // they took in the DEM steps, KT their response to the change of T in this step, the
+    // same amount they take after the solve (exchangeHeat), so that the fluid loses exactly
+    // what the particles gain.
+    std::unique_ptr<volScalarField> T0;  // T at the step's start (heat on)
+    if (temperature) {
+      volScalarField& T = *temperature;
+      T0.reset(new volScalarField("T0", T));
+      fvScalarMatrix TEqn(fvm::ddt(eps, T) + fvm::div(phi, T) - fvm::laplacian(epsf * alpha, T)
+                          == -fvm::Sp(particles.heatResponse() / rhoCp, T) +
+                                 (particles.heatResponse() * *T0 - particles.heatSource()) /
+                                     rhoCp);
+      TEqn.relax();
+      TEqn.solve(mesh.solver("T"));
+    }
     particles.addFluidTime(
         std::chrono::duration<double>(std::chrono::steady_clock::now() - fluidStart).count());
+    if (temperature) particles.exchangeHeat(*temperature, *T0);
 
     runTime.write();
     if (runTime.writeTime()) particles.write();

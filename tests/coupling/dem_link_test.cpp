@@ -172,11 +172,10 @@ TEST(DemLink, SampleRecordsActLikeAddFluid) {
   EXPECT_EQ(differ_from_still, a.local);
 }
 
-// grainFoam has no fluid energy equation: a coupled scene with `heat:` is refused when the
-// link reads it, with the heat block's file:line, the reason and the two ways on
-// (docs/models/heat-transfer.md, "Not yet built"), rather than running without the fluid's
-// side of the heat exchange.
-TEST(DemLink, RefusesASceneWithHeatTransfer) {
+// A coupled scene with `heat:` needs the fluid's convection settings (grainFoam's energy
+// equation exchanges heat by convection): without them the link refuses it, naming the fluid
+// block's file:line, the heat block's and the keys to add.
+TEST(DemLink, RefusesHeatWithoutTheFluidsConvectionSettings) {
   const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "dem_link_heat";
   fs::create_directories(dir);
   const std::string scene = (dir / "scene.yaml").string();
@@ -196,15 +195,12 @@ TEST(DemLink, RefusesASceneWithHeatTransfer) {
   } catch (const std::runtime_error& e) {
     message = e.what();
   }
-  EXPECT_NE(message.find(scene + ":3"), std::string::npos) << message;
-  EXPECT_NE(message.find("heat transfer in a coupled run needs grainFoam's fluid energy "
-                         "equation, which is not built yet"),
-            std::string::npos)
+  // The fluid block (line 7) is named, with the heat block (line 3) and the keys to add.
+  EXPECT_NE(message.find(scene + ":7: error: heat is on (" + scene + ":3)"), std::string::npos)
       << message;
-  EXPECT_NE(message.find("remove the `heat:` block"), std::string::npos) << message;
-  EXPECT_NE(message.find("run the scene with `grain` and a prescribed fluid temperature"),
-            std::string::npos)
-      << message;
+  for (const char* key : {"`temperature: <K>`", "`heat_capacity: <J/(kg K)>`",
+                          "`conductivity: <W/(m K)>`", "docs/models/heat-transfer.md"})
+    EXPECT_NE(message.find(key), std::string::npos) << key << " in " << message;
 }
 
 }  // namespace

@@ -34,6 +34,16 @@
 #       under deltaT refused naming the scene's line.
 #   coupling.nan_guard             a NaN velocity put into the checkpoint: the restarted run
 #       stops at the first DEM step naming that particle, with a diagnostic snapshot.
+#   coupling.heat_equilibrium      cases/heated_box: eight beads at 400 K held still in closed
+#       air at 300 K (heat on): the mixture's thermal energy conserved to 1e-12, the mean
+#       temperatures against the two-body closed form (T_eq, tau with Nu = 2) within 0.5 %,
+#       the exchange balanced to round-off at every write time; a restart at half time ends
+#       with the same T; missing kappa, Cp unlike the scene, heat without convection keys
+#       refused with their messages. About 10 s.
+#   coupling.heat_balance          cases/periodic_box with heat (Gunn), beads at 350 K raining
+#       through water at 300 K, on 1 and 2 ranks: heat taken by the particles = heat lost by
+#       the fluid to 1e-12 relative at every write time, mixture energy conserved to 1e-12,
+#       the two rank counts agree within 1 %. About 10 s.
 if(NOT TARGET grainFoam)
   return()
 endif()
@@ -125,4 +135,6 @@ set_tests_properties(coupling.restart PROPERTIES TIMEOUT 600)  # ~45 s on a quie
 grainflow_coupling_test(stop_signal 2)
 grainflow_coupling_test(nan_guard 2)
 grainflow_coupling_test(scene_output 1)
+grainflow_coupling_test(heat_equilibrium 1)
+grainflow_coupling_test(heat_balance 2)
 set_tests_properties(coupling.stop_signal PROPERTIES TIMEOUT 600)  # ~25 s on a quiet machine
