@@ -16,6 +16,7 @@ case="$1" end="$2" interval="$3"
 shift 3
 np=2
 [ "${1:-}" = -np ] && np="${2:?-np needs a number}"
+BUILD="$(cd "$BUILD" 2> /dev/null && pwd || echo "$BUILD")"  # Allrun runs in the case folder
 [ -x "$BUILD/bin/grainFoam" ] || { echo "run.sh: $BUILD/bin/grainFoam not found; build it (scripts/build.sh) or set GRAINFLOW_BUILD_DIR" >&2; exit 1; }
 [ -d "$ROOT/tutorials/cfd-dem/$case" ] || { echo "run.sh: no tutorial tutorials/cfd-dem/$case" >&2; exit 2; }
 work="$HERE/output/$case"
