@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <mpi.h>
+#include <time.h>
 
 #include <sstream>
 
@@ -21,6 +22,12 @@ namespace grainflow::foam {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+double processCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
 // locate(): a point more than this many cells from the domain's corner is outside (and
 // its cell index would not fit an int).
 constexpr double kFarOutside = 1e9;
@@ -30,9 +37,6 @@ constexpr double kFarOutside = 1e9;
 // orthogonal up to round-off (the correction changes the term by ~|k| relative).
 constexpr double kOrthogonalCorrection = 1e-9;
 
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 // Patch types for a derived field: constraint patches (processor, cyclic, empty, ...)
 // keep their type, every other patch is zeroGradient.
@@ -55,6 +59,13 @@ Foam::IOobject derivedField(const Foam::fvMesh& mesh, const Foam::word& name, bo
 std::array<double, 3> toArray(const Foam::vector& v) { return {v.x(), v.y(), v.z()}; }
 
 }  // namespace
+
+void Stopwatch::restart() {
+  wall0_ = Clock::now();
+  cpu0_ = processCpuSeconds();
+}
+double Stopwatch::wall() const { return std::chrono::duration<double>(Clock::now() - wall0_).count(); }
+double Stopwatch::cpu() const { return processCpuSeconds() - cpu0_; }
 
 ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVectorField& U,
                                    const Foam::volScalarField& p, double rho, double nu)
@@ -563,20 +574,26 @@ void ParticleCoupling::continueVoidFraction() {
 
 ParticleCoupling::~ParticleCoupling() = default;
 
+int ParticleCoupling::gridIndex(int a, double x) const {
+  // The global cell index, from the domain's corner and one spacing on every rank, so a
+  // point on a cell face falls in the same cell whatever the rank layout; then local.
+  const double s = (x - domain_.lo[a]) / gridH_[a];
+  // Below the domain (or NaN), or far beyond it (and beyond int): outside.
+  if (!(s >= 0) || s >= kFarOutside) return -1;
+  int idx = static_cast<int>(s) - gridOffset_[a];  // s >= 0: truncation is floor
+  // A point on the domain's upper face belongs to the last cell.
+  if (idx == gridN_[a] && std::abs(x - domain_.hi[a]) <= 1e-12 * gridH_[a] * gridN_[a])
+    idx = gridN_[a] - 1;
+  if (idx < 0 || idx >= gridN_[a]) return -1;
+  return idx;
+}
+
 Foam::label ParticleCoupling::locate(const Foam::point& x) const {
   if (structured_) {
     std::size_t k = 0;
     for (int a = 2; a >= 0; --a) {
-      // The global cell index, from the domain's corner and one spacing on every rank, so a
-      // point on a cell face falls in the same cell whatever the rank layout; then local.
-      const double s = (x[a] - domain_.lo[a]) / gridH_[a];
-      // Below the domain (or NaN), or far beyond it (and beyond int): outside.
-      if (!(s >= 0) || s >= kFarOutside) return -1;
-      int idx = static_cast<int>(s) - gridOffset_[a];  // s >= 0: truncation is floor
-      // A point on the domain's upper face belongs to the last cell.
-      if (idx == gridN_[a] && std::abs(x[a] - domain_.hi[a]) <= 1e-12 * gridH_[a] * gridN_[a])
-        idx = gridN_[a] - 1;
-      if (idx < 0 || idx >= gridN_[a]) return -1;
+      const int idx = gridIndex(a, x[a]);
+      if (idx < 0) return -1;
       k = k * static_cast<std::size_t>(gridN_[a]) + static_cast<std::size_t>(idx);
     }
     return gridCell_[k];
@@ -613,6 +630,10 @@ void ParticleCoupling::buildFootprints() {
         continue;
       }
     }
+    if (structured_) {
+      structuredFootprint(i, centreCell);
+      continue;
+    }
     for (const coupling::FootprintPoint& q : unit) {
       Foam::point x;
       bool image = false;  // beyond a periodic side: the particle's image deposits it
@@ -637,6 +658,64 @@ void ParticleCoupling::buildFootprints() {
     first_[i + 1] = points_.size();
     if (i < particles_.local()) centreCell_[i] = centreCell;
   }
+}
+
+void ParticleCoupling::structuredFootprint(std::size_t i, Foam::label centreCell) {
+  // buildFootprints()'s general loop on a uniform grid, with the same arithmetic: a
+  // footprint's points share few distinct offsets per axis (7 of 27 with dividedResolution 3),
+  // so the coordinate, its reflection or image and its grid index are found once per distinct
+  // offset and axis, not once per point; a point's cell is then a table look-up.
+  const std::vector<coupling::FootprintPoint>& unit = footprint_.unit_points();
+  if (pointAxis_.size() != unit.size()) {  // once: the distinct offsets per axis
+    pointAxis_.resize(unit.size());
+    for (int a = 0; a < 3; ++a) {
+      axisOffset_[a].clear();
+      for (std::size_t q = 0; q < unit.size(); ++q) {
+        const double o = unit[q].offset[a];
+        const auto at = std::find(axisOffset_[a].begin(), axisOffset_[a].end(), o);
+        pointAxis_[q][a] = static_cast<int>(at - axisOffset_[a].begin());
+        if (at == axisOffset_[a].end()) axisOffset_[a].push_back(o);
+      }
+      axisX_[a].resize(axisOffset_[a].size());
+      axisCell_[a].resize(axisOffset_[a].size());
+    }
+  }
+  const double* centre = particles_.x(i);
+  const double r = particles_.radius(i);
+  for (int a = 0; a < 3; ++a)
+    for (std::size_t m = 0; m < axisOffset_[a].size(); ++m) {
+      // Footprint::points(): the unit offset scaled by the radius.
+      double s = centre[a] + axisOffset_[a][m] * r;
+      int cell = 0;  // grid index along a; kImage: beyond a periodic side
+      // A bounded side reflects the part of a footprint that pokes through it.
+      if (!periodic_[a]) {
+        if (s < domain_.lo[a]) s = 2 * domain_.lo[a] - s;
+        if (s > domain_.hi[a]) s = 2 * domain_.hi[a] - s;
+      } else if (s < domain_.lo[a] || s >= domain_.hi[a]) {
+        cell = kImage;  // periodic axes are half-open, [lo, hi), as in the DEM
+      }
+      axisX_[a][m] = s;
+      axisCell_[a][m] = cell == kImage ? kImage : gridIndex(a, s);
+    }
+  for (std::size_t q = 0; q < unit.size(); ++q) {
+    const std::array<int, 3>& m = pointAxis_[q];
+    const int ix = axisCell_[0][m[0]], iy = axisCell_[1][m[1]], iz = axisCell_[2][m[2]];
+    // The particle's image deposits a point beyond a periodic side.
+    if (ix == kImage || iy == kImage || iz == kImage) continue;
+    // The centre itself (a centred part): its cell is known.
+    const bool atCentre = axisX_[0][m[0]] == centre[0] && axisX_[1][m[1]] == centre[1] &&
+                          axisX_[2][m[2]] == centre[2];
+    Foam::label c = centreCell;
+    if (!atCentre)
+      c = ix < 0 || iy < 0 || iz < 0
+              ? -1
+              : gridCell_[(static_cast<std::size_t>(iz) * gridN_[1] + static_cast<std::size_t>(iy)) *
+                              gridN_[0] +
+                          static_cast<std::size_t>(ix)];
+    if (c >= 0) points_.push_back({c, unit[q].weight});
+  }
+  first_[i + 1] = points_.size();
+  if (i < particles_.local()) centreCell_[i] = centreCell;
 }
 
 void ParticleCoupling::deposit() {
@@ -680,14 +759,14 @@ void ParticleCoupling::deposit() {
   scalarField& Ksl = Ksl_.primitiveFieldRef();
   vectorField& KslUs = KslUs_.primitiveFieldRef();
   vectorField& fExplicit = fExplicit_.primitiveFieldRef();
-  stepClampedVolume_ = 0;
+  double stepClamped = 0;  // this deposit's, on this rank
   double depositedVolume = 0, meshSolidVolume = 0;
   forAll(eps, c) {
     const double raw = 1 - solid[c] / V[c];
     if (raw < minVoidFraction_) {
       ++clampedCells_;
       clampedVolume_ += (minVoidFraction_ - raw) * V[c];
-      stepClampedVolume_ += (minVoidFraction_ - raw) * V[c];
+      stepClamped += (minVoidFraction_ - raw) * V[c];
       eps[c] = minVoidFraction_;
     } else {
       eps[c] = raw;
@@ -705,25 +784,51 @@ void ParticleCoupling::deposit() {
     reconstructLayers();
     forAll(Ksl, c) Ksl[c] *= velocityScale_[c];
   }
-  Ksl_.correctBoundaryConditions();  // written at write times: every patch
-  // KslUs and fParticles are read on a boundary only by grainFoam's fixedFluxPressure
-  // patches (the drag balance there), which are never constraint patches, and are not
-  // written: their symmetry-plane, processor and cyclic values are left unevaluated (on the
-  // Goldschmidt bed, two vector transforms over 5 400 symmetry faces per fluid step).
+  // Ksl, KslUs and fParticles are read on a boundary only by grainFoam's fixedFluxPressure
+  // patches (the drag balance there), which are never constraint patches: their
+  // symmetry-plane, processor and cyclic values are left unevaluated (on the Goldschmidt bed,
+  // two vector transforms over 5 400 symmetry faces per fluid step; on 2 ranks, Ksl's
+  // processor-patch exchange). Ksl is written: at a write time (and before a write at another
+  // time, completeWrittenFields()) every patch is evaluated.
+  if (mesh_.time().writeTime()) {
+    Ksl_.correctBoundaryConditions();
+    kslEvaluated_ = true;
+  } else {
+    kslEvaluated_ = false;
+  }
   const polyBoundaryMesh& patches = mesh_.boundaryMesh();
   forAll(patches, patch) {
     if (polyPatch::constraintType(patches[patch].type())) continue;
+    if (!kslEvaluated_) Ksl_.boundaryFieldRef()[patch].evaluate();
     KslUs_.boundaryFieldRef()[patch].evaluate();
     fExplicit_.boundaryFieldRef()[patch].evaluate();
   }
 
+  // The volume sums are reported at write times only (checkBalance(), write()): summed over
+  // the ranks then (depositSums()), not after every deposit.
+  localSums_[0] = particleVolume;
+  localSums_[1] = depositedVolume;
+  localSums_[2] = meshSolidVolume;
+  localSums_[3] = stepClamped;
+  sumsReduced_ = false;
+}
+
+void ParticleCoupling::depositSums() {
+  if (sumsReduced_) return;
   // Volume not deposited anywhere (footprint points outside every rank's cells).
-  double sums[4] = {particleVolume, depositedVolume, meshSolidVolume, stepClampedVolume_};
+  double sums[4] = {localSums_[0], localSums_[1], localSums_[2], localSums_[3]};
   MPI_Allreduce(MPI_IN_PLACE, sums, 4, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
   lostVolume_ = std::max(0.0, sums[0] - sums[1]);
   particleVolume_ = sums[0];
   meshSolidVolume_ = sums[2];
   stepClampedVolume_ = sums[3];
+  sumsReduced_ = true;
+}
+
+void ParticleCoupling::completeWrittenFields() {
+  if (kslEvaluated_) return;
+  Ksl_.correctBoundaryConditions();
+  kslEvaluated_ = true;
 }
 
 void ParticleCoupling::reconstructLayers() {
@@ -813,7 +918,7 @@ Foam::volVectorField& ParticleCoupling::pressureGradient() {
         mesh_, dimensionedVector("zero", p_.dimensions() / dimLength, Zero),
         extrapolatedCalculatedFvPatchField<vector>::typeName));
   }
-  gaussLinearGrad(p_, *gradP_);
+  gaussLinearGrad(p_, *gradP_, sampling_ == Sampling::cellPoint);
   return *gradP_;
 }
 
@@ -861,7 +966,7 @@ Foam::volVectorField& ParticleCoupling::viscousLaplacian() {
     forAll(faceCells, facei) ivf[faceCells[facei]] += (n * sn[facei]) * pMagSf[facei];
   }
   ivf /= mesh_.Vsc();
-  lap.correctBoundaryConditions();
+  if (sampling_ == Sampling::cellPoint) lap.correctBoundaryConditions();
   return lap;
 }
 
@@ -903,14 +1008,22 @@ void ParticleCoupling::sampleCellPoint() {
 
 void ParticleCoupling::sample() {
   using namespace Foam;
-  // rho grad p and rho nu laplacian(U), scaled in place (no second field).
+  // rho grad p and rho nu laplacian(U), scaled in place (no second field). Sampling `cell`
+  // reads cell values only: their boundary values are neither evaluated (pressureGradient(),
+  // viscousLaplacian(): no processor-patch exchange) nor scaled.
   const dimensionedScalar rho("rho", dimless, rho_);
   volVectorField& gradP = pressureGradient();
-  gradP *= rho;
-  // rho grad p keeps p's kinematic dimensions (rho is dimensionless here): G [Pa/m] by value.
-  if (meanGradPOn_) gradP += dimensionedVector("meanGradP", gradP.dimensions(), meanGradP_);
   volVectorField& divTau = viscousLaplacian();
-  divTau *= rho;
+  if (sampling_ == Sampling::cellPoint) {
+    gradP *= rho;
+    // rho grad p keeps p's kinematic dimensions (rho is dimensionless here): G [Pa/m] by value.
+    if (meanGradPOn_) gradP += dimensionedVector("meanGradP", gradP.dimensions(), meanGradP_);
+    divTau *= rho;
+  } else {
+    gradP.primitiveFieldRef() *= rho_;
+    if (meanGradPOn_) gradP.primitiveFieldRef() += meanGradP_;
+    divTau.primitiveFieldRef() *= rho_;
+  }
   const bool curl = dem_->needs_vorticity();
   tmp<volVectorField> tCurlU;
   if (curl) tCurlU = fvc::curl(U_);
@@ -1114,6 +1227,7 @@ void ParticleCoupling::checkBalance() {
   double worst = 0;
   for (int d = 0; d < 3; ++d) worst = std::max(worst, std::abs(totals[d] + totals[3 + d]));
   balanceError_ = totals[6] > 0 ? worst / totals[6] : 0.0;
+  depositSums();
   const double volumeError =
       particleVolume_ > 0
           ? std::abs(meshSolidVolume_ + stepClampedVolume_ - particleVolume_) / particleVolume_
@@ -1277,7 +1391,7 @@ void ParticleCoupling::reportMixtureMomentum() {
 }
 
 void ParticleCoupling::evolve() {
-  auto t0 = Clock::now();
+  Stopwatch clock;
   sample();  // straight into the DEM (DemLink::fluid_samples or add_fluid)
   if (T_) sampleTemperature();
   if (lateSamplerSet_) {
@@ -1286,15 +1400,15 @@ void ParticleCoupling::evolve() {
     dem_->end_fluid([this](const std::array<double, 3>& x) { return sampleAt(x); });
     lateSamplerSet_ = true;
   }
-  couplingSeconds_ += seconds_since(t0);
-  t0 = Clock::now();
+  add(kCoupling, clock);
+  clock.restart();
   try {
     dem_->advance(subSteps_, snapshotDir_);
   } catch (const std::exception& e) {
     FatalErrorInFunction << "\n" << e.what() << Foam::exit(Foam::FatalError);
   }
-  demSeconds_ += seconds_since(t0);
-  t0 = Clock::now();
+  add(kDem, clock);
+  clock.restart();
   buildFootprints();
   deposit();
   if (T_) depositHeat();
@@ -1303,7 +1417,7 @@ void ParticleCoupling::evolve() {
     checkBalance();
     if (meanGradPOn_) reportMixtureMomentum();
   }
-  couplingSeconds_ += seconds_since(t0);
+  add(kCoupling, clock);
 }
 
 void ParticleCoupling::writeSnapshot() {
@@ -1320,20 +1434,20 @@ void ParticleCoupling::writeSnapshotIfDue() {
   const bool last = t >= time.endTime().value() - 0.5 * dt;
   if (!first && !last && t < (snapshotIndex_ + 1) * snapshotInterval_ - 0.5 * dt) return;
   if (last && lastSnapshotIndex_ == time.timeIndex()) return;
-  auto t0 = Clock::now();
+  const Stopwatch clock;
   try {
     writeSnapshot();
   } catch (const std::exception& e) {
     FatalErrorInFunction << "\n" << e.what() << exit(FatalError);
   }
-  outputSeconds_ += seconds_since(t0);
+  add(kOutput, clock);
   snapshotIndex_ = static_cast<long>(std::floor(t / snapshotInterval_ + 0.5));
   lastSnapshotIndex_ = time.timeIndex();
 }
 
 void ParticleCoupling::write() {
   using namespace Foam;
-  auto t0 = Clock::now();
+  Stopwatch clock;
   const Time& time = mesh_.time();
   std::string checkpoint;
   try {
@@ -1352,19 +1466,21 @@ void ParticleCoupling::write() {
   info.regIOobject::write();
   // The particle output is timed apart: like the fluid's field output (runTime.write()),
   // it is not part of the DEM / coupling / fluid split.
-  outputSeconds_ += seconds_since(t0);
-  t0 = Clock::now();
+  add(kOutput, clock);
+  clock.restart();
   // Writing the checkpoint rebuilt the DEM's lists and reordered its particles: the next
   // fluid samples must follow the new order.
   buildFootprints();
-  couplingSeconds_ += seconds_since(t0);
+  add(kCoupling, clock);
+  depositSums();
   const coupling::DemSummary s = dem_->summary();
   double counts[3] = {double(clampedCells_), clampedVolume_, 0};
   MPI_Allreduce(MPI_IN_PLACE, counts, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
-  double times[4] = {demSeconds_, couplingSeconds_, fluidSeconds_, outputSeconds_};
-  MPI_Allreduce(MPI_IN_PLACE, times, 4, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-  double interval[4];
-  for (int k = 0; k < 4; ++k) {
+  double times[8];
+  std::copy(seconds_, seconds_ + 8, times);
+  MPI_Allreduce(MPI_IN_PLACE, times, 8, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  double interval[8];
+  for (int k = 0; k < 8; ++k) {
     interval[k] = times[k] - reportedSeconds_[k];
     reportedSeconds_[k] = times[k];
   }
@@ -1386,7 +1502,10 @@ void ParticleCoupling::write() {
              << " m^3 solid volume removed), volume not deposited " << lostVolume_ << " m^3\n"
              << cellPoint.c_str()
              << "grainFoam time split since the last write: " << split(interval).c_str() << "\n"
-             << "grainFoam time split: " << split(times).c_str() << Foam::endl;
+             << "grainFoam time split: " << split(times).c_str() << "\n"
+             << "grainFoam CPU time split since the last write: " << split(interval + 4).c_str()
+             << "\n"
+             << "grainFoam CPU time split: " << split(times + 4).c_str() << Foam::endl;
   if (undisturbed_)
     for (const std::string& line : dem_->reports())
       if (line.rfind("undisturbed velocity", 0) == 0)

@@ -26,7 +26,6 @@
 //   laplacian(eps_f c_f rAU_f, p) = div(eps_f phiHbyA) + d(eps)/dt.
 #include <mpi.h>
 
-#include <chrono>
 #include <memory>
 #include <string>
 #include <sstream>
@@ -130,7 +129,7 @@ void solve(const Foam::argList& args) {
     Info << "Time = " << runTime.timeName() << nl << endl;
 
     particles.evolve();
-    const auto fluidStart = std::chrono::steady_clock::now();
+    const grainflow::foam::Stopwatch fluidClock;
 
     const surfaceScalarField epsf(fvc::interpolate(eps));
     // Coefficient of grad p (and of the viscous term); with dragVoidFraction sharpInterface
@@ -224,8 +223,7 @@ void solve(const Foam::argList& args) {
       TEqn.relax();
       TEqn.solve(mesh.solver("T"));
     }
-    particles.addFluidTime(
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - fluidStart).count());
+    particles.addFluidTime(fluidClock);
     if (temperature) particles.exchangeHeat(*temperature, *T0);
 
     runTime.write();
@@ -236,6 +234,7 @@ void solve(const Foam::argList& args) {
     const int signal = grainflow::StopSignals::agreed(MPI_COMM_WORLD);
     if (signal != 0) {
       if (!runTime.writeTime()) {
+        particles.completeWrittenFields();
         runTime.writeNow();
         particles.write();
       }
