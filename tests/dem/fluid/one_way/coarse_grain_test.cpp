@@ -18,14 +18,18 @@
 //    with m ~ k^3, R ~ k), within 0.5 %.
 // 5. Parser: k < 1, a non-number, coarse_grain on a csv insertion, with cohesion and with
 //    a lift force are refused naming file:line, the key and what is allowed.
+// 6. Output: a run's snapshots hold coarse_grain = k and real_count = k^3 for every parcel.
 #include <gtest/gtest.h>
+#include <hdf5.h>
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <numbers>
 #include <sstream>
 #include <string>
 
+#include "dem/engine/run.hpp"
 #include "dem/engine/simulation.hpp"
 #include "dem/fluid/fluid_forces.hpp"
 #include "dem/fluid/schiller_naumann.hpp"
@@ -274,6 +278,46 @@ insert:
                    "virtual_mass"),
             std::string::npos)
       << e;
+}
+
+std::vector<double> dataset(const std::string& file, const char* name) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  std::vector<double> out;
+  if (f < 0) return out;
+  if (H5Lexists(f, name, H5P_DEFAULT) > 0) {
+    const hid_t d = H5Dopen2(f, name, H5P_DEFAULT);
+    const hid_t space = H5Dget_space(d);
+    out.resize(static_cast<std::size_t>(H5Sget_simple_extent_npoints(space)));
+    H5Sclose(space);
+    H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data());
+    H5Dclose(d);
+  }
+  H5Fclose(f);
+  return out;
+}
+
+TEST(CoarseGrain, SnapshotsCarryTheFactorAndTheRealCount) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "coarse_grain_snapshots";
+  fs::remove_all(dir);
+  const Scene s = parse_scene(
+      scene_text(lone_parcel(1e-4, "    coarse_grain: 2.5\n"), 1e-4,
+                 "output: {snapshot_interval: 0.001, progress: false}\n") ,
+      "snapshots.yaml");
+  Scene short_run = s;
+  short_run.time.end = 0.002;
+  RunOptions options;
+  options.output_directory = dir.string();
+  options.progress = false;
+  options.handle_stop_signals = false;
+  std::ostringstream log;
+  run_scene(short_run, options, MPI_COMM_WORLD, log);
+  const std::string file = (dir / "particles_000002.h5").string();
+  EXPECT_EQ(dataset(file, "coarse_grain"), std::vector<double>{2.5});
+  EXPECT_EQ(dataset(file, "real_count"), std::vector<double>{2.5 * 2.5 * 2.5});
+  EXPECT_NE(log.str().find("1 parcels of k = 2.5 stand for 15.625 real particles"),
+            std::string::npos)
+      << log.str();
 }
 
 }  // namespace
