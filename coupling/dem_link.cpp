@@ -140,6 +140,12 @@ DemLink::DemLink(const std::string& scene_file, double fluid_density, double flu
       why << where << ": error: output." << key << " is not used by a coupled run: " << instead
           << "; remove it (grainFoam honours output.directory and output.snapshot_interval)\n";
   }
+  for (const grainflow::Insertion& ins : m.scene.insertions)
+    if (ins.coarse_grain != 1)
+      why << ins.source << ": error: insert.coarse_grain " << ins.coarse_grain
+          << ": coarse-grained parcels are not available in coupled runs yet (the coupling's "
+             "void fraction and undisturbed-velocity correction would need the real particle "
+             "size); use coarse_grain: 1 with grainFoam, or run the scene one-way with grain\n";
   if (!why.str().empty()) throw std::runtime_error(why.str());
   // Checks the force list against the coupled solver (pressure without hydrostatics).
   try {

@@ -113,6 +113,56 @@ void check_grids(const Scene& scene) {
       throw SetupError(scene.fluid->source + ": error: fluid.void_fraction: " + why);
 }
 
+// Coarse graining (docs/models/coarse-graining.md): per parcel class the parcels, the real
+// particles they stand for and their mass, and warnings where the literature says parcels
+// stop standing for the real particles. Collective over comm; nothing without parcels.
+void print_coarse_grain_report(const Scene& scene, const Particles& p, MPI_Comm comm,
+                               std::ostream& out) {
+  const std::vector<double> k = scene.coarse_grain_table();
+  if (k.empty()) return;
+  const std::size_t n = scene.materials.size();
+  // Per material: parcels, real particles, mass, largest parcel radius.
+  std::vector<double> sum(3 * n, 0.0), largest(n, 0.0);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const auto m = static_cast<std::size_t>(p.material[i]);
+    sum[3 * m] += 1;
+    sum[3 * m + 1] += k[m] * k[m] * k[m];
+    sum[3 * m + 2] += p.mass[i];
+    largest[m] = std::max(largest[m], p.radius[i]);
+  }
+  MPI_Allreduce(MPI_IN_PLACE, sum.data(), static_cast<int>(sum.size()), MPI_DOUBLE, MPI_SUM, comm);
+  MPI_Allreduce(MPI_IN_PLACE, largest.data(), static_cast<int>(n), MPI_DOUBLE, MPI_MAX, comm);
+  std::ostream& o = speaker(comm, out);
+  double parcels = 0, real = 0, mass = 0, widest = 0;
+  o << "coarse graining (docs/models/coarse-graining.md):\n";
+  for (std::size_t m = 0; m < n; ++m) {
+    parcels += sum[3 * m];
+    real += sum[3 * m + 1];
+    mass += sum[3 * m + 2];
+    if (k[m] != 1) widest = std::max(widest, 2 * largest[m]);
+    if (k[m] == 1 || sum[3 * m] == 0) continue;
+    o << "  '" << scene.materials[m].name << "': " << static_cast<long long>(sum[3 * m])
+      << " parcels of k = " << k[m] << " stand for " << sum[3 * m + 1]
+      << " real particles of mass " << sum[3 * m + 2] << " kg (real radius up to "
+      << largest[m] / k[m] << " m, parcel radius up to " << largest[m] << " m)\n";
+  }
+  o << "  all particles: " << static_cast<long long>(parcels) << " computed, " << real
+    << " real, mass " << mass << " kg\n";
+  if (widest == 0) return;
+  const Vec3 extent = scene.domain.hi - scene.domain.lo;
+  if (extent.minCoeff() < 10 * widest)
+    o << "  warning: the domain's narrowest side (" << extent.minCoeff()
+      << " m) is less than 10 parcel diameters (" << widest
+      << " m): walls and the bed's own structures (bubbles, shear bands) are then resolved by "
+         "few parcels, where coarse graining is known to fail; lower coarse_grain\n";
+  if (scene.fluid && scene.fluid->computed_void_fraction &&
+      scene.fluid->computed_void_fraction->cell_size < 3 * widest)
+    o << "  warning: the void-fraction cell (" << scene.fluid->computed_void_fraction->cell_size
+      << " m) is smaller than 3 parcel diameters (" << widest
+      << " m): the parcels' void fraction is then not the real particles' (Radl et al. 2011); "
+         "lower coarse_grain or enlarge the cells\n";
+}
+
 }  // namespace
 
 std::string continue_command(const std::string& scene_file, const RunOptions& options, int ranks,
@@ -134,6 +184,7 @@ int check_scene(const Scene& scene, std::ostream& out) {
         make_fluid_forces(*scene.fluid, scene.gravity, scene.domain, MPI_COMM_WORLD));
   sim.initialise();  // lists and first forces only: no time step is taken
   print_report(sim, MPI_COMM_WORLD, out);
+  print_coarse_grain_report(scene, sim.particles(), MPI_COMM_WORLD, out);
   const TimeStepReport& rep = sim.time_step_report();
   if (rep.dt > 0 && std::isfinite(rep.dt))
     speaker(MPI_COMM_WORLD, out) << "steps to reach t_end = " << scene.time.end << " s: "
@@ -172,6 +223,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     sim.add_force_term(make_fluid_forces(*scene.fluid, scene.gravity, scene.domain, comm));
   sim.initialise();
   print_report(sim, comm, out, options.allow_large_time_step);
+  print_coarse_grain_report(scene, sim.particles(), comm, out);
   if (sim.time_step_report().verdict == TimeStepReport::Verdict::refuse &&
       !options.allow_large_time_step)
     throw SetupError(scene.file + ": error: refusing to run with this time step (see above); "
@@ -180,6 +232,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   guard_finite(sim, has_non_finite(sim.particles()), dir, comm);
 
   SnapshotWriter snapshots(comm, dir, "particles", scene.output.fields);
+  snapshots.set_coarse_grain(scene.coarse_grain_table());
   const std::string log_path = (std::filesystem::path(dir) / "log.csv").string();
   std::optional<LogTable> log_table;
   if (options.restart) {

@@ -50,6 +50,7 @@ class FluidForcesWith final : public ForceTerm {
                   const Domain& domain, MPI_Comm comm, std::shared_ptr<CoupledFluid> coupled)
       : s_(s), gravity_(gravity), on_(on), comm_(comm), coupled_(std::move(coupled)) {
     if (s.computed_void_fraction) grid_.emplace(domain, *s.computed_void_fraction);
+    if (!s_.coarse_grain.empty()) coarse_ = s_.coarse_grain.data();
   }
 
   std::string name() const override { return "fluid forces (drag: " + s_.drag_law + ")"; }
@@ -108,7 +109,9 @@ class FluidForcesWith final : public ForceTerm {
       const double d = 2 * p.radius[i];
       const Vec3 slip = f.velocity - p.v[i];
       const double u = slip.norm();
-      const double k = Law({d, u, f.void_fraction, f.density, f.viscosity});
+      const double cg = coarse_ ? coarse_[p.material[i]] : 1.0;
+      const double k =
+          cg * cg * cg * Law({d / cg, u, f.void_fraction, f.density, f.viscosity});
       const double tau_d = k > 0 ? p.mass[i] / k : inf;
       if (tau_d < drag.tau)
         drag = {drag.term, drag.time_scale, tau_d, p.id[i], true, inf, drag.rule};
@@ -188,12 +191,20 @@ class FluidForcesWith final : public ForceTerm {
       FluidSample f =
           coupled_ ? coupled_->sample(samples, i) : s_.field.sample(p.x[i], gravity_);
       if (grid_) f.void_fraction = grid_->at(p.x[i]);
-      const double d = 2 * p.radius[i];
+      double d = 2 * p.radius[i];
       const double volume = sphere_volume(p.radius[i]);
       const Vec3 slip = f.velocity - p.v[i];
       Vec3 force = Vec3::Zero(), carried = Vec3::Zero();
       if (on_.drag) {
+        // A parcel (coarse graining): the real particle's drag, times the k^3 it stands for.
+        double parcel = 1;
+        if (coarse_) {
+          const double cg = coarse_[p.material[i]];
+          d /= cg;
+          parcel = cg * cg * cg;
+        }
         double k = Law({d, slip.norm(), f.void_fraction, f.density, f.viscosity});
+        if (coarse_) k *= parcel;
         if (samples.disturbance && samples.disturbance[i].cell > 0)
           k *= undisturbed(samples.disturbance[i], d, slip.norm(), f);
         const double k_sum = drag.coefficient[i] + k;
@@ -277,6 +288,8 @@ class FluidForcesWith final : public ForceTerm {
   double undisturbed_sum_ = 0, undisturbed_max_ = 0;
 
   FluidSettings s_;
+  // Each material's coarse-graining factor (FluidSettings::coarse_grain); null: all k = 1.
+  const double* coarse_ = nullptr;
   Vec3 gravity_;
   Enabled on_;
   MPI_Comm comm_;
@@ -341,6 +354,12 @@ std::unique_ptr<ForceTerm> make_coupled_fluid_forces(const FluidSettings& settin
       throw std::invalid_argument(
           "virtual_mass is not available in coupled runs yet (the coupling does not sample the "
           "fluid's material derivative Du/Dt); remove it from fluid.forces");
+  if (!settings.coarse_grain.empty())
+    throw std::invalid_argument(
+        "coarse-grained parcels (an insertion's coarse_grain other than 1) are not available in "
+        "coupled runs yet (the coupling's void fraction and undisturbed-velocity correction "
+        "would need the real particle size); use coarse_grain: 1 with grainFoam, or run the "
+        "scene one-way with grain");
   FluidSettings s = settings;
   s.computed_void_fraction.reset();        // the coupling computes eps on the mesh
   s.field.hydrostatic_pressure = false;    // the solver's p excludes rho_f g.x

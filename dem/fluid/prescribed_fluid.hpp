@@ -67,6 +67,10 @@ struct FluidSettings {
   double virtual_mass_coefficient = kSphereVirtualMassCoefficient;
   std::string source;                         // "file:line" of the block, for messages
   std::optional<FluidThermal> thermal;        // `temperature:` given (heat on)
+  // Coarse graining (docs/models/coarse-graining.md): each material's factor k, indexed by
+  // material (Scene::coarse_grain_table); empty when every particle is a real one. A parcel's
+  // drag is the real particle's (diameter d/k) at the parcel's slip and eps, times k^3.
+  std::vector<double> coarse_grain;
 };
 
 }  // namespace grainflow

@@ -402,7 +402,18 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step,
     optional("fluid_force", vectors(extras.fluid_force));
     optional("overlap_max", extras.overlap_max.data());
     optional("temperature", p.temperature.data());
-    static_assert(snapshot_fields.size() == 14, "a new snapshot field needs its write above");
+    if (wants("coarse_grain") || wants("real_count")) {
+      // From the material's factor (set_coarse_grain); not kept between snapshots.
+      std::vector<double> k(p.size(), 1.0), count(p.size(), 1.0);
+      if (!coarse_grain_.empty())
+        for (std::size_t i = 0; i < p.size(); ++i) {
+          k[i] = coarse_grain_[static_cast<std::size_t>(p.material[i])];
+          count[i] = k[i] * k[i] * k[i];
+        }
+      optional("coarse_grain", k.data());
+      optional("real_count", count.data());
+    }
+    static_assert(snapshot_fields.size() == 16, "a new snapshot field needs its write above");
 
     if (contacts) {
       static_assert(sizeof(std::array<GlobalId, 2>) == 2 * sizeof(std::int64_t));

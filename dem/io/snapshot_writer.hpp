@@ -17,6 +17,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dem/core/particles.hpp"
@@ -70,7 +71,14 @@ class SnapshotWriter {
   std::string index_path() const;
   SnapshotFieldSet fields() const { return fields_; }
 
+  // Each material's coarse-graining factor (Scene::coarse_grain_table) for the fields
+  // coarse_grain and real_count; empty (the default): every particle is a real one.
+  void set_coarse_grain(std::vector<double> per_material) {
+    coarse_grain_ = std::move(per_material);
+  }
+
  private:
+  std::vector<double> coarse_grain_;
   MPI_Comm comm_;
   int rank_ = 0;
   int size_ = 1;

@@ -27,7 +27,7 @@ struct SnapshotField {
 
 // The first eight are the default set (and temperature when heat is on); the others are
 // written when the scene's `output.fields` asks for them (docs/scene-reference.md).
-inline constexpr std::array<SnapshotField, 14> snapshot_fields{{
+inline constexpr std::array<SnapshotField, 16> snapshot_fields{{
     {"id", 1, SnapshotField::Type::Int64, "1"},
     {"position", 3, SnapshotField::Type::Float64, "m"},
     {"velocity", 3, SnapshotField::Type::Float64, "m/s"},
@@ -42,6 +42,10 @@ inline constexpr std::array<SnapshotField, 14> snapshot_fields{{
     {"fluid_force", 3, SnapshotField::Type::Float64, "N"},
     {"overlap_max", 1, SnapshotField::Type::Float64, "1"},
     {"temperature", 1, SnapshotField::Type::Float64, "K"},  // heat on (written by default then)
+    // Coarse graining (docs/models/coarse-graining.md; written by default when a scene has
+    // parcels): the factor k and the real particles k^3 a particle stands for.
+    {"coarse_grain", 1, SnapshotField::Type::Float64, "1"},
+    {"real_count", 1, SnapshotField::Type::Float64, "1"},
 }};
 
 // A set of snapshot fields: bit k stands for snapshot_fields[k].

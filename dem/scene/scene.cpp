@@ -21,6 +21,16 @@ int Scene::material_index(const std::string& name) const {
   return -1;
 }
 
+std::vector<double> Scene::coarse_grain_table() const {
+  std::vector<double> k;
+  for (const Material& m : materials)
+    if (m.coarse_grain != 1) {
+      for (const Material& n : materials) k.push_back(n.coarse_grain);
+      break;
+    }
+  return k;
+}
+
 const MaterialPair& Scene::pair(int a, int b) const {
   if (a > b) std::swap(a, b);
   const int n = static_cast<int>(materials.size());

@@ -26,6 +26,13 @@ struct Material {
   double heat_capacity = 0;  // c_p > 0 [J/(kg K)]
   double conductivity = 0;   // k > 0 [W/(m K)]
   double heat_source = 0;    // q [W/kg], any sign (0: none)
+  // Coarse graining (docs/models/coarse-graining.md): a particle of this material is a
+  // parcel of radius k r standing for k^3 real particles of radius r, with the real material's
+  // properties. The parser adds one such parcel class per (material, k != 1) an insertion
+  // asks for, a copy of the real material `real_material` with `coarse_grain` = k and every
+  // pair property of it; a material the scene lists has k = 1 and is its own real material.
+  double coarse_grain = 1;  // k >= 1
+  int real_material = -1;   // index of the listed material (-1: this one)
 };
 
 // Properties of a pair of materials (symmetric). Pairs not listed use the
@@ -184,6 +191,10 @@ struct Insertion {
   // csv: columns x,y,z,radius and optionally vx,vy,vz, wx,wy,wz, material (material by name)
   std::string csv_file;  // resolved relative to the scene file's folder
   std::string source;    // "file:line" of this entry, for messages
+  // fill, stream: coarse-graining factor k >= 1 (`coarse_grain`); with k != 1 the parser has
+  // already set `material` to the parcel class (Material::coarse_grain) and multiplied
+  // `radius` by k, so every particle inserted is a parcel.
+  double coarse_grain = 1;
   // Heat on: the particles' initial temperature [K] (fill, stream; csv rows without a `T`
   // column; snapshots without a temperature dataset). Absent when heat is off.
   std::optional<double> temperature;
@@ -252,6 +263,9 @@ struct Scene {
   bool contacts_possible = true;
 
   int material_index(const std::string& name) const;  // -1 if absent
+  // Every material's coarse-graining factor k (Material::coarse_grain), indexed by material;
+  // empty when every particle is a real one (k = 1 for all).
+  std::vector<double> coarse_grain_table() const;
   const MaterialPair& pair(int a, int b) const;       // precondition: complete table
 };
 

@@ -12,6 +12,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
+#include <string>
 
 #include "coupling/dem_link.hpp"
 #include "dem/core/particles.hpp"
@@ -201,6 +203,40 @@ TEST(DemLink, RefusesHeatWithoutTheFluidsConvectionSettings) {
   for (const char* key : {"`temperature: <K>`", "`heat_capacity: <J/(kg K)>`",
                           "`conductivity: <W/(m K)>`", "docs/models/heat-transfer.md"})
     EXPECT_NE(message.find(key), std::string::npos) << key << " in " << message;
+
+// Coarse-grained parcels (docs/models/coarse-graining.md) are one-way only for now: a coupled
+// run refuses them at start-up, naming the insertion's file:line and the key.
+TEST(DemLink, RefusesCoarseGrainedParcels) {
+  const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "dem_link_parcels";
+  fs::create_directories(dir);
+  const fs::path scene = dir / "parcels.yaml";
+  std::ofstream(scene) << "domain: {min: [0, 0, 0], max: [0.02, 0.02, 0.04]}\n"
+                          "gravity: [0, 0, -9.81]\n"
+                          "time: {step: 1e-5, end: 0.01}\n"
+                          "materials:\n"
+                          "  - {name: glass, youngs_modulus: 5e6, poisson_ratio: 0.3, density: 2500}\n"
+                          "interaction_defaults: {restitution: 0.5}\n"
+                          "contact: {normal: hertz}\n"
+                          "insert:\n"
+                          "  - type: fill\n"
+                          "    region: {box: {min: [0, 0, 0], max: [0.02, 0.02, 0.02]}}\n"
+                          "    count: 10\n"
+                          "    material: glass\n"
+                          "    radius: {distribution: constant, value: 3e-4}\n"
+                          "    coarse_grain: 2\n"
+                          "fluid: {density: 1000, viscosity: 1e-3, drag: di_felice, model: B,\n"
+                          "        pressure: {hydrostatic: false},\n"
+                          "        forces: [drag, pressure_gradient, viscous, buoyancy]}\n";
+  std::string message;
+  try {
+    DemLink link(scene.string(), 1000, 1e-3, MPI_COMM_WORLD);
+  } catch (const std::runtime_error& e) {
+    message = e.what();
+  }
+  EXPECT_NE(message.find("parcels.yaml:9: error: insert.coarse_grain 2: coarse-grained parcels "
+                         "are not available in coupled runs yet"),
+            std::string::npos)
+      << message;
 }
 
 }  // namespace

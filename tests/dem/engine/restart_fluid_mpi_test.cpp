@@ -12,9 +12,11 @@
 #include <mpi.h>
 
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "dem/engine/run.hpp"
 #include "dem/io/checkpoint.hpp"
@@ -111,6 +113,28 @@ TEST(RestartWithFluidForces, RotationalDragContinuesBitIdentically) {
   scene.fluid->field.gradient_direction = Vec3::UnitZ();
   scene.fluid->forces.push_back(FluidForce::rotational_drag);
   expect_restart_identical(scene, kWork / "spin");
+}
+
+// The same bed as coarse-grained parcels (docs/models/coarse-graining.md): 300 parcels of
+// k = 2 (real radii 0.2-0.3 mm, so the same parcel sizes as above) standing for 2400 beads.
+// The factor travels as the parcel class (the material index): restored exactly.
+TEST(RestartWithFluidForces, ParcelsContinueBitIdentically) {
+  const std::string path = std::string(GRAINFLOW_TEST_DATA_DIR) + "/scenes/fluid_bed_checkpoint.yaml";
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  const std::string radius = "radius: {distribution: uniform, min: 4e-4, max: 6e-4}";
+  ASSERT_NE(yaml.find(radius), std::string::npos);
+  yaml.replace(yaml.find(radius), radius.size(),
+               "radius: {distribution: uniform, min: 2e-4, max: 3e-4}\n    coarse_grain: 2");
+  const Scene scene = parse_scene(yaml, path);
+  ASSERT_EQ(scene.materials.size(), 2u);
+  ASSERT_EQ(scene.fluid->coarse_grain, (std::vector<double>{1, 2}));
+  expect_restart_identical(scene, kWork / "parcels");
+  if (rank() != 0) return;
+  const CheckpointData c = read_checkpoint(newest(kWork / "parcels" / "whole", "checkpoint_"));
+  for (int m : c.particles.material) EXPECT_EQ(m, 1);  // every particle is a k = 2 parcel
 }
 
 }  // namespace

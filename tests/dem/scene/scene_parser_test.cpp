@@ -806,7 +806,7 @@ TEST(SceneParser, SnapshotFieldsAndWindow) {
   EXPECT_THAT(unknown, HasSubstr("output.fields[1]: unknown snapshot field 'torqe'; allowed: id, "
                                  "position, velocity, angular_velocity, radius, diameter, mass, "
                                  "material, force, torque, coordination, fluid_force, "
-                                 "overlap_max, temperature (did you mean 'torque'?)"));
+                                 "overlap_max, temperature, coarse_grain, real_count (did you mean 'torque'?)"));
   EXPECT_THAT(expect_at(error_of(kBase + "output:\n  fields: []\n"), 18, 11),
               HasSubstr("output.fields: the list is empty"));
   EXPECT_THAT(expect_at(error_of(kBase + "output:\n  fields: force\n"), 18, 11),

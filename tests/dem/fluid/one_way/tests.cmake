@@ -20,3 +20,11 @@ grain_cli_test(fluid_spin_runs 0 "done: 1000 steps, 1 particles"
 grain_cli_test(fluid_lift_refused 1
                "dt = 0.02 s is beyond the stability limit of the fluid force 'saffman_mei' \\(dt <= 0.009794 s;.*use dt <= 0.00881[0-9] s"
                CMD ${_grain} check ${_scenes}/fluid/saffman_too_coarse.yaml)
+
+# Coarse-grained parcels (docs/models/coarse-graining.md): `grain check` reports the real
+# particles the parcels stand for (20 parcels of k = 2: 160 beads of 0.6 mm, 4.524e-5 kg),
+# names the parcel class in the Rayleigh line, and warns that the void-fraction cell is
+# smaller than 3 parcel diameters.
+grain_cli_test(coarse_grain_check 0
+               "Rayleigh time t_R = [0-9.e-]+ s \\(smallest 'glass\\[k=2\\]' particle\\);'glass\\[k=2\\]': 20 parcels of k = 2 stand for 160 real particles of mass 4.5238[0-9]*e-05 kg;warning: the void-fraction cell \\(0.0025 m\\) is smaller than 3 parcel diameters"
+               CMD ${_grain} check ${_scenes}/fluid/parcels.yaml)

@@ -1,0 +1,325 @@
+// Coarse-grained parcels (docs/models/coarse-graining.md): an insertion's `coarse_grain: k`
+// inserts parcels of radius k r standing for k^3 real particles of radius r.
+//
+// 1. Settling: a lone parcel of glass (real d = 0.2 mm) in quiescent water, drag (Schiller-
+//    Naumann) + pressure gradient (hydrostatic) + viscous, model B. Reference: the real
+//    particle's terminal velocity from K_SN(d, u) u = (rho_p - rho_f) (pi/6) d^3 g, solved by
+//    bisection here (independent of the parcel code). Asserted within 0.5 % for k = 1, 2, 3
+//    (Sakai & Koshizuka 2009: the parcel's drag is k^3 times the real particle's at the
+//    parcel's slip, and its weight and buoyancy are k^3 times the real one's).
+// 2. The fluid's momentum: the implicit drag coefficient of a parcel equals k^3 times that
+//    of a real particle at the same slip, to round-off.
+// 3. k = 1 is today's path: a bed of 30 beads settling in water onto a floor, with contacts,
+//    gives bit-identical positions and velocities with `coarse_grain: 1` and without the key.
+// 4. Contact (Bierwisch et al. 2009, energy-conserving scaling: the parcel keeps the real
+//    material's properties): a parcel-wall Hertz impact returns the material's restitution
+//    e (the Antypov-Elliott mapping, to 0.2 %), and its peak overlap and contact time are k
+//    times the real particle's (Hertz: delta ~ (m v^2 / (Y sqrt(R)))^(2/5), t_c ~ delta/v,
+//    with m ~ k^3, R ~ k), within 0.5 %.
+// 5. Parser: k < 1, a non-number, coarse_grain on a csv insertion, with cohesion and with
+//    a lift force are refused naming file:line, the key and what is allowed.
+// 6. Output: a run's snapshots hold coarse_grain = k and real_count = k^3 for every parcel.
+#include <gtest/gtest.h>
+#include <hdf5.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <numbers>
+#include <sstream>
+#include <string>
+
+#include "dem/engine/run.hpp"
+#include "dem/engine/simulation.hpp"
+#include "dem/fluid/fluid_forces.hpp"
+#include "dem/fluid/schiller_naumann.hpp"
+#include "dem/scene/scene_parser.hpp"
+
+namespace grainflow {
+namespace {
+
+constexpr double kRhoP = 2500, kRhoF = 1000, kMu = 1e-3, kG = 9.81;
+
+// A number as YAML text, exactly (std::to_string keeps 6 decimals only).
+std::string num(double x) {
+  std::ostringstream o;
+  o.precision(17);
+  o << x;
+  return o.str();
+}
+
+// A scene around `insert` (YAML lines of one insertion entry, indented by 4).
+std::string scene_text(const std::string& insert, double dt, const std::string& extra = "") {
+  return R"(domain: {min: [-0.05, -0.05, -0.05], max: [0.05, 0.05, 0.05]}
+gravity: [0, 0, -9.81]
+time: {step: )" + num(dt) +
+         R"(, end: 1}
+materials:
+  - {name: glass, youngs_modulus: 5e6, poisson_ratio: 0.3, density: 2500}
+interaction_defaults: {restitution: 0.5, friction: 0.3}
+contact: {normal: hertz}
+fluid:
+  density: 1000
+  viscosity: 1e-3
+  drag: schiller_naumann
+  model: B
+  forces: [drag, pressure_gradient, viscous]
+)" + extra + "insert:\n  - type: fill\n" +
+         insert;
+}
+
+// Real-particle terminal velocity: K_SN(d, u) u = (rho_p - rho_f) V g by bisection.
+double terminal_velocity(double d) {
+  const double weight = (kRhoP - kRhoF) * std::numbers::pi / 6 * d * d * d * kG;
+  double lo = 0, hi = 10;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (schiller_naumann({d, mid, 1, kRhoF, kMu}) * mid < weight ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+std::string lone_parcel(double r, const std::string& k_line) {
+  return "    region: {box: {min: [-0.001, -0.001, -0.001], max: [0.001, 0.001, 0.001]}}\n"
+         "    count: 1\n    material: glass\n    radius: {distribution: constant, value: " +
+         num(r) + "}\n" + k_line;
+}
+
+TEST(CoarseGrain, ParcelSettlesAtTheRealParticlesTerminalVelocity) {
+  const double d = 0.2e-3, ut = terminal_velocity(d);
+  const double re = kRhoF * d * ut / kMu;
+  const double tau = kRhoP * d * d / (18 * kMu) / (1 + 0.15 * std::pow(re, 0.687));
+  for (double k : {1.0, 2.0, 3.0}) {
+    const std::string key = k == 1 ? "" : "    coarse_grain: " + num(k) + "\n";
+    const Scene s = parse_scene(scene_text(lone_parcel(d / 2, key), tau / 20), "settle.yaml");
+    Simulation sim(s, true, MPI_COMM_SELF);
+    ASSERT_EQ(sim.particles().size(), 1u);
+    const double real_mass = kRhoP * std::numbers::pi / 6 * d * d * d;
+    EXPECT_NEAR(sim.particles().radius[0], k * d / 2, 1e-15);
+    EXPECT_NEAR(sim.particles().mass[0] / (k * k * k * real_mass), 1, 1e-14);
+    sim.add_force_term(make_fluid_forces(*s.fluid, s.gravity, s.domain, MPI_COMM_SELF));
+    sim.advance_to(12 * tau);
+    const double v = -sim.particles().v[0].z();
+    std::printf("k = %g: parcel d = %g m, real u_t = %.6g m/s (Re %.3g), parcel %.6g m/s, "
+                "rel. gap %.2e\n",
+                k, k * d, ut, re, v, std::abs(v / ut - 1));
+    EXPECT_NEAR(v / ut, 1, 0.005) << "k = " << k;
+  }
+}
+
+TEST(CoarseGrain, ParcelDragIsKCubedTimesTheRealParticles) {
+  const double r = 0.1e-3;
+  for (double k : {2.0, 3.0, 2.5}) {
+    const Scene s = parse_scene(
+        scene_text(lone_parcel(r, "    coarse_grain: " + num(k) + "\n"), 1e-5),
+        "drag.yaml");
+    ASSERT_EQ(s.materials.size(), 2u);  // glass and its parcel class
+    EXPECT_EQ(s.materials[1].coarse_grain, k);
+    const auto term = make_fluid_forces(*s.fluid, s.gravity, s.domain, MPI_COMM_SELF);
+    Particles p;
+    const Vec3 v(0.01, -0.02, 0.03);
+    p.add(1, Vec3::Zero(), v, Vec3::Zero(), r, 0, kRhoP);          // a real particle
+    p.add(2, Vec3::Zero(), v, Vec3::Zero(), k * r, 1, kRhoP);      // a parcel
+    ImplicitDrag drag{{0, 0}, {Vec3::Zero(), Vec3::Zero()}, {}, {}};
+    term->add(p, 0, drag);
+    const double ratio = drag.coefficient[1] / drag.coefficient[0];
+    std::printf("k = %g: K_parcel / K_real = %.16g (k^3 = %g)\n", k, ratio, k * k * k);
+    EXPECT_NEAR(ratio / (k * k * k), 1, 1e-14);
+    // The parcel's buoyant weight (pressure gradient on its volume) is k^3 the real one's.
+    EXPECT_NEAR(p.force[1].z() / p.force[0].z() / (k * k * k), 1, 1e-14);
+  }
+}
+
+TEST(CoarseGrain, FactorOneIsBitIdenticalToNoKey) {
+  const std::string bed =
+      "    region: {box: {min: [-0.004, -0.004, -0.004], max: [0.004, 0.004, 0.004]}}\n"
+      "    count: 30\n    material: glass\n    seed: 7\n"
+      "    radius: {distribution: uniform, min: 0.4e-3, max: 0.6e-3}\n";
+  const std::string floor =
+      "walls:\n  - {type: plane, point: [0, 0, -0.005], normal: [0, 0, 1], material: glass}\n";
+  const Scene plain = parse_scene(scene_text(bed, 2e-5, floor), "bed.yaml");
+  const Scene one = parse_scene(scene_text(bed + "    coarse_grain: 1\n", 2e-5, floor), "bed.yaml");
+  EXPECT_TRUE(one.coarse_grain_table().empty());
+  EXPECT_TRUE(one.fluid->coarse_grain.empty());
+  Simulation a(plain, true, MPI_COMM_SELF), b(one, true, MPI_COMM_SELF);
+  a.add_force_term(make_fluid_forces(*plain.fluid, plain.gravity, plain.domain, MPI_COMM_SELF));
+  b.add_force_term(make_fluid_forces(*one.fluid, one.gravity, one.domain, MPI_COMM_SELF));
+  a.advance_to(0.06);
+  b.advance_to(0.06);
+  ASSERT_EQ(a.particles().size(), b.particles().size());
+  EXPECT_GT(a.counters().steps, 2000);
+  for (std::size_t i = 0; i < a.particles().size(); ++i) {
+    EXPECT_EQ(a.particles().id[i], b.particles().id[i]);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(a.particles().x[i][c], b.particles().x[i][c]);
+      EXPECT_EQ(a.particles().v[i][c], b.particles().v[i][c]);
+      EXPECT_EQ(a.particles().omega[i][c], b.particles().omega[i][c]);
+    }
+  }
+}
+
+struct WallImpact {
+  double restitution = 0, max_overlap = 0, contact_time = 0;
+};
+
+// A parcel (real radius 1 mm, factor k) hits the floor at 0.5 m/s without gravity.
+WallImpact wall_impact(double k, double e) {
+  const double r = 1e-3, v = 0.5;
+  const std::string text =
+      "domain: {min: [-0.05, -0.05, -0.05], max: [0.05, 0.05, 0.05]}\n"
+      "time: {step: 1e-6, end: 1}\n"
+      "materials:\n  - {name: glass, youngs_modulus: 1e7, poisson_ratio: 0.3, density: 2500}\n"
+      "interaction_defaults: {restitution: " + num(e) + "}\n"
+      "contact: {normal: hertz, tangential: none}\n"
+      "walls:\n  - {type: plane, point: [0, 0, 0], normal: [0, 0, 1], material: glass}\n"
+      "insert:\n  - type: fill\n"
+      "    region: {box: {min: [-0.01, -0.01, 0.01], max: [0.01, 0.01, 0.03]}}\n"
+      "    count: 1\n    material: glass\n    velocity: [0, 0, -0.5]\n"
+      "    radius: {distribution: constant, value: 1e-3}\n"
+      "    coarse_grain: " + num(k) + "\n";
+  const Scene s = parse_scene(text, "impact.yaml");
+  Simulation sim(s, true, MPI_COMM_SELF);
+  Particles& p = sim.particles();
+  p.x[0] = Vec3(0, 0, k * r * 1.0001);  // just above the floor
+  // Hertz contact time at 0.5 m/s is about 0.3 ms for k = 1 and k times that for a parcel:
+  // about 550 steps per impact.
+  sim.set_dt(k * 5e-7);
+  sim.initialise();
+  WallImpact out;
+  double t_start = -1;
+  for (long n = 0; n < 1'000'000; ++n) {
+    sim.step();
+    const double overlap = k * r - p.x[0].z();
+    if (overlap > 0) {
+      if (t_start < 0) t_start = sim.time();
+      out.max_overlap = std::max(out.max_overlap, overlap);
+    } else if (t_start >= 0) {
+      out.contact_time = sim.time() - t_start;
+      out.restitution = p.v[0].z() / v;
+      return out;
+    }
+  }
+  ADD_FAILURE() << "no rebound";
+  return out;
+}
+
+TEST(CoarseGrain, ParcelWallImpactKeepsTheMaterialsRestitution) {
+  for (double e : {0.5, 0.9}) {
+    const WallImpact real = wall_impact(1, e);
+    std::printf("e = %g, k = 1: restitution %.5f, overlap %.6g m, t_c %.6g s\n", e,
+                real.restitution, real.max_overlap, real.contact_time);
+    EXPECT_NEAR(real.restitution / e, 1, 2e-3);
+    for (double k : {2.0, 3.0}) {
+      const WallImpact w = wall_impact(k, e);
+      std::printf("e = %g, k = %g: restitution %.5f, overlap/k %.6g m, t_c/k %.6g s\n", e, k,
+                  w.restitution, w.max_overlap / k, w.contact_time / k);
+      EXPECT_NEAR(w.restitution / e, 1, 2e-3) << "k = " << k;
+      EXPECT_NEAR(w.max_overlap / (k * real.max_overlap), 1, 5e-3) << "k = " << k;
+      EXPECT_NEAR(w.contact_time / (k * real.contact_time), 1, 5e-3) << "k = " << k;
+    }
+  }
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    parse_scene(text, "cg.yaml");
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(CoarseGrain, ParserNamesFileLineKeyAndAllowedValues) {
+  // The insertion entry starts at line 15; coarse_grain is its sixth line (20).
+  const auto with = [](const std::string& k_line) {
+    return scene_text(lone_parcel(1e-4, k_line), 1e-5);
+  };
+  std::string e = error_of(with("    coarse_grain: 0.5\n"));
+  std::printf("%s\n", e.c_str());
+  EXPECT_NE(e.find("cg.yaml:20:"), std::string::npos) << e;
+  EXPECT_NE(e.find("coarse_grain"), std::string::npos) << e;
+  EXPECT_NE(e.find("value 0.5 is out of range; it must be in [1, 1000]"), std::string::npos) << e;
+  e = error_of(with("    coarse_grain: two\n"));
+  std::printf("%s\n", e.c_str());
+  EXPECT_NE(e.find("cg.yaml:20:"), std::string::npos) << e;
+  EXPECT_NE(e.find("coarse_grain"), std::string::npos) << e;
+  EXPECT_NE(e.find("expected a number, got"), std::string::npos) << e;
+  // A csv insertion keeps its particles' sizes.
+  e = error_of(R"(domain: {min: [0, 0, 0], max: [1, 1, 1]}
+time: {step: 1e-5, end: 1}
+materials:
+  - {name: glass, youngs_modulus: 5e6, poisson_ratio: 0.3, density: 2500}
+interaction_defaults: {restitution: 0.5}
+contact: {normal: hertz}
+insert:
+  - {type: csv, file: complete_particles.csv, material: glass, coarse_grain: 2}
+)");
+  std::printf("%s\n", e.c_str());
+  EXPECT_NE(e.find("cg.yaml:8:"), std::string::npos) << e;
+  EXPECT_NE(e.find("coarse_grain is available on fill and stream insertions"), std::string::npos)
+      << e;
+  // Models not scaled for parcels are refused at their own key, naming the insertion.
+  std::string cohesive = with("    coarse_grain: 2\n");
+  cohesive.replace(cohesive.find("contact: {normal: hertz}"), 24,
+                   "contact: {normal: hertz, cohesion: sjkr}");
+  e = error_of(cohesive);
+  std::printf("%s\n", e.c_str());
+  EXPECT_NE(e.find("cg.yaml:7:"), std::string::npos) << e;
+  EXPECT_NE(e.find("cohesion is not available with coarse-grained parcels, coarse_grain 2 (the "
+                   "insertion at cg.yaml:15)"),
+            std::string::npos)
+      << e;
+  std::string lift = with("    coarse_grain: 2\n");
+  lift.replace(lift.find("forces: [drag, pressure_gradient, viscous]"), 42,
+               "forces: [drag, pressure_gradient, viscous, saffman_mei]");
+  e = error_of(lift);
+  std::printf("%s\n", e.c_str());
+  EXPECT_NE(e.find("cg.yaml:13:"), std::string::npos) << e;
+  EXPECT_NE(e.find("allowed with parcels: drag, pressure_gradient, viscous, buoyancy, "
+                   "virtual_mass"),
+            std::string::npos)
+      << e;
+}
+
+std::vector<double> dataset(const std::string& file, const char* name) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  std::vector<double> out;
+  if (f < 0) return out;
+  if (H5Lexists(f, name, H5P_DEFAULT) > 0) {
+    const hid_t d = H5Dopen2(f, name, H5P_DEFAULT);
+    const hid_t space = H5Dget_space(d);
+    out.resize(static_cast<std::size_t>(H5Sget_simple_extent_npoints(space)));
+    H5Sclose(space);
+    H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data());
+    H5Dclose(d);
+  }
+  H5Fclose(f);
+  return out;
+}
+
+TEST(CoarseGrain, SnapshotsCarryTheFactorAndTheRealCount) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "coarse_grain_snapshots";
+  fs::remove_all(dir);
+  const Scene s = parse_scene(
+      scene_text(lone_parcel(1e-4, "    coarse_grain: 2.5\n"), 1e-4,
+                 "output: {snapshot_interval: 0.001, progress: false}\n") ,
+      "snapshots.yaml");
+  Scene short_run = s;
+  short_run.time.end = 0.002;
+  RunOptions options;
+  options.output_directory = dir.string();
+  options.progress = false;
+  options.handle_stop_signals = false;
+  std::ostringstream log;
+  run_scene(short_run, options, MPI_COMM_WORLD, log);
+  const std::string file = (dir / "particles_000002.h5").string();
+  EXPECT_EQ(dataset(file, "coarse_grain"), std::vector<double>{2.5});
+  EXPECT_EQ(dataset(file, "real_count"), std::vector<double>{2.5 * 2.5 * 2.5});
+  EXPECT_NE(log.str().find("1 parcels of k = 2.5 stand for 15.625 real particles"),
+            std::string::npos)
+      << log.str();
+}
+
+}  // namespace
+}  // namespace grainflow
