@@ -1329,7 +1329,7 @@ void ParticleCoupling::depositHeat() {
 
 void ParticleCoupling::exchangeHeat(const Foam::volScalarField& T, const Foam::volScalarField& T0) {
   using namespace Foam;
-  auto t0 = Clock::now();
+  const Stopwatch clock;
   std::vector<double> acc(particles_.size(), 0.0);
   for (std::size_t i = 0; i < particles_.size(); ++i)
     for (std::size_t j = first_[i]; j < first_[i + 1]; ++j)
@@ -1356,7 +1356,7 @@ void ParticleCoupling::exchangeHeat(const Foam::volScalarField& T, const Foam::v
   MPI_Allreduce(MPI_IN_PLACE, sums, 4, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
   particleHeatTotal_ += sums[0];
   fluidHeatTotal_ += sums[1];
-  couplingSeconds_ += seconds_since(t0);
+  add(kCoupling, clock);
   const Time& time = mesh_.time();
   if (!time.writeTime() && time.timeIndex() != restartIndex_ + 1) return;
   const double imbalance = sums[2] > 0 ? std::abs(sums[0] + sums[1]) / sums[2] : 0.0;

@@ -203,6 +203,7 @@ TEST(DemLink, RefusesHeatWithoutTheFluidsConvectionSettings) {
   for (const char* key : {"`temperature: <K>`", "`heat_capacity: <J/(kg K)>`",
                           "`conductivity: <W/(m K)>`", "docs/models/heat-transfer.md"})
     EXPECT_NE(message.find(key), std::string::npos) << key << " in " << message;
+}
 
 // Coarse-grained parcels (docs/models/coarse-graining.md) are one-way only for now: a coupled
 // run refuses them at start-up, naming the insertion's file:line and the key.
