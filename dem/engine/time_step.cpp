@@ -84,7 +84,7 @@ void accuracy_note(const Scene& scene, TimeStepReport& rep,
                         worst->contact_time / rep.dt, DashpotVelocity::predicted);
     std::ostringstream q;
     q << "with `contact: {dashpot_velocity: predicted}` (second order for damped contacts, "
-         "about 1.8x the cost per step) the restitution error at this dt would be" << about
+         "about 2x the cost per step) the restitution error at this dt would be" << about
       << percent(p.restitution_rms) << " % and the contact-time error" << about
       << percent(p.contact_time_rms) << " % (docs/accuracy-vs-cost.md)";
     rep.notes.push_back(q.str());
