@@ -140,12 +140,6 @@ DemLink::DemLink(const std::string& scene_file, double fluid_density, double flu
       why << where << ": error: output." << key << " is not used by a coupled run: " << instead
           << "; remove it (grainFoam honours output.directory and output.snapshot_interval)\n";
   }
-  for (const grainflow::Insertion& ins : m.scene.insertions)
-    if (ins.coarse_grain != 1)
-      why << ins.source << ": error: insert.coarse_grain " << ins.coarse_grain
-          << ": coarse-grained parcels are not available in coupled runs yet (the coupling's "
-             "void fraction and undisturbed-velocity correction would need the real particle "
-             "size); use coarse_grain: 1 with grainFoam, or run the scene one-way with grain\n";
   if (!why.str().empty()) throw std::runtime_error(why.str());
   // Checks the force list against the coupled solver (pressure without hydrostatics).
   try {
@@ -433,7 +427,22 @@ void DemLink::set_fluid(const std::vector<FluidAtParticle>& samples,
   end_fluid(std::move(late));
 }
 
-void DemLink::correct_self_disturbance(bool on) { impl_->self = on; }
+void DemLink::correct_self_disturbance(bool on) {
+  // The disturbance model (dem/fluid/self_disturbance.hpp) is that of one sphere in its cells;
+  // a parcel's k^3 real particles disturb their cells together, which it does not describe.
+  if (on)
+    for (const grainflow::Insertion& ins : impl_->scene.insertions)
+      if (ins.coarse_grain != 1) {
+        std::ostringstream why;
+        why << ins.source << ": error: insert.coarse_grain " << ins.coarse_grain
+            << ": the undisturbed-velocity correction (constant/couplingProperties "
+               "undisturbedVelocity oseenBrinkman) models one particle's own disturbance, not "
+               "that of a parcel's real particles together; set undisturbedVelocity off, or "
+               "use coarse_grain: 1 (docs/models/coarse-graining.md)";
+        throw std::runtime_error(why.str());
+      }
+  impl_->self = on;
+}
 
 void DemLink::begin_fluid() {
   Impl& m = *impl_;

@@ -354,12 +354,6 @@ std::unique_ptr<ForceTerm> make_coupled_fluid_forces(const FluidSettings& settin
       throw std::invalid_argument(
           "virtual_mass is not available in coupled runs yet (the coupling does not sample the "
           "fluid's material derivative Du/Dt); remove it from fluid.forces");
-  if (!settings.coarse_grain.empty())
-    throw std::invalid_argument(
-        "coarse-grained parcels (an insertion's coarse_grain other than 1) are not available in "
-        "coupled runs yet (the coupling's void fraction and undisturbed-velocity correction "
-        "would need the real particle size); use coarse_grain: 1 with grainFoam, or run the "
-        "scene one-way with grain");
   FluidSettings s = settings;
   s.computed_void_fraction.reset();        // the coupling computes eps on the mesh
   s.field.hydrostatic_pressure = false;    // the solver's p excludes rho_f g.x

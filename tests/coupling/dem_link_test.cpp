@@ -205,37 +205,92 @@ TEST(DemLink, RefusesHeatWithoutTheFluidsConvectionSettings) {
     EXPECT_NE(message.find(key), std::string::npos) << key << " in " << message;
 }
 
-// Coarse-grained parcels (docs/models/coarse-graining.md) are one-way only for now: a coupled
-// run refuses them at start-up, naming the insertion's file:line and the key.
-TEST(DemLink, RefusesCoarseGrainedParcels) {
+// Coarse-grained parcels in a coupled run (docs/models/coarse-graining.md, "Coupled"): the
+// drag coefficient the coupling deposits (K on the fluid's diagonal, ParticleView) is the real
+// particle's at the parcel's slip times k^3, and the explicit force it returns (model B:
+// pressure gradient and viscous force) acts on the parcel's volume, k^3 real volumes.
+// Reference: Schiller-Naumann's K = 3 pi mu d (1 + 0.15 Re^0.687), Re = rho d U / mu, for the
+// real d, and -V grad p + V div(tau) with V = 4/3 pi (k r)^3, computed here.
+const char* kParcelScene =
+    "domain: {min: [0, 0, 0], max: [0.02, 0.02, 0.04]}\n"
+    "gravity: [0, 0, 0]\n"
+    "time: {step: 1e-5, end: 0.01}\n"
+    "materials:\n"
+    "  - {name: glass, youngs_modulus: 5e6, poisson_ratio: 0.3, density: 2500}\n"
+    "interaction_defaults: {restitution: 0.5}\n"
+    "contact: {normal: hertz}\n"
+    "insert:\n"
+    "  - type: fill\n"
+    "    region: {box: {min: [0, 0, 0], max: [0.02, 0.02, 0.02]}}\n"
+    "    count: 10\n"
+    "    material: glass\n"
+    "    radius: {distribution: constant, value: 3e-4}\n"
+    "    coarse_grain: 2\n"
+    "  - {type: fill, region: {box: {min: [0, 0, 0.02], max: [0.02, 0.02, 0.04]}}, count: 10,\n"
+    "     material: glass, radius: {distribution: constant, value: 3e-4}}\n"
+    "fluid: {density: 1000, viscosity: 1e-3, drag: schiller_naumann, model: B,\n"
+    "        pressure: {hydrostatic: false},\n"
+    "        forces: [drag, pressure_gradient, viscous, buoyancy]}\n";
+
+TEST(DemLink, ParcelsCarryTheRealDragTimesK3AndTheirOwnVolume) {
   const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "dem_link_parcels";
   fs::create_directories(dir);
   const fs::path scene = dir / "parcels.yaml";
-  std::ofstream(scene) << "domain: {min: [0, 0, 0], max: [0.02, 0.02, 0.04]}\n"
-                          "gravity: [0, 0, -9.81]\n"
-                          "time: {step: 1e-5, end: 0.01}\n"
-                          "materials:\n"
-                          "  - {name: glass, youngs_modulus: 5e6, poisson_ratio: 0.3, density: 2500}\n"
-                          "interaction_defaults: {restitution: 0.5}\n"
-                          "contact: {normal: hertz}\n"
-                          "insert:\n"
-                          "  - type: fill\n"
-                          "    region: {box: {min: [0, 0, 0], max: [0.02, 0.02, 0.02]}}\n"
-                          "    count: 10\n"
-                          "    material: glass\n"
-                          "    radius: {distribution: constant, value: 3e-4}\n"
-                          "    coarse_grain: 2\n"
-                          "fluid: {density: 1000, viscosity: 1e-3, drag: di_felice, model: B,\n"
-                          "        pressure: {hydrostatic: false},\n"
-                          "        forces: [drag, pressure_gradient, viscous, buoyancy]}\n";
+  std::ofstream(scene) << kParcelScene;
+  const double rho = 1000, mu = 1e-3, r = 3e-4, pi = std::acos(-1.0);
+  DemLink link(scene.string(), rho, mu, MPI_COMM_WORLD);
+  link.initialise();
+  const std::array<double, 3> u{0.004, -0.003, 0.012}, grad_p{20, -10, -150}, div_tau{0.5, 1, -2};
+  FluidAtParticle f;
+  f.velocity = u;
+  f.void_fraction = 0.7;
+  f.pressure_gradient = grad_p;
+  f.viscous_stress_divergence = div_tau;
+  const ParticleSet set = link.particles(false);
+  link.begin_fluid();
+  for (std::size_t i = 0; i < set.local; ++i) link.add_fluid(f);
+  link.end_fluid([f](const std::array<double, 3>&) { return f; });
+  link.advance(1, (dir / "diagnostics").string());  // K and the forces of the first step: v = 0
+  ParticleView view;
+  link.view(view);
+  const double speed = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+  const double d = 2 * r, re = rho * d * speed / mu;
+  const double k_real = 3 * pi * mu * d * (1 + 0.15 * std::pow(re, 0.687));
+  int parcels = 0, reals = 0;
+  for (std::size_t i = 0; i < view.local(); ++i) {
+    const double k = view.radius(i) / r;  // 2 for a parcel, 1 for a real particle
+    ASSERT_TRUE(std::abs(k - 2) < 1e-12 || std::abs(k - 1) < 1e-12) << view.radius(i);
+    (k > 1.5 ? parcels : reals) += 1;
+    EXPECT_NEAR(view.drag_coefficient(i) / (k * k * k * k_real), 1, 1e-13) << "k = " << k;
+    const double volume = 4.0 / 3.0 * pi * std::pow(k * r, 3);
+    const std::array<double, 3> carried = view.exchange_force(i);
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(carried[c], -volume * grad_p[c] + volume * div_tau[c],
+                  1e-13 * volume * std::abs(grad_p[2]))
+          << "k = " << k << ", component " << c;
+  }
+  EXPECT_EQ(parcels, 10);
+  EXPECT_EQ(reals, 10);
+}
+
+// The undisturbed-velocity correction models one particle's own disturbance: with parcels
+// the link refuses it, naming the insertion's file:line and the key.
+TEST(DemLink, RefusesTheUndisturbedVelocityWithParcels) {
+  const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "dem_link_parcels";
+  fs::create_directories(dir);
+  const fs::path scene = dir / "parcels_undisturbed.yaml";
+  std::ofstream(scene) << kParcelScene;
+  DemLink link(scene.string(), 1000, 1e-3, MPI_COMM_WORLD);
+  link.correct_self_disturbance(false);  // off: nothing to refuse
   std::string message;
   try {
-    DemLink link(scene.string(), 1000, 1e-3, MPI_COMM_WORLD);
+    link.correct_self_disturbance(true);
   } catch (const std::runtime_error& e) {
     message = e.what();
   }
-  EXPECT_NE(message.find("parcels.yaml:9: error: insert.coarse_grain 2: coarse-grained parcels "
-                         "are not available in coupled runs yet"),
+  EXPECT_NE(message.find("parcels_undisturbed.yaml:9: error: insert.coarse_grain 2: the "
+                         "undisturbed-velocity correction (constant/couplingProperties "
+                         "undisturbedVelocity oseenBrinkman)"),
             std::string::npos)
       << message;
 }

@@ -138,3 +138,25 @@ grainflow_coupling_test(scene_output 1)
 grainflow_coupling_test(heat_equilibrium 1)
 grainflow_coupling_test(heat_balance 2)
 set_tests_properties(coupling.stop_signal PROPERTIES TIMEOUT 600)  # ~25 s on a quiet machine
+
+# coupling.parcel_bed_ergun (tests/coupling/parcel_bed.py, cases/parcel_bed): coarse-grained
+# parcels in grainFoam. A bed of 1 mm glass beads poured in a periodic 12 mm column with air at
+# 0.2 m/s, as k = 1, 2, 3 parcels: each k's pressure drop within the tolerance k = 1 meets of
+# Ergun with that bed's own eps and height; snapshots carry k and k^3; the deposited volume is
+# the real beads'; the momentum exchange balanced to 1e-12 on 1 and 2 ranks.
+if(TARGET grainflowFoamBCs)
+  add_test(NAME coupling.parcel_bed_ergun
+           COMMAND ${GRAINFLOW_COUPLING_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/parcel_bed.py
+                   parcel_bed_ergun
+                   --foam-env ${PROJECT_SOURCE_DIR}/scripts/foam_env.sh
+                   --solver $<TARGET_FILE:grainFoam>
+                   --mpiexec ${MPIEXEC_EXECUTABLE}
+                   --lib-dir $<TARGET_FILE_DIR:grainflowFoamBCs>
+                   --cases ${CMAKE_CURRENT_LIST_DIR}/cases
+                   --work ${CMAKE_CURRENT_BINARY_DIR}/coupling/parcel_bed_ergun)
+  set_tests_properties(coupling.parcel_bed_ergun PROPERTIES
+    ENVIRONMENT "GRAINFLOW_FOAM_BASHRC=${OpenFOAM_BASHRC};${GRAINFLOW_MPIEXEC_ENV}"
+    LABELS "foam;coupling;mpi"
+    PROCESSORS 2
+    TIMEOUT 300)
+endif()

@@ -1,0 +1,145 @@
+#!/usr/bin/env python3
+"""Coarse-grained parcels in a bubbling fluidised bed (issue 23, validation 1, short form).
+
+The `tutorials/cfd-dem/fluidisedBed` case (12 000 glass beads, d = 1.14-1.26 mm, in a
+60 x 9 x 240 mm column of 3 mm cells, air at 2.0 U_mf after a ramp 0.2-0.3 s) run with the
+beads as parcels of k = 1, 2, 3: the fill's count is 12 000 / k^3 parcels (the real beads'
+number; for k > 1 filled into 2-160 mm instead of 2-82 mm, where random insertion finds room
+for them), the DEM step k x 1.5e-5 s (the contact time grows as k; for k = 3 rounded down to
+3e-4/7 s so that the fluid step, 3e-4 s for every k, is a whole number of DEM steps).
+
+Per k: the mean pressure drop over [--from, end] against the bed's buoyant weight
+N V_p (rho_p - rho_f) g / A (the plateau above U_mf), its standard deviation (bubbles), the
+mean bed height (95 % of the parcel centres below, over the snapshots in the window), and the
+cost: grainFoam's CPU seconds (ExecutionTime) per simulated second and its wall time.
+
+usage: fluidised_bed.py [--ks 1,2,3] [--end 1.0] [--from 0.5] [--work DIR] [--build DIR]
+Prints one row per k and appends them to <work>/fluidised_bed.csv.
+"""
+import argparse
+import csv
+import glob
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+FOAM = os.path.join(ROOT, "scripts", "foam_env.sh")
+TUTORIAL = os.path.join(ROOT, "tutorials", "cfd-dem", "fluidisedBed")
+RHO_F, G = 1.2, 9.81
+AREA = 0.06 * 0.009
+FLUID_STEP = 3e-4
+
+
+def sub(path, old, new):
+    text = open(path).read()
+    if old not in text:
+        sys.exit(f"fluidised_bed: no '{old}' in {path}")
+    open(path, "w").write(text.replace(old, new, 1))
+
+
+def dem_step(k):
+    steps = math.floor(FLUID_STEP / (k * 1.5e-5) + 1e-9)
+    return FLUID_STEP / steps, steps
+
+
+def prepare(work, k, end):
+    case = os.path.join(work, f"k{k}")
+    shutil.rmtree(case, ignore_errors=True)
+    shutil.copytree(TUTORIAL, case, ignore=shutil.ignore_patterns(
+        "particles", "processor*", "postProcessing", "log.*", "*.png", "[1-9]*", "0.[0-9]*"))
+    dt, _ = dem_step(k)
+    scene = os.path.join(case, "particles.yaml")
+    sub(scene, "    count: 12000\n", f"    count: {round(12000 / k**3)}\n    coarse_grain: {k}\n")
+    sub(scene, "  step: 1.5e-5\n", f"  step: {dt:.17g}\n")
+    if k > 1:  # random insertion keeps centres k r inside the region: give the parcels room
+        sub(scene, "max: [0.06, 0.009, 0.082]", "max: [0.06, 0.009, 0.16]")
+    sub(os.path.join(case, "system", "controlDict"), "endTime         1.0;", f"endTime         {end:g};")
+    return case
+
+
+def series(case, name):
+    path = glob.glob(os.path.join(case, "postProcessing", name, "*", "surfaceFieldValue.dat"))[0]
+    rows = np.loadtxt(path)
+    return rows[:, 0], rows[:, 1]
+
+
+def analyse(case, t_from):
+    t, p_in = series(case, "pInlet")
+    _, p_out = series(case, "pOutlet")
+    n = min(len(t), len(p_out))
+    t, dp = t[:n], RHO_F * (p_in[:n] - p_out[:n])
+    window = t >= t_from - 1e-9
+    heights = []
+    for s in sorted(glob.glob(os.path.join(case, "particles", "particles_*.h5"))):
+        with h5py.File(s, "r") as f:
+            if float(f.attrs["time"]) >= t_from - 1e-9:
+                heights.append(np.percentile(f["position"][:, 2], 95))
+            last = s
+    with h5py.File(last, "r") as f:
+        d, m = f["diameter"][:], f["mass"][:]
+        real = f["real_count"][:].sum() if "real_count" in f else len(d)
+    v = math.pi / 6 * d**3
+    weight = float(np.sum(m - RHO_F * v)) * G / AREA
+    return dict(parcels=len(d), real=int(real), dp_mean=float(dp[window].mean()),
+                dp_std=float(dp[window].std()), weight=weight,
+                height=float(np.mean(heights)) if heights else float("nan"))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--ks", default="1,2,3")
+    ap.add_argument("--end", type=float, default=1.0)
+    ap.add_argument("--from", dest="t_from", type=float, default=0.5)
+    ap.add_argument("--work", default=os.path.join(ROOT, "build", "benchmarks", "coarse_grain_fluidised"))
+    ap.add_argument("--build", default=os.environ.get("GRAINFLOW_BUILD_DIR", os.path.join(ROOT, "build")))
+    args = ap.parse_args()
+    os.makedirs(args.work, exist_ok=True)
+    env = dict(os.environ, LD_LIBRARY_PATH=os.path.join(args.build, "lib"))
+    rows = []
+    for k in (int(x) for x in args.ks.split(",")):
+        case = prepare(args.work, k, args.end)
+        started = time.monotonic()
+        for cmd, log in ((["blockMesh"], "log.blockMesh"),
+                         ([os.path.join(args.build, "bin", "grainFoam")], "log.grainFoam")):
+            with open(os.path.join(case, log), "w") as out:
+                if subprocess.call([FOAM] + cmd, cwd=case, stdout=out, stderr=subprocess.STDOUT, env=env):
+                    sys.exit(f"fluidised_bed: k = {k}: {cmd[0]} failed, see {case}/{log}")
+        wall = time.monotonic() - started
+        text = open(os.path.join(case, "log.grainFoam")).read()
+        cpu = float(re.findall(r"ExecutionTime = (\S+) s", text)[-1])
+        imbalance = max(float(x) for x in re.findall(r"relative imbalance (\S+)", text))
+        row = dict(k=k, **analyse(case, args.t_from), cpu_s=cpu, wall_s=wall,
+                   cpu_per_simulated_s=cpu / args.end, worst_imbalance=imbalance)
+        rows.append(row)
+        print(f"k = {k}: {row['parcels']} parcels ({row['real']} beads), mean dp "
+              f"{row['dp_mean']:.1f} Pa = {row['dp_mean'] / row['weight']:.4f} x weight "
+              f"{row['weight']:.1f} Pa, std {row['dp_std']:.1f} Pa, bed height "
+              f"{1e3 * row['height']:.1f} mm, CPU {cpu:.0f} s ({cpu / args.end:.0f} s per "
+              f"simulated s), wall {wall:.0f} s, exchange imbalance {imbalance:.1e}", flush=True)
+    out = os.path.join(args.work, "fluidised_bed.csv")
+    new = not os.path.exists(out)
+    with open(out, "a", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+        if new:
+            w.writeheader()
+        w.writerows(rows)
+    if rows and rows[0]["k"] == 1:
+        base = rows[0]
+        for r in rows[1:]:
+            print(f"k = {r['k']} vs k = 1: bed height {100 * (r['height'] / base['height'] - 1):+.1f} %, "
+                  f"std of dp {100 * (r['dp_std'] / base['dp_std'] - 1):+.1f} %, cost "
+                  f"{base['cpu_s'] / r['cpu_s']:.1f}x less (k^3/2 = {r['k']**3 / 2:g})")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

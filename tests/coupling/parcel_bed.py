@@ -1,0 +1,160 @@
+#!/usr/bin/env python3
+"""coupling.parcel_bed_ergun: coarse-grained parcels in grainFoam against Ergun
+(issue 23, validation 2; docs/models/coarse-graining.md, "Coupled runs").
+
+    parcel_bed.py --foam-env scripts/foam_env.sh --solver bin/grainFoam --mpiexec mpiexec
+                  --lib-dir <build>/lib --cases tests/coupling/cases --work <scratch>
+
+cases/parcel_bed: glass beads of real diameter d = 1 mm (the fill's volume fraction fixes the
+real solid volume, the same for every k) poured onto a distributor in a 12 x 12 mm column
+periodic sideways, air (rho = 1.2 kg/m^3, mu = 1.8e-5 Pa s) entering at U = 0.2 m/s
+superficial from the start (0.37 U_mf: the bed stays fixed), drag gidaspow (Ergun's
+correlation below eps = 0.8), model A, void fraction divided, sampling cell, one mesh of
+CELL-sized cells for every k. Each k in KS runs on 1 rank with parcels of k d standing for k^3
+beads, DEM step k x 1e-5 s (the contact time grows as k), 20 DEM steps per fluid step.
+
+Reference (independent of the coupling): Ergun (1952),
+    dp = H [150 mu U (1-eps)^2 / (eps^3 d^2) + 1.75 rho U^2 (1-eps) / (eps^3 d)],
+with the real d and each bed's own eps and height measured from its last snapshot: the solid
+fraction profile from exact sphere-slice volumes in 0.25 mm slices, eps the mean over the
+bed's core (CORE parcel diameters away from its bottom and top), H = solid volume /
+(A (1 - eps)). Measured: the inlet pressure (the outlet holds p = 0) averaged over the last
+AVERAGE seconds, when the bed has come to rest.
+
+Checks:
+  * each k: |dp / Ergun - 1| <= TOLERANCE, the tolerance k = 1 meets (the bed surface's
+    half-full top cell costs k = 1 a few per cent, docs/models/bed-surface.md);
+  * each k: every parcel's snapshot coarse_grain = k and real_count = k^3, and the particle
+    volume grainFoam deposits (its void-fraction line) = the real beads' volume
+    sum real_count pi d^3 / 6 to 1e-12: the void fraction is the real particles';
+  * the momentum exchange balanced to 1e-12 at every printed line, on 1 rank for every k and
+    on 2 ranks (a shorter run of k = 2 and 3 while the parcels fall across the processor
+    plane).
+Exit status 0 when every check holds.
+"""
+import math
+import os
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from grainfoam_driver import ROUND_OFF, balance_lines, main, snapshots, void_lines  # noqa: E402
+
+KS = (1, 2, 3)
+D = 1e-3                      # real bead diameter [m] (particles.yaml radius 0.5e-3)
+RHO_F, MU, U_S = 1.2, 1.8e-5, 0.2
+WIDTH = 0.012                 # the column's side [m]
+AREA = WIDTH * WIDTH
+CELLS = 3                     # cells across the column (system/blockMeshDict)
+DT = 1e-5                     # DEM step at k = 1 [s]
+END = 0.2                     # simulated time [s]: the pour settles by about 0.15 s
+AVERAGE = 0.03                # the pressure drop is averaged over the run's last 0.03 s
+CORE = 1.5                    # eps from the core, this many parcel diameters from the ends
+TOLERANCE = 0.10              # see the module docstring and the printed k = 1 error
+NP2_END = 0.05                # the 2-rank runs: parcels falling across the processor plane
+
+
+def ergun(eps, height):
+    return height * (150 * MU * U_S * (1 - eps) ** 2 / (eps**3 * D**2) +
+                     1.75 * RHO_F * U_S**2 * (1 - eps) / (eps**3 * D))
+
+
+def bed_geometry(particles):
+    """Core eps and mass-equivalent height of the bed in a snapshot."""
+    z, r = particles["position"][:, 2], particles["radius"]
+    dp = 2 * r.mean()
+    dz = 0.25e-3
+    edges = np.arange(0, z.max() + r.max() + dz, dz)
+    a = np.clip(edges[:-1, None] - z[None, :], -r, r)
+    b = np.clip(edges[1:, None] - z[None, :], -r, r)
+    phi = (math.pi * (r**2 * (b - a) - (b**3 - a**3) / 3)).sum(axis=1) / (AREA * dz)
+    mid = 0.5 * (edges[:-1] + edges[1:])
+    bulk = np.median(phi[(mid > CORE * dp) & (mid < z.max() - CORE * dp)])
+    top = mid[np.nonzero(phi > 0.5 * bulk)[0][-1]]
+    core = (mid > CORE * dp) & (mid < top - CORE * dp)
+    eps = 1 - phi[core].mean()
+    solid = float((4 / 3 * math.pi * r**3).sum())
+    return eps, solid / (AREA * (1 - eps)), top
+
+
+def inlet_dp(case, t_from):
+    import glob
+    path = glob.glob(os.path.join(case, "postProcessing", "inletPressure", "*",
+                                  "surfaceFieldValue.dat"))[0]
+    rows = np.loadtxt(path)
+    return RHO_F * rows[rows[:, 0] > t_from, 1].mean()
+
+
+def bed_case(runner, k, ranks, end):
+    dt = k * DT
+    edits = [("particles.yaml", "coarse_grain: 1", f"coarse_grain: {k}"),
+             ("particles.yaml", "step: 1e-5", f"step: {dt:g}"),
+             ("system/controlDict", "endTime         0.2;", f"endTime         {end:g};"),
+             ("system/controlDict", "deltaT          2e-4;", f"deltaT          {20 * dt:g};"),
+             ("system/controlDict", "writeInterval   0.05;", f"writeInterval   {end / 5:g};")]
+    if ranks == 2 and CELLS % 2:  # an odd count across: split the column along its height
+        edits.append(("system/decomposeParDict", "n (2 1 1);", "n (1 1 2);"))
+    return runner.fresh_case("parcel_bed", f"k{k}_np{ranks}", edits)
+
+
+def check_run(checks, label, k, log, case):
+    """Exchange balance and deposited volume of one run; returns the last snapshot."""
+    lines = balance_lines(log)
+    worst = max((imb for _, _, imb in lines), default=math.inf)
+    drag = max((abs(p[2]) for p, _, _ in lines), default=0.0)
+    checks.expect(len(lines) >= 3 and worst < ROUND_OFF and drag > 0,
+                  f"{label}: momentum exchange balanced to {worst:.3g} (< 1e-12) at "
+                  f"{len(lines)} printed steps (largest vertical force on the particles "
+                  f"{drag:.4g} N)")
+    snaps = snapshots(case)
+    t, last = snaps[-1]
+    if k != 1:
+        ok = bool(np.all(last["coarse_grain"] == k) and np.all(last["real_count"] == k**3))
+        checks.expect(ok, f"{label}: snapshot coarse_grain = {k} and real_count = {k**3} for "
+                          f"all {len(last['id'])} parcels")
+    real = (last["real_count"].sum() if "real_count" in last else len(last["id"]))
+    real_volume = real * math.pi * D**3 / 6
+    printed = void_lines(log)[-1][2]
+    checks.expect(abs(printed - real_volume) <= ROUND_OFF * real_volume,
+                  f"{label}: deposited particle volume {printed:.17g} m^3 = {real:.0f} real "
+                  f"beads x pi d^3/6 (relative {abs(printed - real_volume) / real_volume:.2g})")
+    return last
+
+
+def parcel_bed_ergun(runner, checks):
+    rows = []
+    for k in KS:
+        case = bed_case(runner, k, 1, END)
+        started = time.monotonic()
+        log = runner.solve(case, 1)
+        wall = time.monotonic() - started
+        label = f"k = {k}, 1 rank"
+        last = check_run(checks, label, k, log, case)
+        eps, height, top = bed_geometry(last)
+        speed = float(np.linalg.norm(last["velocity"], axis=1).max())
+        dp = inlet_dp(case, END - AVERAGE)
+        ref = ergun(eps, height)
+        error = dp / ref - 1
+        rows.append((k, len(last["id"]), eps, height, dp, ref, error, wall))
+        print(f"  {label}: {len(last['id'])} particles, bed eps {eps:.4f}, height "
+              f"{height * 1e3:.2f} mm (top {top * 1e3:.2f} mm), fastest particle {speed:.2g} m/s; "
+              f"dp {dp:.2f} Pa, Ergun {ref:.2f} Pa, error {100 * error:+.2f} %; "
+              f"{wall:.1f} s wall", flush=True)
+        checks.expect(speed < 0.05, f"{label}: the bed is at rest (fastest particle "
+                                    f"{speed:.2g} m/s < 0.05 m/s)")
+        checks.expect(abs(error) <= TOLERANCE,
+                      f"{label}: dp within {100 * TOLERANCE:g} % of Ergun ({100 * error:+.2f} %)")
+    for k in KS[1:]:
+        case = bed_case(runner, k, 2, NP2_END)
+        log = runner.solve(case, 2)
+        check_run(checks, f"k = {k}, 2 ranks", k, log, case)
+    print("  k  particles  eps     H [mm]  dp [Pa]  Ergun [Pa]  error    wall [s]")
+    for k, n, eps, h, dp, ref, err, wall in rows:
+        print(f"  {k}  {n:9d}  {eps:.4f}  {h * 1e3:6.2f}  {dp:7.2f}  {ref:10.2f}  "
+              f"{100 * err:+6.2f} %  {wall:7.1f}")
+
+
+if __name__ == "__main__":
+    sys.exit(main({"parcel_bed_ergun": parcel_bed_ergun}, "coupling", __doc__))
