@@ -5,12 +5,14 @@
     parcel_bed.py --foam-env scripts/foam_env.sh --solver bin/grainFoam --mpiexec mpiexec
                   --lib-dir <build>/lib --cases tests/coupling/cases --work <scratch>
 
-cases/parcel_bed: glass beads of real diameter d = 1 mm (the fill's volume fraction fixes the
-real solid volume, the same for every k) poured onto a distributor in a 12 x 12 mm column
-periodic sideways, air (rho = 1.2 kg/m^3, mu = 1.8e-5 Pa s) entering at U = 0.2 m/s
-superficial from the start (0.37 U_mf: the bed stays fixed), drag gidaspow (Ergun's
-correlation below eps = 0.8), model A, void fraction divided, sampling cell, one mesh of
-CELL-sized cells for every k. Each k in KS runs on 1 rank with parcels of k d standing for k^3
+cases/parcel_bed: about 3960 glass beads of real diameter d = 1 mm (the fill's volume
+fraction, 0.12 of the 12 x 12 x 120 mm column, fixes the real solid volume, the same for every
+k), thrown down at 1 m/s onto a distributor in the column, periodic sideways; air
+(rho = 1.2 kg/m^3, mu = 1.8e-5 Pa s) enters at U = 0.2 m/s superficial from the start
+(0.37 U_mf: the bed stays fixed); drag gidaspow (Ergun's correlation below eps = 0.8), model A,
+void fraction divided, sampling cell, dragVoidFraction sharpInterface (the bed's surface,
+docs/models/bed-surface.md), one mesh of 4 mm cells (3 x 3 x 30) for every k: 4 d, 2 and
+1.33 parcel diameters. Each k in KS runs on 1 rank with parcels of k d standing for k^3
 beads, DEM step k x 1e-5 s (the contact time grows as k), 20 DEM steps per fluid step.
 
 Reference (independent of the coupling): Ergun (1952),
@@ -22,8 +24,11 @@ bed's core (CORE parcel diameters away from its bottom and top), H = solid volum
 AVERAGE seconds, when the bed has come to rest.
 
 Checks:
-  * each k: |dp / Ergun - 1| <= TOLERANCE, the tolerance k = 1 meets (the bed surface's
-    half-full top cell costs k = 1 a few per cent, docs/models/bed-surface.md);
+  * each k: |dp / Ergun - 1| <= TOLERANCE, the tolerance k = 1 meets: measured -4.9 % at
+    k = 1 (docs/models/bed-surface.md: -4.7 % at 4 d cells), -2.4 % at k = 2, -1.6 % at k = 3;
+    without sharpInterface -11.5, -15.7 and -18.2 % (the half-full top cell);
+  * each bed at rest when dp is averaged (mean particle speed < 5 mm/s; a surface bead may
+    still rattle);
   * each k: every parcel's snapshot coarse_grain = k and real_count = k^3, and the particle
     volume grainFoam deposits (its void-fraction line) = the real beads' volume
     sum real_count pi d^3 / 6 to 1e-12: the void fraction is the real particles';
@@ -52,7 +57,7 @@ DT = 1e-5                     # DEM step at k = 1 [s]
 END = 0.2                     # simulated time [s]: the pour settles by about 0.15 s
 AVERAGE = 0.03                # the pressure drop is averaged over the run's last 0.03 s
 CORE = 1.5                    # eps from the core, this many parcel diameters from the ends
-TOLERANCE = 0.10              # see the module docstring and the printed k = 1 error
+TOLERANCE = 0.06              # k = 1 reaches -4.9 % (see the module docstring)
 NP2_END = 0.05                # the 2-rank runs: parcels falling across the processor plane
 
 
@@ -133,7 +138,8 @@ def parcel_bed_ergun(runner, checks):
         label = f"k = {k}, 1 rank"
         last = check_run(checks, label, k, log, case)
         eps, height, top = bed_geometry(last)
-        speed = float(np.linalg.norm(last["velocity"], axis=1).max())
+        speeds = np.linalg.norm(last["velocity"], axis=1)
+        speed, mean_speed = float(speeds.max()), float(speeds.mean())
         dp = inlet_dp(case, END - AVERAGE)
         ref = ergun(eps, height)
         error = dp / ref - 1
@@ -142,8 +148,8 @@ def parcel_bed_ergun(runner, checks):
               f"{height * 1e3:.2f} mm (top {top * 1e3:.2f} mm), fastest particle {speed:.2g} m/s; "
               f"dp {dp:.2f} Pa, Ergun {ref:.2f} Pa, error {100 * error:+.2f} %; "
               f"{wall:.1f} s wall", flush=True)
-        checks.expect(speed < 0.05, f"{label}: the bed is at rest (fastest particle "
-                                    f"{speed:.2g} m/s < 0.05 m/s)")
+        checks.expect(mean_speed < 5e-3, f"{label}: the bed is at rest (mean particle speed "
+                                         f"{mean_speed:.2g} m/s < 5 mm/s)")
         checks.expect(abs(error) <= TOLERANCE,
                       f"{label}: dp within {100 * TOLERANCE:g} % of Ergun ({100 * error:+.2f} %)")
     for k in KS[1:]:
