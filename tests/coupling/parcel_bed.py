@@ -32,6 +32,7 @@ Checks:
   * each k: every parcel's snapshot coarse_grain = k and real_count = k^3, and the particle
     volume grainFoam deposits (its void-fraction line) = the real beads' volume
     sum real_count pi d^3 / 6 to 1e-12: the void fraction is the real particles';
+  * undisturbedVelocity oseenBrinkman refused with parcels, naming the insertion;
   * the momentum exchange balanced to 1e-12 at every printed line, on 1 rank for every k and
     on 2 ranks (a shorter run of k = 2 and 3 while the parcels fall across the processor
     plane).
@@ -152,6 +153,16 @@ def parcel_bed_ergun(runner, checks):
                                          f"{mean_speed:.2g} m/s < 5 mm/s)")
         checks.expect(abs(error) <= TOLERANCE,
                       f"{label}: dp within {100 * TOLERANCE:g} % of Ergun ({100 * error:+.2f} %)")
+    # Refused with parcels: the undisturbed-velocity correction (one particle's disturbance).
+    case = runner.fresh_case("parcel_bed", "refuse_undisturbed", [
+        ("particles.yaml", "coarse_grain: 1", "coarse_grain: 2"),
+        ("constant/couplingProperties", "dragVoidFraction sharpInterface;",
+         "undisturbedVelocity oseenBrinkman;")])
+    runner.run(case, "blockMesh", "blockMesh")
+    out = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    checks.expect("particles.yaml:23: error: insert.coarse_grain 2: the undisturbed-velocity "
+                  "correction (constant/couplingProperties undisturbedVelocity oseenBrinkman)" in out,
+                  "undisturbedVelocity oseenBrinkman with parcels refused, naming the insertion")
     for k in KS[1:]:
         case = bed_case(runner, k, 2, NP2_END)
         log = runner.solve(case, 2)
