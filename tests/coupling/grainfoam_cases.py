@@ -965,11 +965,10 @@ def heat_front_profiles(case, bed):
     """Per write time: (t, fluid front, solid front, worst |theta_f - Schumann| over the bed's
     cells) measured from the T field (cell averages over each layer of cells, the inlet
     value at z = 0) and the snapshots (mean temperature of each layer of beads), and the
-    largest bead displacement since t = 0."""
+    largest bead displacement from the lattice site it started on (bed.csv: the nearest site,
+    the beads moving far less than d / 2)."""
     out = []
     snaps = dict((round(t, 6), p) for t, p in snapshots(case))
-    first = min(snaps) if snaps else None
-    x0 = snaps[first]["position"] if snaps else None
     moved = 0.0
     for folder in time_folders(case):
         t = float(folder)
@@ -989,7 +988,8 @@ def heat_front_profiles(case, bed):
             zl = np.array([z[layer == k].mean() for k in range(BED_LAYERS)])
             tl = np.array([p["temperature"][layer == k].mean() for k in range(BED_LAYERS)])
             solid = schumann.crossing(zl, (tl - BED_T0) / (BED_TIN - BED_T0))
-            moved = max(moved, float(np.max(np.linalg.norm(p["position"] - x0, axis=1))))
+            site = (np.floor(p["position"] / BED_D) + 0.5) * BED_D
+            moved = max(moved, float(np.max(np.linalg.norm(p["position"] - site, axis=1))))
         out.append((t, fluid, solid, profile_error))
     return out, moved
 
