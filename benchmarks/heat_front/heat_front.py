@@ -11,8 +11,8 @@ Schumann (1929) with Gunn's (1978) coefficient (tests/coupling/schumann.py), the
 
 Rows:
   cells d, 2 d, 4 d high (28, 14, 7 cells over 84 mm; 2 x 2 cells of 2 d across) at 1 ms;
-  fluid steps 0.5, 1, 2 ms (25, 50, 100 DEM steps of 20 us) on cells of 2 d;
-  heat off: the same case (cells 2 d, 1 ms) without `heat:` and its keys, alternated with
+  fluid steps 0.5, 1, 2 ms (25, 50, 100 DEM steps of 20 us) on cells of d;
+  heat off: the same case (cells d, 1 ms) without `heat:` and its keys, alternated with
   heat on --repeat times for the cost comparison.
 
 usage: heat_front.py [--end 0.5] [--repeat 2] [--work DIR] [--build DIR]
@@ -51,9 +51,9 @@ def cpu_split(log):
     return tuple(float(x) for x in m[-1]) if m else (float("nan"),) * 3
 
 
-def run(runner, name, end, cells=14, step="1e-3", heat=True):
+def run(runner, name, end, cells=28, step="1e-3", heat=True):
     edits = [("system/controlDict", "endTime         0.4;", f"endTime         {end:g};"),
-             ("system/blockMeshDict", "(2 2 14)", f"(2 2 {cells})"),
+             ("system/blockMeshDict", "(2 2 28)", f"(2 2 {cells})"),
              ("system/controlDict", "deltaT          1e-3;", f"deltaT          {step};")]
     if not heat:
         edits += HEAT_OFF
@@ -108,8 +108,8 @@ def main():
 
     rows = []
     for label, cells, step in (("cells d", 28, "1e-3"), ("cells 2 d", 14, "1e-3"),
-                               ("cells 4 d", 7, "1e-3"), ("step 0.5 ms", 14, "5e-4"),
-                               ("step 2 ms", 14, "2e-3")):
+                               ("cells 4 d", 7, "1e-3"), ("step 0.5 ms", 28, "5e-4"),
+                               ("step 2 ms", 28, "2e-3")):
         case, log, cpu, wall = run(runner, label.replace(" ", "_"), a.end, cells, step)
         wf, ws, last, moved = errors(case)
         rows.append((label, cells, step, wf, ws, last, sum(cpu), cpu, moved))

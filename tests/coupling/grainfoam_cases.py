@@ -973,7 +973,7 @@ def heat_front_profiles(case, bed):
     for folder in time_folders(case):
         t = float(folder)
         field = read_scalar_field(os.path.join(case, folder, "T"))
-        per_layer = field.size // 4            # 2 x 2 cells per layer, x fastest, z slowest
+        per_layer = field.size // 4            # 2 x 2 cells per level, x fastest, z slowest
         dz = BED_COLUMN[1] / per_layer
         theta = (field.reshape(per_layer, 4).mean(axis=1) - BED_T0) / (BED_TIN - BED_T0)
         zc = (np.arange(per_layer) + 0.5) * dz
@@ -997,7 +997,8 @@ def heat_front_profiles(case, bed):
 def heat_front(runner, checks):
     """cases/heated_bed: 384 beads (d = 3 mm, simple cubic lattice, eps = 1 - pi/6) resting
     on a distributor, 72 mm of bed, air at 400 K entering at 0.8 m/s into the bed at 300 K
-    (contact conduction off, 2 x 2 x 14 cells of 2 d, 50 DEM steps per fluid step of 1 ms).
+    (contact conduction off, 2 x 2 x 28 cells, 2 d across and d high, 50 DEM steps per fluid
+    step of 1 ms).
     Reference (tests/coupling/schumann.py, numpy only): Schumann's (1929) solution of plug
     flow through a bed of lumped particles without axial conduction, with h from Gunn's
     (1978) correlation written out there (Re = 160, Pr = 0.692, Nu = 23.30); the front is

@@ -46,9 +46,9 @@
 #       the two rank counts agree within 1 %. About 10 s.
 #   coupling.heat_front            cases/heated_bed: 384 beads (d = 3 mm) on a simple cubic
 #       lattice resting on a distributor, air at 400 K entering the bed at 300 K at 0.8 m/s
-#       (contact conduction off): the fluid's and the beads' thermal fronts (theta = 1/2)
+#       (contact conduction off, cells d high): the fluid's and the beads' thermal fronts (theta = 1/2)
 #       at 0.1 ... 0.4 s against Schumann (1929) with Gunn's h (tests/coupling/schumann.py,
-#       numpy only) within 5 %; the bed stays put (< 0.1 d); exchange balanced. About 15 s.
+#       numpy only) within 5 %; the bed stays put (< 0.1 d); exchange balanced. About 6 s.
 if(NOT TARGET grainFoam)
   return()
 endif()
