@@ -26,7 +26,10 @@ snapshots against references that do not come from the coupling itself:
                         temperature with the two-body time constant, the mixture's energy
                         conserved; restart continues T exactly;
   heat_balance          conservation: the heat the particles take is the heat the fluid
-                        loses, to round-off, on 1 and 2 ranks.
+                        loses, to round-off, on 1 and 2 ranks;
+  heat_front            closed form: the thermal front of a packed bed heated by hot gas
+                        against Schumann's (1929) solution with Gunn's coefficient
+                        (tests/coupling/schumann.py).
 
 Exit status 0 when every check holds; otherwise each failed check is printed and the exit
 status is 1. Logs stay in the case folders (log.<program>). Shared helpers:
@@ -46,7 +49,8 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
 from grainfoam_driver import (FLOAT, ROUND_OFF, balance_lines, main, read_scalar_field,  # noqa: E402
-                              snapshots, void_lines)
+                              snapshots, time_folders, void_lines)
+import schumann  # noqa: E402  (tests/coupling/schumann.py)
 
 
 # --- coupling.void_fraction_volume ------------------------------------------------------
@@ -942,10 +946,115 @@ def heat_balance(runner, checks):
                                    f"{diff:.3g} < 1e-2")
 
 
+# --- coupling.heat_front ------------------------------------------------------------------
+
+BED_D = 3e-3                  # cases/heated_bed: beads of 3 mm on a simple cubic lattice
+BED_LAYERS = 24               # 4 x 4 beads per layer: a 72 mm bed
+BED_COLUMN = (0.012, 0.084)   # column width and height (mesh and DEM domain)
+BED_T0, BED_TIN = 300.0, 400.0
+
+
+def heated_bed_reference():
+    """The bed's numbers from the case files (not from the solver): eps of the lattice,
+    air and glass as in particles.yaml and transportProperties, h from Gunn (1978)."""
+    return schumann.Bed(d=BED_D, eps=1 - math.pi / 6, u=0.8, rho_f=1.2, mu=1.8e-5,
+                        c_f=1000.0, k_f=0.026, rho_s=2500.0, c_s=6.0)
+
+
+def heat_front_profiles(case, bed):
+    """Per write time: (t, fluid front, solid front, worst |theta_f - Schumann| over the bed's
+    cells) measured from the T field (cell averages over each layer of cells, the inlet
+    value at z = 0) and the snapshots (mean temperature of each layer of beads), and the
+    largest bead displacement from the lattice site it started on (bed.csv: the nearest site,
+    the beads moving far less than d / 2)."""
+    out = []
+    snaps = dict((round(t, 6), p) for t, p in snapshots(case))
+    moved = 0.0
+    for folder in time_folders(case):
+        t = float(folder)
+        field = read_scalar_field(os.path.join(case, folder, "T"))
+        per_layer = field.size // 4            # 2 x 2 cells per level, x fastest, z slowest
+        dz = BED_COLUMN[1] / per_layer
+        theta = (field.reshape(per_layer, 4).mean(axis=1) - BED_T0) / (BED_TIN - BED_T0)
+        zc = (np.arange(per_layer) + 0.5) * dz
+        fluid = schumann.crossing(np.concatenate(([0.0], zc)), np.concatenate(([1.0], theta)))
+        in_bed = zc < BED_LAYERS * BED_D
+        profile_error = max(abs(th - bed.fluid(z, t)) for z, th in zip(zc[in_bed], theta[in_bed]))
+        solid = float("nan")
+        p = snaps.get(round(t, 6))
+        if p is not None:
+            z = p["position"][:, 2]
+            layer = np.floor(z / BED_D).astype(int)
+            zl = np.array([z[layer == k].mean() for k in range(BED_LAYERS)])
+            tl = np.array([p["temperature"][layer == k].mean() for k in range(BED_LAYERS)])
+            solid = schumann.crossing(zl, (tl - BED_T0) / (BED_TIN - BED_T0))
+            site = (np.floor(p["position"] / BED_D) + 0.5) * BED_D
+            moved = max(moved, float(np.max(np.linalg.norm(p["position"] - site, axis=1))))
+        out.append((t, fluid, solid, profile_error))
+    return out, moved
+
+
+def heat_front(runner, checks):
+    """cases/heated_bed: 384 beads (d = 3 mm, simple cubic lattice, eps = 1 - pi/6) resting
+    on a distributor, 72 mm of bed, air at 400 K entering at 0.8 m/s into the bed at 300 K
+    (contact conduction off, 2 x 2 x 28 cells, 2 d across and d high, 50 DEM steps per fluid
+    step of 1 ms).
+    Reference (tests/coupling/schumann.py, numpy only): Schumann's (1929) solution of plug
+    flow through a bed of lumped particles without axial conduction, with h from Gunn's
+    (1978) correlation written out there (Re = 160, Pr = 0.692, Nu = 23.30); the front is
+    where theta = (T - T_0) / (T_in - T_0) = 1/2, of the fluid (the T field) and of the beads
+    (each layer's mean temperature), at 0.1, 0.2, 0.3 and 0.4 s: within 5 %. What the
+    reference neglects and the run has: the fluid's axial conduction eps k_f d2T/dz2, whose
+    effect on the front is computed (Laplace-transform solution with it, < 0.1 %); the
+    beads' motion (they settle by their contacts' overlap: < 0.1 d, checked). The exchange
+    is balanced at every write time as in heat_balance."""
+    bed = heated_bed_reference()
+    print(f"  bed: eps = {bed.eps:.4f}, Re = {bed.re:.2f}, Pr = {bed.pr:.4f}, Gunn Nu = "
+          f"{bed.nu:.3f}, h = {bed.h:.2f} W/(m2 K), h a = {bed.h * bed.a:.4g} W/(m3 K), "
+          f"h a z / (rho_f c_f U) = 1 at z = {1e3 / bed.xi(1.0):.2f} mm")
+    z_bed = BED_LAYERS * BED_D
+    check = schumann.self_check(bed, (0.1, 0.2, 0.3, 0.4), z_bed)
+    checks.expect(check < 1e-8, f"Schumann's Bessel integral = Talbot inversion of its Laplace "
+                                f"transform to {check:.2g} (< 1e-8)")
+    case = runner.fresh_case("heated_bed", "heat_front")
+    log = runner.solve(case, 1)
+    lines = heat_lines(log)
+    check_heat_balance(checks, "heated bed", lines, 5)
+    profiles, moved = heat_front_profiles(case, bed)
+    checks.expect(len(profiles) == 4, f"{len(profiles)} write times, 4 expected")
+    checks.expect(moved < 0.1 * BED_D, f"the bed stays put: largest bead displacement "
+                                       f"{moved * 1e3:.4f} mm = {moved / BED_D:.4f} d < 0.1 d")
+    for t, fluid, solid, profile_error in profiles:
+        ref_f = schumann.front(bed.fluid, t, z_bed)
+        ref_s = schumann.front(bed.solid, t, z_bed)
+        conducting = schumann.front(bed.fluid_conducting, t, z_bed, tol=1e-8)
+        err_f, err_s = (fluid - ref_f) / ref_f, (solid - ref_s) / ref_s
+        checks.expect(abs(err_f) < 0.05 and abs(err_s) < 0.05 and
+                      abs(conducting - ref_f) < 1e-3 * ref_f,
+                      f"t = {t:.1f} s: fluid front {1e3 * fluid:.3f} mm (Schumann {1e3 * ref_f:.3f} "
+                      f"mm, {100 * err_f:+.2f} %), bead front {1e3 * solid:.3f} mm (Schumann "
+                      f"{1e3 * ref_s:.3f} mm, {100 * err_s:+.2f} %), within 5 %; with the "
+                      f"fluid's axial conduction the reference moves "
+                      f"{100 * (conducting - ref_f) / ref_f:+.3f} %; largest |theta_f - "
+                      f"Schumann| in the bed's cells {profile_error:.4f}")
+    # What 5 % tells apart: the same reference with h halved or doubled.
+    t = profiles[-1][0] if profiles else 0.4
+    ref = schumann.front(bed.fluid, t, z_bed)
+    for factor in (0.5, 2.0):
+        other = schumann.Bed(bed.d, bed.eps, bed.u, bed.rho_f, bed.mu, bed.c_f, bed.k_f,
+                             bed.rho_s, bed.c_s, h=factor * bed.h)
+        z = schumann.front(other.fluid, t, z_bed)
+        early = schumann.front(other.fluid, 0.1, z_bed)
+        print(f"  (h x {factor:g}: the fluid front at {t:.1f} s would be {1e3 * z:.3f} mm, "
+              f"{100 * (z - ref) / ref:+.2f} %; at 0.1 s "
+              f"{100 * (early / schumann.front(bed.fluid, 0.1, z_bed) - 1):+.2f} %)")
+
+
 TESTS = {f.__name__: f for f in (void_fraction_volume, exchange_balance, neutrally_buoyant,
                                   cellpoint_ranks,
                                  refuses_bad_setup, restart, stop_signal, nan_guard,
-                                 scene_output, heat_equilibrium, heat_balance)}
+                                 scene_output, heat_equilibrium, heat_balance,
+                                 heat_front)}
 
 
 if __name__ == "__main__":
