@@ -11,18 +11,20 @@ set_tests_properties(accuracy_cost.dem_short PROPERTIES
   LABELS "accuracy_cost"
   TIMEOUT 120)
 
-# accuracy_cost.coarse_grain_hopper (benchmarks/coarse_grain/hopper.py --ks 2,3 --check TOL):
+# accuracy_cost.coarse_grain_hopper (benchmarks/coarse_grain/hopper.py --ks 2,3 --check 0.12):
 # the real mass of 19 656 glass beads (d = 2 mm) as parcels of k = 2 and 3 discharging from a
-# flat-bottomed bin through a 36 mm orifice (9 and 6 parcel diameters). Passes when the k = 2
-# rate is within the tolerance the real beads (k = 1) reach of Beverloo with the real d, and
-# for both k every parcel carries k and k^3, its mass is k^3 real masses, the real mass above,
-# below and removed adds up to the settled bed's to 1e-12, the removed parcels match the log,
-# and parcels x k^3 = the real count. docs/models/coarse-graining.md, "Hopper discharge".
+# flat-bottomed bin through a 36 mm orifice (9 and 6 parcel diameters). The parcels flow at
+# Beverloo's rate for their own size (-24 % and -43 % against the beads); with Beverloo's
+# annulus put back to the real size (x Bev(d)/Bev(k d)) each k's rate must lie within 12 % of
+# the beads' (the error the beads reach against Beverloo; measured -3.2 % and -5.8 %). Real
+# mass: every parcel carries k and k^3 and k^3 real masses; the mass in the domain plus the
+# removed parcels' equals the settled bed's to 1e-12; removed parcels match the log; parcels x
+# k^3 = the real count. docs/models/coarse-graining.md, "Hopper discharge".
 grainflow_find_python(GRAINFLOW_HOPPER_PYTHON "h5py,numpy" "accuracy_cost.coarse_grain_hopper is")
 if(GRAINFLOW_HOPPER_PYTHON)
   add_test(NAME accuracy_cost.coarse_grain_hopper
            COMMAND ${GRAINFLOW_HOPPER_PYTHON} ${PROJECT_SOURCE_DIR}/benchmarks/coarse_grain/hopper.py
-                   --ks 2,3 --check-k 2 --check 0.20
+                   --ks 2,3 --check 0.12
                    --grain $<TARGET_FILE:grain>
                    --work ${CMAKE_CURRENT_BINARY_DIR}/coarse_grain_hopper)
   set_tests_properties(accuracy_cost.coarse_grain_hopper PROPERTIES
