@@ -27,8 +27,8 @@ the empty annulus k_B d is a particle-scale effect, and the parcels do flow at a
 rate. The corrected rate W x Bev(d) / Bev(k d) puts the annulus back to the real size.
 
 The bin is a compromise for the budget (k = 1 under 20 000 beads): D_bin = 2 D0 (Mankoc et
-al. 2007, Granular Matter 9:407, ask for > 2.5 D0 and > D0 + 30 d for a rate independent of the bin) and a bed about D0
-deep (da Silva et al. 2025, arXiv:2512.03698, find Beverloo's constant rate above h = 2 D0),
+al. 2007, Granular Matter 9:407, ask for > 2.5 D0 and > D0 + 30 d for a rate independent of
+the bin) and a bed about D0 deep (da Silva et al. 2025, arXiv:2512.03698, find Beverloo's constant rate above h = 2 D0),
 so the beads themselves flow below Beverloo's rate and the rate falls as the bed drains.
 
 Checks with --check TOL (the CTest short form, --ks 2,3): each k's corrected rate within TOL
@@ -192,6 +192,13 @@ def real_mass(f, k):
     return f["position"][:], m, f["id"][:]
 
 
+def particle_steps(logcsv):
+    """Steps x particles summed over the log's intervals: the cost, independent of the load."""
+    with open(logcsv) as f:
+        rows = list(csv.DictReader(f))
+    return sum((int(b["step"]) - int(a["step"])) * int(a["particles"]) for a, b in zip(rows, rows[1:]))
+
+
 def removed_column(logcsv):
     with open(logcsv) as f:
         rows = list(csv.DictReader(f))
@@ -238,7 +245,9 @@ def analyse(case, k):
         w = float("nan")
     else:
         w = -np.polyfit(t[win], above[win], 1)[0]
-    return dict(k=k, parcels=parcels, real_mass=total, phi=phi, rho_b=phi * RHO_P, top=top, w=w,
+    work = sum(particle_steps(os.path.join(case, stage, "log.csv")) for stage in ("fill", "discharge"))
+    return dict(k=k, parcels=parcels, particle_steps=work, real_mass=total, phi=phi, rho_b=phi * RHO_P,
+                top=top, w=w,
                 t_from=float(t[win].min()) if win.any() else float("nan"),
                 t_to=float(t[win].max()) if win.any() else float("nan"),
                 mass_defect=worst, removed=removed_log, problems=problems)
@@ -252,7 +261,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--ks", default="1,2,3")
     ap.add_argument("--work", default="hopper_work")
-    ap.add_argument("--grain", default=os.path.join(os.environ.get("GRAINFLOW_BUILD_DIR", os.path.join(ROOT, "build")), "bin", "grain"))
+    build = os.environ.get("GRAINFLOW_BUILD_DIR", os.path.join(ROOT, "build"))
+    ap.add_argument("--grain", default=os.path.join(build, "bin", "grain"))
     ap.add_argument("--check", type=float, default=None,
                     help="fail unless the rate of each k in --check-k, corrected for Beverloo's annulus "
                          "(x Bev(d)/Bev(k d)), is within this fraction of the k = 1 rate")
@@ -285,7 +295,7 @@ def main():
     print(f"Beverloo: C = {C_BEV}, k_B = {K_BEV}, D0 = {1e3 * D0:.0f} mm, rho_b = {rho_b:.0f} kg/m3 "
           f"(k = 1 core), real d = {1e3 * D_MEAN:.1f} mm: W = {1e3 * beverloo(rho_b, D_MEAN):.1f} g/s")
     print("k parcels real_mass[g] rho_b_core top[mm] W[g/s] vs_Bev(d) Bev(kd)[g/s] vs_Bev(kd) vs_k1 "
-          "W_corr[g/s] corr_vs_k1 fit[s] cpu_fill[s] cpu_discharge[s] wall[s]")
+          "W_corr[g/s] corr_vs_k1 fit[s] particle_steps cpu_fill[s] cpu_discharge[s] wall[s]")
     failed = []
     with open(os.path.join(a.work, "hopper.csv"), "a", newline="") as out:
         wr = csv.writer(out)
@@ -299,11 +309,14 @@ def main():
             print(f"{k} {r['parcels']} {1e3 * r['real_mass']:.2f} {r['rho_b']:.0f} {1e3 * r['top']:.1f} "
                   f"{1e3 * r['w']:.1f} {100 * err:+.1f}% {1e3 * bev_k:.1f} {100 * err_k:+.1f}% {vs1} "
                   f"{1e3 * corrected:.1f} {cvs1} "
-                  f"{r['t_from']:.2f}-{r['t_to']:.2f} {r['cpu_fill']:.1f} {r['cpu_discharge']:.1f} {r['wall']:.0f}")
+                  f"{r['t_from']:.2f}-{r['t_to']:.2f} {r['particle_steps']:.3g} "
+                  f"{r['cpu_fill']:.1f} {r['cpu_discharge']:.1f} {r['wall']:.0f}")
             print(f"  k = {k}: real mass conserved to {r['mass_defect']:.1e}, {r['removed']} parcels removed "
                   f"({r['removed'] * k**3} real beads)")
-            wr.writerow([time.strftime("%Y-%m-%dT%H:%M:%S"), k, r["parcels"], r["real_mass"], r["rho_b"],
-                         r["w"], err, err_k, corrected, r["cpu_fill"], r["cpu_discharge"], r["wall"]])
+            if not a.analyse_only:
+                wr.writerow([time.strftime("%Y-%m-%dT%H:%M:%S"), k, r["parcels"], r["real_mass"], r["rho_b"],
+                             r["w"], err, err_k, corrected, r["particle_steps"], r["cpu_fill"],
+                             r["cpu_discharge"], r["wall"]])
             failed += [f"k = {k}: {p}" for p in r["problems"]]
             rate_checked = a.check_k is None or k in [int(x) for x in a.check_k.split(",")]
             if a.check is not None and rate_checked and not abs(corrected / w1 - 1) <= a.check:
