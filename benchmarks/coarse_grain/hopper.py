@@ -28,8 +28,9 @@ rate. The corrected rate W x Bev(d) / Bev(k d) puts the annulus back to the real
 
 The bin is a compromise for the budget (k = 1 under 20 000 beads): D_bin = 2 D0 (Mankoc et
 al. 2007, Granular Matter 9:407, ask for > 2.5 D0 and > D0 + 30 d for a rate independent of
-the bin) and a bed about D0 deep (da Silva et al. 2025, arXiv:2512.03698, find Beverloo's constant rate above h = 2 D0),
-so the beads themselves flow below Beverloo's rate and the rate falls as the bed drains.
+the bin) and a bed about D0 deep (da Silva et al. 2025, arXiv:2512.03698, find Beverloo's
+constant rate above h = 2 D0), so the beads themselves flow below Beverloo's rate and the rate
+falls as the bed drains.
 
 Checks with --check TOL (the CTest short form, --ks 2,3): each k's corrected rate within TOL
 of the beads' rate (W_K1, measured by this script at k = 1; with k = 1 in --ks, that run's);
