@@ -247,7 +247,7 @@ def analyse(case, k):
     else:
         w = -np.polyfit(t[win], above[win], 1)[0]
     work = sum(particle_steps(os.path.join(case, stage, "log.csv")) for stage in ("fill", "discharge"))
-    return dict(k=k, parcels=parcels, particle_steps=work, real_mass=total, phi=phi, rho_b=phi * RHO_P,
+    return dict(k=k, parcels=parcels, particle_steps=work, t=t, above=above, real_mass=total, phi=phi, rho_b=phi * RHO_P,
                 top=top, w=w,
                 t_from=float(t[win].min()) if win.any() else float("nan"),
                 t_to=float(t[win].max()) if win.any() else float("nan"),
@@ -256,6 +256,32 @@ def analyse(case, k):
 
 def beverloo(rho_b, d):
     return C_BEV * rho_b * math.sqrt(G) * (D0 - K_BEV * d) ** 2.5
+
+
+def plot(rows, rho_b, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    for i, r in enumerate(rows):
+        k = r["k"]
+        ax.plot(r["t"], 1e3 * r["above"], "o-", ms=3, color=f"C{i}",
+                label=f"k = {k} ({r['parcels']} parcels): W = {1e3 * r['w']:.0f} g/s")
+        t0 = r["t_from"]
+        m0 = float(np.interp(t0, r["t"], r["above"]))
+        span = np.array([t0, t0 + 0.2])
+        ax.plot(span, 1e3 * (m0 - beverloo(rho_b, k * D_MEAN) * (span - t0)), ":", color=f"C{i}", lw=1.2,
+                label=f"Beverloo with the parcel size {1e3 * k * D_MEAN:.0f} mm")
+        if i == 0:
+            ax.plot(span, 1e3 * (m0 - beverloo(rho_b, D_MEAN) * (span - t0)), "k--", lw=1,
+                    label=f"Beverloo with the real size {1e3 * D_MEAN:.0f} mm")
+    ax.set_xlabel("t [s]")
+    ax.set_ylabel("real mass above the orifice [g]")
+    ax.set_title(f"Flat-bottomed bin, D0 = {1e3 * D0:.0f} mm, real d = {1e3 * D_MEAN:.0f} mm")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    print(f"{path} written")
 
 
 def main():
@@ -268,7 +294,8 @@ def main():
                     help="fail unless the rate of each k in --check-k, corrected for Beverloo's annulus "
                          "(x Bev(d)/Bev(k d)), is within this fraction of the k = 1 rate")
     ap.add_argument("--check-k", default=None, help="the ks whose rate --check tests (default: all)")
-    ap.add_argument("--analyse-only", action="store_true")
+    ap.add_argument("--analyse-only", action="store_true", help="analyse the runs already in --work")
+    ap.add_argument("--plot", default=None, help="write the real mass above the orifice against time to this PNG")
     a = ap.parse_args()
     ks = [int(s) for s in a.ks.split(",")]
     os.makedirs(a.work, exist_ok=True)
@@ -324,6 +351,8 @@ def main():
                 failed.append(f"k = {k}: W {1e3 * r['w']:.1f} g/s, corrected {1e3 * corrected:.1f} g/s, is "
                               f"{100 * (corrected / w1 - 1):+.1f}% from the beads' {1e3 * w1:.1f} g/s "
                               f"(tolerance {100 * a.check:.0f}%)")
+    if a.plot:
+        plot(rows, rho_b, a.plot)
     for f in failed:
         print("FAIL:", f)
     sys.exit(1 if failed else 0)
