@@ -287,7 +287,7 @@ def plot(rows, rho_b, path):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--ks", default="1,2,3")
-    ap.add_argument("--work", default="hopper_work")
+    ap.add_argument("--work", default=os.path.join(ROOT, "build", "benchmarks", "coarse_grain_hopper"))
     build = os.environ.get("GRAINFLOW_BUILD_DIR", os.path.join(ROOT, "build"))
     ap.add_argument("--grain", default=os.path.join(build, "bin", "grain"))
     ap.add_argument("--check", type=float, default=None,
