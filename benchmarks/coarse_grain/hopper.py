@@ -270,8 +270,9 @@ def plot(rows, rho_b, path):
         t0 = r["t_from"]
         m0 = float(np.interp(t0, r["t"], r["above"]))
         span = np.array([t0, t0 + 0.2])
-        ax.plot(span, 1e3 * (m0 - beverloo(rho_b, k * D_MEAN) * (span - t0)), ":", color=f"C{i}", lw=1.2,
-                label=f"Beverloo with the parcel size {1e3 * k * D_MEAN:.0f} mm")
+        if k != 1:
+            ax.plot(span, 1e3 * (m0 - beverloo(rho_b, k * D_MEAN) * (span - t0)), ":", color=f"C{i}", lw=1.2,
+                    label=f"Beverloo with the parcel size {1e3 * k * D_MEAN:.0f} mm")
         if i == 0:
             ax.plot(span, 1e3 * (m0 - beverloo(rho_b, D_MEAN) * (span - t0)), "k--", lw=1,
                     label=f"Beverloo with the real size {1e3 * D_MEAN:.0f} mm")
