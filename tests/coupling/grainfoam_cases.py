@@ -1087,8 +1087,9 @@ def balanced_decomposition(runner, checks):
     cells below one plane on rank 0 and the rest on rank 1, at a cut that is best for the
     objective, found here by trying every cut over the layers counted from bed.csv and the
     mesh's numbering (`sum`: the larger slab's cells + w particles least, w = 4: 13 layers;
-    `phases`: the busier DEM slab's plus the busier fluid slab's least, w = 4: 12 layers, w =
-    0.25: 12 to 20 tie; equal slabs would cut at 28). grainFoam then runs 10 fluid steps on
+    `phases`: the busier DEM slab's plus the busier fluid slab's least, w = 4: 12 layers; w =
+    0.25: 28, the equal slabs, as the beads are too cheap to pay for the cells a lower cut
+    moves to rank 1). grainFoam then runs 10 fluid steps on
     the `phases`, w = 4 decomposition (2 ranks): each rank owns the beads of its slab, the
     DEM's cut plane is the mesh's, and the momentum exchange balances to round-off."""
     height = 3e-3 * BALANCE_LAYERS

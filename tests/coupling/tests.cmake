@@ -53,9 +53,9 @@
 #       column twice as tall (the bed in its lowest 24 of 56 cell layers), cut along z for 2
 #       ranks: every cell on rank 0 or 1, two slabs, the cut best for the objective (every cut
 #       tried in the test): `sum` (larger slab's cells + w particles least) at w = 4, `phases`
-#       (busier DEM slab + busier fluid slab least) at w = 0.25 and 4; grainFoam on the last on
-#       2 ranks: each rank owns its slab's beads, the DEM's cut plane is the mesh's, exchange
-#       balanced. About 20 s.
+#       (busier DEM slab + busier fluid slab least) at w = 0.25 (28 layers: equal slabs) and 4
+#       (12); grainFoam on the last on 2 ranks: each rank owns its slab's beads, the DEM's cut
+#       plane is the mesh's, exchange balanced. About 40 s on the loaded 2-core machine.
 if(NOT TARGET grainFoam)
   return()
 endif()
@@ -158,6 +158,7 @@ grainflow_coupling_test(heat_equilibrium 1)
 grainflow_coupling_test(heat_balance 2)
 grainflow_coupling_test(heat_front 1)
 grainflow_coupling_test(balanced_decomposition 2)
+set_tests_properties(coupling.balanced_decomposition PROPERTIES TIMEOUT 300)  # ~40 s loaded
 set_tests_properties(coupling.stop_signal PROPERTIES TIMEOUT 600)  # ~25 s on a quiet machine
 
 # coupling.parcel_bed_ergun (tests/coupling/parcel_bed.py, cases/parcel_bed): coarse-grained
