@@ -178,6 +178,7 @@ def main():
     ap.add_argument("--ranks", type=int, default=2)
     ap.add_argument("--voidfraction", default="divided", choices=["centre", "divided"])
     ap.add_argument("--work", default=str(HERE / "output"))
+    ap.add_argument("--report-only", action="store_true", help="print the figures of the last run's log")
     args = ap.parse_args()
     build = pathlib.Path(os.environ.get("GRAINFLOW_BUILD_DIR", ROOT / "build")).resolve()
     solver = build / "bin" / "grainFoam"
@@ -193,10 +194,6 @@ def main():
     os.environ.update(env)  # million.settle_tile runs grain through mpirun
     x_tile, period = million.settle_tile(desc, grain, work)
     case = work / f"bed_np{args.ranks}_u{args.velocity:g}_{args.voidfraction}"
-    shutil.rmtree(case, ignore_errors=True)
-    case.mkdir(parents=True)
-    n, size = million.write_bed(case / "bed.h5", x_tile, period, TILES, desc)
-    write_case(case, case / "bed.h5", size, args, desc)
     foam = str(ROOT / "scripts" / "foam_env.sh")
 
     def sh(cmd, log):
@@ -205,6 +202,14 @@ def main():
         if r.returncode != 0:
             sys.exit(f"run.py: {' '.join(cmd)} failed:\n" + (case / log).read_text()[-3000:])
 
+    if args.report_only:
+        n = len(x_tile) * TILES[0] * TILES[1]
+        report(case, n, args)
+        return
+    shutil.rmtree(case, ignore_errors=True)
+    case.mkdir(parents=True)
+    n, size = million.write_bed(case / "bed.h5", x_tile, period, TILES, desc)
+    write_case(case, case / "bed.h5", size, args, desc)
     sh([foam, "blockMesh"], "log.blockMesh")
     cmd = [str(solver)]
     if args.ranks > 1:
@@ -214,18 +219,25 @@ def main():
           f"({args.fluid_steps * DEM_STEPS_PER_FLUID_STEP} DEM steps) on {args.ranks} ranks, inflow "
           f"{args.velocity:g} m/s: {case}", flush=True)
     sh(cmd if args.ranks > 1 else [foam, *cmd], "log.grainFoam")
+    report(case, n, args)
+
+
+def report(case, n, args):
     log = (case / "log.grainFoam").read_text()
-    for pattern in (r"^MPI ranks: .*$", r"^grainFoam particles: .*$", r"^grainFoam (CPU )?time split: .*$",
+    for pattern in (r"^  processor grid .*$", r"^grainFoam particles: .*$", r"^grainFoam (?:CPU )?time split: .*$",
                     r"^grainFoam rank \d+ since the last write: .*$", r"^grainFoam exchange balance: .*$"):
         for line in re.findall(pattern, log, re.M)[-2:]:
             print("  " + line)
-    split = re.findall(r"^grainFoam time split: DEM ([0-9.e+-]+) s .*?coupling ([0-9.e+-]+) s", log, re.M)
-    clock = re.findall(r"^ExecutionTime = ([0-9.e+-]+) s", log, re.M)
-    if split:
-        coupling = float(split[-1][1])
-        print(f"  coupling per fluid step {1e3 * coupling / args.fluid_steps:.1f} ms, "
-              f"per particle and fluid step {1e9 * coupling / args.fluid_steps / n:.0f} ns")
-    print(f"  grainFoam ExecutionTime {clock[-1] if clock else '?'} s")
+    clock = re.findall(r"^ExecutionTime = ([0-9.e+-]+) s  ClockTime = ([0-9.e+-]+) s", log, re.M)
+    for kind in ("", "CPU "):
+        split = re.findall(rf"^grainFoam {kind}time split: DEM ([0-9.e+-]+) s .*?coupling ([0-9.e+-]+) s",
+                           log, re.M)
+        if split:
+            coupling = float(split[-1][1])
+            print(f"  coupling ({kind or 'wall '}time) per fluid step {1e3 * coupling / args.fluid_steps:.1f} ms, "
+                  f"per particle and fluid step {1e9 * coupling / args.fluid_steps / n:.0f} ns")
+    if clock:
+        print(f"  grainFoam ExecutionTime (CPU, rank 0) {clock[-1][0]} s, ClockTime {clock[-1][1]} s")
 
 
 if __name__ == "__main__":

@@ -11,7 +11,8 @@ at END/2, twice, each on a fresh copy (the inflow starts at 0.2 s: until then th
             the bed (6 mm high once settled, 35 mm with 12 000 beads) all on rank 0;
   balanced  scripts/balanced_decomposition.py --axis z with the equal run's snapshot at the
             first write time as the particles and its log as the particle cost
-            (--weight-from), then decomposePar and grainFoam on that `manual` decomposition.
+            (--weight-from; or --particle-cost W), then decomposePar and grainFoam on that
+            `manual` decomposition.
 
 For each it prints the per-rank lines of the second interval (particles, DEM working and
 waiting, coupling, fluid), the whole-run time split (max over ranks), grainFoam's wall time
@@ -95,7 +96,7 @@ def report(name, case, log):
     rank_lines = re.findall(r"^grainFoam rank \d+ since the last write: .*$", log, re.M)
     split = re.findall(r"^grainFoam time split: (.*)$", log, re.M)
     clock = re.findall(r"^ExecutionTime = ([0-9.e+-]+) s", log, re.M)
-    cuts = re.findall(r"^MPI ranks: .*$", log, re.M)
+    cuts = re.findall(r"^  processor grid .*$", log, re.M)
     imbalance = [float(v) for v in re.findall(r"relative imbalance ([-+0-9.eEnaif]+)", log)]
     snaps = snapshots(case)
     with h5py.File(snaps[-1], "r") as f:
@@ -107,7 +108,7 @@ def report(name, case, log):
     second = p_in[:, 0] > t_half + 1e-9
     print(f"== {name}: {case}")
     for line in cuts[:1]:
-        print("  DEM: " + line)
+        print("  DEM:" + line)
     for line in rank_lines[-2:]:
         print("  " + line)
     # The run as a whole, per rank: the lines' seconds summed over the write times.
