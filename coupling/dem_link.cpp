@@ -649,6 +649,8 @@ DemSummary DemLink::summary() const {
   s.removed = g.removed;
   s.max_overlap_ratio = g.max_overlap_ratio;
   s.kinetic_energy = g.kinetic_translational + g.kinetic_rotational;
+  s.local_particles = static_cast<long>(sim.particles().size());
+  s.collective_wait_seconds = sim.collective_wait_seconds();
   long late = impl_->fluid->late_samples();
   MPI_Allreduce(MPI_IN_PLACE, &late, 1, MPI_LONG, MPI_SUM, impl_->dem_comm);
   s.late_samples = late;

@@ -117,6 +117,10 @@ struct ProcessorGrid {
 struct DemSummary {
   long particles = 0, contacts = 0, removed = 0, late_samples = 0;
   double max_overlap_ratio = 0, kinetic_energy = 0;
+  // This rank's own: particles owned, and the wall-clock seconds its DEM has spent waiting
+  // in the steps' collectives for the other ranks (Simulation::collective_wait_seconds).
+  long local_particles = 0;
+  double collective_wait_seconds = 0;
 };
 
 class DemLink {

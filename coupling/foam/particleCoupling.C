@@ -19,6 +19,24 @@
 #include "wallFvPatch.H"
 
 namespace grainflow::foam {
+
+namespace {
+
+// The processor grid's inner cut planes, as the DEM takes them from the mesh decomposition:
+// "; cuts along z at 0.039 m" (nothing for a single rank).
+std::string cutsText(const coupling::ProcessorGrid& grid) {
+  std::ostringstream text;
+  for (int a = 0; a < 3; ++a) {
+    if (grid.dims[a] < 2) continue;
+    text << "; cuts along " << "xyz"[a] << " at";
+    for (int k = 1; k < grid.dims[a]; ++k) text << (k > 1 ? ", " : " ") << grid.cuts[a][k];
+    text << " m";
+  }
+  return text.str();
+}
+
+}  // namespace
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -497,7 +515,7 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
        << "\n"
        << "  dt_CFD " << dtFluid << " s = " << subSteps_ << " x dt_DEM " << dtDem << " s\n"
        << "  processor grid " << grid.dims[0] << " x " << grid.dims[1] << " x " << grid.dims[2]
-       << "; cell location "
+       << cutsText(grid).c_str() << "; cell location "
        << (structuredRanks == Pstream::nProcs() ? "uniform grid (direct)"
                                                 : "octree search on some ranks")
        << endl;
@@ -1495,6 +1513,33 @@ void ParticleCoupling::write() {
     return text.str();
   };
   const std::string cellPoint = cellPointLine();
+  // Per rank (parallel runs): the particles it owns and its own wall-clock split since the
+  // last write, the DEM's part split into work and waiting for the other ranks, which
+  // shows how evenly the shared decomposition spreads the work (docs/parallel.md).
+  std::string perRank;
+  if (Pstream::parRun()) {
+    const double now[5] = {double(s.local_particles), seconds_[kDem] - s.collective_wait_seconds,
+                           s.collective_wait_seconds, seconds_[kCoupling], seconds_[kFluid]};
+    double mine[5] = {now[0], 0, 0, 0, 0};
+    for (int k = 1; k < 5; ++k) {
+      mine[k] = now[k] - reportedRank_[k];
+      reportedRank_[k] = now[k];
+    }
+    int ranks = 1, rank = 0;
+    MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    std::vector<double> all(rank == 0 ? 5 * ranks : 0);
+    MPI_Gather(mine, 5, MPI_DOUBLE, all.data(), 5, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    std::ostringstream text;
+    text.precision(3);
+    for (int r = 0; r < (rank == 0 ? ranks : 0); ++r) {
+      const double* v = &all[5 * r];
+      text << "\ngrainFoam rank " << r << " since the last write: " << long(v[0])
+           << " particles; DEM " << v[1] << " s working + " << v[2]
+           << " s waiting for other ranks, coupling " << v[3] << " s, fluid " << v[4] << " s";
+    }
+    perRank = text.str();
+  }
   Foam::Info << "grainFoam particles: " << s.particles << " particles, " << s.contacts
              << " contacts, max overlap " << s.max_overlap_ratio << " r, removed " << s.removed
              << ", sampled on arrival " << s.late_samples << "; void fraction clamped "
@@ -1505,7 +1550,8 @@ void ParticleCoupling::write() {
              << "grainFoam time split: " << split(times).c_str() << "\n"
              << "grainFoam CPU time split since the last write: " << split(interval + 4).c_str()
              << "\n"
-             << "grainFoam CPU time split: " << split(times + 4).c_str() << Foam::endl;
+             << "grainFoam CPU time split: " << split(times + 4).c_str() << perRank.c_str()
+             << Foam::endl;
   if (undisturbed_)
     for (const std::string& line : dem_->reports())
       if (line.rfind("undisturbed velocity", 0) == 0)

@@ -388,7 +388,9 @@ bool Simulation::needs_rebuild() const {
   int local = !leaving_.empty() || moved_beyond_half_skin_;
   if (decomp_->size() == 1) return local;
   int any = 0;
+  const double start = MPI_Wtime();
   MPI_Allreduce(&local, &any, 1, MPI_INT, MPI_LOR, comm_);
+  collective_wait_seconds_ += MPI_Wtime() - start;
   return any;
 }
 
@@ -857,7 +859,11 @@ bool Simulation::check_contacts(const ContactGuards& s, bool finite_here) const 
                           s.unresolved.fewest > 0 ? n_min / s.unresolved.fewest : 0.0,
                           fast.ratio, finite_here ? 0.0 : 1.0};
   double worst[4] = {mine[0], mine[1], mine[2], mine[3]};
-  if (decomp_->size() > 1) MPI_Allreduce(MPI_IN_PLACE, worst, 4, MPI_DOUBLE, MPI_MAX, comm_);
+  if (decomp_->size() > 1) {
+    const double start = MPI_Wtime();
+    MPI_Allreduce(MPI_IN_PLACE, worst, 4, MPI_DOUBLE, MPI_MAX, comm_);
+    collective_wait_seconds_ += MPI_Wtime() - start;
+  }
   if (worst[0] <= limit && worst[1] <= 1 && worst[2] <= 1) return worst[3] == 0;
   std::ostringstream o;
   o.precision(4);

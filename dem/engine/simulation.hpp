@@ -122,6 +122,10 @@ class Simulation {
   void initialise();
   void step();
   void advance_to(double t_end);
+  // Wall-clock seconds this rank has spent in the two collectives of every step (the contact
+  // guards' reduction at its end and the rebuild check at the next one's start): where a
+  // rank that finished its forces early waits for the busiest (load imbalance).
+  double collective_wait_seconds() const { return collective_wait_seconds_; }
 
   Particles& particles() { return p_; }  // this rank's particles
   const Particles& particles() const { return p_; }
@@ -268,6 +272,7 @@ class Simulation {
 
   Scene scene_;
   MPI_Comm comm_;
+  mutable double collective_wait_seconds_ = 0;  // see collective_wait_seconds()
   std::unique_ptr<Decomposition> decomp_;
   std::unique_ptr<Exchange> exchange_;
   Particles p_;

@@ -29,7 +29,10 @@ snapshots against references that do not come from the coupling itself:
                         loses, to round-off, on 1 and 2 ranks;
   heat_front            closed form: the thermal front of a packed bed heated by hot gas
                         against Schumann's (1929) solution with Gunn's coefficient
-                        (tests/coupling/schumann.py).
+                        (tests/coupling/schumann.py);
+  balanced_decomposition  scripts/balanced_decomposition.py: the cut of a settled bed's
+                        column where the larger slab's work (cells + w particles) is least,
+                        against every cut tried here; grainFoam runs on it, the DEM sharing it.
 
 Exit status 0 when every check holds; otherwise each failed check is printed and the exit
 status is 1. Logs stay in the case folders (log.<program>). Shared helpers:
@@ -1050,11 +1053,114 @@ def heat_front(runner, checks):
               f"{100 * (early / schumann.front(bed.fluid, 0.1, z_bed) - 1):+.2f} %)")
 
 
+# --- coupling.balanced_decomposition -----------------------------------------------------
+
+BALANCE_LAYERS = 56           # the heated_bed column made twice as tall: 56 cell layers of 3 mm
+PER_RANK_LINE = re.compile(r"^grainFoam rank (\d+) since the last write: (\d+) particles; DEM "
+                           + FLOAT + r" s working \+ " + FLOAT + r" s waiting", re.M)
+
+
+def slab_sums(values, k):
+    return sum(values[:k]), sum(values[k:])
+
+
+def expected_cuts(cells, particles, w, objective):
+    """Every cut (layers on rank 0) that is best for the objective, found by trying them all,
+    and the best value: `sum`, the larger slab's cells + w particles; `phases`, the larger
+    slab's w particles plus the larger slab's cells (the DEM and the fluid each wait for
+    their busiest rank)."""
+    def value(k):
+        if objective == "sum":
+            return max(slab_sums([c + w * n for c, n in zip(cells, particles)], k))
+        return max(slab_sums([w * n for n in particles], k)) + max(slab_sums(cells, k))
+    values = {k: value(k) for k in range(1, len(cells))}
+    best = min(values.values())
+    return [k for k, v in values.items() if v <= best * (1 + 1e-12)], best
+
+
+def balanced_decomposition(runner, checks):
+    """scripts/balanced_decomposition.py on a bed settled at the bottom of a tall column:
+    cases/heated_bed (384 beads, 24 layers of 16 on a 3 mm lattice, each layer in one layer
+    of 2 x 2 cells) in a column made 168 mm tall (56 cell layers, the bed in the lowest 24),
+    cut along z for 2 ranks. For each objective and particle cost w (cells per particle)
+    tried, the script's constant/cellDecomposition must give every cell a rank, put the
+    cells below one plane on rank 0 and the rest on rank 1, at a cut that is best for the
+    objective, found here by trying every cut over the layers counted from bed.csv and the
+    mesh's numbering (`sum`: the larger slab's cells + w particles least, w = 4: 13 layers;
+    `phases`: the busier DEM slab's plus the busier fluid slab's least, w = 4: 12 layers; w =
+    0.25: 28, the equal slabs, as the beads are too cheap to pay for the cells a lower cut
+    moves to rank 1). grainFoam then runs 10 fluid steps on
+    the `phases`, w = 4 decomposition (2 ranks): each rank owns the beads of its slab, the
+    DEM's cut plane is the mesh's, and the momentum exchange balances to round-off."""
+    height = 3e-3 * BALANCE_LAYERS
+    case = runner.fresh_case("heated_bed", "balanced_decomposition", [
+        ("system/blockMeshDict", "(0 0 84) (12 0 84) (12 12 84) (0 12 84)",
+         "(0 0 168) (12 0 168) (12 12 168) (0 12 168)"),
+        ("system/blockMeshDict", "(2 2 28)", f"(2 2 {BALANCE_LAYERS})"),
+        ("particles.yaml", "max: [0.012, 0.012, 0.084]", f"max: [0.012, 0.012, {height:g}]"),
+        ("system/controlDict", "endTime         0.4;", "endTime         0.01;"),
+        ("system/controlDict", "writeInterval   0.1;", "writeInterval   0.005;")])
+    runner.run(case, "blockMesh", "blockMesh")
+    with open(os.path.join(case, "bed.csv")) as f:
+        rows = [line for line in f if line.strip() and not line.startswith("#")]
+    bed = np.loadtxt(rows[1:], delimiter=",")  # after the header x,y,z,radius
+    layer_particles = np.bincount((bed[:, 2] / 3e-3).astype(int), minlength=BALANCE_LAYERS)
+    layer_cells = [4] * BALANCE_LAYERS  # 2 x 2 cells per layer
+    script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts",
+                          "balanced_decomposition.py")
+    k = None
+    for objective, w in (("sum", 4.0), ("phases", 0.25), ("phases", 4.0)):
+        best_cuts, best = expected_cuts(layer_cells, layer_particles, w, objective)
+        r = subprocess.run([sys.executable, script, case, "--ranks", "2", "--axis", "z",
+                            "--particles", os.path.join(case, "bed.csv"),
+                            "--particle-cost", str(w), "--objective", objective],
+                           env=runner.env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                           text=True, timeout=120)
+        print(r.stdout)
+        what = f"{objective}, w = {w}"
+        checks.expect(r.returncode == 0, f"{what}: the script ran")
+        if r.returncode != 0:
+            return
+        with open(os.path.join(case, "constant", "cellDecomposition")) as f:
+            text = f.read()
+        m = re.search(r"\n(\d+)\s*\(([^)]*)\)", text)
+        owner = np.array(m.group(2).split(), dtype=int) if m else np.array([], dtype=int)
+        n = 4 * BALANCE_LAYERS
+        layer = np.arange(n) // 4  # blockMesh numbers the cells x fastest, then y, then z
+        checks.expect(m is not None and int(m.group(1)) == n and len(owner) == n and
+                      set(owner.tolist()) <= {0, 1},
+                      f"{what}: every one of the {n} cells has rank 0 or 1")
+        k = int((owner == 0).sum()) // 4 if len(owner) == n else None
+        checks.expect(k is not None and np.array_equal(owner, (layer >= k).astype(int)),
+                      f"{what}: rank 0 holds the {k} lowest layers, rank 1 the rest")
+        checks.expect(k in best_cuts, f"{what}: {k} layers is a best cut (every cut tried: "
+                                      f"{best_cuts[0]}..{best_cuts[-1]}, value {best:g}; equal "
+                                      f"slabs 28)")
+    with open(os.path.join(case, "system", "decomposeParDict.balanced")) as f:
+        text = f.read()
+    checks.expect("method          manual;" in text and "numberOfSubdomains 2;" in text,
+                  "decomposeParDict.balanced: method manual on 2 subdomains")
+    dict_args = ("-decomposeParDict", "system/decomposeParDict.balanced")
+    runner.run(case, "decomposePar", "decomposePar", *dict_args)
+    log = runner.run(case, "grainFoam", runner.solver, *dict_args, ranks=2)
+    below = int(layer_particles[:k].sum())
+    counts = [(int(a), int(b)) for a, b, _, _ in PER_RANK_LINE.findall(log)]
+    checks.expect(len(counts) == 4 and counts == [(0, below), (1, 384 - below)] * 2,
+                  f"each rank owns the beads of its slab: rank 0 {below}, rank 1 {384 - below} "
+                  f"at both write times (log: {counts})")
+    checks.expect(f"processor grid 1 x 1 x 2; cuts along z at {k * 3e-3:g} m" in log,
+                  f"the DEM's cut plane is the mesh's, z = {k * 3e-3:g} m")
+    lines = balance_lines(log)
+    checks.expect(len(lines) >= 2 and max(b[2] for b in lines) < ROUND_OFF,
+                  f"momentum exchange balanced to round-off at every write time "
+                  f"({max((b[2] for b in lines), default=None)} < {ROUND_OFF:g})")
+
+
 TESTS = {f.__name__: f for f in (void_fraction_volume, exchange_balance, neutrally_buoyant,
                                   cellpoint_ranks,
                                  refuses_bad_setup, restart, stop_signal, nan_guard,
                                  scene_output, heat_equilibrium, heat_balance,
-                                 heat_front)}
+                                 heat_front, balanced_decomposition)}
 
 
 if __name__ == "__main__":

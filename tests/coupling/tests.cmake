@@ -49,6 +49,13 @@
 #       (contact conduction off, cells d high): the fluid's and the beads' thermal fronts (theta = 1/2)
 #       at 0.1 ... 0.4 s against Schumann (1929) with Gunn's h (tests/coupling/schumann.py,
 #       numpy only) within 5 %; the bed stays put (< 0.1 d); exchange balanced. About 6 s.
+#   coupling.balanced_decomposition  scripts/balanced_decomposition.py on cases/heated_bed in a
+#       column twice as tall (the bed in its lowest 24 of 56 cell layers), cut along z for 2
+#       ranks: every cell on rank 0 or 1, two slabs, the cut best for the objective (every cut
+#       tried in the test): `sum` (larger slab's cells + w particles least) at w = 4, `phases`
+#       (busier DEM slab + busier fluid slab least) at w = 0.25 (28 layers: equal slabs) and 4
+#       (12); grainFoam on the last on 2 ranks: each rank owns its slab's beads, the DEM's cut
+#       plane is the mesh's, exchange balanced. About 40 s on the loaded 2-core machine.
 if(NOT TARGET grainFoam)
   return()
 endif()
@@ -150,6 +157,8 @@ grainflow_coupling_test(scene_output 1)
 grainflow_coupling_test(heat_equilibrium 1)
 grainflow_coupling_test(heat_balance 2)
 grainflow_coupling_test(heat_front 1)
+grainflow_coupling_test(balanced_decomposition 2)
+set_tests_properties(coupling.balanced_decomposition PROPERTIES TIMEOUT 300)  # ~40 s loaded
 set_tests_properties(coupling.stop_signal PROPERTIES TIMEOUT 600)  # ~25 s on a quiet machine
 
 # coupling.parcel_bed_ergun (tests/coupling/parcel_bed.py, cases/parcel_bed): coarse-grained
