@@ -19,6 +19,8 @@ Reference values (DESIGN.md section 7), all for the REAL beads (d = parcel diame
   Wen & Yu (1966)       Re_mf = sqrt(33.7^2 + 0.0408 Ar) - 33.7,  Ar = g rho_f (rho_p - rho_f) d^3 / mu^2
   Ergun (1952)          dp/L = 150 mu U (1-e)^2 / (e^3 d^2) + 1.75 rho_f U^2 (1-e) / (e^3 d);
                         U_mf where dp/L = (1-e)(rho_p - rho_f) g, with the settled bed's e
+  the drag law's own packed bed (di_felice, VANS model A): dp/L = n F(U/e) / e, n = (1-e)/V_bead,
+                        and its U_mf the same way (the coupling's error apart from the law's)
 with d the Sauter mean diameter of the real beads. p excludes hydrostatics, so
 dp = rho_f (p_inlet - p_outlet) is the bed's share alone. The measured U_mf is where the
 fitted packed-bed curve dp = a U + b U^2 (ramp samples below 0.7 dp_w) meets dp_w.
@@ -159,6 +161,27 @@ a_e = 150 * mu * (1 - eps) ** 2 / (eps**3 * d32**2)
 b_e = 1.75 * rho_f * (1 - eps) / (eps**3 * d32)
 c_e = (1 - eps) * (rho_pm - rho_f) * g
 u_mf_ergun = (-a_e + math.sqrt(a_e**2 + 4 * b_e * c_e)) / (2 * b_e)
+
+
+def di_felice_gradient(u_sup):
+    """-dp/dx [Pa/m] of a packed bed of the real beads at superficial velocity u_sup under the
+    case's own drag law, Di Felice (1994) as dem/fluid/di_felice.hpp writes it: per bead
+    F = K U, K = (pi/8) rho_f d^2 eps^(2-chi) (0.63 sqrt(U) + 4.8 sqrt(mu/(rho_f eps d)))^2,
+    U = u_sup/eps the interstitial slip, chi = 3.7 - 0.65 exp(-(1.5 - log10 Re)^2/2),
+    Re = rho_f eps d U/mu; with VANS model A the fluid carries n F / eps per volume."""
+    u = u_sup / eps
+    re = rho_f * eps * d32 * u / mu
+    chi = 3.7 - 0.65 * math.exp(-0.5 * (1.5 - math.log10(re)) ** 2) if re > 0 else 3.7
+    root = 0.63 * math.sqrt(u) + 4.8 * math.sqrt(mu / (rho_f * eps * d32))
+    force = math.pi / 8 * rho_f * d32**2 * eps ** (2 - chi) * root**2 * u
+    return (1 - eps) / (math.pi / 6 * d32**3) * force / eps
+
+
+lo_u, hi_u = 1e-6, 10.0  # U_mf of the drag law: its packed-bed gradient = (1 - eps)(rho_p - rho_f) g
+for _ in range(200):
+    mid = 0.5 * (lo_u + hi_u)
+    lo_u, hi_u = (mid, hi_u) if di_felice_gradient(mid) < c_e else (lo_u, mid)
+u_mf_df = 0.5 * (lo_u + hi_u)
 # Measured: packed-bed part of the ramp (inflow rising, dp below 0.7 of the weight).
 ramp = (u_s > 1e-9) & (u_s < u_s.max() - 1e-9) & (dp < 0.7 * weight) & (t <= t[np.argmax(u_s)])
 if ramp.sum() >= 5:
@@ -200,7 +223,8 @@ if os.path.exists(log):
 
 print(f"largeBed: {len(d_parcel)} parcels of k = {np.unique(k).round(6).tolist()} stand for "
       f"{n_real} real beads d32 {d32*1e3:.3f} mm; U_mf Wen-Yu {u_mf_wy:.3f} m/s, Ergun "
-      f"(settled eps {eps:.3f}) {u_mf_ergun:.3f} m/s, measured {u_mf_meas:.3f} m/s; "
+      f"(settled eps {eps:.3f}) {u_mf_ergun:.3f} m/s, the drag law's (di_felice) packed bed "
+      f"{u_mf_df:.3f} m/s, measured {u_mf_meas:.3f} m/s; "
       f"U_s {u_final:.3f} m/s = {u_final/u_mf_wy:.2f} U_mf(Wen-Yu); mean dp over "
       f"{args.t_from:g}-{t[-1]:.3g} s {dp_mean:.1f} Pa (std {100*dp_std/dp_mean:.1f} %), bed weight "
       f"{weight:.1f} Pa, ratio {ratio:.4f} (tolerance {100*args.tolerance:g} %: "
@@ -246,14 +270,18 @@ ax.plot(u_s[window], dp[window], ".", ms=2, color="tab:green", alpha=0.4,
 uu = np.linspace(0, u_s.max(), 200)
 ax.plot(uu, (a_e * uu + b_e * uu**2) * weight / c_e, "k-", lw=1,  # L = weight / c_e
         label=f"Ergun, real d32 and settled ε = {eps:.3f}")
+ax.plot(uu, [di_felice_gradient(u) * weight / c_e for u in uu], "-", color="tab:purple", lw=1,
+        label="the drag law's own packed bed (di_felice, real d32, ε)")
 if np.isfinite(u_mf_meas):
     ax.plot(uu, a_m * uu + b_m * uu**2, "--", color="tab:blue", lw=1, label="fit of the ramp below 0.7 × weight")
 ax.axhline(weight, color="k", ls="--", lw=1, label="bed weight")
-for u, name, col in ((u_mf_wy, "Wen–Yu", "tab:red"), (u_mf_ergun, "Ergun", "k"),
-                     (u_mf_meas, "measured", "tab:blue")):
+for i, (u, name, col) in enumerate(((u_mf_wy, "Wen–Yu", "tab:red"), (u_mf_ergun, "Ergun", "k"),
+                                    (u_mf_df, "di_felice", "tab:purple"),
+                                    (u_mf_meas, "measured", "tab:blue"))):
     if np.isfinite(u):
         ax.axvline(u, color=col, ls=":", lw=1)
-        ax.text(u, 1.45 * weight, f" U_mf {name}\n {u:.3f}", color=col, fontsize=7, va="top")
+        ax.text(u, (1.45 - 0.12 * i) * weight, f" U_mf {name} {u:.3f}", color=col, fontsize=7,
+                va="top")
 ax.set_xlim(0, 1.05 * u_s.max())
 ax.set_ylim(0, 1.5 * weight)
 ax.set_xlabel("superficial velocity U_s [m/s]")
