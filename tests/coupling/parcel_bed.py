@@ -117,7 +117,8 @@ def check_run(checks, label, k, log, case):
     # grainFoam's start-up warning for parcels large against the cells (3 parcel diameters,
     # Radl et al. 2011): none for the beads (4 d cells), one line for k = 2 and 3 (cells of 2 and
     # 1.33 parcel diameters), and none saying the parcels are wider than a cell.
-    warned = [line for line in log.splitlines() if line.startswith("grainFoam coupling: warning: parcels")]
+    warned = [line for line in log.splitlines()
+              if line.startswith("grainFoam coupling: warning: parcels")]
     third = [line for line in warned if line.startswith(
         f"grainFoam coupling: warning: parcels 'glass[k={k}]' (diameter up to {k * D:g} m) are "
         "wider than a third of the fluid cells (smallest 0.004 m, typical 0.004 m)")]
