@@ -12,6 +12,7 @@
 
 #include "dem/engine/checkpoint_series.hpp"
 #include "dem/engine/finite_guard.hpp"
+#include "dem/engine/parcel_limits.hpp"
 #include "dem/engine/simulation.hpp"
 #include "dem/fluid/coupled_fluid.hpp"
 #include "dem/fluid/fluid_forces.hpp"
@@ -728,6 +729,14 @@ std::vector<std::string> DemLink::reports() const { return impl_->simulation().f
 
 std::vector<std::string> DemLink::force_limit_notes() const {
   return impl_->simulation().force_limit_notes();
+}
+
+std::vector<std::string> DemLink::parcel_cell_warnings(double smallest_cell,
+                                                      double typical_cell) const {
+  if (impl_->scene.coarse_grain_table().empty()) return {};
+  const std::vector<ParcelClass> classes =
+      parcel_classes(impl_->scene, impl_->simulation().particles(), impl_->dem_comm);
+  return grainflow::parcel_cell_warnings(classes, smallest_cell, typical_cell, "the fluid cells");
 }
 
 }  // namespace grainflow::coupling

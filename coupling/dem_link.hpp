@@ -255,6 +255,13 @@ class DemLink {
   // fluid sample: fluid at rest), one line each, and an "error: ..." line for a step beyond
   // an explicit force's limit (docs/models/fluid-forces.md).
   std::vector<std::string> force_limit_notes() const;
+  // Coarse-grained parcels against the fluid cells, the rule `grain check` applies to its
+  // void-fraction cells (dem/engine/parcel_limits.hpp; Radl et al. 2011): one "warning: ..."
+  // line per parcel class whose largest parcel is wider than a third of the smallest cell
+  // [m], and one more when it is wider than that cell; each names the class (glass[k=3]),
+  // its parcel diameter and the smallest and typical cell sizes. Empty without parcels or
+  // when they are small enough. Collective (after initialise()).
+  std::vector<std::string> parcel_cell_warnings(double smallest_cell, double typical_cell) const;
 
  private:
   struct Impl;

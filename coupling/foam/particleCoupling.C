@@ -550,6 +550,11 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
       settings.drag_void_fraction = sharpInterface_ ? "sharpInterface" : "cell";
       Info << "  " << coupling::describe_coupled_accuracy(settings).c_str() << endl;
     }
+    // Coarse-grained parcels against the cells (the rule of grain check; Radl et al. 2011).
+    // Cell size: the cube root of a cell's volume, the smallest and that of the mean cell.
+    const double smallest = std::cbrt(gMin(mesh.V().field()));
+    for (const std::string& w : dem_->parcel_cell_warnings(smallest, std::cbrt(sums[2] / cells)))
+      Info << "grainFoam coupling: " << w.c_str() << endl;
   }
 
   voidFraction_.oldTime();  // keep old times for ddt(voidfraction)

@@ -12,6 +12,7 @@
 #include "dem/core/number_format.hpp"
 #include "dem/engine/checkpoint_series.hpp"
 #include "dem/engine/finite_guard.hpp"
+#include "dem/engine/parcel_limits.hpp"
 #include "dem/engine/simulation.hpp"
 #include "dem/engine/stop_signals.hpp"
 #include "dem/fluid/fluid_forces.hpp"
@@ -115,52 +116,46 @@ void check_grids(const Scene& scene) {
 
 // Coarse graining (docs/models/coarse-graining.md): per parcel class the parcels, the real
 // particles they stand for and their mass, and warnings where the literature says parcels
-// stop standing for the real particles. Collective over comm; nothing without parcels.
+// stop standing for the real particles (dem/engine/parcel_limits.hpp, the rules grainFoam
+// applies to its mesh too). Collective over comm; nothing without parcels.
 void print_coarse_grain_report(const Scene& scene, const Particles& p, MPI_Comm comm,
                                std::ostream& out) {
-  const std::vector<double> k = scene.coarse_grain_table();
-  if (k.empty()) return;
-  const std::size_t n = scene.materials.size();
-  // Per material: parcels, real particles, mass, largest parcel radius.
-  std::vector<double> sum(3 * n, 0.0), largest(n, 0.0);
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    const auto m = static_cast<std::size_t>(p.material[i]);
-    sum[3 * m] += 1;
-    sum[3 * m + 1] += k[m] * k[m] * k[m];
-    sum[3 * m + 2] += p.mass[i];
-    largest[m] = std::max(largest[m], p.radius[i]);
+  if (scene.coarse_grain_table().empty()) return;
+  const std::vector<ParcelClass> classes = parcel_classes(scene, p, comm);
+  long long parcels = 0;
+  double real = 0, mass = 0;
+  {
+    // Every particle, real ones (k = 1) included, for the totals.
+    const std::vector<double> k = scene.coarse_grain_table();
+    double sum[3] = {0, 0, 0};
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const double ki = k[static_cast<std::size_t>(p.material[i])];
+      sum[0] += 1;
+      sum[1] += ki * ki * ki;
+      sum[2] += p.mass[i];
+    }
+    MPI_Allreduce(MPI_IN_PLACE, sum, 3, MPI_DOUBLE, MPI_SUM, comm);
+    parcels = static_cast<long long>(sum[0]);
+    real = sum[1];
+    mass = sum[2];
   }
-  MPI_Allreduce(MPI_IN_PLACE, sum.data(), static_cast<int>(sum.size()), MPI_DOUBLE, MPI_SUM, comm);
-  MPI_Allreduce(MPI_IN_PLACE, largest.data(), static_cast<int>(n), MPI_DOUBLE, MPI_MAX, comm);
   std::ostream& o = speaker(comm, out);
-  double parcels = 0, real = 0, mass = 0, widest = 0;
   o << "coarse graining (docs/models/coarse-graining.md):\n";
-  for (std::size_t m = 0; m < n; ++m) {
-    parcels += sum[3 * m];
-    real += sum[3 * m + 1];
-    mass += sum[3 * m + 2];
-    if (k[m] != 1) widest = std::max(widest, 2 * largest[m]);
-    if (k[m] == 1 || sum[3 * m] == 0) continue;
-    o << "  '" << scene.materials[m].name << "': " << static_cast<long long>(sum[3 * m])
-      << " parcels of k = " << k[m] << " stand for " << sum[3 * m + 1]
-      << " real particles of mass " << sum[3 * m + 2] << " kg (real radius up to "
-      << largest[m] / k[m] << " m, parcel radius up to " << largest[m] << " m)\n";
-  }
-  o << "  all particles: " << static_cast<long long>(parcels) << " computed, " << real
-    << " real, mass " << mass << " kg\n";
-  if (widest == 0) return;
+  for (const ParcelClass& c : classes)
+    o << "  '" << c.name << "': " << c.parcels << " parcels of k = " << c.k << " stand for "
+      << c.real << " real particles of mass " << c.mass << " kg (real radius up to "
+      << c.largest_diameter / (2 * c.k) << " m, parcel radius up to " << c.largest_diameter / 2
+      << " m)\n";
+  o << "  all particles: " << parcels << " computed, " << real << " real, mass " << mass
+    << " kg\n";
   const Vec3 extent = scene.domain.hi - scene.domain.lo;
-  if (extent.minCoeff() < 10 * widest)
-    o << "  warning: the domain's narrowest side (" << extent.minCoeff()
-      << " m) is less than 10 parcel diameters (" << widest
-      << " m): walls and the bed's own structures (bubbles, shear bands) are then resolved by "
-         "few parcels, where coarse graining is known to fail; lower coarse_grain\n";
-  if (scene.fluid && scene.fluid->computed_void_fraction &&
-      scene.fluid->computed_void_fraction->cell_size < 3 * widest)
-    o << "  warning: the void-fraction cell (" << scene.fluid->computed_void_fraction->cell_size
-      << " m) is smaller than 3 parcel diameters (" << widest
-      << " m): the parcels' void fraction is then not the real particles' (Radl et al. 2011); "
-         "lower coarse_grain or enlarge the cells\n";
+  for (const std::string& w : parcel_domain_warnings(classes, extent.minCoeff()))
+    o << "  " << w << "\n";
+  if (scene.fluid && scene.fluid->computed_void_fraction) {
+    const double h = scene.fluid->computed_void_fraction->cell_size;
+    for (const std::string& w : parcel_cell_warnings(classes, h, h, "the void-fraction cell"))
+      o << "  " << w << "\n";
+  }
 }
 
 }  // namespace

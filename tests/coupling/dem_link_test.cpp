@@ -9,13 +9,17 @@
 #include <gtest/gtest.h>
 #include <mpi.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "coupling/dem_link.hpp"
+#include "dem/core/number_format.hpp"
 #include "dem/core/particles.hpp"
 #include "dem/io/output_directory.hpp"
 #include "dem/io/snapshot_writer.hpp"
@@ -271,6 +275,76 @@ TEST(DemLink, ParcelsCarryTheRealDragTimesK3AndTheirOwnVolume) {
   }
   EXPECT_EQ(parcels, 10);
   EXPECT_EQ(reals, 10);
+}
+
+// The fluidisedBed tutorial's beads (d = 1.14-1.26 mm glass in air, cells of 3 mm) as parcels
+// of k = 1, 2, 3: grainFoam's start-up warning (DemLink::parcel_cell_warnings, the rule of
+// grain check; Radl et al. 2011). k = 1: real beads, no warning. k = 2: parcels up to 2.52 mm,
+// cells of 1.19 parcel diameters, one warning (fewer than 3). k = 3: parcels up to 3.78 mm,
+// wider than the cells: both warnings, each naming the class glass[k=3], the largest parcel
+// diameter (from the particles, independently of the link) and the cell sizes.
+std::string fluidised_bed_scene(double k) {
+  std::ostringstream s;
+  s << "domain: {min: [0, 0, 0], max: [0.06, 0.009, 0.06]}\n"
+       "gravity: [0, 0, -9.81]\n"
+       "time: {step: 1.5e-5, end: 0.01}\n"
+       "materials:\n"
+       "  - {name: glass, youngs_modulus: 2e6, poisson_ratio: 0.25, density: 2500}\n"
+       "interaction_defaults: {restitution: 0.9, friction: 0.3}\n"
+       "contact: {normal: hertz, tangential: history}\n"
+       "insert:\n"
+       "  - type: fill\n"
+       "    region: {box: {min: [0, 0, 0.002], max: [0.06, 0.009, 0.05]}}\n"
+       "    count: 30\n"
+       "    material: glass\n"
+       "    radius: {distribution: uniform, min: 0.57e-3, max: 0.63e-3}\n"
+       "    coarse_grain: "
+    << k << "\n"
+       "    seed: 1\n"
+       "fluid: {density: 1.2, viscosity: 1.8e-5, drag: di_felice, model: A,\n"
+       "        pressure: {hydrostatic: false},\n"
+       "        forces: [drag, pressure_gradient, viscous, buoyancy]}\n";
+  return s.str();
+}
+
+TEST(DemLink, WarnsOfParcelsLargeAgainstTheCells) {
+  const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "dem_link_parcels";
+  fs::create_directories(dir);
+  const double cell = 0.003;
+  for (const int k : {1, 2, 3}) {
+    const fs::path scene = dir / ("fluidised_bed_k" + std::to_string(k) + ".yaml");
+    std::ofstream(scene) << fluidised_bed_scene(k);
+    DemLink link(scene.string(), 1.2, 1.8e-5, MPI_COMM_WORLD);
+    link.initialise();
+    const std::vector<std::string> warnings = link.parcel_cell_warnings(cell, cell);
+    const ParticleSet set = link.particles(false);
+    double widest = 0;
+    for (std::size_t i = 0; i < set.local; ++i) widest = std::max(widest, 2 * set.radius[i]);
+    MPI_Allreduce(MPI_IN_PLACE, &widest, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    ASSERT_GT(widest, k * 1.14e-3);
+    ASSERT_LE(widest, k * 1.26e-3 * (1 + 1e-12));
+    if (k == 1) {
+      EXPECT_TRUE(warnings.empty()) << warnings.front();
+      continue;
+    }
+    const std::string cls = "parcels 'glass[k=" + std::to_string(k) + "]' (diameter up to " +
+                            significant(widest) + " m)";
+    const std::string cells = "(smallest 0.003 m, typical 0.003 m)";
+    ASSERT_EQ(warnings.size(), k == 3 ? 2u : 1u);
+    EXPECT_EQ(warnings[0].rfind("warning: " + cls + " are wider than a third of the fluid cells " +
+                                    cells + ": cells of " + significant(cell / widest, 3) +
+                                    " parcel diameters, fewer than 3;",
+                                0),
+              0u)
+        << warnings[0];
+    EXPECT_NE(warnings[0].find("(Radl et al. 2011)"), std::string::npos) << warnings[0];
+    if (k == 3) {
+      EXPECT_EQ(warnings[1].rfind("warning: " + cls + " are wider than the fluid cells " + cells,
+                                  0),
+                0u)
+          << warnings[1];
+    }
+  }
 }
 
 // The undisturbed-velocity correction models one particle's own disturbance: with parcels

@@ -114,6 +114,17 @@ def check_run(checks, label, k, log, case):
                   f"{label}: momentum exchange balanced to {worst:.3g} (< 1e-12) at "
                   f"{len(lines)} printed steps (largest vertical force on the particles "
                   f"{drag:.4g} N)")
+    # grainFoam's start-up warning for parcels large against the cells (3 parcel diameters,
+    # Radl et al. 2011): none for the beads (4 d cells), one line for k = 2 and 3 (cells of 2 and
+    # 1.33 parcel diameters), and none saying the parcels are wider than a cell.
+    warned = [line for line in log.splitlines()
+              if line.startswith("grainFoam coupling: warning: parcels")]
+    third = [line for line in warned if line.startswith(
+        f"grainFoam coupling: warning: parcels 'glass[k={k}]' (diameter up to {k * D:g} m) are "
+        "wider than a third of the fluid cells (smallest 0.004 m, typical 0.004 m)")]
+    checks.expect(len(warned) == len(third) == (0 if k == 1 else 1),
+                  f"{label}: {len(warned)} start-up warning(s) of parcels against the cells "
+                  f"(expected {0 if k == 1 else 1}){': ' + warned[0] if warned else ''}")
     snaps = snapshots(case)
     t, last = snaps[-1]
     if k != 1:

@@ -1,0 +1,82 @@
+#include "dem/engine/parcel_limits.hpp"
+
+#include <algorithm>
+#include <sstream>
+
+#include "dem/core/number_format.hpp"
+
+namespace grainflow {
+
+std::vector<ParcelClass> parcel_classes(const Scene& scene, const Particles& p, MPI_Comm comm) {
+  const std::vector<double> k = scene.coarse_grain_table();
+  if (k.empty()) return {};
+  const std::size_t n = scene.materials.size();
+  // Per material: parcels, real particles, mass; largest parcel radius.
+  std::vector<double> sum(3 * n, 0.0), largest(n, 0.0);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const auto m = static_cast<std::size_t>(p.material[i]);
+    sum[3 * m] += 1;
+    sum[3 * m + 1] += k[m] * k[m] * k[m];
+    sum[3 * m + 2] += p.mass[i];
+    largest[m] = std::max(largest[m], p.radius[i]);
+  }
+  MPI_Allreduce(MPI_IN_PLACE, sum.data(), static_cast<int>(sum.size()), MPI_DOUBLE, MPI_SUM, comm);
+  MPI_Allreduce(MPI_IN_PLACE, largest.data(), static_cast<int>(n), MPI_DOUBLE, MPI_MAX, comm);
+  std::vector<ParcelClass> out;
+  for (std::size_t m = 0; m < n; ++m) {
+    if (k[m] == 1 || sum[3 * m] == 0) continue;
+    out.push_back({scene.materials[m].name, k[m], static_cast<long long>(sum[3 * m]),
+                   sum[3 * m + 1], sum[3 * m + 2], 2 * largest[m]});
+  }
+  return out;
+}
+
+std::vector<std::string> parcel_cell_warnings(const std::vector<ParcelClass>& classes,
+                                              double smallest_cell, double typical_cell,
+                                              const std::string& cell_what) {
+  std::vector<std::string> out;
+  if (!(smallest_cell > 0)) return out;
+  for (const ParcelClass& c : classes) {
+    const double d = c.largest_diameter;
+    if (!(3 * d > smallest_cell)) continue;
+    const std::string cells = "(smallest " + significant(smallest_cell) + " m, typical " +
+                              significant(typical_cell) + " m)";
+    std::ostringstream o;
+    o << "warning: parcels '" << c.name << "' (diameter up to " << significant(d)
+      << " m) are wider than a third of " << cell_what << " " << cells << ": cells of "
+      << significant(smallest_cell / d, 3)
+      << " parcel diameters, fewer than 3; the parcels' void fraction and drag are then not "
+         "the real particles' (Radl et al. 2011); lower coarse_grain or enlarge the cells";
+    out.push_back(o.str());
+    if (smallest_cell < d) {
+      std::ostringstream w;
+      w << "warning: parcels '" << c.name << "' (diameter up to " << significant(d)
+        << " m) are wider than " << cell_what << " " << cells
+        << ": a parcel spans several cells, so the cells resolve structures (voids, bubbles, "
+           "the bed surface) smaller than a parcel, which the parcels cannot have; "
+           "coarse graining fails there (Radl et al. 2011)";
+      out.push_back(w.str());
+    }
+  }
+  return out;
+}
+
+std::vector<std::string> parcel_domain_warnings(const std::vector<ParcelClass>& classes,
+                                                double narrowest_side) {
+  double widest = 0;
+  const ParcelClass* by = nullptr;
+  for (const ParcelClass& c : classes)
+    if (c.largest_diameter > widest) {
+      widest = c.largest_diameter;
+      by = &c;
+    }
+  if (!by || !(narrowest_side < 10 * widest)) return {};
+  std::ostringstream o;
+  o << "warning: the domain's narrowest side (" << significant(narrowest_side)
+    << " m) is less than 10 diameters of parcels '" << by->name << "' (" << significant(widest)
+    << " m): walls and the bed's own structures (bubbles, shear bands) are then resolved by "
+       "few parcels, where coarse graining is known to fail; lower coarse_grain";
+  return {o.str()};
+}
+
+}  // namespace grainflow

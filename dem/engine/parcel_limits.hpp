@@ -1,0 +1,44 @@
+#pragma once
+// Where coarse-grained parcels stop standing for their real particles
+// (docs/models/coarse-graining.md, "Limits"). One rule for every program that knows the
+// fluid cells: `grain check` / `grain run` (the one-way computed void fraction's cell) and
+// grainFoam (its mesh, at start-up).
+#include <mpi.h>
+
+#include <string>
+#include <vector>
+
+#include "dem/core/particles.hpp"
+#include "dem/scene/scene.hpp"
+
+namespace grainflow {
+
+// One parcel class (a material with k != 1) as the particles present show it.
+struct ParcelClass {
+  std::string name;  // the class's material name, e.g. "glass[k=3]"
+  double k = 1;
+  long long parcels = 0;
+  double real = 0;              // real particles the parcels stand for (parcels x k^3)
+  double mass = 0;              // [kg]
+  double largest_diameter = 0;  // of a parcel [m]
+};
+
+// The scene's parcel classes with at least one parcel among the particles of every rank
+// (collective over comm); empty without parcels. In material order.
+std::vector<ParcelClass> parcel_classes(const Scene& scene, const Particles& p, MPI_Comm comm);
+
+// Parcels against fluid cells (Radl et al. 2011): one line per class whose largest parcel is
+// wider than a third of the smallest cell (cells under 3 parcel diameters), and one more when
+// the smallest cell is narrower than that parcel. Each line starts with "warning: " and names
+// the class, its parcel diameter, the smallest and the typical cell size [m] and
+// `cell_what` (what the cells are, e.g. "the void-fraction cell"). Empty: nothing to warn.
+std::vector<std::string> parcel_cell_warnings(const std::vector<ParcelClass>& classes,
+                                              double smallest_cell, double typical_cell,
+                                              const std::string& cell_what);
+
+// Parcels against the domain: a line when the domain's narrowest side is less than 10
+// diameters of the widest parcel (walls and the bed's structures resolved by few parcels).
+std::vector<std::string> parcel_domain_warnings(const std::vector<ParcelClass>& classes,
+                                                double narrowest_side);
+
+}  // namespace grainflow
