@@ -63,12 +63,18 @@ def mpirun(np_, args, env):
     return subprocess.run(base + args, env=e, check=True, capture_output=True, text=True).stdout
 
 
+def build_mpi_count(out_dir):
+    """The profiling layer, compiled when its source is newer than the library."""
+    lib, src = os.path.join(out_dir, "libmpi_count.so"), os.path.join(HERE, "mpi_count.c")
+    if not os.path.exists(lib) or os.path.getmtime(lib) < os.path.getmtime(src):
+        subprocess.run(["mpicc", "-O2", "-shared", "-fPIC", "-o", lib, src], check=True)
+    return lib
+
+
 def measure(build, particles, steps):
     out_dir = os.path.join(build, "scaling_model")
     os.makedirs(out_dir, exist_ok=True)
-    lib = os.path.join(out_dir, "libmpi_count.so")
-    subprocess.run(["mpicc", "-O2", "-shared", "-fPIC", "-o", lib, os.path.join(HERE, "mpi_count.c")],
-                   check=True)
+    lib = build_mpi_count(out_dir)
     runs = {}
     for np_ in (1, 2, 4, 8):
         counts = os.path.join(out_dir, f"counts_{np_}.txt")
@@ -98,47 +104,128 @@ def measure(build, particles, steps):
     return path
 
 
-def measure_fluid(build):
-    """grainFoam's messages and reductions per fluid step: fluidisedBed --short on 2 ranks, run
-    to 0.015 s and to 0.045 s (50 and 150 fluid steps) with mpi_count preloaded; the difference
-    of the two runs' totals over the 100 steps between them."""
+def symbolise(stack_lines):
+    """The function names of the frames in mpi_count's stack lines (MODULE+0xOFFSET), looked up
+    in each module's symbol table (nm; the dynamic table where a library has no other)."""
+    tables = {}
+
+    def table(mod):
+        if mod not in tables:
+            rows = []
+            for opt in ([], ["-D"]):
+                try:
+                    out = subprocess.run(["nm", "-C", "-n", "--defined-only"] + opt + [mod],
+                                         capture_output=True, text=True).stdout
+                except OSError:
+                    out = ""
+                for line in out.splitlines():
+                    parts = line.split(" ", 2)
+                    if len(parts) == 3 and parts[1] in "TtWw":
+                        rows.append((int(parts[0], 16), parts[2]))
+                if rows:
+                    break
+            tables[mod] = ([r[0] for r in rows], [r[1] for r in rows])
+        return tables[mod]
+
+    import bisect
+    names = []
+    for frame in stack_lines:
+        mod, _, off = frame.rpartition("+0x")
+        addrs, syms = table(mod) if mod != "?" else ([], [])
+        i = bisect.bisect_right(addrs, int(off, 16) - 1) - 1  # a return address: the call is before it
+        names.append(syms[i] if i >= 0 else f"{os.path.basename(mod)}+0x{off}")
+    return names
+
+
+# Who made an MPI call, from its call stack (the first rule that matches a frame, outermost
+# rules first): the DEM's steps, the coupling (ParticleCoupling and the DEM link's exchanges
+# outside the steps), else the fluid (the PIMPLE loop), split into the pressure solver
+# (GAMG), the other linear solvers, and the rest (fvc operators, boundary updates, continuity
+# errors, Courant number).
+def who(names):
+    text = "\n".join(names)
+    if "DemLink::advance" in text:
+        return "DEM"
+    if "ParticleCoupling::" in text or "DemLink::" in text:
+        return "coupling"
+    if "GAMG" in text:
+        return "fluid: GAMG (p)"
+    if "Solver::solve" in text or "lduMatrix::solve" in text or "fvMatrix" in text and "::solve" in text:
+        return "fluid: other solves"
+    return "fluid: rest"
+
+
+PARTS = ("DEM", "coupling", "fluid: GAMG (p)", "fluid: other solves", "fluid: rest")
+
+
+def measure_fluid(build, np_=2, ends=("0.015", "0.045")):
+    """grainFoam's messages and reductions per fluid step and rank, by who makes them:
+    fluidisedBed --short on np_ ranks, run to ends[0] and to ends[1] (by default 0.015 s and
+    0.045 s: 50 and 150 fluid steps; no write time in either) with mpi_count preloaded, the two
+    runs side by side; the difference of their totals over the fluid steps between."""
+    import glob
     import shutil
+    import yaml
     out_dir = os.path.join(build, "scaling_model")
     os.makedirs(out_dir, exist_ok=True)
-    lib = os.path.join(out_dir, "libmpi_count.so")
-    subprocess.run(["mpicc", "-O2", "-shared", "-fPIC", "-o", lib, os.path.join(HERE, "mpi_count.c")],
-                   check=True)
-    case = os.path.join(out_dir, "fluidisedBed")
-    shutil.rmtree(case, ignore_errors=True)
-    shutil.copytree(os.path.join(ROOT, "tutorials", "cfd-dem", "fluidisedBed"), case)
+    lib = build_mpi_count(out_dir)
     tut = os.path.join(ROOT, "tutorials", "cfd-dem")
-    totals = {}
-    for end in ("0.015", "0.045"):
-        counts = os.path.join(out_dir, f"fluid_counts_{end}.txt")
-        if os.path.exists(counts):
-            os.remove(counts)
+    runs = {}
+    for end in ends:
+        case = os.path.join(out_dir, f"fluidisedBed_np{np_}_{end}")
+        shutil.rmtree(case, ignore_errors=True)
+        shutil.copytree(os.path.join(tut, "fluidisedBed"), case)
+        # No write time inside either run (the write-time sums and checks are not per step).
+        ctl = os.path.join(case, "system", "controlDict")
+        text = re.sub(r"^writeInterval .*$", "writeInterval   100000;", open(ctl).read(), flags=re.M)
+        open(ctl, "w").write(text)
         # The short scene of Allrun --short: 2000 beads poured from 2-20 mm.
-        import yaml
         scene = yaml.safe_load(open(os.path.join(case, "particles.yaml")))
         scene["insert"][0]["count"] = 2000
         scene["insert"][0]["region"]["box"]["max"][2] = 0.02
         yaml.safe_dump(scene, open(os.path.join(case, "particles_short.yaml"), "w"), sort_keys=False)
         open(os.path.join(case, "system", "shortRun.coupling"), "w").write('scene "particles_short.yaml";\n')
         open(os.path.join(case, "system", "shortRun"), "w").write(f"endTime {end};\n")
-        script = f"set -e; cd {case}; source {tut}/run_case.sh; run_case -np 2"
+        counts = os.path.join(out_dir, f"fluid_counts_np{np_}_{end}.txt")
+        stacks = os.path.join(out_dir, f"fluid_stacks_np{np_}_{end}")
+        for f in [counts] + glob.glob(stacks + ".*"):
+            os.remove(f) if os.path.exists(f) else None
+        script = f"set -e; cd {case}; source {tut}/run_case.sh; run_case -np {np_}"
         env = dict(os.environ, GRAINFLOW_SOURCE_DIR=ROOT, GRAINFLOW_BUILD_DIR=build,
                    OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-                   OMPI_MCA_mca_base_env_list=f"LD_PRELOAD={lib};MPI_COUNT_OUT={counts}")
-        subprocess.run(["bash", "-c", script], env=env, check=True, stdout=subprocess.DEVNULL)
+                   # A waiting rank yields its core: on a shared or oversubscribed machine the
+                   # runs finish sooner, and the counts are the same.
+                   OMPI_MCA_mpi_yield_when_idle="1",
+                   OMPI_MCA_mca_base_env_list=f"LD_PRELOAD={lib};MPI_COUNT_OUT={counts};MPI_COUNT_STACKS={stacks}")
+        runs[end] = (subprocess.Popen(["bash", "-c", script], env=env, stdout=subprocess.DEVNULL), stacks)
+    totals = {}
+    for end, (proc, stacks) in runs.items():
+        if proc.wait() != 0:
+            sys.exit(f"model.py --fluid: the run to {end} s failed (see its log.grainFoam)")
         t = {}
-        for line in open(counts):
-            d = dict(kv.split("=") for kv in line.split())
-            if d["rank"] == "0":
-                t[d["kind"]] = t.get(d["kind"], 0) + int(d["calls"])
+        for path in glob.glob(stacks + ".*"):
+            for line in open(path):
+                head, _, stack = line.rstrip("\n").partition(" stack=")
+                d = dict(kv.split("=") for kv in head.split())
+                if d["kind"] not in ("allreduce", "p2p"):
+                    continue
+                key = (int(d["rank"]), d["kind"], who(symbolise(stack.split(";"))))
+                t[key] = t.get(key, 0) + int(d["calls"])
         totals[end] = t
-    for kind in ("allreduce", "p2p"):
-        per = (totals["0.045"].get(kind, 0) - totals["0.015"].get(kind, 0)) / 100
-        print(f"grainFoam, fluidisedBed --short, 2 ranks: {per:.0f} {kind} calls per fluid step (rank 0)")
+    steps = round((float(ends[1]) - float(ends[0])) / 3e-4)
+    per = {k: (totals[ends[1]].get(k, 0) - totals[ends[0]].get(k, 0)) / steps
+           for k in set(totals[ends[0]]) | set(totals[ends[1]])}
+    print(f"grainFoam, fluidisedBed --short (2000 beads, 4 800 cells), {np_} ranks: calls per fluid step "
+          f"(over fluid steps {round(float(ends[0]) / 3e-4)}-{round(float(ends[1]) / 3e-4)})\n")
+    print("| rank | kind | " + " | ".join(PARTS) + " | total |")
+    print("|---:|---|" + "---:|" * (len(PARTS) + 1))
+    for r in range(np_):
+        for kind in ("allreduce", "p2p"):
+            row = [per.get((r, kind, w), 0.0) for w in PARTS]
+            print(f"| {r} | {kind} | " + " | ".join(f"{x:.1f}" for x in row) + f" | {sum(row):.1f} |")
+    json.dump({f"{r} {k} {w}": v for (r, k, w), v in sorted(per.items())},
+              open(os.path.join(out_dir, f"fluid_np{np_}.json"), "w"), indent=1)
+    return per
 
 
 # ---- the model ----------------------------------------------------------------------------
@@ -303,12 +390,16 @@ if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--measure", action="store_true")
     ap.add_argument("--fluid", action="store_true")
+    ap.add_argument("--np", type=int, default=2, help="ranks of --fluid (4: oversubscribed)")
+    ap.add_argument("--ends", default="0.015,0.045",
+                    help="end times of --fluid's two runs; their difference gives the counts per step")
     ap.add_argument("--build", default=os.environ.get("GRAINFLOW_BUILD_DIR", os.path.join(ROOT, "build")))
     ap.add_argument("--particles", type=int, default=100000)
     ap.add_argument("--steps", type=int, default=50)
     a = ap.parse_args()
+    a.build = os.path.abspath(a.build)
     if a.fluid:
-        measure_fluid(a.build)
+        measure_fluid(a.build, a.np, tuple(a.ends.split(",")))
         sys.exit(0)
     path = os.path.join(a.build, "scaling_model", "measured.json")
     if a.measure or not os.path.exists(path):
