@@ -3,7 +3,7 @@
 
     benchmarks/scaling_model/model.py --measure [--build DIR]   # counts on 1, 2, 4, 8 ranks
     benchmarks/scaling_model/model.py                           # the model from the last counts
-    benchmarks/scaling_model/model.py --fluid                   # grainFoam's counts per fluid step
+    benchmarks/scaling_model/model.py --fluid [--np 4]          # grainFoam's counts per fluid step
 
 --measure runs bench_strong_scaling (a dense FCC bed of 100 000 spheres) on 1, 2, 4 and 8 ranks
 (4 and 8 oversubscribed: the counts do not depend on the cores) with the MPI profiling layer
@@ -16,7 +16,13 @@ sends and reduces per step in DIR/scaling_model/measured.json. The model then
   3. predicts the 1 -> 2 rank speed-up from the 1-rank time per particle-step and compares it
      with docs/parallel-scaling.md's measurement;
   4. extrapolates strong and weak scaling of the DEM bed and of a coupled bed to 64, 256 and
-     1024 ranks on the cluster network below, with the part that stops scaling first.
+     1024 ranks on the cluster network below, with the part that stops scaling first;
+  5. with the counts of --fluid on 2 and 4 ranks, predicts the 4-rank counts from the 2-rank
+     ones, and the coupled tutorial's 1 -> 2 rank speed-up, against the measured ones.
+
+--fluid [--np N] counts grainFoam's allreduces and messages per fluid step and rank on N ranks
+(default 2), and tells from each call's stack whether the DEM, the coupling or the PIMPLE loop
+made it; it stores them in DIR/scaling_model/fluid_npN.json.
 
 The formulas, the network and the limits are explained in docs/scaling-model.md; this script
 prints its tables.
@@ -37,12 +43,13 @@ T_PS_DENSE = 1 / 2.78e6    # s per particle-step, dense FCC bed, 1 rank (docs/pa
 SPEEDUP_DENSE_2 = 1.75     # its measured 1 -> 2 rank speed-up (same page)
 PAIR_SHARE = 0.75          # share of a step's time that scales with the pairs evaluated
                            # (pair sweep 68 % + walls 7 % of the loop, docs/performance.md)
-# The coupled bed, from the fluidisedBed tutorial on 2 ranks (issue 22's measurement):
-# 12 000 beads, 4 800 cells, 20 DEM steps per fluid step; time split DEM 63 %, coupling
-# 12.1 %, fluid 24.9 %. The settled-bed rate of docs/performance.md, 1.48e7 particle-steps/s,
+# The coupled bed, from the fluidisedBed tutorial (12 000 beads, 4 800 cells, 20 DEM steps per
+# fluid step): its CPU time split on 1 rank over the first 100 fluid steps (DEM 57.3 %,
+# coupling 16.1 %, fluid 26.6 %; on 1 rank no part waits for another rank, so the split is the
+# compute alone). The settled-bed rate of docs/performance.md, 1.48e7 particle-steps/s,
 # stands for its DEM.
 T_PS_BED = 1 / 1.48e7
-FB = dict(beads=12000, cells=4800, substeps=20, dem=0.63, coupling=0.121, fluid=0.249)
+FB = dict(beads=12000, cells=4800, substeps=20, dem=0.573, coupling=0.161, fluid=0.266)
 
 # ---- the cluster the model assumes ------------------------------------------------------
 NET = dict(
@@ -63,12 +70,18 @@ def mpirun(np_, args, env):
     return subprocess.run(base + args, env=e, check=True, capture_output=True, text=True).stdout
 
 
+def build_mpi_count(out_dir):
+    """The profiling layer, compiled when its source is newer than the library."""
+    lib, src = os.path.join(out_dir, "libmpi_count.so"), os.path.join(HERE, "mpi_count.c")
+    if not os.path.exists(lib) or os.path.getmtime(lib) < os.path.getmtime(src):
+        subprocess.run(["mpicc", "-O2", "-shared", "-fPIC", "-o", lib, src], check=True)
+    return lib
+
+
 def measure(build, particles, steps):
     out_dir = os.path.join(build, "scaling_model")
     os.makedirs(out_dir, exist_ok=True)
-    lib = os.path.join(out_dir, "libmpi_count.so")
-    subprocess.run(["mpicc", "-O2", "-shared", "-fPIC", "-o", lib, os.path.join(HERE, "mpi_count.c")],
-                   check=True)
+    lib = build_mpi_count(out_dir)
     runs = {}
     for np_ in (1, 2, 4, 8):
         counts = os.path.join(out_dir, f"counts_{np_}.txt")
@@ -98,47 +111,161 @@ def measure(build, particles, steps):
     return path
 
 
-def measure_fluid(build):
-    """grainFoam's messages and reductions per fluid step: fluidisedBed --short on 2 ranks, run
-    to 0.015 s and to 0.045 s (50 and 150 fluid steps) with mpi_count preloaded; the difference
-    of the two runs' totals over the 100 steps between them."""
+_SYMBOL_TABLES = {}
+
+
+def symbolise(stack_lines):
+    """The function names of the frames in mpi_count's stack lines (MODULE+0xOFFSET), looked up
+    in each module's symbol table (nm; the dynamic table where a library has no other)."""
+    tables = _SYMBOL_TABLES
+
+    def table(mod):
+        if mod not in tables:
+            rows = []
+            for opt in ([], ["-D"]):
+                try:
+                    out = subprocess.run(["nm", "-C", "-n", "--defined-only"] + opt + [mod],
+                                         capture_output=True, text=True).stdout
+                except OSError:
+                    out = ""
+                for line in out.splitlines():
+                    parts = line.split(" ", 2)
+                    if len(parts) == 3 and parts[1] in "TtWw":
+                        rows.append((int(parts[0], 16), parts[2]))
+                if rows:
+                    break
+            tables[mod] = ([r[0] for r in rows], [r[1] for r in rows])
+        return tables[mod]
+
+    import bisect
+    names = []
+    for frame in stack_lines:
+        mod, _, off = frame.rpartition("+0x")
+        addrs, syms = table(mod) if mod != "?" else ([], [])
+        i = bisect.bisect_right(addrs, int(off, 16) - 1) - 1  # a return address: the call is before it
+        names.append(syms[i] if i >= 0 else f"{os.path.basename(mod)}+0x{off}")
+    return names
+
+
+# Who made an MPI call, from its call stack (the first rule that matches a frame, outermost
+# rules first): the DEM's steps, the coupling (ParticleCoupling and the DEM link's exchanges
+# outside the steps), else the fluid (the PIMPLE loop), split into the pressure solver
+# (GAMG), the other linear solvers, and the rest (fvc operators, boundary updates, continuity
+# errors, Courant number).
+def who(names):
+    text = "\n".join(names)
+    if "DemLink::advance" in text:
+        return "DEM"
+    if "ParticleCoupling::" in text or "DemLink::" in text:
+        return "coupling"
+    if "GAMG" in text:
+        return "fluid: GAMG (p)"
+    if "Solver::solve" in text or "lduMatrix::solve" in text or "fvMatrix" in text and "::solve" in text:
+        return "fluid: other solves"
+    return "fluid: rest"
+
+
+PARTS = ("DEM", "coupling", "fluid: GAMG (p)", "fluid: other solves", "fluid: rest")
+
+
+def measure_fluid(build, np_=2, ends=("0.009", "0.024")):
+    """grainFoam's messages and reductions per fluid step and rank, by who makes them:
+    fluidisedBed --short on np_ ranks, run to ends[0] and to ends[1] (by default 0.009 s and
+    0.024 s: 30 and 80 fluid steps; no write time in either) with mpi_count preloaded, the two
+    runs side by side; the difference of their totals over the fluid steps between."""
+    import glob
     import shutil
+    import yaml
     out_dir = os.path.join(build, "scaling_model")
     os.makedirs(out_dir, exist_ok=True)
-    lib = os.path.join(out_dir, "libmpi_count.so")
-    subprocess.run(["mpicc", "-O2", "-shared", "-fPIC", "-o", lib, os.path.join(HERE, "mpi_count.c")],
-                   check=True)
-    case = os.path.join(out_dir, "fluidisedBed")
-    shutil.rmtree(case, ignore_errors=True)
-    shutil.copytree(os.path.join(ROOT, "tutorials", "cfd-dem", "fluidisedBed"), case)
+    lib = build_mpi_count(out_dir)
     tut = os.path.join(ROOT, "tutorials", "cfd-dem")
-    totals = {}
-    for end in ("0.015", "0.045"):
-        counts = os.path.join(out_dir, f"fluid_counts_{end}.txt")
-        if os.path.exists(counts):
-            os.remove(counts)
+    runs = {}
+    for end in ends:
+        case = os.path.join(out_dir, f"fluidisedBed_np{np_}_{end}")
+        shutil.rmtree(case, ignore_errors=True)
+        shutil.copytree(os.path.join(tut, "fluidisedBed"), case)
+        # No write time inside either run (the write-time sums and checks are not per step).
+        ctl = os.path.join(case, "system", "controlDict")
+        text = re.sub(r"^writeInterval .*$", "writeInterval   100000;", open(ctl).read(), flags=re.M)
+        open(ctl, "w").write(text)
         # The short scene of Allrun --short: 2000 beads poured from 2-20 mm.
-        import yaml
         scene = yaml.safe_load(open(os.path.join(case, "particles.yaml")))
         scene["insert"][0]["count"] = 2000
         scene["insert"][0]["region"]["box"]["max"][2] = 0.02
         yaml.safe_dump(scene, open(os.path.join(case, "particles_short.yaml"), "w"), sort_keys=False)
         open(os.path.join(case, "system", "shortRun.coupling"), "w").write('scene "particles_short.yaml";\n')
         open(os.path.join(case, "system", "shortRun"), "w").write(f"endTime {end};\n")
-        script = f"set -e; cd {case}; source {tut}/run_case.sh; run_case -np 2"
+        counts = os.path.join(out_dir, f"fluid_counts_np{np_}_{end}.txt")
+        stacks = os.path.join(out_dir, f"fluid_stacks_np{np_}_{end}")
+        for f in [counts] + glob.glob(stacks + ".*"):
+            os.remove(f) if os.path.exists(f) else None
+        script = f"set -e; cd {case}; source {tut}/run_case.sh; run_case -np {np_}"
         env = dict(os.environ, GRAINFLOW_SOURCE_DIR=ROOT, GRAINFLOW_BUILD_DIR=build,
                    OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-                   OMPI_MCA_mca_base_env_list=f"LD_PRELOAD={lib};MPI_COUNT_OUT={counts}")
-        subprocess.run(["bash", "-c", script], env=env, check=True, stdout=subprocess.DEVNULL)
+                   # A waiting rank yields its core: on a shared or oversubscribed machine the
+                   # runs finish sooner, and the counts are the same.
+                   OMPI_MCA_mpi_yield_when_idle="1",
+                   OMPI_MCA_mca_base_env_list=f"LD_PRELOAD={lib};MPI_COUNT_OUT={counts};MPI_COUNT_STACKS={stacks}")
+        runs[end] = (subprocess.Popen(["bash", "-c", script], env=env, stdout=subprocess.DEVNULL), stacks)
+    for end, (proc, stacks) in runs.items():
+        if proc.wait() != 0:
+            sys.exit(f"model.py --fluid: the run to {end} s failed (see its log.grainFoam)")
+    return tally_fluid(out_dir, np_, ends)
+
+
+def tally_fluid(out_dir, np_, ends):
+    """The calls per fluid step, rank, kind and part from the stack files of measure_fluid's
+    two runs; printed, and stored in fluid_npN.json."""
+    import glob
+    totals = {}
+    for end in ends:
+        stacks = os.path.join(out_dir, f"fluid_stacks_np{np_}_{end}")
         t = {}
-        for line in open(counts):
-            d = dict(kv.split("=") for kv in line.split())
-            if d["rank"] == "0":
-                t[d["kind"]] = t.get(d["kind"], 0) + int(d["calls"])
+        for path in glob.glob(stacks + ".*"):
+            for line in open(path):
+                head, _, stack = line.rstrip("\n").partition(" stack=")
+                d = dict(kv.split("=") for kv in head.split())
+                if d["kind"] not in ("allreduce", "p2p"):
+                    continue
+                names = symbolise(stack.split(";"))
+                key = (int(d["rank"]), d["kind"], who(names))
+                t[key] = t.get(key, 0) + int(d["calls"])
+                # The calls of grain's own exchanges (one per direction along a cut axis,
+                # MPI_PROC_NULL where a rank has no neighbour), within the coupling's.
+                if key[2] == "coupling" and any("grainflow::Exchange::" in n for n in names):
+                    k2 = key[:2] + ("coupling: grain exchanges",)
+                    t[k2] = t.get(k2, 0) + int(d["calls"])
         totals[end] = t
-    for kind in ("allreduce", "p2p"):
-        per = (totals["0.045"].get(kind, 0) - totals["0.015"].get(kind, 0)) / 100
-        print(f"grainFoam, fluidisedBed --short, 2 ranks: {per:.0f} {kind} calls per fluid step (rank 0)")
+    steps = round((float(ends[1]) - float(ends[0])) / 3e-4)
+    per = {k: (totals[ends[1]].get(k, 0) - totals[ends[0]].get(k, 0)) / steps
+           for k in set(totals[ends[0]]) | set(totals[ends[1]])}
+    print(f"grainFoam, fluidisedBed --short (2000 beads, 4 800 cells), {np_} ranks: calls per fluid step "
+          f"(over fluid steps {round(float(ends[0]) / 3e-4)}-{round(float(ends[1]) / 3e-4)})\n")
+    print("| rank | kind | " + " | ".join(PARTS) + " | total |")
+    print("|---:|---|" + "---:|" * (len(PARTS) + 1))
+    for r in range(np_):
+        for kind in ("allreduce", "p2p"):
+            row = [per.get((r, kind, w), 0.0) for w in PARTS]
+            print(f"| {r} | {kind} | " + " | ".join(f"{x:.1f}" for x in row) + f" | {sum(row):.1f} |")
+    # GAMG's cycles for p per fluid step over the same steps, from the longer run's log.
+    t, cycles, steps_seen = None, 0, set()
+    for line in open(os.path.join(out_dir, f"fluidisedBed_np{np_}_{ends[1]}", "log.grainFoam")):
+        m = re.match(r"^Time = (\S+)", line)
+        if m:
+            t = float(m.group(1))
+        m = re.search(r"GAMG:  Solving for p,.*No Iterations (\d+)", line)
+        if m and t is not None and t > float(ends[0]) + 1e-9:
+            cycles += int(m.group(1))
+            steps_seen.add(t)
+    per_cycle = cycles / max(len(steps_seen), 1)
+    print(f"\nGAMG cycles for p per fluid step: {per_cycle:.2f}; per cycle, rank 0: "
+          f"{per.get((0, 'allreduce', PARTS[2]), 0) / per_cycle:.1f} allreduces, "
+          f"{per.get((0, 'p2p', PARTS[2]), 0) / per_cycle:.1f} messages")
+    out = {f"{r} {k} {w}": v for (r, k, w), v in sorted(per.items())}
+    out["gamg_cycles"] = per_cycle
+    json.dump(out, open(os.path.join(out_dir, f"fluid_np{np_}.json"), "w"), indent=1)
+    return per
 
 
 # ---- the model ----------------------------------------------------------------------------
@@ -270,6 +397,7 @@ def report(path):
     # ---- coupled bed -------------------------------------------------------------------------
     t_cell = FB["fluid"] / FB["dem"] * FB["substeps"] * FB["beads"] * T_PS_BED / FB["cells"]
     print(f"\nfluid cost per cell and fluid step (fluidisedBed split against the DEM's rate): {t_cell*1e6:.2f} us")
+    check_coupled(runs, t_cell, os.path.dirname(path))
     rho_bed = 0.6 / (4 / 3 * math.pi * R ** 3)
     for Np, C in ((100000, 40000), (10**6, 400000)):
         print(f"\n## Strong scaling, coupled bed ({Np:,} spheres, {C:,} cells, 20 DEM steps per fluid step)\n")
@@ -290,25 +418,113 @@ def report(path):
             eff = t_one / (p * total)
             lim = max((t_dem, "DEM"), (t_fc, "fluid compute"), (t_fr, "fluid reductions + halo"))[1]
             print(f"| {p} | {n:,.0f} | {c:,.0f} | {t_dem*1e3:.3f} | {t_fc*1e3:.3f} | {t_fr*1e3:.3f} | {eff:.2f} | {lim} |")
+        p = 2
+        while True:
+            n, c = Np / p, C / p
+            tc, tm, g = dem_step(n, p, rho_bed, T_PS_BED)
+            t_dem = FB["substeps"] * (tc + tm)
+            t_fc = t_cell * c * (1 + FB["coupling"] / FB["fluid"])
+            off = 0.0 if p <= NET["ranks_per_node"] else 0.25
+            lat = (1 - off) * NET["alpha_node"] + off * NET["alpha"]
+            t_fr = FLUID_REDUCTIONS * allreduce_time(p) + FLUID_HALO * min(p - 1, 6) * lat
+            if t_one / (p * (t_dem + t_fc + t_fr)) < 0.5:
+                break
+            p *= 2
+        print(f"\nefficiency below 50 % at {p} ranks ({Np / p:,.0f} spheres, {C / p:,.0f} cells per rank)")
+    # The fluid alone: the cells per rank at which its synchronisations cost as much as its
+    # compute (fluid + coupling), on 64 and 1024 ranks.
+    for p in (64, 1024):
+        off = 0.0 if p <= NET["ranks_per_node"] else 0.25
+        lat = (1 - off) * NET["alpha_node"] + off * NET["alpha"]
+        t_fr = FLUID_REDUCTIONS * allreduce_time(p) + FLUID_HALO * 6 * lat
+        print(f"fluid on {p} ranks: synchronisations {t_fr*1e3:.2f} ms per fluid step = the compute of "
+              f"{t_fr / (t_cell * (1 + FB['coupling'] / FB['fluid'])):,.0f} cells per rank")
 
 
-# Per fluid step of fluidisedBed --short on 2 ranks (model.py --fluid): 885 allreduces, of which
-# the 20 DEM steps make 40, and 828 point-to-point messages to the one neighbour rank, of which
-# the DEM makes 40; the rest is the PIMPLE loop (15.7 GAMG cycles for p, 8.4 sweeps for U) and
-# the coupling.
-FLUID_REDUCTIONS = 845  # allreduces per fluid step besides the DEM's
-FLUID_HALO = 788        # halo exchanges per fluid step besides the DEM's (a message per neighbour)
+def check_coupled(runs, t_cell, out_dir):
+    """Checks of the coupled bed against this machine: the 4-rank counts predicted from the
+    2-rank ones (model.py --fluid --np 2 and --np 4), and the 1 -> 2 rank speed-up of
+    fluidisedBed --short."""
+    counts = {}
+    for np_ in (2, 4):
+        f = os.path.join(out_dir, f"fluid_np{np_}.json")
+        if os.path.exists(f):
+            counts[np_] = {tuple(k.split(" ", 2)): v for k, v in json.load(open(f)).items()
+                           if k != "gamg_cycles"}
+            counts[np_]["cycles"] = json.load(open(f)).get("gamg_cycles", 0)
+    if len(counts) == 2:
+        print("\n## fluidisedBed --short on 4 ranks (oversubscribed): calls per fluid step, predicted "
+              "from 2 ranks / measured\n")
+        print("A rank's allreduces do not depend on its neighbours. Its messages: grain's exchanges "
+              "(the DEM's, and the coupling's ghost exchanges) call once per direction whatever the "
+              "neighbours; OpenFOAM's processor patches send those of a rank of 2 (one neighbour) "
+              "times its neighbours (slabs along x: 1 at the ends, 2 inside).\n")
+        print("| rank | neighbours | kind | " + " | ".join(PARTS) + " | total |")
+        print("|---:|---:|---|" + "---:|" * (len(PARTS) + 1))
+        for r in range(4):
+            nb = 1 if r in (0, 3) else 2
+            for kind in ("allreduce", "p2p"):
+                cells, tp, tm = [], 0.0, 0.0
+                for w in PARTS:
+                    two = counts[2].get(("0", kind, w), 0.0)
+                    # grain's exchanges call once per direction whatever the neighbours;
+                    # OpenFOAM's processor patches send a message per neighbour.
+                    fixed = two if w == "DEM" else counts[2].get(("0", kind, "coupling: grain exchanges"), 0.0) \
+                        if w == "coupling" else 0.0
+                    pred = two if kind == "allreduce" else fixed + (two - fixed) * nb
+                    meas = counts[4].get((str(r), kind, w), 0.0)
+                    tp, tm = tp + pred, tm + meas
+                    cells.append(f"{pred:.1f} / {meas:.1f}")
+                print(f"| {r} | {nb} | {kind} | " + " | ".join(cells) + f" | {tp:.1f} / {tm:.1f} |")
+        c2, c4 = counts[2]["cycles"], counts[4]["cycles"]
+        if c2 and c4:
+            g = [(counts[n].get(("0", k, PARTS[2]), 0) / counts[n]["cycles"]) for n in (2, 4)
+                 for k in ("allreduce", "p2p")]
+            print(f"\nGAMG cycles for p per fluid step: {c2:.2f} on 2 ranks, {c4:.2f} on 4; per cycle "
+                  f"(rank 0) {g[0]:.1f} / {g[2]:.1f} allreduces and {g[1]:.1f} / {g[3]:.1f} messages per neighbour")
+    # 1 -> 2 ranks, fluidisedBed --short (2000 beads, 4 800 cells, 2000 fluid steps), measured:
+    # 1 rank 37 s, split DEM 38 / coupling 9 / fluid 53 % (tutorials/cfd-dem/fluidisedBed/
+    # README.md); 2 ranks, quiet, 38.6 s (DEM 12.65 s, coupling 2.46 s, fluid 23.5 s;
+    # docs/performance.md). Predicted: each part's compute halves (the DEM's a little less: the
+    # ghosts' pairs), plus each fluid step's synchronisations at the model's in-node costs.
+    if 2 in counts:
+        steps, t1 = 2000, 37.0
+        d1, c1, f1 = 0.38 * t1, 0.09 * t1, 0.53 * t1
+        rows = [(key, v) for key, v in counts[2].items()
+                if len(key) == 3 and key[0] == "0" and key[2] in PARTS]
+        ar = sum(v for (r, k, w), v in rows if k == "allreduce")
+        msg = sum(v for (r, k, w), v in rows if k == "p2p")
+        sync = steps * (ar * allreduce_time(2) + msg * NET["alpha_node"])
+        t2 = d1 / 2 + c1 / 2 + f1 / 2 + sync
+        t2_meas = 12.65 + 2.46 + 23.5
+        print(f"\nfluidisedBed --short, 1 -> 2 ranks: predicted {t1:.1f} s -> {t2:.1f} s "
+              f"(synchronisations {sync:.1f} s: {ar:.0f} allreduces and {msg:.0f} messages per fluid "
+              f"step), speed-up {t1 / t2:.2f}; measured {t1:.1f} s -> {t2_meas:.1f} s, speed-up "
+              f"{t1 / t2_meas:.2f}. The difference, {t2_meas - t2 + sync:.1f} s over the compute, is "
+              f"{(t2_meas - (t2 - sync)) / steps / (ar + msg) * 1e6:.1f} us per synchronisation on this machine.")
+
+
+# Per fluid step of fluidisedBed --short on 2 ranks (model.py --fluid, fluid steps 30-80):
+# 905 allreduces, of which the 20 DEM steps make 40, the coupling none, the PIMPLE loop 865
+# (838 in GAMG's 16.1 cycles for p); 839 point-to-point calls to the one neighbour, of which the
+# DEM makes 45, the coupling 9 and the PIMPLE loop 785 (725 in GAMG).
+FLUID_REDUCTIONS = 865  # allreduces per fluid step besides the DEM's
+FLUID_HALO = 794        # halo exchanges per fluid step besides the DEM's (a message per neighbour)
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--measure", action="store_true")
     ap.add_argument("--fluid", action="store_true")
+    ap.add_argument("--np", type=int, default=2, help="ranks of --fluid (4: oversubscribed)")
+    ap.add_argument("--ends", default="0.009,0.024",
+                    help="end times of --fluid's two runs; their difference gives the counts per step")
     ap.add_argument("--build", default=os.environ.get("GRAINFLOW_BUILD_DIR", os.path.join(ROOT, "build")))
     ap.add_argument("--particles", type=int, default=100000)
     ap.add_argument("--steps", type=int, default=50)
     a = ap.parse_args()
+    a.build = os.path.abspath(a.build)
     if a.fluid:
-        measure_fluid(a.build)
+        measure_fluid(a.build, a.np, tuple(a.ends.split(",")))
         sys.exit(0)
     path = os.path.join(a.build, "scaling_model", "measured.json")
     if a.measure or not os.path.exists(path):

@@ -13,10 +13,21 @@
  *   rank=R epoch=E kind=K calls=C bytes=B seconds=S
  * Kinds: p2p (Send, Isend, Sendrecv: bytes sent), allreduce, bcast, gather (Gather, Gatherv,
  * Allgather, Exscan: bytes contributed), wait (Wait*, Recv: time only).
+ *
+ * With $MPI_COUNT_STACKS set, each rank R also writes, per distinct call stack of a p2p,
+ * allreduce, bcast or gather call, one line to the file $MPI_COUNT_STACKS.R:
+ *   rank=R kind=K calls=C stack=MODULE+0xOFFSET;MODULE+0xOFFSET;...   (innermost first)
+ * so that a script can tell who made the call (model.py --fluid: DEM, coupling or fluid) by
+ * looking the offsets up in the modules' symbol tables.
  */
+#define _GNU_SOURCE
+#include <dlfcn.h>
+#include <execinfo.h>
 #include <mpi.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 enum { P2P, ALLREDUCE, BCAST, GATHER, WAIT, KINDS };
 static const char* kind_name[KINDS] = {"p2p", "allreduce", "bcast", "gather", "wait"};
@@ -30,10 +41,69 @@ static long long size_of(MPI_Datatype t, int count) {
   PMPI_Type_size(t, &s);
   return (long long)s * count;
 }
+/* The call stacks, when $MPI_COUNT_STACKS is set: an open-addressing table keyed by the
+ * return addresses. */
+enum { MAX_FRAMES = 40, TABLE = 1 << 14 };
+typedef struct {
+  void* frames[MAX_FRAMES];
+  int depth, kind;
+  long long calls;
+} Stack;
+static Stack* stacks = NULL;
+static int stacks_on = -1; /* -1: not looked at yet */
+
+static void record_stack(int k) {
+  if (stacks_on < 0) stacks_on = getenv("MPI_COUNT_STACKS") != NULL;
+  if (!stacks_on || k == WAIT) return;
+  if (!stacks) stacks = calloc(TABLE, sizeof(Stack));
+  if (!stacks) return;
+  void* f[MAX_FRAMES];
+  const int n = backtrace(f, MAX_FRAMES);
+  uint64_t h = (uint64_t)k * 0x9e3779b97f4a7c15ull;
+  for (int i = 0; i < n; ++i) h = (h ^ (uint64_t)(uintptr_t)f[i]) * 0x100000001b3ull;
+  for (uint64_t j = 0; j < TABLE; ++j) {
+    Stack* s = &stacks[(h + j) & (TABLE - 1)];
+    if (s->calls == 0) {
+      memcpy(s->frames, f, sizeof(void*) * n);
+      s->depth = n;
+      s->kind = k;
+    } else if (s->kind != k || s->depth != n || memcmp(s->frames, f, sizeof(void*) * n) != 0) {
+      continue;
+    }
+    s->calls += 1;
+    return;
+  }
+}
+
+static void write_stacks(int rank) {
+  const char* path = getenv("MPI_COUNT_STACKS");
+  if (!stacks || !path) return;
+  char name[4096];
+  snprintf(name, sizeof name, "%s.%d", path, rank); /* a file per rank: no interleaved lines */
+  FILE* f = fopen(name, "w");
+  if (!f) return;
+  for (int j = 0; j < TABLE; ++j) {
+    const Stack* s = &stacks[j];
+    if (s->calls == 0) continue;
+    fprintf(f, "rank=%d kind=%s calls=%lld stack=", rank, kind_name[s->kind], s->calls);
+    for (int i = 1; i < s->depth; ++i) { /* frame 0 is record_stack's caller, add() */
+      Dl_info d;
+      if (dladdr(s->frames[i], &d) && d.dli_fname)
+        fprintf(f, "%s%s+0x%lx", i > 1 ? ";" : "", d.dli_fname,
+                (unsigned long)((uintptr_t)s->frames[i] - (uintptr_t)d.dli_fbase));
+      else
+        fprintf(f, "%s?+0x%lx", i > 1 ? ";" : "", (unsigned long)(uintptr_t)s->frames[i]);
+    }
+    fputc('\n', f);
+  }
+  fclose(f);
+}
+
 static void add(int k, long long b, double t0) {
   calls[epoch][k] += 1;
   bytes[epoch][k] += b;
   seconds[epoch][k] += PMPI_Wtime() - t0;
+  record_stack(k);
 }
 
 int MPI_Barrier(MPI_Comm c) {
@@ -131,5 +201,6 @@ int MPI_Finalize(void) {
                   kind_name[k], calls[e][k], bytes[e][k], seconds[e][k]);
     fclose(f);
   }
+  write_stacks(rank);
   return PMPI_Finalize();
 }
