@@ -826,6 +826,56 @@ time: {step: 1e-5, end: 1}
   EXPECT_NE(e.find("the field 'temperature' needs heat transfer"), std::string::npos) << e;
 }
 
+// Error against the step (docs/accuracy-vs-cost.md, "Heat transfer: error against the step"):
+// one 1 mm glass bead at rest in still water (Ranz-Marshall, Nu = 2, tau = m c / (h A) =
+// 0.29 s) cooling for 3 tau at dt = tau/20, tau/80, tau/320. The error of T - T_f against
+// the exponential is the implicit step's, (1 + dt/tau)^(-n) e^(t/tau) - 1 ~ t dt / (2 tau^2):
+// equal to that closed form to 1e-9, and first order (slope 0.95-1.05).
+TEST(HeatTransfer, LumpedCoolingErrorIsFirstOrderInTheStep) {
+  const double d = 1e-3, rho = 2500, c = 840, kf = 0.6, t0 = 400, tf = 300;
+  const double m = rho * kPi * d * d * d / 6, ha = 2 * kf * kPi * d, tau = m * c / ha;
+  std::vector<double> errors;
+  for (const int per_tau : {20, 80, 320}) {
+    const double dt = tau / per_tau;
+    Scene s = parse_scene(R"(domain: {min: [-0.01, -0.01, -0.01], max: [0.01, 0.01, 0.01]}
+time: {step: 1e-3, end: 100}
+heat: {}
+materials:
+  - {name: glass, youngs_modulus: 1e7, poisson_ratio: 0.3, density: 2500, heat_capacity: 840,
+     conductivity: 1}
+interaction_defaults: {restitution: 0.5, friction: 0.3}
+contact: {normal: hertz}
+fluid: {density: 1000, viscosity: 1e-3, drag: schiller_naumann, model: B,
+        forces: [drag, pressure_gradient, viscous], temperature: 300, heat_capacity: 4180,
+        conductivity: 0.6}
+)",
+                          "step_error.yaml");
+    s.time.step = dt;
+    Simulation sim(s, false);
+    sim.add_force_term(make_fluid_forces(*s.fluid, s.gravity, s.domain, MPI_COMM_WORLD));
+    sim.particles().add(1, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), 0.5 * d, 0, rho);
+    sim.particles().temperature.back() = t0;
+    sim.next_id() = 2;
+    sim.set_dt(dt);
+    sim.initialise();
+    const int n = 3 * per_tau;
+    for (int k = 0; k < n; ++k) sim.step();
+    const double t = n * dt;
+    const double error = (sim.particles().temperature[0] - tf) / ((t0 - tf) * std::exp(-t / tau)) - 1;
+    const double implicit = std::pow(1 + dt / tau, -n) * std::exp(t / tau) - 1;
+    std::printf("dt = tau/%d: error of T - T_f after 3 tau %.6e (implicit Euler %.6e, t dt/(2 tau^2) "
+                "%.6e)\n",
+                per_tau, error, implicit, t * dt / (2 * tau * tau));
+    EXPECT_NEAR(error, implicit, 1e-9);
+    errors.push_back(error);
+  }
+  for (std::size_t k = 0; k + 1 < errors.size(); ++k) {
+    const double slope = std::log(errors[k] / errors[k + 1]) / std::log(4.0);
+    EXPECT_GT(slope, 0.95);
+    EXPECT_LT(slope, 1.05);
+  }
+}
+
 // `grain check`'s heat limits (thermal_limits.hpp) against their closed forms: for one
 // 1 mm sphere of glass (c = 0.01 J/(kg K): a binding limit) the conduction time scale
 // tau_k = m c / (2 k a), a = sqrt(R* delta) at delta = time.max_overlap r and R* = r/2 (a pair;
