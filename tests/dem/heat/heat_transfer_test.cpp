@@ -27,6 +27,7 @@
 #include "dem/fluid/fluid_forces.hpp"
 #include "dem/heat/heat_laws.hpp"
 #include "dem/heat/thermal_limits.hpp"
+#include "dem/insert/insertion.hpp"
 #include "dem/scene/scene_parser.hpp"
 
 namespace grainflow {
@@ -542,11 +543,13 @@ insert:
   - {type: csv, file: )" + file + ", material: glass" + extra + "}\n",
                        (dir / "csv_t.yaml").string());
   };
+  // The insertion alone (what Simulation runs at start-up), without the contact tables.
   const auto temperatures = [&](const Scene& s) {
-    Simulation sim(s);
-    std::vector<double> t(sim.particles().size());
-    for (std::size_t i = 0; i < t.size(); ++i)
-      t[sim.particles().id[i] - 1] = sim.particles().temperature[i];
+    Particles p;
+    GlobalId next = 1;
+    insert_particles(s, p, next);
+    std::vector<double> t(p.size());
+    for (std::size_t i = 0; i < t.size(); ++i) t[p.id[i] - 1] = p.temperature[i];
     return t;
   };
   EXPECT_EQ(temperatures(scene("heat: {}\n", "beads_t.csv", "")), (std::vector<double>{312.5, 287.25}));
@@ -554,7 +557,7 @@ insert:
             (std::vector<double>{350, 350}));
   const auto refusal = [&](const Scene& s) {
     try {
-      Simulation sim(s);
+      temperatures(s);
     } catch (const std::exception& e) {
       return std::string(e.what());
     }
