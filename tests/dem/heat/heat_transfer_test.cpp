@@ -28,6 +28,8 @@
 #include "dem/heat/heat_laws.hpp"
 #include "dem/heat/thermal_limits.hpp"
 #include "dem/insert/insertion.hpp"
+#include "dem/io/output_directory.hpp"
+#include "dem/io/snapshot_writer.hpp"
 #include "dem/scene/scene_parser.hpp"
 
 namespace grainflow {
@@ -603,6 +605,58 @@ insert:
   e = refusal(scene("heat: {}\n", "beads_bad.csv", ""));
   EXPECT_NE(e.find("beads_bad.csv:3"), std::string::npos) << e;
   EXPECT_NE(e.find("temperature T must be > 0 K"), std::string::npos) << e;
+}
+
+// A snapshot's temperatures (written with the `temperature` field) start the particles of a
+// `snapshot` insertion exactly; the entry's `temperature` overrides them; a snapshot written
+// without them is refused with heat on unless the entry gives one.
+TEST(HeatTransfer, SnapshotInsertionCarriesTheTemperatures) {
+  const std::filesystem::path dir =
+      std::filesystem::path(GRAINFLOW_BINARY_DIR) / "test_output" / "heat_snapshot";
+  std::filesystem::remove_all(dir);
+  prepare_output_directory(dir.string());
+  Particles p;
+  p.add(1, Vec3(0, 0, 0), Vec3::Zero(), Vec3::Zero(), 1e-3, 0, 2500);
+  p.temperature.back() = 312.125;
+  p.add(2, Vec3(0.005, 0, 0), Vec3::Zero(), Vec3::Zero(), 1e-3, 0, 2500);
+  p.temperature.back() = 287.0625;
+  SnapshotWriter with(MPI_COMM_WORLD, dir.string(), "with_t",
+                      snapshot_default_fields | snapshot_field_bit("temperature"));
+  SnapshotWriter without(MPI_COMM_WORLD, dir.string(), "without_t", snapshot_default_fields);
+  const std::string with_file = with.write(p, 0.5, 10), without_file = without.write(p, 0.5, 10);
+  Scene s = parse_scene(R"(domain: {min: [-0.01, -0.01, -0.01], max: [0.01, 0.01, 0.01]}
+time: {step: 1e-6, end: 1}
+heat: {}
+materials:
+  - {name: glass, youngs_modulus: 1e7, poisson_ratio: 0.3, density: 2500, heat_capacity: 800,
+     conductivity: 1}
+interaction_defaults: {restitution: 0.5, friction: 0.3}
+contact: {normal: hertz}
+)",
+                        "snapshot_t.yaml");
+  Insertion ins;
+  ins.kind = Insertion::Kind::snapshot;
+  ins.snapshot_file = with_file;
+  ins.source = "<test>";
+  s.insertions.push_back(ins);
+  const auto inserted = [&]() {
+    Particles q;
+    GlobalId next = 1;
+    insert_particles(s, q, next);
+    return q.temperature;
+  };
+  EXPECT_EQ(inserted(), (std::vector<double>{312.125, 287.0625}));
+  s.insertions[0].temperature = 350;
+  EXPECT_EQ(inserted(), (std::vector<double>{350, 350}));
+  s.insertions[0].snapshot_file = without_file;
+  EXPECT_EQ(inserted(), (std::vector<double>{350, 350}));
+  s.insertions[0].temperature.reset();
+  try {
+    inserted();
+    ADD_FAILURE() << "a snapshot without temperatures was accepted with heat on";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("holds no temperatures"), std::string::npos) << e.what();
+  }
 }
 
 // The chain of SteadyChainMatchesSeriesResistances between a wall feeding q'' and a wall at
