@@ -7,7 +7,10 @@ from its snapshot by every variant) runs S steps with:
     the cost of the code's presence when off;
   - heat off;
   - heat on: contact conduction, floor at 400 K, beads at 300 K;
-  - a fluid block (water-like gas flow) without heat, and the same with convection and conduction.
+  - heat on with the soft-particle contact radius (`contact_radius: morris_static`);
+  - a fluid block (water-like gas flow) without heat, and the same with convection and conduction;
+  - the fluid block with eps computed from the particles (4 mm cells) without heat, and the
+    same with conduction and Gunn's convection at each particle's cell eps.
 Cost: CPU seconds of the `grain` process (the machine may be shared), median of interleaved
 rounds (order reversed every other round).
 
@@ -48,20 +51,26 @@ FLUID = """fluid:
   density: 1.2
   viscosity: 1.8e-5
   velocity: [0, 0, 0.3]
-  drag: schiller_naumann
+{void_fraction}  drag: schiller_naumann
   model: B
   forces: [drag, pressure_gradient, viscous]
 {thermal}"""
 FLUID_THERMAL = "  temperature: 500\n  heat_capacity: 1005\n  conductivity: 0.026\n"
 
 
-def scene(end, out, insert, heat, fluid, thermal_fluid=False):
+COMPUTED_EPS = "  void_fraction: {cell_size: 0.004, minimum: 0.3}\n"
+
+
+def scene(end, out, insert, heat, fluid, thermal_fluid=False, morris=False, computed_eps=False):
+    thermal = FLUID_THERMAL + ("  convection: gunn\n" if computed_eps else "")
     return SCENE.format(
         dt=DT, end=end, out=out, insert=insert,
-        heat_block="heat: {}\n" if heat else "",
-        material=MATERIAL.format(heat=HEAT_MATERIAL if heat else ""),
+        heat_block=("heat: {contact_radius: morris_static}\n" if morris else "heat: {}\n") if heat else "",
+        material=MATERIAL.format(heat=(HEAT_MATERIAL + (", real_youngs_modulus: 6.3e10" if morris else ""))
+                                 if heat else ""),
         floor=", temperature: 400" if heat else "",
-        fluid=FLUID.format(thermal=FLUID_THERMAL if thermal_fluid else "") if fluid else "")
+        fluid=FLUID.format(thermal=thermal if thermal_fluid else "",
+                           void_fraction=COMPUTED_EPS if computed_eps else "") if fluid else "")
 
 
 def cpu_of(cmd):
@@ -96,8 +105,12 @@ def main():
                       os.path.join(args.baseline, "bin", "grain"), (cold, False, False)))
     cases += [("heat off", grain, (cold, False, False)),
               ("heat on: conduction, floor at 400 K", grain, (warm, True, False)),
+              ("heat on: conduction, morris_static contact radius", grain, (warm, True, False, False, True)),
               ("fluid forces, heat off", grain, (cold, False, True)),
-              ("fluid forces, heat on: conduction + convection", grain, (warm, True, True, True))]
+              ("fluid forces, heat on: conduction + convection", grain, (warm, True, True, True)),
+              ("fluid forces, computed eps, heat off", grain, (cold, False, True, False, False, True)),
+              ("fluid forces, computed eps, heat on: conduction + Gunn convection", grain,
+               (warm, True, True, True, False, True))]
     files = []
     for k, (_, _, spec) in enumerate(cases):
         path = os.path.join(work, f"scene_{k}.yaml")

@@ -34,6 +34,8 @@ struct TermLimit {
   std::string rule;        // where dt_max comes from, or why there is none
 };
 
+class VoidFractionGrid;
+
 class ForceTerm {
  public:
   virtual ~ForceTerm() = default;
@@ -46,6 +48,9 @@ class ForceTerm {
   virtual std::string report() const { return {}; }
   // Whether add() sets the implicit spin drag (ImplicitDrag::spin_coefficient).
   virtual bool implicit_spin() const { return false; }
+  // The void fraction the term computes from the particles in add() (fluid.void_fraction:
+  // {cell_size, ...}), for convection to use the same eps; nullptr when it computes none.
+  virtual const VoidFractionGrid* void_fraction_grid() const { return nullptr; }
   // The stability limit of each force of the term at the particles' present state.
   virtual std::vector<TermLimit> limits(const Particles& /*p*/, double /*time*/) const {
     return {};

@@ -1356,6 +1356,11 @@ void Simulation::advance_to(double t_end) {
   while (time_ < t_end - 0.5 * dt_) step();
 }
 
+void Simulation::add_force_term(std::unique_ptr<ForceTerm> term) {
+  if (heat_ && term->void_fraction_grid()) heat_->use_void_fraction(term->void_fraction_grid());
+  terms_.push_back(std::move(term));
+}
+
 void Simulation::advance_temperatures() {
   exchange_->forward_values(p_.temperature, 1, ghost_temperature_);
   heat_->step(p_, ghosts_, ghost_temperature_, local_list_, ghost_list_, walls_, wall_neighbours_,

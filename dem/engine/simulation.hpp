@@ -89,7 +89,9 @@ class Simulation {
 
   // Adds a non-contact force term (evaluated every step after contacts); call
   // before initialise().
-  void add_force_term(std::unique_ptr<ForceTerm> term) { terms_.push_back(std::move(term)); }
+  // A term that computes the void fraction from the particles (fluid.void_fraction:
+  // {cell_size, ...}) lends it to convection (HeatTransfer::use_void_fraction).
+  void add_force_term(std::unique_ptr<ForceTerm> term);
   const ImplicitDrag& implicit_drag() const { return drag_; }
   // The force terms' stability limits found at initialise() (TermLimit), the same on every
   // rank, and the same as one line: each term with dt / its time scale, for messages.

@@ -81,6 +81,9 @@ class FluidForcesWith final : public ForceTerm {
   }
 
   bool implicit_spin() const override { return on_.rotation; }
+  const VoidFractionGrid* void_fraction_grid() const override {
+    return grid_ ? &*grid_ : nullptr;
+  }
 
   std::vector<TermLimit> limits(const Particles& p, double /*time*/) const override {
     constexpr double inf = std::numeric_limits<double>::infinity();

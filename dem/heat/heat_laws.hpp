@@ -31,6 +31,30 @@ inline double effective_conductivity(double k_i, double k_j) {
 // Contact radius a = sqrt(R* delta) [m] (Hertz; used for Hooke contacts too).
 inline double contact_radius(double r_star, double overlap) { return std::sqrt(r_star * overlap); }
 
+// Hertz's effective modulus 1/Y* = (1 - nu_a^2)/Y_a + (1 - nu_b^2)/Y_b [Pa].
+inline double hertz_effective_modulus(double y_a, double nu_a, double y_b, double nu_b) {
+  return 1 / ((1 - nu_a * nu_a) / y_a + (1 - nu_b * nu_b) / y_b);
+}
+
+// Soft-particle corrections of the contact radius (Morris et al. 2016): a simulation run
+// with a Young's modulus below the real one has, under the same load, a larger overlap and
+// contact radius than the real material, and in an impact a longer contact. With Hertz's
+// theory, a = sqrt(R* delta) and the ratio s = Y*_sim / Y*_real (< 1 when softened):
+//  - an enduring contact under a load F: a = (3 F R* / (4 Y*))^(1/3), so the real radius is
+//    a_sim s^(1/3);
+//  - an elastic impact at speed v: a_max = sqrt(R* delta_max) with
+//    delta_max = (15 m* v^2 / (16 Y* R*^(1/2)))^(2/5), and the contact time t_c is
+//    proportional to delta_max / v, so the heat 2 k* dT integral(a dt) = 2 k* dT a_max t_c c0
+//    of the whole impact scales as Y*^(-1/5) Y*^(-2/5) = Y*^(-3/5): the simulated impact
+//    conducts the real impact's heat with a = a_sim s^(3/5) (the enduring factor s^(1/3)
+//    times the contact-time factor (t_c,real / t_c,sim)^(2/3) = s^(4/15)).
+inline double morris_static_radius_factor(double y_star_sim, double y_star_real) {
+  return std::cbrt(y_star_sim / y_star_real);
+}
+inline double morris_collision_radius_factor(double y_star_sim, double y_star_real) {
+  return std::pow(y_star_sim / y_star_real, 0.6);
+}
+
 // Batchelor & O'Brien's conductance 2 k* a [W/K].
 inline double contact_conductance(double k_star, double a) { return 2 * k_star * a; }
 

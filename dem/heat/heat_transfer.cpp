@@ -10,6 +10,25 @@
 
 namespace grainflow {
 
+std::vector<double> contact_radius_factors(const Scene& scene) {
+  const std::size_t n = scene.materials.size();
+  std::vector<double> f(n * n, 1.0);
+  if (!scene.heat || scene.heat->contact_radius == ContactRadiusModel::geometric) return f;
+  for (std::size_t a = 0; a < n; ++a)
+    for (std::size_t b = 0; b < n; ++b) {
+      const Material& ma = scene.materials[a];
+      const Material& mb = scene.materials[b];
+      const double sim = hertz_effective_modulus(ma.youngs_modulus, ma.poisson_ratio,
+                                                 mb.youngs_modulus, mb.poisson_ratio);
+      const double real = hertz_effective_modulus(ma.real_youngs_modulus, ma.poisson_ratio,
+                                                  mb.real_youngs_modulus, mb.poisson_ratio);
+      f[a * n + b] = scene.heat->contact_radius == ContactRadiusModel::morris_static
+                         ? morris_static_radius_factor(sim, real)
+                         : morris_collision_radius_factor(sim, real);
+    }
+  return f;
+}
+
 HeatTransfer::HeatTransfer(const Scene& scene)
     : materials_(static_cast<int>(scene.materials.size())),
       conduction_(scene.heat && scene.heat->conduction),
@@ -19,15 +38,19 @@ HeatTransfer::HeatTransfer(const Scene& scene)
     source_.push_back(m.heat_source);
     k_.push_back(m.conductivity);
   }
+  radius_factor_ = contact_radius_factors(scene);
   k_star_.resize(static_cast<std::size_t>(materials_) * materials_);
   for (int a = 0; a < materials_; ++a)
     for (int b = 0; b < materials_; ++b)
-      k_star_[a * materials_ + b] = effective_conductivity(k_[std::min(a, b)], k_[std::max(a, b)]);
+      k_star_[a * materials_ + b] =
+          effective_conductivity(k_[std::min(a, b)], k_[std::max(a, b)]) *
+          radius_factor_[std::min(a, b) * materials_ + std::max(a, b)];
   for (const Wall& w : scene.walls) wall_thermal_.push_back(w.thermal);
   wall_heat_.assign(wall_thermal_.size(), 0.0);
   if (scene.fluid) {
     fluid_thermal_ = scene.fluid->thermal;
     field_ = scene.fluid->field;
+    computed_void_fraction_ = scene.fluid->computed_void_fraction.has_value();
   }
 }
 
@@ -46,11 +69,12 @@ void HeatTransfer::walls_pass(const Particles& p, const WallSet& walls, const Wa
     // One touching contact of particle i with this wall, of overlap `overlap`.
     const auto conduct = [&](std::size_t i, double overlap) {
       const double a = contact_radius(p.radius[i], overlap);  // R* = r_i: a flat wall
-      const double q =
-          th.kind == WallThermal::Kind::temperature
-              ? contact_conductance(k_star_[p.material[i] * materials_ + wall.material], a) *
-                    (th.value - p.temperature[i])
-              : th.value * std::numbers::pi * a * a;
+      const std::size_t pair = static_cast<std::size_t>(p.material[i]) * materials_ + wall.material;
+      // k_star_ holds the radius factor f; the flux wall's area is pi (f a)^2.
+      const double q = th.kind == WallThermal::Kind::temperature
+                           ? contact_conductance(k_star_[pair], a) * (th.value - p.temperature[i])
+                           : th.value * std::numbers::pi * (radius_factor_[pair] * a) *
+                                 (radius_factor_[pair] * a);
       q_[i] += q;
       wall_heat_[w] += q;
     };
@@ -138,6 +162,9 @@ void HeatTransfer::step(Particles& p, const Ghosts& g, const std::vector<double>
     coupled_step(p, dt);
     return;
   }
+  if (convection && computed_void_fraction_ && !void_fraction_)
+    throw std::logic_error("HeatTransfer: the scene computes the void fraction from the "
+                           "particles, but no fluid force term lent its grid");
   for (std::size_t i = 0; i < n; ++i) {
     const double c = p.mass[i] * cp_[p.material[i]];
     const double s = p.mass[i] * source_[p.material[i]];
@@ -147,7 +174,9 @@ void HeatTransfer::step(Particles& p, const Ghosts& g, const std::vector<double>
       continue;
     }
     const Vec3 u = field_.sample(p.x[i], gravity_).velocity;
-    const double h = convective_conductance(*fluid_thermal_, field_, 2 * p.radius[i],
+    const double eps = void_fraction_ ? void_fraction_->at(p.x[i]) : field_.void_fraction;
+    const double h = convective_conductance(*fluid_thermal_, eps, field_.density,
+                                            field_.viscosity, 2 * p.radius[i],
                                             (u - p.v[i]).norm());
     const double t_f = fluid_thermal_->temperature;
     Tw[i] = (Tw[i] + dt * (q_[i] + s + h * t_f) / c) / (1 + dt * h / c);

@@ -17,6 +17,7 @@
 #include "dem/core/particles.hpp"
 #include "dem/engine/canonical_order.hpp"
 #include "dem/fluid/coupled_fluid.hpp"
+#include "dem/fluid/void_fraction_grid.hpp"
 #include "dem/neighbour/verlet_list.hpp"
 #include "dem/neighbour/wall_neighbours.hpp"
 #include "dem/parallel/ghosts.hpp"
@@ -24,6 +25,11 @@
 #include "dem/walls/wall_set.hpp"
 
 namespace grainflow {
+
+// The factor f of the contact radius a = f sqrt(R* delta) of each pair of materials
+// [a * materials + b] (heat.contact_radius; heat_laws.hpp): 1 with `geometric`, Morris et
+// al.'s (2016) correction for the real Young's moduli otherwise.
+std::vector<double> contact_radius_factors(const Scene& scene);
 
 class HeatTransfer {
  public:
@@ -55,6 +61,10 @@ class HeatTransfer {
   // for the fluid's energy equation. Needs the scene's fluid `temperature:` block (the
   // convection law, c_p and k_f); `fluid` must outlive this object.
   void couple(CoupledFluid* fluid) { coupled_ = fluid; }
+  // One-way mode with fluid.void_fraction computed from the particles: convection reads each
+  // particle's eps from `grid` (the fluid forces' grid, updated in their add() at the step's
+  // end positions, before this step) instead of the uniform value. `grid` must outlive this.
+  void use_void_fraction(const VoidFractionGrid* grid) { void_fraction_ = grid; }
   // Thermal energy sum m c T of this rank's particles [J].
   double thermal_energy(const Particles& p) const;
 
@@ -64,12 +74,16 @@ class HeatTransfer {
 
   int materials_ = 0;
   bool conduction_ = true;
-  std::vector<double> k_star_;  // [a * materials + b], symmetric
+  // [a * materials + b], symmetric: k* times the contact-radius factor f (the conductance
+  // 2 k* f sqrt(R* delta)); f itself for the flux walls' area pi (f a)^2.
+  std::vector<double> k_star_, radius_factor_;
   std::vector<double> cp_, source_, k_;
   std::vector<WallThermal> wall_thermal_;  // per scene wall (= WallSet entry)
   std::optional<FluidThermal> fluid_thermal_;
   PrescribedFluid field_;
   CoupledFluid* coupled_ = nullptr;
+  const VoidFractionGrid* void_fraction_ = nullptr;
+  bool computed_void_fraction_ = false;  // the scene's eps comes from the particles
   Vec3 gravity_ = Vec3::Zero();
   std::vector<double> q_;  // heat flow into each local particle in this step [W]
   std::vector<double> wall_heat_;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "dem/heat/heat_laws.hpp"
+#include "dem/heat/heat_transfer.hpp"
 
 namespace grainflow {
 
@@ -32,6 +33,7 @@ ThermalLimits check_thermal_limits(const Scene& scene, const Particles& p, TimeS
     return scene.materials[m].density * sphere_volume(r_min[m]) * scene.materials[m].heat_capacity;
   };
   const double overlap = scene.time.max_overlap;
+  const std::vector<double> factor = contact_radius_factors(scene);  // a = f sqrt(R* delta)
   std::string where;
   if (scene.heat->conduction && scene.contacts_possible)
     for (int a = 0; a < nm; ++a) {
@@ -42,7 +44,7 @@ ThermalLimits check_thermal_limits(const Scene& scene, const Particles& p, TimeS
         const double rs = r_min[a] * r_min[b] / (r_min[a] + r_min[b]);
         const double g = contact_conductance(
             effective_conductivity(ka, scene.materials[b].conductivity),
-            contact_radius(rs, overlap * std::min(r_min[a], r_min[b])));
+            factor[a * nm + b] * contact_radius(rs, overlap * std::min(r_min[a], r_min[b])));
         if (capacity(a) / g < out.conduction_time) {
           out.conduction_time = capacity(a) / g;
           where = "'" + scene.materials[a].name + "' on '" + scene.materials[b].name + "'";
@@ -52,7 +54,7 @@ ThermalLimits check_thermal_limits(const Scene& scene, const Particles& p, TimeS
         if (w.thermal.kind != WallThermal::Kind::temperature) continue;
         const double g = contact_conductance(
             effective_conductivity(ka, scene.materials[w.material].conductivity),
-            contact_radius(r_min[a], overlap * r_min[a]));
+            factor[a * nm + w.material] * contact_radius(r_min[a], overlap * r_min[a]));
         if (capacity(a) / g < out.conduction_time) {
           out.conduction_time = capacity(a) / g;
           where = "'" + scene.materials[a].name + "' on wall '" + w.name + "'";
@@ -65,8 +67,14 @@ ThermalLimits check_thermal_limits(const Scene& scene, const Particles& p, TimeS
     const double slip = scene.fluid->field.sample(centre, scene.gravity).velocity.norm();
     for (int a = 0; a < nm; ++a) {
       if (r_min[a] == inf) continue;
-      const double h =
+      double h =
           convective_conductance(*scene.fluid->thermal, scene.fluid->field, 2 * r_min[a], slip);
+      // eps computed from the particles: anywhere between its minimum and 1; the larger h.
+      if (const auto& grid = scene.fluid->computed_void_fraction)
+        for (const double eps : {grid->minimum, 1.0})
+          h = std::max(h, convective_conductance(*scene.fluid->thermal, eps,
+                                                 scene.fluid->field.density,
+                                                 scene.fluid->field.viscosity, 2 * r_min[a], slip));
       if (capacity(a) / h < out.convection_time) {
         out.convection_time = capacity(a) / h;
         smallest = scene.materials[a].name;
@@ -111,6 +119,7 @@ ThermalLimits check_thermal_limits(const Scene& scene, const Particles& p, TimeS
     o << "heat convection: time scale m c / (h A) = " << out.convection_time
       << " s (smallest '" << smallest << "' particle at rest in the prescribed flow, "
       << (scene.fluid->thermal->nusselt == NusseltLaw::gunn ? "Gunn" : "Ranz-Marshall")
+      << (scene.fluid->computed_void_fraction ? ", the larger h of eps = its minimum and 1" : "")
       << "); implicit, stable at any dt";
     if (dt > 0) o << "; dt / tau = " << dt / out.convection_time;
     rep.notes.push_back(o.str());

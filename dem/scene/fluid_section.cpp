@@ -42,8 +42,7 @@ std::vector<FluidForce> parse_forces(const Field& f) {
 
 // The prescribed fluid temperature and what convection needs (heat on): `temperature`,
 // `heat_capacity`, `conductivity` (for the Prandtl number), `convection` (Nusselt law).
-std::optional<FluidThermal> parse_thermal(const Map& m, const FluidSettings& s,
-                                          const std::optional<HeatSettings>& heat) {
+std::optional<FluidThermal> parse_thermal(const Map& m, const std::optional<HeatSettings>& heat) {
   const std::optional<Field> t = m.find("temperature");
   if (!t) {
     for (const char* key : {"heat_capacity", "conductivity", "convection"})
@@ -56,9 +55,6 @@ std::optional<FluidThermal> parse_thermal(const Map& m, const FluidSettings& s,
   if (!heat)
     t->fail_at_key("a fluid temperature is given, but heat transfer is off; add a top-level "
                    "`heat: {}` block to switch it on, or remove this key");
-  if (s.computed_void_fraction)
-    t->fail_at_key("convection with a void fraction computed from the particles is not built "
-                   "yet; give a uniform `void_fraction: <eps>` or remove `temperature`");
   FluidThermal th;
   th.temperature = t->number(kPositive);
   th.heat_capacity = m.get("heat_capacity", "add the fluid's `heat_capacity: <J/(kg K)>` (the "
@@ -121,7 +117,7 @@ FluidSettings parse_fluid_section(const Field& f, const Vec3& gravity,
     forces.fail(*problem);
   s.virtual_mass_coefficient = m.number_or("virtual_mass_coefficient",
                                            kSphereVirtualMassCoefficient, kNonNegative);
-  s.thermal = parse_thermal(m, s, heat);
+  s.thermal = parse_thermal(m, heat);
   return s;
 }
 

@@ -26,6 +26,9 @@ struct Material {
   double heat_capacity = 0;  // c_p > 0 [J/(kg K)]
   double conductivity = 0;   // k > 0 [W/(m K)]
   double heat_source = 0;    // q [W/kg], any sign (0: none)
+  // The real material's Young's modulus [Pa] > 0 when heat.contact_radius corrects the
+  // contact radius of soft particles (HeatSettings::contact_radius), else 0.
+  double real_youngs_modulus = 0;
   // Coarse graining (docs/models/coarse-graining.md): a particle of this material is a
   // parcel of radius k r standing for k^3 real particles of radius r, with the real material's
   // properties. The parser adds one such parcel class per (material, k != 1) an insertion
@@ -236,9 +239,17 @@ struct ParallelSettings {
 
 // Heat transfer (docs/models/heat-transfer.md): present when the scene switches it on
 // (`heat:`); absent, no thermal code runs.
+// The contact radius a of conduction (docs/models/heat-transfer.md, "Contact radius"):
+// the overlap's geometric (Hertz) radius, or that radius corrected for a Young's modulus
+// softer than the real one (Morris et al. 2016): for enduring contacts (the real contact
+// radius under the same load) or for collisions (the real heat of a whole Hertz impact).
+enum class ContactRadiusModel { geometric, morris_static, morris_collision };
+
 struct HeatSettings {
   // Contact conduction law (Batchelor & O'Brien 1977, Q = 2 k* a dT) on or off.
   bool conduction = true;
+  ContactRadiusModel contact_radius = ContactRadiusModel::geometric;
+  std::string contact_radius_source;  // "file:line" of `contact_radius`, for messages
   std::string source;  // "file:line" of the block, for messages
 };
 

@@ -122,7 +122,7 @@ void defer(Deferred& later, F&& check) {
 // The thermal properties of a material: required with heat on, refused without it.
 void read_material_heat(const Map& m, const std::optional<HeatSettings>& heat, Material& mat) {
   if (!heat) {
-    for (const char* key : {"heat_capacity", "conductivity", "heat_source"})
+    for (const char* key : {"heat_capacity", "conductivity", "heat_source", "real_youngs_modulus"})
       if (const auto f = m.find(key))
         f->fail_at_key(std::string("`") + key +
                        "` is a heat-transfer property, but heat transfer is off; add a top-level "
@@ -134,6 +134,21 @@ void read_material_heat(const Map& m, const std::optional<HeatSettings>& heat, M
       m.get("heat_capacity", "add `heat_capacity: <J/(kg K)>`" + hint).number(kPositive);
   mat.conductivity = m.get("conductivity", "add `conductivity: <W/(m K)>`" + hint).number(kPositive);
   mat.heat_source = m.number_or("heat_source", 0.0, kAny);
+  // The soft-particle contact-radius corrections need the real material's modulus.
+  if (heat->contact_radius == ContactRadiusModel::geometric) {
+    if (const auto f = m.find("real_youngs_modulus"))
+      f->fail_at_key("`real_youngs_modulus` is used only by the soft-particle contact-radius "
+                     "corrections, and heat.contact_radius is geometric (" + heat->source +
+                     "); set `contact_radius: morris_static` or `morris_collision`, or remove "
+                     "this key");
+    return;
+  }
+  mat.real_youngs_modulus =
+      m.get("real_youngs_modulus",
+            "add `real_youngs_modulus: <Pa>`, the real material's Young's modulus (heat."
+            "contact_radius at " + heat->contact_radius_source + " corrects the contact radius "
+            "for it)")
+          .number(kPositive);
 }
 
 std::vector<Material> parse_materials(const Field& f, Deferred& later,
@@ -148,7 +163,7 @@ std::vector<Material> parse_materials(const Field& f, Deferred& later,
                   " are allowed (every pair of materials gets its own contact properties)");
   for (const Field& item : items) {
     const Map m = item.map({"name", "youngs_modulus", "poisson_ratio", "density", "heat_capacity",
-                            "conductivity", "heat_source"});
+                            "conductivity", "heat_source", "real_youngs_modulus"});
     const Field name = m.get("name", "add `name: <material name>`");
     Material mat;
     mat.name = name.text();
@@ -802,8 +817,9 @@ OutputSettings parse_output(const Field& f, const TimeSettings& time, bool heat)
   return o;
 }
 
-// `heat: {conduction: batchelor_obrien | none, contact_radius: geometric}`
-// (docs/models/heat-transfer.md). What is not built is refused here, by name.
+// `heat: {conduction: batchelor_obrien | none,
+//         contact_radius: geometric | morris_static | morris_collision}`
+// (docs/models/heat-transfer.md).
 HeatSettings parse_heat(const Field& f) {
   HeatSettings h;
   h.source = f.source().label + ":" + std::to_string(f.line());
@@ -812,10 +828,14 @@ HeatSettings parse_heat(const Field& f) {
   if (const auto c = m.find("conduction"))
     h.conduction = c->choice<bool>("contact conduction law",
                                    {{"batchelor_obrien", true}, {"none", false}});
-  if (const auto a = m.find("contact_radius"))
-    a->choice<bool>("contact radius for conduction (the soft-particle corrections of Morris et al. "
-                    "2016 and Lu et al. 2017 are not built yet)",
-                    {{"geometric", true}});
+  if (const auto a = m.find("contact_radius")) {
+    h.contact_radius = a->choice<ContactRadiusModel>(
+        "contact radius for conduction",
+        {{"geometric", ContactRadiusModel::geometric},
+         {"morris_static", ContactRadiusModel::morris_static},
+         {"morris_collision", ContactRadiusModel::morris_collision}});
+    h.contact_radius_source = f.source().label + ":" + std::to_string(a->line());
+  }
   return h;
 }
 
@@ -946,6 +966,14 @@ Scene build_scene(const Field& root) {
     s.contact = parse_contact(*c);
   else
     defer(for_contacts, [&] { top.get("contact", "add `contact: {normal: hertz}`"); });
+  // The corrections are Hertz's contact radius at the real modulus: a Hooke spring's overlap
+  // is not Hertz's, so they are not offered with it.
+  if (s.heat && s.heat->contact_radius != ContactRadiusModel::geometric &&
+      s.contact.normal == NormalModel::hooke)
+    top.get("heat").map().get("contact_radius").fail_at_key(
+        "the soft-particle contact-radius corrections (morris_static, morris_collision) are "
+        "built for `contact: {normal: hertz}` only; with `normal: hooke` use "
+        "`contact_radius: geometric`");
   if (const auto n = top.find("neighbour")) s.neighbour = parse_neighbour(*n);
   if (const auto w = top.find("walls")) s.walls = parse_walls(*w, s.materials, s.heat);
   if (const auto i = top.find("insert")) {
