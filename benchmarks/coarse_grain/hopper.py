@@ -294,6 +294,9 @@ def main():
     ap.add_argument("--check", type=float, default=None,
                     help="fail unless the rate of each k in --check-k, corrected for Beverloo's annulus "
                          "(x Bev(d)/Bev(k d)), is within this fraction of the k = 1 rate")
+    ap.add_argument("--check-beverloo", type=float, default=None,
+                    help="fail unless each k's rate is within this fraction of Beverloo's correlation "
+                         "evaluated with the parcel diameter k d and that run's own measured bulk density")
     ap.add_argument("--check-k", default=None, help="the ks whose rate --check tests (default: all)")
     ap.add_argument("--analyse-only", action="store_true", help="analyse the runs already in --work")
     ap.add_argument("--plot", default=None, help="write the real mass above the orifice against time to this PNG")
@@ -352,6 +355,14 @@ def main():
                 failed.append(f"k = {k}: W {1e3 * r['w']:.1f} g/s, corrected {1e3 * corrected:.1f} g/s, is "
                               f"{100 * (corrected / w1 - 1):+.1f}% from the beads' {1e3 * w1:.1f} g/s "
                               f"(tolerance {100 * a.check:.0f}%)")
+            if a.check_beverloo is not None:
+                own = beverloo(r["rho_b"], k * D_MEAN)  # independent of every other run
+                print(f"  k = {k}: W / Beverloo(k d, own rho_b {r['rho_b']:.0f} kg/m3 = {1e3 * own:.1f} g/s) "
+                      f"- 1 = {100 * (r['w'] / own - 1):+.1f}%")
+                if not abs(r["w"] / own - 1) <= a.check_beverloo:
+                    failed.append(f"k = {k}: W {1e3 * r['w']:.1f} g/s is {100 * (r['w'] / own - 1):+.1f}% from "
+                                  f"Beverloo with the parcel size ({1e3 * own:.1f} g/s; tolerance "
+                                  f"{100 * a.check_beverloo:.0f}%)")
     if a.plot:
         plot(rows, rho_b, a.plot)
     for f in failed:

@@ -135,7 +135,7 @@ function(grainflow_coupling_test name ranks)
                    --work ${CMAKE_CURRENT_BINARY_DIR}/coupling/${name})
   set_tests_properties(coupling.${name} PROPERTIES
     ENVIRONMENT "GRAINFLOW_FOAM_BASHRC=${OpenFOAM_BASHRC};${GRAINFLOW_MPIEXEC_ENV}"
-    TIMEOUT 60)
+    TIMEOUT 300)  # a hang guard: each takes seconds to ~40 s alone, several times that under load
   if(ranks GREATER 1)
     set_tests_properties(coupling.${name} PROPERTIES LABELS "foam;coupling;mpi"
                          PROCESSORS ${ranks})
