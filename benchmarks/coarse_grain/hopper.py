@@ -301,6 +301,7 @@ def main():
     ap.add_argument("--analyse-only", action="store_true", help="analyse the runs already in --work")
     ap.add_argument("--plot", default=None, help="write the real mass above the orifice against time to this PNG")
     a = ap.parse_args()
+    a.grain = os.path.abspath(a.grain)  # the runs' working directory is each case
     ks = [int(s) for s in a.ks.split(",")]
     os.makedirs(a.work, exist_ok=True)
     rows = []

@@ -19,12 +19,15 @@ set_tests_properties(accuracy_cost.dem_short PROPERTIES
 # the beads' (the error the beads reach against Beverloo; measured -3.2 % and -5.8 %). Real
 # mass: every parcel carries k and k^3 and k^3 real masses; the mass in the domain plus the
 # removed parcels' equals the settled bed's to 1e-12; removed parcels match the log; parcels x
-# k^3 = the real count. docs/models/coarse-graining.md, "Hopper discharge".
+# k^3 = the real count. Independently of any earlier run, each k's rate must lie within 20 % of
+# Beverloo's correlation evaluated with the parcel size and that run's own bulk density (the
+# beads reach -11.7 % in this shallow bin, C's own spread is +-9 %; measured -12.6 %, -16.2 %).
+# docs/models/coarse-graining.md, "Hopper discharge".
 grainflow_find_python(GRAINFLOW_HOPPER_PYTHON "h5py,numpy" "accuracy_cost.coarse_grain_hopper is")
 if(GRAINFLOW_HOPPER_PYTHON)
   add_test(NAME accuracy_cost.coarse_grain_hopper
            COMMAND ${GRAINFLOW_HOPPER_PYTHON} ${PROJECT_SOURCE_DIR}/benchmarks/coarse_grain/hopper.py
-                   --ks 2,3 --check 0.12
+                   --ks 2,3 --check 0.12 --check-beverloo 0.20
                    --grain $<TARGET_FILE:grain>
                    --work ${CMAKE_CURRENT_BINARY_DIR}/coarse_grain_hopper)
   set_tests_properties(accuracy_cost.coarse_grain_hopper PROPERTIES
