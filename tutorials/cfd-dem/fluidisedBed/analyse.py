@@ -36,6 +36,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 import yaml
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from foam_case import foam_entry, series  # noqa: E402 (tutorials/cfd-dem/foam_case.py)
+
 ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 ap.add_argument("case", nargs="?", default=os.path.dirname(os.path.abspath(__file__)))
 ap.add_argument("--short", action="store_true",
@@ -54,35 +57,6 @@ if args.tolerance is None:
 plot_name = "fluidisedBed_short" if args.short else "fluidisedBed"
 
 
-def foam_entry(path, key):
-    """The value of the first `key value;` entry of an OpenFOAM dictionary (a string)."""
-    text = open(path).read()
-    m = re.search(r"^\s*" + key + r"\s+([^;]+);", text, re.M)
-    if not m:
-        sys.exit(f"analyse.py: no '{key}' in {path}")
-    return m.group(1).strip().strip('"')
-
-
-def series(name):
-    """(time, value) of a surfaceFieldValue function object; restarts are appended."""
-    files = sorted(glob.glob(f"{case}/postProcessing/{name}/*/surfaceFieldValue*.dat"),
-                   key=lambda f: float(os.path.basename(os.path.dirname(f))))
-    if not files:
-        sys.exit(f"analyse.py: no {case}/postProcessing/{name}/*/surfaceFieldValue.dat; "
-                 "has grainFoam run?")
-    area = None
-    data = []
-    for f in files:
-        for line in open(f):
-            if line.startswith("# Area"):
-                area = float(line.split(":")[1])
-            elif line.strip() and not line.startswith("#"):
-                data.append([float(v) for v in line.split()[:2]])
-    d = np.array(data)
-    _, keep = np.unique(d[:, 0], return_index=True)  # a restart repeats times
-    return d[keep, 0], d[keep, 1], area
-
-
 # --- fluid, beads, geometry ------------------------------------------------------------
 transport = f"{case}/constant/transportProperties"
 rho_f = float(foam_entry(transport, "rho"))
@@ -91,9 +65,9 @@ scene_file = os.path.join(case, foam_entry(f"{case}/constant/couplingProperties"
 scene = yaml.safe_load(open(scene_file))
 g = float(np.linalg.norm(scene.get("gravity", [0, 0, 0])))
 
-t_in, p_in, area = series("pInlet")
-t_out, p_out, _ = series("pOutlet")
-t_q, q_in, _ = series("inletFlow")
+t_in, p_in, area = series(case, "pInlet")
+t_out, p_out, _ = series(case, "pOutlet")
+t_q, q_in, _ = series(case, "inletFlow")
 n = min(len(t_in), len(t_out), len(t_q))
 t, dp = t_in[:n], rho_f * (p_in[:n] - p_out[:n])  # [Pa]
 u_s = -q_in[:n] / area  # superficial inflow [m/s]; phi < 0 enters the domain

@@ -46,6 +46,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 import yaml
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from foam_case import foam_entry, series  # noqa: E402 (tutorials/cfd-dem/foam_case.py)
+
 ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 ap.add_argument("case", nargs="?", default=os.path.dirname(os.path.abspath(__file__)))
 ap.add_argument("--short", action="store_true", help="the Allrun --short case")
@@ -55,28 +58,6 @@ case = args.case
 if args.tolerance is None:
     args.tolerance = 0.01
 plot_name = "heatedBed_short" if args.short else "heatedBed"
-
-
-def foam_entry(path, key):
-    text = open(path).read()
-    m = re.search(r"^\s*" + key + r"\s+([^;]+);", text, re.M)
-    if not m:
-        sys.exit(f"analyse.py: no '{key}' in {path}")
-    return m.group(1).strip().strip('"')
-
-
-def series(name):
-    """(time, value) of a surfaceFieldValue function object; restarts are appended."""
-    files = sorted(glob.glob(f"{case}/postProcessing/{name}/*/surfaceFieldValue*.dat"),
-                   key=lambda f: float(os.path.basename(os.path.dirname(f))))
-    if not files:
-        sys.exit(f"analyse.py: no {case}/postProcessing/{name}/*/surfaceFieldValue.dat; "
-                 "has grainFoam run?")
-    data = [[float(v) for v in line.split()[:2]] for f in files for line in open(f)
-            if line.strip() and not line.startswith("#")]
-    d = np.array(data)
-    _, keep = np.unique(d[:, 0], return_index=True)
-    return d[keep, 0], d[keep, 1]
 
 
 NUM = r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
@@ -98,9 +79,9 @@ e = e[keep]
 transport = f"{case}/constant/transportProperties"
 rho_f = float(foam_entry(transport, "rho"))
 cp_f = float(foam_entry(transport, "Cp"))
-t_q, q = series("inletFlow")
-t_hi, h_in = series("heatIn")
-t_ho, h_out = series("heatOut")
+t_q, q, _ = series(case, "inletFlow")
+t_hi, h_in, _ = series(case, "heatIn")
+t_ho, h_out, _ = series(case, "heatOut")
 n = min(len(t_q), len(t_hi), len(t_ho))
 t, q, h_in, h_out = t_q[:n], -q[:n], -h_in[:n], h_out[:n]   # inflow positive
 dt = np.diff(np.concatenate(([0.0], t)))
