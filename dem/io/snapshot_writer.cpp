@@ -359,11 +359,16 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step,
     Hid dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
     Hid dxpl(H5Pcreate(H5P_DATASET_XFER), H5Pclose);
     bool ok = fapl.valid() && dcpl.valid() && dxpl.valid();
-    ok = ok && H5Pset_fapl_mpio(fapl.get(), comm_, MPI_INFO_NULL) >= 0;
-    // Metadata written collectively instead of by rank 0 alone plus broadcasts (scales better).
-    ok = ok && H5Pset_coll_metadata_write(fapl.get(), true) >= 0;
-    ok = ok && H5Pset_all_coll_metadata_ops(fapl.get(), true) >= 0;
-    ok = ok && H5Pset_dxpl_mpio(dxpl.get(), H5FD_MPIO_COLLECTIVE) >= 0;
+    if (size_ > 1) {
+      ok = ok && H5Pset_fapl_mpio(fapl.get(), comm_, MPI_INFO_NULL) >= 0;
+      // Metadata written collectively instead of by rank 0 alone plus broadcasts (scales
+      // better).
+      ok = ok && H5Pset_coll_metadata_write(fapl.get(), true) >= 0;
+      ok = ok && H5Pset_all_coll_metadata_ops(fapl.get(), true) >= 0;
+      ok = ok && H5Pset_dxpl_mpio(dxpl.get(), H5FD_MPIO_COLLECTIVE) >= 0;
+    }
+    // One rank writes through HDF5's default (POSIX) driver: the same file, without the
+    // collective filtered-chunk path of MPI-IO, which copies every chunk once more.
     // Parallel HDF5 allocates datasets at creation; without this it would also write fill
     // values there first, doubling the I/O.
     ok = ok && H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_NEVER) >= 0;
