@@ -678,9 +678,23 @@ void ParticleCoupling::buildFootprints() {
       const Foam::label c = atCentre ? centreCell : locate(x);
       if (c >= 0) points_.push_back({c, q.weight});
     }
+    mergeFootprintCells(first_[i]);
     first_[i + 1] = points_.size();
     if (i < particles_.local()) centreCell_[i] = centreCell;
   }
+}
+
+void ParticleCoupling::mergeFootprintCells(std::size_t begin) {
+  std::size_t end = begin;  // points_[begin, end): the merged cells so far
+  for (std::size_t j = begin; j < points_.size(); ++j) {
+    std::size_t k = begin;
+    while (k < end && points_[k].cell != points_[j].cell) ++k;
+    if (k < end)
+      points_[k].weight += points_[j].weight;
+    else
+      points_[end++] = points_[j];
+  }
+  points_.resize(end);
 }
 
 void ParticleCoupling::structuredFootprint(std::size_t i, Foam::label centreCell) {
@@ -737,6 +751,7 @@ void ParticleCoupling::structuredFootprint(std::size_t i, Foam::label centreCell
                           static_cast<std::size_t>(ix)];
     if (c >= 0) points_.push_back({c, unit[q].weight});
   }
+  mergeFootprintCells(first_[i]);
   first_[i + 1] = points_.size();
   if (i < particles_.local()) centreCell_[i] = centreCell;
 }
