@@ -155,7 +155,11 @@ void solve(const Foam::argList& args) {
       // The uniform part G of the pressure gradient: a cell source (its volume integral is
       // exactly -c G V, so the mixture's net force stays zero); zero when off.
       if (meanGradP) UEqn -= -c * particles.meanPressureGradient() / rho;
-      if (pimple.momentumPredictor()) solve(UEqn == -c * fvc::grad(p));
+      // facePressure dragSeries: the cell gradient with the face pressures of half cells in
+      // series (ParticleCoupling::seriesGradient), in the predictor and the corrected U.
+      const bool series = particles.dragSeriesPressure();
+      if (pimple.momentumPredictor())
+        solve(UEqn == -c * (series ? particles.seriesGradient(p) : fvc::grad(p)));
 
       while (pimple.correct()) {
         const volScalarField rAU(1.0 / UEqn.A());
@@ -195,7 +199,10 @@ void solve(const Foam::argList& args) {
           if (pimple.finalNonOrthogonalIter()) {
             phi = phiHbyA - pEqn.flux();
             p.relax();
-            U = HbyA - fvc::reconstruct(pEqn.flux() / epsf);
+            if (series)
+              U = HbyA - rAU * c * particles.seriesGradient(p);
+            else
+              U = HbyA - fvc::reconstruct(pEqn.flux() / epsf);
             U.correctBoundaryConditions();
           }
         }
