@@ -24,6 +24,10 @@
 // and f (explicit forces the model returns to the fluid) are explicit sources.
 // Pressure–velocity coupling: U = HbyA - rAU c grad p inserted into continuity gives
 //   laplacian(eps_f c_f rAU_f, p) = div(eps_f phiHbyA) + d(eps)/dt.
+// With couplingProperties facePressure dragSeries the cell gradient of p in the predictor and
+// in the corrected U = HbyA - rAU c grad p is ParticleCoupling::seriesGradient (face pressures
+// of half cells crossed in series with their drag resistances); otherwise Gauss linear and
+// U = HbyA - reconstruct(rAU_f c_f snGrad p).
 #include <mpi.h>
 
 #include <memory>
