@@ -115,7 +115,8 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
   {
     const wordList allowed{"scene", "voidFraction", "dividedResolution", "smoothingFactor",
                            "sampling", "minVoidFraction", "ddtVoidFraction",
-                           "undisturbedVelocity", "meanPressureGradient", "dragVoidFraction"};
+                           "undisturbedVelocity", "meanPressureGradient", "dragVoidFraction",
+                           "facePressure"};
     for (const word& key : dict.toc())
       if (!allowed.found(key))
         FatalIOErrorInFunction(dict) << "unknown key '" << key << "'; allowed: " << allowed
@@ -222,6 +223,17 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
     FatalIOErrorInFunction(dict) << "dragVoidFraction sharpInterface and undisturbedVelocity "
                                     "oseenBrinkman are not combined (the disturbance model "
                                     "reads the cells' unscaled Ksl); switch one of them off"
+                                 << exit(FatalIOError);
+
+  const word facePressure = dict.lookupOrDefault<word>("facePressure", "linear");
+  if (facePressure == "dragSeries")
+    dragSeriesPressure_ = true;
+  else if (facePressure != "linear")
+    FatalIOErrorInFunction(dict) << "facePressure " << facePressure
+                                 << " is not one of: linear (the momentum equation's cell "
+                                    "pressure gradient is Gauss linear), dragSeries (the face "
+                                    "pressure between two cells crossed in series with their "
+                                    "drag resistances, docs/models/bed-surface.md)"
                                  << exit(FatalIOError);
 
   // --- the DEM ----------------------------------------------------------------------
@@ -503,7 +515,8 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
        << coupling::void_fraction_method_name(vf) << " (" << label(footprint_.size())
        << " points per particle), sampling " << sampling << ", minVoidFraction " << minVoidFraction_
        << ", ddt(voidfraction) " << (ddtVoidFraction_ ? "on" : "off") << ", dragVoidFraction "
-       << (sharpInterface_ ? "sharpInterface" : "cell") << "\n"
+       << (sharpInterface_ ? "sharpInterface" : "cell") << ", facePressure "
+       << (dragSeriesPressure_ ? "dragSeries" : "linear") << "\n"
        << "  viscous term at the particles: "
        << (orthogonal ? "Gauss linear uncorrected (the mesh is orthogonal: largest "
                         "non-orthogonal correction vector "
@@ -943,8 +956,53 @@ void ParticleCoupling::reconstructLayers() {
   dragVoidFraction_.correctBoundaryConditions();
 }
 
+Foam::tmp<Foam::volVectorField> ParticleCoupling::seriesGradient(
+    const Foam::volScalarField& p) const {
+  // Darcy across the two half cells of a face: c dp/dn = r q on either side, the same
+  // superficial flux q through both; the face pressure where the two half-cell drops meet.
+  // A bed's last full cell next to particle-free fluid then carries the bed's gradient
+  // (p_f = p_N) instead of the mean of the bed's and the free fluid's (Gauss linear).
+  using namespace Foam;
+  const dimensionedScalar rho("rho", dimDensity, rho_);
+  volScalarField r(IOobject("dragResistance", mesh_.time().timeName(), mesh_, IOobject::NO_READ,
+                            IOobject::NO_WRITE, false),
+                   Ksl_ / (rho * voidFraction_));
+  if (model_ == 'A') r /= sharpInterface_ ? dragVoidFraction_ : voidFraction_;
+  r.correctBoundaryConditions();  // the neighbours' r across coupled patches
+  surfaceScalarField pf(fvc::interpolate(p));
+  const scalarField& w = mesh_.weights().primitiveField();
+  const labelUList& owner = mesh_.owner();
+  const labelUList& neighbour = mesh_.neighbour();
+  const auto series = [](double wP, double rP, double rN, double pP, double pN, double linear) {
+    const double gP = wP * rN, gN = (1 - wP) * rP;
+    return gP + gN > 0 ? (gP * pP + gN * pN) / (gP + gN) : linear;
+  };
+  forAll(owner, f)
+    pf[f] = series(w[f], r[owner[f]], r[neighbour[f]], p[owner[f]], p[neighbour[f]], pf[f]);
+  forAll(pf.boundaryField(), patch) {
+    const fvPatchScalarField& pb = p.boundaryField()[patch];
+    if (!pb.coupled()) continue;
+    const labelUList& cells = mesh_.boundary()[patch].faceCells();
+    const scalarField& wb = mesh_.weights().boundaryField()[patch];
+    const tmp<scalarField> pN = pb.patchNeighbourField();
+    const tmp<scalarField> rN = r.boundaryField()[patch].patchNeighbourField();
+    scalarField& pfb = pf.boundaryFieldRef()[patch];
+    forAll(cells, i)
+      pfb[i] = series(wb[i], r[cells[i]], rN()[i], p[cells[i]], pN()[i], pfb[i]);
+  }
+  tmp<volVectorField> grad(fvc::surfaceIntegrate(mesh_.Sf() * pf));
+  grad.ref().rename("seriesGrad(" + p.name() + ')');
+  return grad;
+}
+
 Foam::volVectorField& ParticleCoupling::pressureGradient() {
   using namespace Foam;
+  if (dragSeriesPressure_) {
+    // The gradient the fluid's momentum equation carries (grainFoam), at the particles too.
+    gradPOther_ = seriesGradient(p_);
+    if (sampling_ == Sampling::cellPoint) gradPOther_.ref().correctBoundaryConditions();
+    return gradPOther_.ref();
+  }
   if (!gaussLinearGrad_) {
     gradPOther_ = fvc::grad(p_);
     return gradPOther_.ref();

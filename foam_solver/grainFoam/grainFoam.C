@@ -24,6 +24,10 @@
 // and f (explicit forces the model returns to the fluid) are explicit sources.
 // Pressure–velocity coupling: U = HbyA - rAU c grad p inserted into continuity gives
 //   laplacian(eps_f c_f rAU_f, p) = div(eps_f phiHbyA) + d(eps)/dt.
+// With couplingProperties facePressure dragSeries the cell gradient of p in the predictor and
+// in the corrected U = HbyA - rAU c grad p is ParticleCoupling::seriesGradient (face pressures
+// of half cells crossed in series with their drag resistances); otherwise Gauss linear and
+// U = HbyA - reconstruct(rAU_f c_f snGrad p).
 #include <mpi.h>
 
 #include <memory>
@@ -155,7 +159,11 @@ void solve(const Foam::argList& args) {
       // The uniform part G of the pressure gradient: a cell source (its volume integral is
       // exactly -c G V, so the mixture's net force stays zero); zero when off.
       if (meanGradP) UEqn -= -c * particles.meanPressureGradient() / rho;
-      if (pimple.momentumPredictor()) solve(UEqn == -c * fvc::grad(p));
+      // facePressure dragSeries: the cell gradient with the face pressures of half cells in
+      // series (ParticleCoupling::seriesGradient), in the predictor and the corrected U.
+      const bool series = particles.dragSeriesPressure();
+      if (pimple.momentumPredictor())
+        solve(UEqn == -c * (series ? particles.seriesGradient(p) : fvc::grad(p)));
 
       while (pimple.correct()) {
         const volScalarField rAU(1.0 / UEqn.A());
@@ -195,7 +203,10 @@ void solve(const Foam::argList& args) {
           if (pimple.finalNonOrthogonalIter()) {
             phi = phiHbyA - pEqn.flux();
             p.relax();
-            U = HbyA - fvc::reconstruct(pEqn.flux() / epsf);
+            if (series)
+              U = HbyA - rAU * c * particles.seriesGradient(p);
+            else
+              U = HbyA - fvc::reconstruct(pEqn.flux() / epsf);
             U.correctBoundaryConditions();
           }
         }

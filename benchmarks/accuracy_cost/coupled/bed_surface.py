@@ -21,11 +21,13 @@ the last time the horizontally averaged pressure of every cell layer: dp/dz betw
 against the closed form, the void fraction of each layer and the law at that void fraction.
 
 Usage: bed_surface.py [--laws gidaspow,koch_hill] [--cells 6,4,3] [--surface cell,sharpInterface]
-                      [--ranks 1] [--profile] [--plot FILE.png] [--check PERCENT] [--end 0.06]
-                      [--work DIR] [--build DIR]
+                      [--pressure linear] [--ranks 1] [--profile] [--plot FILE.png]
+                      [--check PERCENT] [--end 0.06] [--work DIR] [--build DIR]
 --cells: cells across the 12 mm column (6, 4, 3: cells of 2, 3, 4 d).
 --surface: couplingProperties dragVoidFraction, comma-separated (cell: the key is left out,
            the default; sharpInterface).
+--pressure: couplingProperties facePressure for every run (linear: the key is left out, the
+            default; dragSeries).
 --check: exit 1 unless every run with a surface treatment is within PERCENT of the closed
          form and every exchange imbalance printed is below 1e-12.
 Appends one row per run to <work>/bed_surface.csv.
@@ -115,6 +117,7 @@ def main():
     ap.add_argument("--laws", default="gidaspow,koch_hill")
     ap.add_argument("--cells", default="6,4,3")
     ap.add_argument("--surface", default="cell")
+    ap.add_argument("--pressure", default="linear")
     ap.add_argument("--ranks", type=int, default=1)
     ap.add_argument("--profile", action="store_true")
     ap.add_argument("--plot", default="")
@@ -138,7 +141,7 @@ def main():
         for cells in (int(c) for c in args.cells.split(",")):
             h = 0.012 / cells
             for surface in args.surface.split(","):
-                name = f"bed_{law}_c{cells}_{surface}" + (f"_np{args.ranks}" if args.ranks > 1 else "")
+                name = f"bed_{law}_c{cells}_{surface}" + (f"_{args.pressure}" if args.pressure != "linear" else "") + (f"_np{args.ranks}" if args.ranks > 1 else "")
                 case = cs.bed_case(args.work, name, snapshot, cells, "divided", "cell", 20, u=U_S,
                                    end=args.end)
                 cs.sub(f"{case}/particles.yaml", r"^  drag: \S+", f"  drag: {law}")
@@ -146,11 +149,15 @@ def main():
                 if surface != "cell":
                     with open(f"{case}/constant/couplingProperties", "a") as f:
                         f.write(f"dragVoidFraction {surface};\n")
+                if args.pressure != "linear":
+                    with open(f"{case}/constant/couplingProperties", "a") as f:
+                        f.write(f"facePressure {args.pressure};\n")
                 cost = run_case(case, args.build, name, args.ranks)
                 dp = cs.bed_dp(case, args.end / 2)
                 worst = imbalance(case)
                 error = dp / reference - 1
                 row = dict(law=law, cells=cells, cell_over_d=round(h / d, 3), surface=surface,
+                           face_pressure=args.pressure,
                            ranks=args.ranks, dp=dp, reference=reference, error=error,
                            imbalance=worst, **cost)
                 rows.append(row)
