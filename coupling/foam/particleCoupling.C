@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <limits>
 #include <chrono>
 #include <cmath>
 #include <mpi.h>
@@ -726,7 +727,6 @@ void ParticleCoupling::structuredFootprint(std::size_t i, Foam::label centreCell
         pointAxis_[q][a] = static_cast<int>(at - axisOffset_[a].begin());
         if (at == axisOffset_[a].end()) axisOffset_[a].push_back(o);
       }
-      axisX_[a].resize(axisOffset_[a].size());
       axisCell_[a].resize(axisOffset_[a].size());
     }
   }
@@ -744,27 +744,66 @@ void ParticleCoupling::structuredFootprint(std::size_t i, Foam::label centreCell
       } else if (s < domain_.lo[a] || s >= domain_.hi[a]) {
         cell = kImage;  // periodic axes are half-open, [lo, hi), as in the DEM
       }
-      axisX_[a][m] = s;
       axisCell_[a][m] = cell == kImage ? kImage : gridIndex(a, s);
     }
-  for (std::size_t q = 0; q < unit.size(); ++q) {
-    const std::array<int, 3>& m = pointAxis_[q];
-    const int ix = axisCell_[0][m[0]], iy = axisCell_[1][m[1]], iz = axisCell_[2][m[2]];
-    // The particle's image deposits a point beyond a periodic side.
-    if (ix == kImage || iy == kImage || iz == kImage) continue;
-    // The centre itself (a centred part): its cell is known.
-    const bool atCentre = axisX_[0][m[0]] == centre[0] && axisX_[1][m[1]] == centre[1] &&
-                          axisX_[2][m[2]] == centre[2];
-    Foam::label c = centreCell;
-    if (!atCentre)
-      c = ix < 0 || iy < 0 || iz < 0
-              ? -1
-              : gridCell_[(static_cast<std::size_t>(iz) * gridN_[1] + static_cast<std::size_t>(iy)) *
-                              gridN_[0] +
-                          static_cast<std::size_t>(ix)];
-    if (c >= 0) points_.push_back({c, unit[q].weight});
+  // Each axis's grid indices lie in [lo, lo + 3) for a footprint up to three cells across
+  // (any particle up to one cell in diameter): the points' weights are summed per (x, y, z)
+  // slot, then each occupied slot is one entry, located once. A wider footprint takes the
+  // general route, point by point, merged afterwards. (A point at the centre itself falls in
+  // the centre's cell either way: locate() uses the same grid indices.)
+  int lo[3];
+  bool narrow = true;
+  for (int a = 0; a < 3; ++a) {
+    int l = std::numeric_limits<int>::max(), h = std::numeric_limits<int>::min();
+    for (const int c : axisCell_[a])
+      if (c >= 0) {
+        l = std::min(l, c);
+        h = std::max(h, c);
+      }
+    lo[a] = l;
+    narrow = narrow && (l > h || h - l < 3);  // l > h: no point on this rank's grid
   }
-  mergeFootprintCells(first_[i]);
+  if (narrow) {
+    // The slots in the order of their first point, as mergeFootprintCells() leaves them, so
+    // both routes give the same entries to the last bit.
+    double slot[27] = {};
+    bool used[27] = {};
+    int order[27];
+    int slots = 0;
+    for (std::size_t q = 0; q < unit.size(); ++q) {
+      const std::array<int, 3>& m = pointAxis_[q];
+      const int ix = axisCell_[0][m[0]], iy = axisCell_[1][m[1]], iz = axisCell_[2][m[2]];
+      // Beyond a periodic side (the particle's image deposits it) or outside this rank's grid.
+      if (ix < 0 || iy < 0 || iz < 0) continue;
+      const int k = (ix - lo[0]) + 3 * (iy - lo[1]) + 9 * (iz - lo[2]);
+      if (!used[k]) {
+        used[k] = true;
+        order[slots++] = k;
+      }
+      slot[k] += unit[q].weight;
+    }
+    for (int n = 0; n < slots; ++n) {
+      const int k = order[n];
+      const double w = slot[k];
+      const std::size_t ix = static_cast<std::size_t>(lo[0] + k % 3),
+                        iy = static_cast<std::size_t>(lo[1] + (k / 3) % 3),
+                        iz = static_cast<std::size_t>(lo[2] + k / 9);
+      const Foam::label c = gridCell_[(iz * gridN_[1] + iy) * gridN_[0] + ix];
+      if (c >= 0) points_.push_back({c, w});
+    }
+  } else {
+    for (std::size_t q = 0; q < unit.size(); ++q) {
+      const std::array<int, 3>& m = pointAxis_[q];
+      const int ix = axisCell_[0][m[0]], iy = axisCell_[1][m[1]], iz = axisCell_[2][m[2]];
+      if (ix < 0 || iy < 0 || iz < 0) continue;
+      const Foam::label c =
+          gridCell_[(static_cast<std::size_t>(iz) * gridN_[1] + static_cast<std::size_t>(iy)) *
+                        gridN_[0] +
+                    static_cast<std::size_t>(ix)];
+      if (c >= 0) points_.push_back({c, unit[q].weight});
+    }
+    mergeFootprintCells(first_[i]);
+  }
   first_[i + 1] = points_.size();
   if (i < particles_.local()) centreCell_[i] = centreCell;
 }
