@@ -30,6 +30,18 @@ set_tests_properties(coupling.undisturbed_settling PROPERTIES
   LABELS "foam;coupling;accuracy_cost"
   TIMEOUT 600)
 
+# coupling.undisturbed_settling_re2: the same at Re_t = 2 in cells of 3 d, where the particle
+# sits inside one cell across its motion and the correction reads its own transverse cell
+# weights (20.8 % too fast without the correction).
+add_test(NAME coupling.undisturbed_settling_re2
+         COMMAND ${GRAINFLOW_SWEEPS_PYTHON} ${PROJECT_SOURCE_DIR}/benchmarks/accuracy_cost/coupled/settling_cells.py
+                 --re 2 --cells 3 --courant 0.05 --width 10 --fall 30 --correction oseenBrinkman
+                 --check 3 --work ${CMAKE_CURRENT_BINARY_DIR}/undisturbed_settling_re2
+                 --build ${PROJECT_BINARY_DIR})
+set_tests_properties(coupling.undisturbed_settling_re2 PROPERTIES
+  LABELS "foam;coupling;accuracy_cost"
+  TIMEOUT 600)
+
 # coupling.hindered_settling: a suspension in a fully periodic box (x, y, z; mesh cyclic on
 # all faces) held by meanPressureGradient suspensionWeight, eps = 0.7, drag di_felice, a
 # simple cubic crystal of 8 particles per cell (cells 2.4 d, 1 rank): the mean slip (fluid
