@@ -16,6 +16,7 @@
 #include "dem/engine/simulation.hpp"
 #include "dem/fluid/coupled_fluid.hpp"
 #include "dem/fluid/fluid_forces.hpp"
+#include "dem/fluid/self_disturbance.hpp"
 #include "dem/io/output_directory.hpp"
 #include "dem/io/snapshot_writer.hpp"
 #include "dem/scene/scene_parser.hpp"
@@ -577,8 +578,17 @@ void DemLink::add_fluid(const FluidAtParticle& f) {
   m.pending.push_back(CoupledSample{vec(f.velocity), f.void_fraction, vec(f.pressure_gradient),
                                     vec(f.viscous_stress_divergence)});
   if (m.curl) m.pending_vorticity.push_back(vec(f.vorticity));
-  if (m.self) m.pending_disturbance.push_back(
-        {f.disturbance_cell, f.disturbance_spread, f.disturbance_screening});
+  if (m.self) {
+    SelfDisturbance sd{f.disturbance_cell, f.disturbance_spread, f.disturbance_screening};
+    if (f.disturbance_placed) {
+      sd.placed = true;
+      for (int a = 0; a < 3; ++a) {
+        const std::array<double, 3>& w = f.disturbance_weights[a];
+        sd.transverse[a] = transverse_coefficients(w[0], w[1], w[2]);
+      }
+    }
+    m.pending_disturbance.push_back(sd);
+  }
 }
 
 void DemLink::end_fluid(std::function<FluidAtParticle(const std::array<double, 3>&)> late) {

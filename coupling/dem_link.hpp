@@ -36,6 +36,11 @@ struct FluidAtParticle {
   double disturbance_cell = 0;
   double disturbance_spread = 0;
   double disturbance_screening = 0;
+  // The footprint's weight marginal on each mesh axis over the cells at offsets -1, 0, 1 from
+  // the particle's own (fractions of its weight), when the footprint reaches no further on
+  // any axis (disturbance_placed; else the place-averaged disturbance is used).
+  std::array<std::array<double, 3>, 3> disturbance_weights{};
+  bool disturbance_placed = false;
   double temperature = 0;  // T_f [K] (coupled heat; see DemLink::heat_on)
 };
 

@@ -1242,11 +1242,15 @@ void ParticleCoupling::sample() {
   }
   // Footprint-weighted cell values; ghosts' shares go back to their owners. With
   // undisturbedVelocity, also the cells' size (V^(2/3)), the other particles' drag per volume
-  // there and the particle's own share of it.
+  // there, the particle's own share of it, and the footprint's weight marginal on each axis
+  // over the cells at offsets -1, 0, 1 from the particle's own (17 + 3 a + 1 + offset): the
+  // offset of a cell along a is round((C_a - x_a) / h_c), h_c = V^(1/3), from the particle's
+  // (or its periodic image's) centre, the same on every rank.
   dem_->begin_fluid();
-  const std::size_t W = undisturbed_ ? 17 : 14;
+  const std::size_t W = undisturbed_ ? 26 : 14;
   std::vector<double> acc(W * particles_.size(), 0.0);
   const scalarField& V = mesh_.V().field();
+  const vectorField& cellCentres = mesh_.C().primitiveField();
   std::vector<PointInCell> cellsOfParticle;  // a footprint's weight per cell
   for (std::size_t i = 0; i < particles_.size(); ++i) {
     double* a = &acc[W * i];
@@ -1275,7 +1279,13 @@ void ParticleCoupling::sample() {
       a[13] += w;
       if (undisturbed_) {
         a[14] += w * Ksl_[c];
-        a[16] += w * std::cbrt(V[c] * V[c]);
+        const double hc = std::cbrt(V[c]);
+        a[16] += w * hc * hc;
+        const double* centre = particles_.x(i);
+        for (int d = 0; d < 3; ++d) {
+          const double o = std::floor((cellCentres[c][d] - centre[d]) / hc + 0.5);
+          if (o >= -1 && o <= 1) a[18 + 3 * d + static_cast<int>(o)] += w;
+        }
         bool found = false;
         for (PointInCell& q : cellsOfParticle)
           if (q.cell == c) {
@@ -1311,6 +1321,13 @@ void ParticleCoupling::sample() {
       f.disturbance_spread = footprintSpread_ * particles_.radius(i);
       f.disturbance_screening =
           std::max(0.0, (a[14] - particles_.drag_coefficient(i) * a[15]) * norm);
+      // The particle's place across its motion: its marginals, if they hold all its weight.
+      f.disturbance_placed = true;
+      for (int d = 0; d < 3; ++d) {
+        const double* m = &a[17 + 3 * d];
+        if (m[0] + m[1] + m[2] < a[13] * (1 - 1e-9)) f.disturbance_placed = false;
+        for (int k = 0; k < 3; ++k) f.disturbance_weights[d][k] = m[k] * norm;
+      }
     }
     dem_->add_fluid(f);
   }

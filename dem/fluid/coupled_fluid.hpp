@@ -11,6 +11,7 @@
 // The fluid-force term writes back, per particle, the explicit part of the force that
 // the fluid gets through the exchange term (exchange_force, in the particles' order of
 // the last step): which forces that includes depends on the VANS model (vans_model.hpp).
+#include <array>
 #include <functional>
 #include <unordered_map>
 #include <vector>
@@ -36,11 +37,18 @@ struct CoupledSample {
 // drag is to see the undisturbed velocity (couplingProperties undisturbedVelocity;
 // self_disturbance.hpp): the size of the cells the footprint covers, the footprint's own
 // spread and the drag coefficient per volume of the other particles around it (Brinkman
-// screening). cell = 0: no correction for this particle.
+// screening), and where it sits in its cells. cell = 0: no correction for this particle.
 struct SelfDisturbance {
   double cell = 0;       // h [m]
   double spread = 0;     // s [m], standard deviation per axis of the footprint's points
   double screening = 0;  // beta [kg/m^3/s]
+  // Per mesh axis x, y, z: the coefficients a_0..a_2 of the footprint's weight marginal on
+  // the cells at offsets -1, 0, 1 from the particle's own (transverse_coefficients in
+  // self_disturbance.hpp); the two axes across the motion are used. placed = false: not
+  // known, or the footprint reaches further than one cell from the particle's own on some
+  // axis; the place-averaged factor is used.
+  std::array<std::array<double, 3>, 3> transverse{};
+  bool placed = false;
 };
 
 class CoupledFluid {

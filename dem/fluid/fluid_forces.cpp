@@ -209,7 +209,7 @@ class FluidForcesWith final : public ForceTerm {
         double k = Law({d, slip.norm(), f.void_fraction, f.density, f.viscosity});
         if (coarse_) k *= parcel;
         if (samples.disturbance && samples.disturbance[i].cell > 0)
-          k *= undisturbed(samples.disturbance[i], d, slip.norm(), f);
+          k *= undisturbed(samples.disturbance[i], d, slip, f);
         const double k_sum = drag.coefficient[i] + k;
         if (k_sum > 0)
           drag.fluid_velocity[i] =
@@ -264,13 +264,23 @@ class FluidForcesWith final : public ForceTerm {
   // at the undisturbed slip, with m the mobility of the particle's disturbance on its cells'
   // lattice. The momentum equation of the disturbance has the viscosity c mu (c = eps in
   // model A, 1 in model B) and the advecting density eps rho.
-  double undisturbed(const SelfDisturbance& sd, double d, double w_seen, const FluidSample& f) {
+  // The disturbance's transverse factor is that of the particle's own weights on the two mesh
+  // axes across the motion, the motion's axis being the one most aligned with the slip.
+  double undisturbed(const SelfDisturbance& sd, double d, const Vec3& slip, const FluidSample& f) {
+    const double w_seen = slip.norm();
+    const std::array<double, 3>*ax = nullptr, *ay = nullptr;
+    if (sd.placed) {
+      const Vec3 a = slip.cwiseAbs();
+      const int along = a[0] >= a[1] ? (a[0] >= a[2] ? 0 : 2) : (a[1] >= a[2] ? 1 : 2);
+      ax = &sd.transverse[(along + 1) % 3];
+      ay = &sd.transverse[(along + 2) % 3];
+    }
     const double mu_e = (s_.model == VansModel::A ? f.void_fraction : 1.0) * f.viscosity;
     const double rho_e = f.void_fraction * f.density;
     const double eps = f.void_fraction;
     const auto k = [&](double w) { return Law({d, w, eps, f.density, f.viscosity}); };
     const auto m = [&](double w) {
-      return lattice_self_mobility(sd.cell, sd.spread, w, rho_e, mu_e, sd.screening);
+      return lattice_self_mobility(sd.cell, sd.spread, w, rho_e, mu_e, sd.screening, ax, ay);
     };
     bool limited = false;
     const double k0 = k(w_seen);

@@ -118,7 +118,15 @@ double SelfDisturbanceTable::operator()(double re_sigma, double screening) const
   return std::exp(lp);
 }
 
-double lattice_self_disturbance(double re_h, double screening, double spread_over_h) {
+namespace {
+
+// The tricubic interpolation's points and weights at (Re_h, b, s/h), shared by the tables.
+struct LatticeStencil {
+  std::array<int, 4> ix, iy, iz;
+  std::array<double, 4> wx, wy, wz;
+};
+
+LatticeStencil lattice_stencil(double re_h, double screening, double spread_over_h) {
   namespace t = lattice_table;
   // Fractional indices along the three axes; outside the table the end cells are used (held
   // below Re_h and b, extrapolated linearly above: there the Catmull-Rom weights at t > 1
@@ -136,9 +144,6 @@ double lattice_self_disturbance(double re_h, double screening, double spread_ove
   split(x, t::n_re, true, i, fx);
   split(y, t::n_b, true, j, fy);
   split(z, t::n_spread, true, k, fz);
-  const auto at = [&](int kk, int ii, int jj) {
-    return t::log_phi[(static_cast<std::size_t>(kk) * t::n_re + ii) * t::n_b + jj];
-  };
   // Outside [0, 1] in a coordinate (extrapolation above the table): linear in that one.
   const auto weights = [](double f, int m, int n, std::array<int, 4>& idx, std::array<double, 4>& w) {
     if (f > 1 || f < 0) {
@@ -165,21 +170,58 @@ double lattice_self_disturbance(double re_h, double screening, double spread_ove
       w[3] = 0;
     }
   };
-  std::array<int, 4> ix, iy, iz;
-  std::array<double, 4> wx, wy, wz;
-  weights(fx, i, t::n_re, ix, wx);
-  weights(fy, j, t::n_b, iy, wy);
-  weights(fz, k, t::n_spread, iz, wz);
-  double lp = 0;
+  LatticeStencil st;
+  weights(fx, i, t::n_re, st.ix, st.wx);
+  weights(fy, j, t::n_b, st.iy, st.wy);
+  weights(fz, k, t::n_spread, st.iz, st.wz);
+  return st;
+}
+
+// Interpolates the tables `logs` (each [spread][re][b] in log) on one stencil: out[m] the
+// value of table m.
+template <std::size_t N>
+std::array<double, N> lattice_interpolate(const LatticeStencil& st,
+                                          const std::array<const double*, N>& logs) {
+  namespace t = lattice_table;
+  std::array<double, N> lp{};
   for (int c = 0; c < 4; ++c) {
-    if (wz[c] == 0) continue;
+    if (st.wz[c] == 0) continue;
     for (int a = 0; a < 4; ++a) {
-      if (wx[a] == 0) continue;
-      for (int e = 0; e < 4; ++e)
-        if (wy[e] != 0) lp += wz[c] * wx[a] * wy[e] * at(iz[c], ix[a], iy[e]);
+      if (st.wx[a] == 0) continue;
+      for (int e = 0; e < 4; ++e) {
+        if (st.wy[e] == 0) continue;
+        const double w = st.wz[c] * st.wx[a] * st.wy[e];
+        const std::size_t at =
+            (static_cast<std::size_t>(st.iz[c]) * t::n_re + st.ix[a]) * t::n_b + st.iy[e];
+        for (std::size_t m = 0; m < N; ++m) lp[m] += w * logs[m][at];
+      }
     }
   }
-  return std::exp(lp);
+  for (double& v : lp) v = std::exp(v);
+  return lp;
+}
+
+}  // namespace
+
+double lattice_self_disturbance(double re_h, double screening, double spread_over_h) {
+  return lattice_interpolate<1>(lattice_stencil(re_h, screening, spread_over_h),
+                                {lattice_table::log_phi})[0];
+}
+
+double lattice_self_disturbance(double re_h, double screening, double spread_over_h,
+                                const std::array<double, 3>& ax, const std::array<double, 3>& ay) {
+  namespace t = lattice_table;
+  const std::array<double, 6> v =
+      lattice_interpolate<6>(lattice_stencil(re_h, screening, spread_over_h),
+                             {t::log_t00, t::log_t01, t::log_t02, t::log_t11, t::log_t12, t::log_t22});
+  // T_ij symmetric: T[i][j] = v[pair index].
+  const double tt[3][3] = {{v[0], v[1], v[2]}, {v[1], v[3], v[4]}, {v[2], v[4], v[5]}};
+  double phi = 0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) phi += ax[i] * ay[j] * tt[i][j];
+  // The integral is positive; a sum that cancels to within the tables' interpolation error
+  // (weights split over cells -1 and +1 with none between) is held at zero.
+  return std::max(phi, 0.0);
 }
 
 const SelfDisturbanceTable& self_disturbance_table() {

@@ -28,6 +28,7 @@
 // discretises it, whose response at the scale of a cell differs from the continuous one
 // (softer in Stokes flow, and carrying the force off through a whole cell's section at high
 // cell Reynolds number).
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -83,13 +84,45 @@ const SelfDisturbanceTable& self_disturbance_table();
 // the lattice's own scale has stopped mattering: u' = -F phi_lat(Re_2s, b_2s, 1/2) / (2 mu_e s).
 double lattice_self_disturbance(double re_h, double screening, double spread_over_h);
 
+// The self-disturbance with the particle's actual place across its motion. The footprint's
+// weights, summed over the cells of one transverse axis (its marginal W_j on the cells at
+// integer offsets j = -1, 0, 1 from the particle's own), stay the same while the particle
+// moves along the other axis, and the lattice reads them back exactly: the transverse factor
+// of the integrand is |sum_j W_j e^(i q j)|^2 = C0 + C1 cos q + C2 cos 2q (C0 = sum W_j^2,
+// C1 = 2 sum W_j W_j+1, C2 = 2 W_-1 W_1) in place of the place-averaged A(q). Written in the
+// non-negative basis f_0 = 1, f_1 = (1 + cos q)/2, f_2 = f_1^2 (one cell; half and half over
+// two; 1/4, 1/2, 1/4 over three) as a_0 f_0 + a_1 f_1 + a_2 f_2 with
+//     a_0 = C0 - C1 + C2,   a_1 = 2 C1 - 8 C2,   a_2 = 8 C2,
+// the disturbance is phi_lat = sum_ij a_i(x) a_j(y) T_ij(Re_h, b, s/h), each T_ij the integral
+// above with f_i(q_x) f_j(q_y) for A(q_x) A(q_y) (the passage average along the motion, with
+// the spread s, stays). The six T_ij are tabulated with phi_lat (same axes, same
+// interpolation). Averaged over places the a_i give back the place-averaged phi_lat
+// (scripts/lattice_self_disturbance.py checks it).
+inline std::array<double, 3> transverse_coefficients(double w_minus, double w_0, double w_plus) {
+  const double c0 = w_minus * w_minus + w_0 * w_0 + w_plus * w_plus;
+  const double c1 = 2 * (w_minus * w_0 + w_0 * w_plus);
+  const double c2 = 2 * w_minus * w_plus;
+  return {c0 - c1 + c2, 2 * c1 - 8 * c2, 8 * c2};
+}
+
+// phi_lat with the transverse coefficients ax, ay (transverse_coefficients) of the two axes
+// across the motion.
+double lattice_self_disturbance(double re_h, double screening, double spread_over_h,
+                                const std::array<double, 3>& ax, const std::array<double, 3>& ay);
+
 // The mobility m = u' / F [s/kg] of a particle's self-disturbance on cells of size h [m]
 // with footprint spread s [m], at slip w [m/s], for the momentum equation with density rho_e,
-// viscosity mu_e and Brinkman coefficient beta [kg/m^3/s].
+// viscosity mu_e and Brinkman coefficient beta [kg/m^3/s]. ax, ay: the transverse
+// coefficients of the particle's place across its motion; null: the place-averaged factor
+// (also used where s > h/2 and the cell size is taken as 2 s).
 inline double lattice_self_mobility(double h, double s, double w, double rho_e, double mu_e,
-                                    double beta) {
+                                    double beta, const std::array<double, 3>* ax = nullptr,
+                                    const std::array<double, 3>* ay = nullptr) {
   const double l = 2 * s > h ? 2 * s : h;
-  return lattice_self_disturbance(rho_e * w * l / mu_e, beta * l * l / mu_e, s / l) / (mu_e * l);
+  const double re = rho_e * w * l / mu_e, b = beta * l * l / mu_e;
+  const double phi = ax && ay && l == h ? lattice_self_disturbance(re, b, s / l, *ax, *ay)
+                                        : lattice_self_disturbance(re, b, s / l);
+  return phi / (mu_e * l);
 }
 
 // The undisturbed slip for drag: given the slip the particle sees (sampled fluid minus

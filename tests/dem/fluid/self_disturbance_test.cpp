@@ -126,6 +126,106 @@ TEST(SelfDisturbance, LatticeMobilityIsContinuousWhereTheFootprintOutgrowsTheCel
   EXPECT_NEAR(above / below, 1, 1e-6);
 }
 
+// The particle's own place across its motion (transverse_coefficients and the six tables
+// T_ij): |sum_j W_j e^(i q j)|^2 in the basis f_0, f_1, f_2 for any weights over three cells.
+TEST(SelfDisturbance, TransverseCoefficientsRepresentTheWeightsFactor) {
+  std::mt19937 gen(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (int k = 0; k < 20; ++k) {
+    double w[3] = {u(gen), u(gen), u(gen)};
+    const double sum = w[0] + w[1] + w[2];
+    for (double& x : w) x /= sum;
+    const std::array<double, 3> a = transverse_coefficients(w[0], w[1], w[2]);
+    for (double q : {0.0, 0.4, 1.3, 2.2, pi}) {
+      const double re = w[0] * std::cos(-q) + w[1] + w[2] * std::cos(q);
+      const double im = w[0] * std::sin(-q) + w[2] * std::sin(q);
+      const double f1 = (1 + std::cos(q)) / 2;
+      EXPECT_NEAR(a[0] + a[1] * f1 + a[2] * f1 * f1, re * re + im * im, 1e-14);
+    }
+  }
+  // One cell, half and half, 1/4 1/2 1/4: the basis functions themselves.
+  EXPECT_EQ(transverse_coefficients(0, 1, 0), (std::array<double, 3>{1, 0, 0}));
+  EXPECT_EQ(transverse_coefficients(0, 0.5, 0.5), (std::array<double, 3>{0, 1, 0}));
+  EXPECT_EQ(transverse_coefficients(0.25, 0.5, 0.25), (std::array<double, 3>{0, 0, 1}));
+}
+
+TEST(SelfDisturbance, LatticeTransverseTablesFollowTheQuadrature) {
+  // scripts/lattice_self_disturbance.py, Quadrature(24, 64, 12).phi(re, b, s)[1:]: T_00, T_01,
+  // T_02, T_11, T_12, T_22 between the table's nodes; the tolerance of the place-averaged
+  // table (6e-3).
+  struct Case {
+    double re, b, s;
+    std::array<double, 6> t;
+  };
+  const std::array<double, 3> f[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  const int pair[6][2] = {{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}};
+  for (const Case& c :
+       {Case{0.37, 0.0, 0.07, {0.15062385009801024, 0.09795314748206786, 0.08018226217763774,
+                               0.06692233623172728, 0.055982889581751204, 0.04721680054313254}},
+        Case{5.3, 0.02, 0.11, {0.061484005642746066, 0.03452836960556171, 0.026508853600499063,
+                               0.01977545972021641, 0.015331396750043396, 0.01191212624886562}},
+        Case{42.0, 0.0, 0.19, {0.010942002527721352, 0.005628442139661259, 0.0042334854690474965,
+                               0.0029023597409128924, 0.002189221880348813, 0.0016520346012275189}},
+        Case{260.0, 3.0, 0.3, {0.0018647541701069129, 0.0009375671693729969, 0.0007027447925966662,
+                               0.0004714532006375867, 0.0003535600506646882, 0.00026510366376654844}},
+        Case{0.05, 50.0, 0.45, {0.007318662176544091, 0.0037197340620757067, 0.0027228017496943946,
+                                0.001891015825688433, 0.001383978098300693, 0.0010078829248762954}}})
+    for (int k = 0; k < 6; ++k) {
+      const int i = pair[k][0], j = pair[k][1];
+      EXPECT_NEAR(lattice_self_disturbance(c.re, c.b, c.s, f[i], f[j]) / c.t[k], 1, 6e-3)
+          << "T_" << i << j << ", Re_h " << c.re << ", b " << c.b << ", s/h " << c.s;
+      // Symmetric in the two transverse axes.
+      EXPECT_NEAR(lattice_self_disturbance(c.re, c.b, c.s, f[j], f[i]) /
+                      lattice_self_disturbance(c.re, c.b, c.s, f[i], f[j]),
+                  1, 1e-14);
+    }
+}
+
+TEST(SelfDisturbance, LatticePlacedFactorAtZeroSpreadIsThePlaceAveragedOne) {
+  // A point footprint (s = 0) always sits in one cell: A(q) = 1 = f_0.
+  const std::array<double, 3> one = {1, 0, 0};
+  for (double re : {0.0, 0.02, 1.7, 30.0, 5e3})
+    for (double b : {0.0, 0.4, 300.0})
+      EXPECT_NEAR(lattice_self_disturbance(re, b, 0, one, one) / lattice_self_disturbance(re, b, 0),
+                  1, 1e-12);
+}
+
+TEST(SelfDisturbance, LatticePlacedFactorAveragedOverPlacesIsThePlaceAveragedOne) {
+  // Footprint points spread as e^(-x/s)/s (x > 0) along each axis have the autocorrelation
+  // e^(-|x|/s)/(2s) the place-averaged factor assumes. A centre at u in its cell
+  // (-1/2 <= u < 1/2) puts the weights (0, 1 - e, e), e = e^(-(1/2 - u)/s), on the cells -1,
+  // 0, 1 (the share beyond cell 1, 4e-5 of the average at s/h = 1/8, lumped into it); the
+  // transverse coefficients averaged over u on both axes give the place-averaged phi.
+  const double s = 0.125;
+  std::array<double, 3> mean = {0, 0, 0};
+  const int n = 4000;
+  for (int k = 0; k < n; ++k) {
+    const double u = (k + 0.5) / n - 0.5, e = std::exp(-(0.5 - u) / s);
+    const std::array<double, 3> a = transverse_coefficients(0, 1 - e, e);
+    for (int m = 0; m < 3; ++m) mean[m] += a[m] / n;
+  }
+  for (double re : {0.0, 0.3, 4.0, 60.0})
+    for (double b : {0.0, 1.0})
+      EXPECT_NEAR(lattice_self_disturbance(re, b, s, mean, mean) / lattice_self_disturbance(re, b, s),
+                  1, 3e-3)
+          << "Re_h " << re << ", b " << b;
+  // A particle inside one cell reads more of its own disturbance than the average over
+  // places: 1.22 times at Re_h = 4, s/h = 0.11 (the quadrature: 0.073952 against 0.060741).
+  const std::array<double, 3> one = {1, 0, 0};
+  EXPECT_NEAR(lattice_self_disturbance(4, 0, 0.11, one, one) / lattice_self_disturbance(4, 0, 0.11),
+              0.07395161682715552 / 0.060740756234141775, 6e-3);
+}
+
+TEST(SelfDisturbance, LatticeMobilityWithPlaceIsThePlaceAveragedOneBeyondHalfACell) {
+  // For s > h/2 (cell size taken as 2 s) the particle's weights on the cells are not used.
+  const double h = 1e-3, rho = 1000, mu = 0.01, w = 0.02, beta = 50;
+  const std::array<double, 3> one = {1, 0, 0};
+  EXPECT_EQ(lattice_self_mobility(h, 0.6 * h, w, rho, mu, beta, &one, &one),
+            lattice_self_mobility(h, 0.6 * h, w, rho, mu, beta));
+  EXPECT_GT(lattice_self_mobility(h, 0.2 * h, w, rho, mu, beta, &one, &one),
+            lattice_self_mobility(h, 0.2 * h, w, rho, mu, beta));
+}
+
 TEST(SelfDisturbance, UndisturbedFactorSolvesTheFixedPoint) {
   bool limited = true;
   // Constant k and m: 1 / (1 - k m).
