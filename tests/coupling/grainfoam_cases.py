@@ -424,6 +424,17 @@ def refuses_bad_setup(runner, checks):
                   "meanPressureGradient suspensionWeight with walls across gravity: refused, "
                   "naming the axis z")
 
+    # 6. facePressure: an unknown value is refused naming the file, its line and both values.
+    case = runner.fresh_case("periodic_box", "face_pressure_unknown", [
+        ("constant/couplingProperties", "sampling        cell;",
+         "facePressure    harmonic;\nsampling        cell;")])
+    runner.run(case, "blockMesh", "blockMesh")
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    checks.expect("facePressure harmonic is not one of: linear" in log and "dragSeries" in log
+                  and re.search(r"couplingProperties\D+line \d+", log) is not None,
+                  "facePressure harmonic: refused, naming linear, dragSeries and "
+                  "constant/couplingProperties with its line")
+
 
 # --- coupling.restart -------------------------------------------------------------------
 
