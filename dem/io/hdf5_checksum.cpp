@@ -2,21 +2,148 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstring>
+#include <vector>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "dem/io/hdf5_errors.hpp"
 
 namespace grainflow {
 
-bool add_checksum(hid_t dcpl, int rank, const hsize_t* dims, std::size_t element_bytes) {
-  if (dims[0] == 0) return true;
+hsize_t checksum_chunk_rows(int rank, const hsize_t* dims, std::size_t element_bytes) {
   const hsize_t row_bytes = (rank == 2 ? dims[1] : 1) * std::max<std::size_t>(element_bytes, 1);
   // Equal chunks of at most 1 MiB: HDF5 allocates whole chunks, so a last chunk mostly
   // empty would waste its size in the file.
   const hsize_t max_rows = std::max<hsize_t>((hsize_t(1) << 20) / row_bytes, 1);
   const hsize_t chunks = (dims[0] + max_rows - 1) / max_rows;
-  const hsize_t rows = (dims[0] + chunks - 1) / chunks;
-  const hsize_t chunk[2] = {rows, rank == 2 ? dims[1] : 1};
+  return (dims[0] + chunks - 1) / chunks;
+}
+
+bool add_checksum(hid_t dcpl, int rank, const hsize_t* dims, std::size_t element_bytes) {
+  if (dims[0] == 0) return true;
+  const hsize_t chunk[2] = {checksum_chunk_rows(rank, dims, element_bytes), rank == 2 ? dims[1] : 1};
   return H5Pset_chunk(dcpl, rank, chunk) >= 0 && H5Pset_fletcher32(dcpl) >= 0;
+}
+
+namespace {
+
+// Fletcher's two running sums over 16-bit words w_0, w_1, ...: s1 = sum of the words, s2 = the
+// sum of s1 after each word, i.e. each word times the number of words from it to the end. Both
+// are kept modulo 65535 (exact: HDF5 reduces with (x & 0xffff) + (x >> 16), which keeps the
+// residue, and its blocks of 360 words never overflow 32 bits).
+struct FletcherSums {
+  std::uint64_t s1 = 0;
+  std::uint64_t s2 = 0;
+
+  // One more word.
+  void add(std::uint64_t w) {
+    s1 += w;
+    s2 += s1;
+  }
+  // A block of m words whose plain sum is `sum` and whose weighted sum, each word times the
+  // number of words from it to the block's end, is `weighted`.
+  void add_block(std::uint64_t m, std::uint64_t sum, std::uint64_t weighted) {
+    s2 += m * s1 + weighted;
+    s1 += sum;
+    reduce();
+  }
+  void reduce() {
+    s1 %= 65535;
+    s2 %= 65535;
+  }
+};
+
+std::uint64_t big_endian_word(const unsigned char* p) {
+  return (std::uint64_t{p[0]} << 8) | p[1];
+}
+
+}  // namespace
+
+std::uint32_t fletcher32(const void* data, std::size_t bytes) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  std::size_t words = bytes / 2;
+  FletcherSums sums;
+  bool nonzero = false;
+#if defined(__SSE2__)
+  // Eight words per 16 bytes, one per 32-bit lane in two registers (lanes 0-3 the first four
+  // words, 4-7 the last four). Over T iterations lane l sums A_l = sum_t w(8t + l) and
+  // B_l = sum_t (T - t) w(8t + l); the block's weighted sum is then sum_l (8 B_l - l A_l).
+  // T = 256 keeps B below 65535 * 256 * 257 / 2 < 2^32.
+  constexpr std::size_t block_iterations = 256;
+  const __m128i zero = _mm_setzero_si128();
+  __m128i any = zero;
+  while (words >= 8) {
+    const std::size_t iterations = std::min(words / 8, block_iterations);
+    __m128i a_lo = zero, a_hi = zero, b_lo = zero, b_hi = zero;
+    for (std::size_t t = 0; t < iterations; ++t, p += 16) {
+      const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p));
+      any = _mm_or_si128(any, v);
+      const __m128i w = _mm_or_si128(_mm_slli_epi16(v, 8), _mm_srli_epi16(v, 8));
+      a_lo = _mm_add_epi32(a_lo, _mm_unpacklo_epi16(w, zero));
+      a_hi = _mm_add_epi32(a_hi, _mm_unpackhi_epi16(w, zero));
+      b_lo = _mm_add_epi32(b_lo, a_lo);
+      b_hi = _mm_add_epi32(b_hi, a_hi);
+    }
+    alignas(16) std::uint32_t a[8], b[8];
+    _mm_store_si128(reinterpret_cast<__m128i*>(a), a_lo);
+    _mm_store_si128(reinterpret_cast<__m128i*>(a + 4), a_hi);
+    _mm_store_si128(reinterpret_cast<__m128i*>(b), b_lo);
+    _mm_store_si128(reinterpret_cast<__m128i*>(b + 4), b_hi);
+    std::uint64_t sum = 0, weighted = 0;
+    for (std::uint64_t l = 0; l < 8; ++l) {
+      sum += a[l];
+      weighted += 8 * std::uint64_t{b[l]} - l * a[l];
+    }
+    sums.add_block(8 * iterations, sum, weighted);
+    words -= 8 * iterations;
+  }
+  nonzero = _mm_movemask_epi8(_mm_cmpeq_epi8(any, zero)) != 0xffff;
+#endif
+  // The words left (all of them without SSE2), reduced often enough to stay far from overflow.
+  for (std::size_t k = 0; k < words; ++k, p += 2) {
+    const std::uint64_t w = big_endian_word(p);
+    nonzero = nonzero || w != 0;
+    sums.add(w);
+    if ((k & 0xffff) == 0xffff) sums.reduce();
+  }
+  if (bytes % 2) {  // an odd byte: the high byte of one more word
+    nonzero = nonzero || *p != 0;
+    sums.add(std::uint64_t{*p} << 8);
+  }
+  sums.reduce();
+  // HDF5's reduction never brings a non-zero sum to 0: a multiple of 65535 stays 65535. Both
+  // sums are non-zero exactly when some word is.
+  const auto fold = [nonzero](std::uint64_t s) {
+    return static_cast<std::uint32_t>(nonzero && s == 0 ? 65535 : s);
+  };
+  return (fold(sums.s2) << 16) | fold(sums.s1);
+}
+
+bool write_checksummed(hid_t dataset, int rank, const hsize_t* dims, std::size_t element_bytes,
+                       const void* data) {
+  if (dims[0] == 0) return true;
+  const std::size_t row_bytes = (rank == 2 ? dims[1] : 1) * element_bytes;
+  const hsize_t rows = checksum_chunk_rows(rank, dims, element_bytes);
+  const std::size_t chunk_bytes = rows * row_bytes;
+  // One chunk and its checksum; the last chunk's rows past the data are zeros (HDF5 stores and
+  // checks a partial last chunk at its full size and reads only the rows inside).
+  std::vector<unsigned char> chunk(chunk_bytes + 4);
+  const auto* source = static_cast<const unsigned char*>(data);
+  for (hsize_t first = 0; first < dims[0]; first += rows) {
+    const std::size_t n = std::min(rows, dims[0] - first) * row_bytes;
+    std::memcpy(chunk.data(), source + first * row_bytes, n);
+    std::memset(chunk.data() + n, 0, chunk_bytes - n);
+    const std::uint32_t sum = fletcher32(chunk.data(), chunk_bytes);
+    for (std::size_t b = 0; b < 4; ++b)  // little-endian, as HDF5's filter stores it
+      chunk[chunk_bytes + b] = static_cast<unsigned char>(sum >> (8 * b));
+    const hsize_t offset[2] = {first, 0};
+    if (H5Dwrite_chunk(dataset, H5P_DEFAULT, 0, offset, chunk_bytes + 4, chunk.data()) < 0)
+      return false;
+  }
+  return true;
 }
 
 hid_t checksummed_layout(int rank, const hsize_t* dims, std::size_t element_bytes) {
