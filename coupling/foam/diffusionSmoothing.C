@@ -1,6 +1,6 @@
-#include "diffusionSmoothing.H"
-
 #include <cmath>
+
+#include "coupling/foam/diffusionSmoothing.H"
 
 namespace grainflow::foam {
 

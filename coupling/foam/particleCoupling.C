@@ -604,7 +604,8 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
       settings.cell_over_d = std::cbrt(sums[2] / cells) / (sums[0] / sums[1]);
       settings.steps_per_fluid = subSteps_;
       settings.drag_void_fraction = sharpInterface_ ? "sharpInterface" : "cell";
-      if (smoothing_) settings.diffusion_bandwidth_over_d = smoothing_->bandwidth() / (sums[0] / sums[1]);
+      if (smoothing_)
+        settings.diffusion_bandwidth_over_d = smoothing_->bandwidth() / (sums[0] / sums[1]);
       Info << "  " << coupling::describe_coupled_accuracy(settings).c_str() << endl;
     }
     // Coarse-grained parcels against the cells (the rule of grain check; Radl et al. 2011).
