@@ -131,6 +131,12 @@ std::string describe_coupled_accuracy(const CoupledSettings& s) {
            "measurements are in docs/models/bed-surface.md";
     return out.str();
   }
+  if (s.diffusion_bandwidth_over_d > 0) {
+    out << "diffusionBandwidth " << number(s.diffusion_bandwidth_over_d, 3)
+        << " d: no measured table here (the tables are without averaging); its hindered-"
+           "settling measurements are in docs/models/undisturbed-velocity.md";
+    return out.str();
+  }
   out << footprint_line(s) << "\n  " << interval_line(s);
   return out.str();
 }

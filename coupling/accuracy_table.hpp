@@ -101,6 +101,7 @@ struct CoupledSettings {
   double cell_over_d = 0;
   int steps_per_fluid = 1;
   std::string drag_void_fraction = "cell";  // couplingProperties dragVoidFraction
+  double diffusion_bandwidth_over_d = 0;    // couplingProperties diffusionBandwidth / mean d
 };
 
 // Lines (the first without indentation, the others indented by two spaces) saying what the

@@ -117,7 +117,7 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
     const wordList allowed{"scene", "voidFraction", "dividedResolution", "smoothingFactor",
                            "sampling", "minVoidFraction", "ddtVoidFraction",
                            "undisturbedVelocity", "meanPressureGradient", "dragVoidFraction",
-                           "facePressure"};
+                           "facePressure", "diffusionBandwidth"};
     for (const word& key : dict.toc())
       if (!allowed.found(key))
         FatalIOErrorInFunction(dict) << "unknown key '" << key << "'; allowed: " << allowed
@@ -237,6 +237,43 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
                                     "drag resistances, docs/models/bed-surface.md)"
                                  << exit(FatalIOError);
 
+  const scalar bandwidth = dict.lookupOrDefault<scalar>("diffusionBandwidth", 0.0);
+  if (bandwidth < 0)
+    FatalIOErrorInFunction(dict) << "diffusionBandwidth " << bandwidth
+                                 << " is negative; it is the bandwidth b [m] of the "
+                                    "diffusion-based averaging (Gaussian exp(-r^2/b^2)), 0 "
+                                    "for none"
+                                 << exit(FatalIOError);
+  if (bandwidth > 0) {
+    const char* clash = sampling_ != Sampling::cell ? "sampling cellPoint"
+                        : undisturbed_              ? "undisturbedVelocity oseenBrinkman"
+                        : sharpInterface_           ? "dragVoidFraction sharpInterface"
+                                                    : nullptr;
+    if (clash)
+      FatalIOErrorInFunction(dict)
+          << "diffusionBandwidth " << bandwidth << " is not combined with " << clash
+          << " (the averaging keeps the exchange balanced with sampling cell on the "
+             "cells' own values); set diffusionBandwidth 0 or sampling cell, "
+             "undisturbedVelocity off, dragVoidFraction cell"
+          << exit(FatalIOError);
+    smoothing_ = std::make_unique<DiffusionSmoothing>(mesh, bandwidth);
+    Info << "grainFoam coupling: diffusionBandwidth b = " << bandwidth
+         << " m: eps, Ksl, KslUs, fParticles and the fluid the particles read are averaged "
+            "by diffusion to pseudo-time b^2/4 (Gaussian exp(-r^2/b^2), sigma = b/sqrt(2) = "
+         << bandwidth / std::sqrt(2.0) << " m) in " << smoothing_->steps()
+         << " explicit steps, each giving away at most " << smoothing_->stepRate()
+         << " of a cell's value (Sun & Xiao 2015)" << endl;
+    const auto work = [&mesh](const char* name) {
+      return std::make_unique<volVectorField>(
+          derivedField(mesh, name, false), mesh,
+          dimensionedVector("zero", dimless, Zero), derivedPatchTypes(mesh));
+    };
+    smoothU_ = work("smoothedU");
+    smoothGradP_ = work("smoothedGradP");
+    smoothDivTau_ = work("smoothedDivTau");
+    smoothCurlU_ = work("smoothedCurlU");
+  }
+
   // --- the DEM ----------------------------------------------------------------------
   if (!sceneFile.isAbsolute()) sceneFile = cwd() / sceneFile;
   try {
@@ -245,6 +282,11 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
   } catch (const std::exception& e) {
     FatalErrorInFunction << "\n" << e.what() << exit(FatalError);
   }
+  if (smoothing_ && dem_->heat_on())
+    FatalIOErrorInFunction(dict) << "diffusionBandwidth is not combined with the scene's heat: "
+                                    "block (the heat exchange is deposited and sampled "
+                                    "without the averaging); set diffusionBandwidth 0"
+                                 << exit(FatalIOError);
   model_ = dem_->vans_model();
   domain_ = dem_->domain();
   periodic_ = dem_->periodic();
@@ -562,6 +604,8 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
       settings.cell_over_d = std::cbrt(sums[2] / cells) / (sums[0] / sums[1]);
       settings.steps_per_fluid = subSteps_;
       settings.drag_void_fraction = sharpInterface_ ? "sharpInterface" : "cell";
+      if (smoothing_)
+        settings.diffusion_bandwidth_over_d = smoothing_->bandwidth() / (sums[0] / sums[1]);
       Info << "  " << coupling::describe_coupled_accuracy(settings).c_str() << endl;
     }
     // Coarse-grained parcels against the cells (the rule of grain check; Radl et al. 2011).
@@ -851,6 +895,21 @@ void ParticleCoupling::deposit() {
   vectorField& fExplicit = fExplicit_.primitiveFieldRef();
   double stepClamped = 0;  // this deposit's, on this rank
   double depositedVolume = 0, meshSolidVolume = 0;
+  if (smoothing_) {
+    // The averaging acts on the deposited fields before the clamp (it conserves their
+    // volume integrals; a uniform eps stays uniform).
+    forAll(eps, c) {
+      eps[c] = 1 - solid[c] / V[c];
+      Ksl[c] = K[c] / V[c];
+      KslUs[c] = KU[c] / V[c];
+      fExplicit[c] = F[c] / V[c];
+    }
+    smoothing_->apply(voidFraction_);
+    smoothing_->apply(Ksl_);
+    smoothing_->apply(KslUs_);
+    smoothing_->apply(fExplicit_);
+    forAll(eps, c) solid[c] = (1 - eps[c]) * V[c];
+  }
   forAll(eps, c) {
     const double raw = 1 - solid[c] / V[c];
     if (raw < minVoidFraction_) {
@@ -861,9 +920,11 @@ void ParticleCoupling::deposit() {
     } else {
       eps[c] = raw;
     }
-    Ksl[c] = K[c] / V[c];
-    KslUs[c] = KU[c] / V[c];
-    fExplicit[c] = F[c] / V[c];
+    if (!smoothing_) {
+      Ksl[c] = K[c] / V[c];
+      KslUs[c] = KU[c] / V[c];
+      fExplicit[c] = F[c] / V[c];
+    }
     depositedVolume += solid[c];
     meshSolidVolume += (1 - eps[c]) * V[c];
   }
@@ -1246,6 +1307,23 @@ void ParticleCoupling::sample() {
   // over the cells at offsets -1, 0, 1 from the particle's own (17 + 3 a + 1 + offset): the
   // offset of a cell along a is round((C_a - x_a) / h_c), h_c = V^(1/3), from the particle's
   // (or its periodic image's) centre, the same on every rank.
+  // diffusionBandwidth: the particles read the fields averaged by the same diffusion as
+  // the deposit (its adjoint: sum V S(Ksl) U = sum V Ksl S(U), the balance stays exact).
+  const UList<vector>* Uc = &U_.primitiveField();
+  const UList<vector>* Gc = &gradP.primitiveField();
+  const UList<vector>* Tc = &divTau.primitiveField();
+  const UList<vector>* Cc = curl ? &tCurlU().primitiveField() : nullptr;
+  if (smoothing_) {
+    const auto smoothed = [this](volVectorField& work, const UList<vector>* from) {
+      work.primitiveFieldRef() = *from;
+      smoothing_->apply(work);
+      return &work.primitiveField();
+    };
+    Uc = smoothed(*smoothU_, Uc);
+    Gc = smoothed(*smoothGradP_, Gc);
+    Tc = smoothed(*smoothDivTau_, Tc);
+    if (curl) Cc = smoothed(*smoothCurlU_, Cc);
+  }
   dem_->begin_fluid();
   const std::size_t W = undisturbed_ ? 26 : 14;
   std::vector<double> acc(W * particles_.size(), 0.0);
@@ -1261,20 +1339,20 @@ void ParticleCoupling::sample() {
       if (sharpInterface_) {
         const double wu = w * velocityScale_[c], wg = w * gradScale_[c];
         for (int d = 0; d < 3; ++d) {
-          a[d] += wu * U_[c][d];
-          a[4 + d] += wg * gradP[c][d];
+          a[d] += wu * (*Uc)[c][d];
+          a[4 + d] += wg * (*Gc)[c][d];
         }
         a[3] += w * dragVoidFraction_[c];
       } else {
         for (int d = 0; d < 3; ++d) {
-          a[d] += w * U_[c][d];
-          a[4 + d] += w * gradP[c][d];
+          a[d] += w * (*Uc)[c][d];
+          a[4 + d] += w * (*Gc)[c][d];
         }
         a[3] += w * voidFraction_[c];
       }
       for (int d = 0; d < 3; ++d) {
-        a[7 + d] += w * divTau[c][d];
-        if (curl) a[10 + d] += w * tCurlU()[c][d];
+        a[7 + d] += w * (*Tc)[c][d];
+        if (curl) a[10 + d] += w * (*Cc)[c][d];
       }
       a[13] += w;
       if (undisturbed_) {
@@ -1338,7 +1416,7 @@ coupling::FluidAtParticle ParticleCoupling::sampleAt(const std::array<double, 3>
   coupling::FluidAtParticle f;
   const Foam::label c = locate(Foam::point(x[0], x[1], x[2]));
   if (c < 0) return f;
-  f.velocity = toArray(U_[c]);
+  f.velocity = toArray(sampledU()[c]);
   f.void_fraction = voidFraction_[c];
   if (T_) f.temperature = (*T_)[c];
   if (meanGradPOn_) f.pressure_gradient = toArray(meanGradP_);
@@ -1351,7 +1429,9 @@ coupling::FluidAtParticle ParticleCoupling::sampleAt(const std::array<double, 3>
 
 void ParticleCoupling::checkBalance() {
   using namespace Foam;
-  // Particle side: K (u_p - v) + F_exchange, with u_p the footprint-weighted U.
+  // Particle side: K (u_p - v) + F_exchange, with u_p the footprint-weighted U (smoothed
+  // with diffusionBandwidth, as sample() read it).
+  const vectorField& Up = sampledU();
   constexpr std::size_t W = 4;
   std::vector<double> acc(W * particles_.size(), 0.0);
   for (std::size_t i = 0; i < particles_.size(); ++i)
@@ -1359,7 +1439,7 @@ void ParticleCoupling::checkBalance() {
       const label c = points_[j].cell;
       const double w = points_[j].weight;
       const double ws = sharpInterface_ ? w * velocityScale_[c] : w;
-      for (int d = 0; d < 3; ++d) acc[W * i + d] += ws * U_[c][d];
+      for (int d = 0; d < 3; ++d) acc[W * i + d] += ws * Up[c][d];
       acc[W * i + 3] += w;
     }
   const std::vector<double> u = dem_->sum_onto_owners(acc, W);

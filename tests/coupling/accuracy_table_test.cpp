@@ -145,6 +145,17 @@ TEST(AccuracyTable, SharpInterfaceIsNotQuotedTheDefaultsTable) {
       << text;
 }
 
+// diffusionBandwidth averages eps and the exchange over several diameters: the tables,
+// measured without it, are not quoted.
+TEST(AccuracyTable, DiffusionBandwidthIsNotQuotedTheDefaultsTable) {
+  CoupledSettings s = bed("divided", "cell", 2, 20);
+  s.diffusion_bandwidth_over_d = 2.83;
+  const std::string text = describe_coupled_accuracy(s);
+  EXPECT_EQ(text.find("-7.3 %"), std::string::npos) << text;
+  EXPECT_NE(text.find("diffusionBandwidth 2.83 d: no measured table here"), std::string::npos)
+      << text;
+}
+
 // (a) A single settling sphere in cells of 3 d was quoted the packed bed's -12.6 % (its
 // error is +18 %): it gets no packed-bed figure, and the settling table only where that was
 // measured (divided, cell, 10 d cells: +1.10 % at N = 1 ... +1.14 % at N = 100).

@@ -1167,11 +1167,94 @@ def balanced_decomposition(runner, checks):
                   f"({max((b[2] for b in lines), default=None)} < {ROUND_OFF:g})")
 
 
+# --- coupling.diffusion_smoothing -------------------------------------------------------
+
+
+def diffusion_smoothing(runner, checks):
+    """couplingProperties diffusionBandwidth b (coupling/foam/diffusionSmoothing.H): the
+    deposited fields diffused to pseudo-time b^2/4 (Sun & Xiao 2015).
+    1. One bead at rest in cases/neutral_particle (a closed 10 mm box of 5^3 cells of 2 mm,
+       the bead in the middle cell), voidFraction centre (all its volume in that cell),
+       b = 1.6 mm: grainFoam takes 2 explicit steps, which reach the cells next to the walls
+       but no wall, so the solid fraction is the discrete heat kernel, whose variance is
+       exactly twice the pseudo-time per axis: sum phi V (x - x_c)^2 / sum phi V = b^2 / 2
+       (Gaussian exp(-r^2/b^2)), its centre the middle cell's, its integral the bead's
+       volume. Tolerance 1e-9 relative: phi = 1 - eps is read from 17-digit eps, and the
+       outermost cells hold phi ~ 1e-5.
+    2. cases/periodic_box in a flow (as exchange_balance), divided, b = 5 mm (12 steps, across
+       the cyclic x and y patches, the walls along z and, on 2 ranks, the processor plane):
+       exchange balanced to 1e-12 (the particles read the fluid smoothed by the same,
+       self-adjoint operator), sum (1 - eps) V = the beads' volume to 1e-12, and eps on 2
+       ranks = eps on 1 rank to 1e-12.
+    3. Refused: a negative bandwidth, and diffusionBandwidth with sampling cellPoint."""
+    b, h = 1.6e-3, 2e-3
+    case = runner.fresh_case("neutral_particle", "smoothing_kernel", [
+        ("constant/couplingProperties", "voidFraction    divided;",
+         f"voidFraction    centre;\ndiffusionBandwidth {b};"),
+        ("system/controlDict", "endTime         0.1;", "endTime         0.002;"),
+        ("system/controlDict", "writeInterval   0.05;", "writeInterval   0.001;")])
+    log = runner.solve(case, 1)
+    checks.expect("diffusionBandwidth b = 0.0016" in log and "in 2 explicit steps" in log,
+                  "b = 1.6 mm in cells of 2 mm: the log says 2 explicit steps")
+    snaps = snapshots(case)
+    radius = float(snaps[-1][1]["radius"][0]) if snaps else 0.0
+    vp = 4.0 / 3.0 * math.pi * radius**3
+    centre = np.array([5e-3, 5e-3, 5e-3])  # the middle cell's centre
+    ijk = np.stack(np.meshgrid(np.arange(5), np.arange(5), np.arange(5), indexing="ij"),
+                   axis=-1)
+    # blockMesh numbers cells with x fastest: cell = i + 5 j + 25 k
+    x = ((ijk.transpose(2, 1, 0, 3).reshape(-1, 3)) + 0.5) * h
+    for folder in time_folders(case):
+        phi = 1 - read_scalar_field(os.path.join(case, folder, "voidfraction"))
+        mass = float(np.sum(phi)) * h**3
+        first = (phi @ x) * h**3 / mass
+        second = (phi @ (x - centre) ** 2) * h**3 / mass
+        checks.expect(abs(mass - vp) < 1e-9 * vp,
+                      f"t = {folder}: sum (1 - eps) V = {mass:.12g} m^3, the bead's {vp:.12g}")
+        checks.expect(np.max(np.abs(first - centre)) < 1e-9 * h,
+                      f"t = {folder}: centre of the solid {first} m = the middle cell's")
+        checks.expect(np.max(np.abs(second / (b * b / 2) - 1)) < 1e-9,
+                      f"t = {folder}: variance per axis {second} m^2 = b^2/2 = {b * b / 2:g} m^2")
+
+    edits = [("0/U", "internalField   uniform (0 0 0);", "internalField   uniform (0.05 0.02 0);"),
+             ("constant/couplingProperties", "ddtVoidFraction on;",
+              "ddtVoidFraction on;\ndiffusionBandwidth 5e-3;")]
+    eps = {}
+    for ranks in (1, 2):
+        case = runner.fresh_case("periodic_box", f"smoothing_np{ranks}", edits)
+        log = runner.solve(case, ranks)
+        checks.expect("in 12 explicit steps" in log, f"np {ranks}: b = 5 mm in 12 steps")
+        lines = balance_lines(log)
+        checks.expect(len(lines) == 2 and all(line[2] < ROUND_OFF for line in lines),
+                      f"np {ranks}: exchange imbalance {[line[2] for line in lines]} < 1e-12")
+        volumes = void_lines(log)
+        checks.expect(len(volumes) == 2 and all(v[3] < ROUND_OFF for v in volumes),
+                      f"np {ranks}: sum (1 - eps) V vs the beads' volume, relative "
+                      f"{[v[3] for v in volumes]} < 1e-12")
+        for folder in TIME_FOLDERS:
+            eps[(ranks, folder)] = read_scalar_field(os.path.join(case, folder, "voidfraction"))
+    for folder in TIME_FOLDERS:
+        diff = float(np.max(np.abs(eps[(1, folder)] - eps[(2, folder)])))
+        checks.expect(diff < ROUND_OFF, f"t = {folder}: max |eps(np 1) - eps(np 2)| = {diff:.3g}")
+
+    for name, text, expected in (
+            ("smoothing_negative", "diffusionBandwidth -1e-3;", "diffusionBandwidth -0.001 is negative"),
+            ("smoothing_cellpoint", "diffusionBandwidth 1e-3;\nsampling        cellPoint;",
+             "diffusionBandwidth 0.001 is not combined with sampling cellPoint")):
+        case = runner.fresh_case("periodic_box", name, [
+            ("constant/couplingProperties", "sampling        cell;", text if "cellPoint" in text
+             else text + "\nsampling        cell;")])
+        runner.run(case, "blockMesh", "blockMesh")
+        log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+        checks.expect(expected in log, f"{name}: refused ('{expected}')")
+
+
 TESTS = {f.__name__: f for f in (void_fraction_volume, exchange_balance, neutrally_buoyant,
                                   cellpoint_ranks,
                                  refuses_bad_setup, restart, stop_signal, nan_guard,
                                  scene_output, heat_equilibrium, heat_balance,
-                                 heat_front, balanced_decomposition)}
+                                 heat_front, balanced_decomposition,
+                                 diffusion_smoothing)}
 
 
 if __name__ == "__main__":

@@ -56,6 +56,12 @@
 #       (busier DEM slab + busier fluid slab least) at w = 0.25 (28 layers: equal slabs) and 4
 #       (12); grainFoam on the last on 2 ranks: each rank owns its slab's beads, the DEM's cut
 #       plane is the mesh's, exchange balanced. About 40 s on the loaded 2-core machine.
+#   coupling.diffusion_smoothing   diffusionBandwidth: one bead's solid fraction in
+#       cases/neutral_particle (voidFraction centre, b = 1.6 mm, 2 steps) has variance b^2/2
+#       per axis (the Gaussian exp(-r^2/b^2)) to 1e-9, its centre and volume the bead's;
+#       cases/periodic_box in a flow with b = 5 mm on 1 and 2 ranks: exchange balanced and
+#       volume conserved to 1e-12, eps(2 ranks) = eps(1 rank) to 1e-12; a negative b and b
+#       with cellPoint refused. About 10 s.
 if(NOT TARGET grainFoam)
   return()
 endif()
@@ -158,6 +164,7 @@ grainflow_coupling_test(heat_equilibrium 1)
 grainflow_coupling_test(heat_balance 2)
 grainflow_coupling_test(heat_front 1)
 grainflow_coupling_test(balanced_decomposition 2)
+grainflow_coupling_test(diffusion_smoothing 2)
 set_tests_properties(coupling.balanced_decomposition PROPERTIES TIMEOUT 300)  # ~40 s loaded
 set_tests_properties(coupling.stop_signal PROPERTIES TIMEOUT 600)  # ~25 s on a quiet machine
 

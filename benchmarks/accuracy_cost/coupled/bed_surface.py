@@ -100,6 +100,37 @@ def layer_profile(case, cells):
     return p * cs.RHO_F, e
 
 
+def bulk_gradients(case, cells, h, face_pressure):
+    """The cells' own -dp/dz in the bed's bulk at the last written time, as the run's
+    momentum equation had it: Gauss linear (the mean of the two neighbours' pressures), or
+    dragSeries (the face pressures of the half cells in series, resistance r = Ksl/(rho eps c),
+    c = eps: model A, a bulk cell read as one layer). Bulk: layers k whose neighbours k - 1 and
+    k + 1 have a mean eps below 0.5, k >= 1. In each layer the fluid's steady balance holds for
+    the eps-weighted mean of the cell gradients, sum eps g = the drag; the layer-mean gradient,
+    which the pressure profile shows, exceeds it by -cov(eps, g) / mean(eps). Returns the spread
+    of eps per cell, the mean g, the eps-weighted mean g and that excess (relative), averaged
+    over the bulk layers."""
+    times = [t for t in os.listdir(case) if re.fullmatch(r"[0-9.]+(e-?\d+)?", t) and t != "0"]
+    last = max(times, key=float)
+    nz, n = int(round(cells * 5)), cells * cells
+    read = lambda name: read_internal(os.path.join(case, last, name)).reshape(nz, n)
+    p, e, k = read("p") * cs.RHO_F, read("voidfraction"), read("Ksl")
+    r = k / (cs.RHO_F * e * e)
+    rows = []
+    for z in range(1, nz - 1):
+        if max(e[z - 1].mean(), e[z].mean(), e[z + 1].mean()) >= 0.5:
+            continue
+        if face_pressure == "dragSeries":
+            face = lambda a, b: (r[b] * p[a] + r[a] * p[b]) / (r[a] + r[b])
+            g = -(face(z, z + 1) - face(z - 1, z)) / h
+        else:
+            g = -(p[z + 1] - p[z - 1]) / (2 * h)
+        ez = e[z]
+        cov = np.mean((ez - ez.mean()) * (g - g.mean()))
+        rows.append((ez.std(), g.mean(), np.mean(ez * g) / ez.mean(), -cov / ez.mean() / g.mean()))
+    return np.mean(np.array(rows), axis=0) if rows else None
+
+
 def inlet_pressure(case):
     """The area-averaged inlet pressure [Pa] at the last time step."""
     rows = np.loadtxt(glob.glob(os.path.join(case, "postProcessing", "inletPressure", "*",
@@ -173,6 +204,12 @@ def main():
                     p_inlet = inlet_pressure(case)
                     profiles.append((law, cells, surface, h, p, e_cell, p_inlet, gradient, height))
                     print_profile(law, d, h, p, e_cell, p_inlet, gradient, height)
+                    bulk = bulk_gradients(case, cells, h, args.pressure)
+                    if bulk is not None:
+                        print(f"    bulk layers, cell gradients ({args.pressure}): eps spread per "
+                              f"cell {bulk[0]:.3f}; -dp/dz layer mean {bulk[1]:.0f} Pa/m, "
+                              f"eps-weighted (the drag's balance) {bulk[2]:.0f} Pa/m; layer mean "
+                              f"above it by -cov(eps, g)/(eps g) = {100 * bulk[3]:+.2f} %")
     out = os.path.join(args.work, "bed_surface.csv")
     new = not os.path.exists(out)
     with open(out, "a", newline="") as f:

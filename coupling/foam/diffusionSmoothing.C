@@ -1,0 +1,77 @@
+#include <cmath>
+
+#include "coupling/foam/diffusionSmoothing.H"
+
+namespace grainflow::foam {
+
+DiffusionSmoothing::DiffusionSmoothing(const Foam::fvMesh& mesh, double bandwidth)
+    : mesh_(mesh), bandwidth_(bandwidth) {
+  using namespace Foam;
+  // |S_f| / |d_f| per face: deltaCoeffs is 1 / |d| between the two cell centres (across a
+  // coupled patch, to the neighbour's centre).
+  const surfaceScalarField& delta = mesh.deltaCoeffs();
+  const surfaceScalarField& magSf = mesh.magSf();
+  internalCoeff_ = magSf.primitiveField() * delta.primitiveField();
+  patchCoeff_.setSize(mesh.boundary().size());
+  scalarField rate(mesh.nCells(), 0.0);  // sum_f |S|/|d| / V per cell
+  const labelUList& owner = mesh.owner();
+  const labelUList& neighbour = mesh.neighbour();
+  forAll(internalCoeff_, f) {
+    rate[owner[f]] += internalCoeff_[f];
+    rate[neighbour[f]] += internalCoeff_[f];
+  }
+  forAll(mesh.boundary(), patch) {
+    const fvPatch& fp = mesh.boundary()[patch];
+    if (!fp.coupled()) continue;
+    const scalarField& area = magSf.boundaryField()[patch];
+    const scalarField& inverseDistance = delta.boundaryField()[patch];
+    patchCoeff_[patch] = area * inverseDistance;
+    const labelUList& cells = fp.faceCells();
+    forAll(cells, i) rate[cells[i]] += patchCoeff_[patch][i];
+  }
+  rV_ = 1.0 / mesh.V().field();
+  rate *= rV_;
+  const double maxRate = gMax(rate);
+  // Pseudo-time T = b^2 / 4 in steps of at most 1 / (2 maxRate).
+  const double T = 0.25 * bandwidth * bandwidth;
+  steps_ = std::max(1, static_cast<int>(std::ceil(2 * T * maxRate - 1e-9)));
+  const double dtau = T / steps_;
+  stepRate_ = dtau * maxRate;
+  internalCoeff_ *= dtau;
+  forAll(patchCoeff_, patch) patchCoeff_[patch] *= dtau;
+}
+
+template <class Type>
+void DiffusionSmoothing::smooth(
+    Foam::GeometricField<Type, Foam::fvPatchField, Foam::volMesh>& field) const {
+  using namespace Foam;
+  const labelUList& owner = mesh_.owner();
+  const labelUList& neighbour = mesh_.neighbour();
+  Field<Type>& phi = field.primitiveFieldRef();
+  Field<Type> change(phi.size());
+  for (int step = 0; step < steps_; ++step) {
+    change = Zero;
+    forAll(internalCoeff_, f) {
+      const Type flux = internalCoeff_[f] * (phi[neighbour[f]] - phi[owner[f]]);
+      change[owner[f]] += flux;
+      change[neighbour[f]] -= flux;
+    }
+    // Coupled patches: the neighbour's cell values (processor exchange, cyclic mapping).
+    field.correctBoundaryConditions();
+    const auto& boundary = field.boundaryField();
+    forAll(boundary, patch) {
+      if (!boundary[patch].coupled()) continue;
+      const scalarField& c = patchCoeff_[patch];
+      const tmp<Field<Type>> other = boundary[patch].patchNeighbourField();
+      const labelUList& cells = mesh_.boundary()[patch].faceCells();
+      forAll(cells, i) change[cells[i]] += c[i] * (other()[i] - phi[cells[i]]);
+    }
+    forAll(phi, cell) phi[cell] += rV_[cell] * change[cell];
+  }
+  field.correctBoundaryConditions();
+}
+
+void DiffusionSmoothing::apply(Foam::volScalarField& field) const { smooth(field); }
+void DiffusionSmoothing::apply(Foam::volVectorField& field) const { smooth(field); }
+
+}  // namespace grainflow::foam
