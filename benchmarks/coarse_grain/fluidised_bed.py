@@ -9,11 +9,21 @@ for them, and time.max_overlap 0.3 instead of 0.2 for the harder landing), the D
 3e-4/7 s so that the fluid step, 3e-4 s for every k, is a whole number of DEM steps).
 
 Per k: the mean pressure drop over [--from, end] against the bed's buoyant weight
-N V_p (rho_p - rho_f) g / A (the plateau above U_mf), its standard deviation (bubbles), the
-mean bed height (95 % of the parcel centres below, over the snapshots in the window), and the
-cost: grainFoam's CPU seconds (ExecutionTime) per simulated second and its wall time.
+N V_p (rho_p - rho_f) g / A (the plateau above U_mf), its standard deviation (bubbles), three
+mean bed heights over the snapshots (fields) in the window (bed_height.py):
+  real      95 % of the real particles' mass below, each parcel's k^3 beads spread over its
+            sphere (the real-particle height, issue 23's measure);
+  centres   95 % of the parcel centres below (a parcel counts once, at its centre);
+  pressure  where the time-mean, horizontally averaged pressure has fallen to 5 % of the
+            drop above the outlet's (95 % of the weight the fluid carries lies below);
+and, from the last snapshot before the inflow (0.2 s), the settled bed's real-particle height
+and solid fraction (real volume over A times twice the mass-mean height);
+and the cost: grainFoam's CPU seconds (ExecutionTime) per simulated second and its wall time.
 
-usage: fluidised_bed.py [--ks 1,2,3] [--end 1.0] [--from 0.5] [--work DIR] [--build DIR]
+usage: fluidised_bed.py [--ks 1,2,3] [--end 1.0] [--from 0.5] [--seed 1] [--work DIR]
+                        [--build DIR] [--analyse-only]
+--seed sets the fill's random seed (another realisation of the same bed; cases k<k>_seed<s>).
+--analyse-only reads the cases already in DIR (the cost columns from their logs).
 Prints one row per k and appends them to <work>/fluidised_bed.csv.
 """
 import argparse
@@ -30,6 +40,8 @@ import time
 import h5py
 import numpy as np
 
+from bed_height import centre_height, foam_scalar_field, pressure_height, real_height
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 FOAM = os.path.join(ROOT, "scripts", "foam_env.sh")
@@ -37,6 +49,7 @@ TUTORIAL = os.path.join(ROOT, "tutorials", "cfd-dem", "fluidisedBed")
 RHO_F, G = 1.2, 9.81
 AREA = 0.06 * 0.009
 FLUID_STEP = 3e-4
+INFLOW_START = 0.2  # 0/U: the inflow ramps up from 0.2 s
 
 
 def sub(path, old, new):
@@ -51,8 +64,12 @@ def dem_step(k):
     return FLUID_STEP / steps, steps
 
 
-def prepare(work, k, end):
-    case = os.path.join(work, f"k{k}")
+def case_dir(work, k, seed):
+    return os.path.join(work, f"k{k}_seed{seed}")
+
+
+def prepare(work, k, end, seed):
+    case = case_dir(work, k, seed)
     shutil.rmtree(case, ignore_errors=True)
     shutil.copytree(TUTORIAL, case, ignore=shutil.ignore_patterns(
         "particles", "processor*", "postProcessing", "log.*", "*.png", "[1-9]*", "0.[0-9]*"))
@@ -60,6 +77,7 @@ def prepare(work, k, end):
     scene = os.path.join(case, "particles.yaml")
     sub(scene, "    count: 12000\n", f"    count: {round(12000 / k**3)}\n    coarse_grain: {k}\n")
     sub(scene, "  step: 1.5e-5\n", f"  step: {dt:.17g}\n")
+    sub(scene, "    seed: 1\n", f"    seed: {seed}\n")
     if k > 1:  # random insertion keeps centres k r inside the region: give the parcels room
         sub(scene, "max: [0.06, 0.009, 0.082]", "max: [0.06, 0.009, 0.16]")
         # The longer fall lands them harder: at k = 2 a pair reached 20.3 % overlap in the pour.
@@ -80,11 +98,18 @@ def analyse(case, t_from):
     n = min(len(t), len(p_out))
     t, dp = t[:n], RHO_F * (p_in[:n] - p_out[:n])
     window = t >= t_from - 1e-9
-    heights = []
+    centres, reals, settled = [], [], None
     for s in sorted(glob.glob(os.path.join(case, "particles", "particles_*.h5"))):
         with h5py.File(s, "r") as f:
-            if float(f.attrs["time"]) >= t_from - 1e-9:
-                heights.append(np.percentile(f["position"][:, 2], 95))
+            ts = float(f.attrs["time"])
+            if ts >= t_from - 1e-9 or ts <= INFLOW_START + 1e-9:
+                z, r, m = f["position"][:, 2], 0.5 * f["diameter"][:], f["mass"][:]
+            if ts >= t_from - 1e-9:
+                centres.append(centre_height(z))
+                reals.append(real_height(z, r, m))
+            elif ts <= INFLOW_START + 1e-9:  # the last snapshot before the inflow: the settled bed
+                settled = (real_height(z, r, m), float(np.sum(4 / 3 * math.pi * r**3) / AREA
+                                                        / (2 * np.dot(m, z) / m.sum())))
             last = s
     with h5py.File(last, "r") as f:
         d, m = f["diameter"][:], f["mass"][:]
@@ -93,7 +118,37 @@ def analyse(case, t_from):
     weight = float(np.sum(m - RHO_F * v)) * G / AREA
     return dict(parcels=len(d), real=int(real), dp_mean=float(dp[window].mean()),
                 dp_std=float(dp[window].std()), weight=weight,
-                height=float(np.mean(heights)) if heights else float("nan"))
+                height=float(np.mean(reals)) if reals else float("nan"),
+                height_centres=float(np.mean(centres)) if centres else float("nan"),
+                height_sd=float(np.std(reals)) if reals else float("nan"),
+                height_pressure=pressure_profile_height(case, t_from, t, p_in[:n], p_out[:n]),
+                snapshots=len(reals), settled_height=settled[0] if settled else float("nan"),
+                settled_solid_fraction=settled[1] if settled else float("nan"))
+
+
+def pressure_profile_height(case, t_from, t, p_in, p_out):
+    """pressure_height of the time-mean profile: the written p fields (cell layers of the
+    uniform 20 x 3 x 80 mesh, x fastest, z slowest) averaged over each layer, between the
+    inlet's and the outlet's area-averaged p at the same times, averaged over the write times
+    from t_from on."""
+    nx, ny, nz, height = 20, 3, 80, 0.24
+    profiles = []
+    for d in glob.glob(os.path.join(case, "[0-9]*")):
+        try:
+            tw = float(os.path.basename(d))
+        except ValueError:
+            continue
+        if tw < t_from - 1e-9 or not os.path.exists(os.path.join(d, "p")):
+            continue
+        i = int(np.argmin(abs(t - tw)))
+        if abs(t[i] - tw) > 1e-6:
+            continue
+        layers = foam_scalar_field(os.path.join(d, "p")).reshape(nz, ny * nx).mean(axis=1)
+        profiles.append(np.concatenate(([p_in[i]], layers, [p_out[i]])))
+    if not profiles:
+        return float("nan")
+    z = np.concatenate(([0.0], (np.arange(nz) + 0.5) * height / nz, [height]))
+    return pressure_height(z, np.mean(profiles, axis=0))
 
 
 def main():
@@ -101,6 +156,8 @@ def main():
     ap.add_argument("--ks", default="1,2,3")
     ap.add_argument("--end", type=float, default=1.0)
     ap.add_argument("--from", dest="t_from", type=float, default=0.5)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--analyse-only", action="store_true")
     ap.add_argument("--work", default=os.path.join(ROOT, "build", "benchmarks", "coarse_grain_fluidised"))
     ap.add_argument("--build", default=os.environ.get("GRAINFLOW_BUILD_DIR", os.path.join(ROOT, "build")))
     args = ap.parse_args()
@@ -108,24 +165,31 @@ def main():
     env = dict(os.environ, LD_LIBRARY_PATH=os.path.join(args.build, "lib"))
     rows = []
     for k in (int(x) for x in args.ks.split(",")):
-        case = prepare(args.work, k, args.end)
-        started = time.monotonic()
-        for cmd, log in ((["blockMesh"], "log.blockMesh"),
-                         ([os.path.join(args.build, "bin", "grainFoam")], "log.grainFoam")):
-            with open(os.path.join(case, log), "w") as out:
-                if subprocess.call([FOAM] + cmd, cwd=case, stdout=out, stderr=subprocess.STDOUT, env=env):
-                    sys.exit(f"fluidised_bed: k = {k}: {cmd[0]} failed, see {case}/{log}")
-        wall = time.monotonic() - started
+        if args.analyse_only:
+            case, wall = case_dir(args.work, k, args.seed), float("nan")
+        else:
+            case = prepare(args.work, k, args.end, args.seed)
+            started = time.monotonic()
+            for cmd, log in ((["blockMesh"], "log.blockMesh"),
+                             ([os.path.join(args.build, "bin", "grainFoam")], "log.grainFoam")):
+                with open(os.path.join(case, log), "w") as out:
+                    if subprocess.call([FOAM] + cmd, cwd=case, stdout=out, stderr=subprocess.STDOUT, env=env):
+                        sys.exit(f"fluidised_bed: k = {k}: {cmd[0]} failed, see {case}/{log}")
+            wall = time.monotonic() - started
         text = open(os.path.join(case, "log.grainFoam")).read()
         cpu = float(re.findall(r"ExecutionTime = (\S+) s", text)[-1])
         imbalance = max(float(x) for x in re.findall(r"relative imbalance (\S+)", text))
-        row = dict(k=k, **analyse(case, args.t_from), cpu_s=cpu, wall_s=wall,
+        row = dict(k=k, seed=args.seed, **analyse(case, args.t_from), cpu_s=cpu, wall_s=wall,
                    cpu_per_simulated_s=cpu / args.end, worst_imbalance=imbalance)
         rows.append(row)
         print(f"k = {k}: {row['parcels']} parcels ({row['real']} beads), mean dp "
               f"{row['dp_mean']:.1f} Pa = {row['dp_mean'] / row['weight']:.4f} x weight "
-              f"{row['weight']:.1f} Pa, std {row['dp_std']:.1f} Pa, bed height "
-              f"{1e3 * row['height']:.1f} mm, CPU {cpu:.0f} s ({cpu / args.end:.0f} s per "
+              f"{row['weight']:.1f} Pa, std {row['dp_std']:.1f} Pa, bed height (real particles) "
+              f"{1e3 * row['height']:.2f} mm (sd over {row['snapshots']} snapshots "
+              f"{1e3 * row['height_sd']:.2f}), parcel centres {1e3 * row['height_centres']:.2f} mm, "
+              f"pressure {1e3 * row['height_pressure']:.2f} mm; settled before the inflow: real-particle "
+              f"height {1e3 * row['settled_height']:.2f} mm, solid fraction "
+              f"{row['settled_solid_fraction']:.3f}; CPU {cpu:.0f} s ({cpu / args.end:.0f} s per "
               f"simulated s), wall {wall:.0f} s, exchange imbalance {imbalance:.1e}", flush=True)
     out = os.path.join(args.work, "fluidised_bed.csv")
     new = not os.path.exists(out)
@@ -137,7 +201,9 @@ def main():
     if rows and rows[0]["k"] == 1:
         base = rows[0]
         for r in rows[1:]:
-            print(f"k = {r['k']} vs k = 1: bed height {100 * (r['height'] / base['height'] - 1):+.1f} %, "
+            rel = {key: 100 * (r[key] / base[key] - 1) for key in ("height", "height_centres", "height_pressure")}
+            print(f"k = {r['k']} vs k = 1: bed height (real particles) {rel['height']:+.1f} %, "
+                  f"(parcel centres) {rel['height_centres']:+.1f} %, (pressure) {rel['height_pressure']:+.1f} %, "
                   f"std of dp {100 * (r['dp_std'] / base['dp_std'] - 1):+.1f} %, cost "
                   f"{base['cpu_s'] / r['cpu_s']:.1f}x less (k^3/2 = {r['k']**3 / 2:g})")
     return 0
