@@ -17,13 +17,17 @@ mean bed heights over the snapshots (fields) in the window (bed_height.py):
   pressure  where the time-mean, horizontally averaged pressure has fallen to 5 % of the
             drop above the outlet's (95 % of the weight the fluid carries lies below);
 and, from the last snapshot before the inflow (0.2 s), the settled bed's real-particle height
-and solid fraction (real volume over A times twice the mass-mean height);
+and solid fraction (real volume over A times twice the mass-mean height); from the written void
+fractions, the bubble holdup (the fraction of the bed's cells with eps > 0.8) and the emulsion's
+mean eps (the bed's other cells);
 and the cost: grainFoam's CPU seconds (ExecutionTime) per simulated second and its wall time.
 
 usage: fluidised_bed.py [--ks 1,2,3] [--end 1.0] [--from 0.5] [--seed 1] [--work DIR]
-                        [--build DIR] [--analyse-only]
+                        [--build DIR] [--analyse-only] [--diagnose]
 --seed sets the fill's random seed (another realisation of the same bed; cases k<k>_seed<s>).
 --analyse-only reads the cases already in DIR (the cost columns from their logs).
+--diagnose also prints the heights per snapshot, the solid-fraction profiles and the real mass
+across the depth.
 Prints one row per k and appends them to <work>/fluidised_bed.csv.
 """
 import argparse
@@ -40,7 +44,8 @@ import time
 import h5py
 import numpy as np
 
-from bed_height import centre_height, foam_scalar_field, pressure_height, real_height
+from bed_height import (centre_height, foam_scalar_field, pressure_height, real_height,
+                        sphere_fraction_below)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
@@ -123,32 +128,80 @@ def analyse(case, t_from):
                 height_sd=float(np.std(reals)) if reals else float("nan"),
                 height_pressure=pressure_profile_height(case, t_from, t, p_in[:n], p_out[:n]),
                 snapshots=len(reals), settled_height=settled[0] if settled else float("nan"),
-                settled_solid_fraction=settled[1] if settled else float("nan"))
+                settled_solid_fraction=settled[1] if settled else float("nan"),
+                **dict(zip(("bubble_holdup", "emulsion_voidfraction"), bubbles(case, t_from))))
 
 
-def pressure_profile_height(case, t_from, t, p_in, p_out):
-    """pressure_height of the time-mean profile: the written p fields (cell layers of the
-    uniform 20 x 3 x 80 mesh, x fastest, z slowest) averaged over each layer, between the
-    inlet's and the outlet's area-averaged p at the same times, averaged over the write times
-    from t_from on."""
-    nx, ny, nz, height = 20, 3, 80, 0.24
-    profiles = []
+NX, NY, NZ, HEIGHT = 20, 3, 80, 0.24  # the uniform mesh of 3 mm cells, x fastest, z slowest
+
+
+def written_fields(case, t_from, name):
+    """(time, field as [z, y, x]) of each written field `name` from t_from on."""
+    out = []
     for d in glob.glob(os.path.join(case, "[0-9]*")):
         try:
             tw = float(os.path.basename(d))
         except ValueError:
             continue
-        if tw < t_from - 1e-9 or not os.path.exists(os.path.join(d, "p")):
-            continue
+        if tw >= t_from - 1e-9 and os.path.exists(os.path.join(d, name)):
+            out.append((tw, foam_scalar_field(os.path.join(d, name)).reshape(NZ, NY, NX)))
+    return sorted(out, key=lambda x: x[0])
+
+
+def pressure_profile_height(case, t_from, t, p_in, p_out):
+    """pressure_height of the time-mean profile: the written p fields averaged over each cell
+    layer, between the inlet's and the outlet's area-averaged p at the same times, averaged
+    over the write times from t_from on."""
+    profiles = []
+    for tw, p in written_fields(case, t_from, "p"):
         i = int(np.argmin(abs(t - tw)))
-        if abs(t[i] - tw) > 1e-6:
-            continue
-        layers = foam_scalar_field(os.path.join(d, "p")).reshape(nz, ny * nx).mean(axis=1)
-        profiles.append(np.concatenate(([p_in[i]], layers, [p_out[i]])))
+        if abs(t[i] - tw) <= 1e-6:
+            profiles.append(np.concatenate(([p_in[i]], p.mean(axis=(1, 2)), [p_out[i]])))
     if not profiles:
         return float("nan")
-    z = np.concatenate(([0.0], (np.arange(nz) + 0.5) * height / nz, [height]))
+    z = np.concatenate(([0.0], (np.arange(NZ) + 0.5) * HEIGHT / NZ, [HEIGHT]))
     return pressure_height(z, np.mean(profiles, axis=0))
+
+
+def bubbles(case, t_from):
+    """Over the written void fractions from t_from on: the bubble holdup (the fraction of the
+    bed's cells with eps > 0.8; the bed: the cell layers whose mean eps is below 0.9) and the
+    emulsion's mean eps (the bed's other cells)."""
+    hold, emulsion = [], []
+    for _, e in written_fields(case, t_from, "voidfraction"):
+        bed = e[e.mean(axis=(1, 2)) < 0.9]
+        hold.append(float((bed > 0.8).mean()))
+        emulsion.append(float(bed[bed <= 0.8].mean()))
+    return (float(np.mean(hold)), float(np.mean(emulsion))) if hold else (float("nan"),) * 2
+
+
+def diagnose(case, t_from):
+    """Print the heights per snapshot, the settled and the time-mean fluidised solid fraction
+    per 3 mm layer (real mass spread over each sphere) and the real mass across the depth in
+    the lower bed (z 5-25 mm, nine 1 mm bins)."""
+    edges, yedges = np.arange(0, 0.0901, 0.003), np.linspace(0, 0.009, 10)
+
+    def spread(c, r, m, e):
+        return (m[:, None] * np.diff(sphere_fraction_below((e[None, :] - c[:, None]) / r[:, None]), axis=1)).sum(0)
+    heights, fluid, depth, settled = [], [], [], None
+    for s in sorted(glob.glob(os.path.join(case, "particles", "particles_*.h5"))):
+        with h5py.File(s, "r") as f:
+            ts, x, r, m = float(f.attrs["time"]), f["position"][:], 0.5 * f["diameter"][:], f["mass"][:]
+        rho = float(m.sum() / np.sum(4 / 3 * math.pi * r**3))
+        layers = spread(x[:, 2], r, m, edges) / (rho * AREA * 0.003)
+        if ts <= INFLOW_START + 1e-9:
+            settled = (ts, layers)
+        elif ts >= t_from - 1e-9:
+            heights.append((ts, real_height(x[:, 2], r, m), centre_height(x[:, 2])))
+            fluid.append(layers)
+            low = (x[:, 2] > 0.005) & (x[:, 2] < 0.025)
+            depth.append(spread(x[low, 1], r[low], m[low], yedges) / m[low].sum())
+    print(f"  {os.path.basename(case)}: heights real/centres [mm] per snapshot: "
+          + " ".join(f"{ts:.2f}:{1e3 * a:.1f}/{1e3 * b:.1f}" for ts, a, b in heights))
+    print(f"    solid fraction per 3 mm layer, settled (t = {settled[0]:.2f} s): "
+          + " ".join(f"{v:.2f}" for v in settled[1]))
+    print("    solid fraction per 3 mm layer, fluidised (time mean): " + " ".join(f"{v:.2f}" for v in np.mean(fluid, 0)))
+    print("    real mass across the depth, z 5-25 mm, 1 mm bins: " + " ".join(f"{v:.3f}" for v in np.mean(depth, 0)))
 
 
 def main():
@@ -158,6 +211,7 @@ def main():
     ap.add_argument("--from", dest="t_from", type=float, default=0.5)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--analyse-only", action="store_true")
+    ap.add_argument("--diagnose", action="store_true")
     ap.add_argument("--work", default=os.path.join(ROOT, "build", "benchmarks", "coarse_grain_fluidised"))
     ap.add_argument("--build", default=os.environ.get("GRAINFLOW_BUILD_DIR", os.path.join(ROOT, "build")))
     args = ap.parse_args()
@@ -182,6 +236,8 @@ def main():
         row = dict(k=k, seed=args.seed, **analyse(case, args.t_from), cpu_s=cpu, wall_s=wall,
                    cpu_per_simulated_s=cpu / args.end, worst_imbalance=imbalance)
         rows.append(row)
+        if args.diagnose:
+            diagnose(case, args.t_from)
         print(f"k = {k}: {row['parcels']} parcels ({row['real']} beads), mean dp "
               f"{row['dp_mean']:.1f} Pa = {row['dp_mean'] / row['weight']:.4f} x weight "
               f"{row['weight']:.1f} Pa, std {row['dp_std']:.1f} Pa, bed height (real particles) "
@@ -189,7 +245,8 @@ def main():
               f"{1e3 * row['height_sd']:.2f}), parcel centres {1e3 * row['height_centres']:.2f} mm, "
               f"pressure {1e3 * row['height_pressure']:.2f} mm; settled before the inflow: real-particle "
               f"height {1e3 * row['settled_height']:.2f} mm, solid fraction "
-              f"{row['settled_solid_fraction']:.3f}; CPU {cpu:.0f} s ({cpu / args.end:.0f} s per "
+              f"{row['settled_solid_fraction']:.3f}; bubble holdup {row['bubble_holdup']:.3f}, emulsion eps "
+              f"{row['emulsion_voidfraction']:.3f}; CPU {cpu:.0f} s ({cpu / args.end:.0f} s per "
               f"simulated s), wall {wall:.0f} s, exchange imbalance {imbalance:.1e}", flush=True)
     out = os.path.join(args.work, "fluidised_bed.csv")
     new = not os.path.exists(out)
