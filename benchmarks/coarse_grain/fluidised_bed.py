@@ -22,9 +22,11 @@ fractions, the bubble holdup (the fraction of the bed's cells with eps > 0.8) an
 mean eps (the bed's other cells);
 and the cost: grainFoam's CPU seconds (ExecutionTime) per simulated second and its wall time.
 
-usage: fluidised_bed.py [--ks 1,2,3] [--end 1.0] [--from 0.5] [--seed 1] [--work DIR]
+usage: fluidised_bed.py [--ks 1,2,3] [--end 1.0] [--from 0.5] [--seed 1] [--depth 0.009] [--work DIR]
                         [--build DIR] [--analyse-only] [--diagnose]
 --seed sets the fill's random seed (another realisation of the same bed; cases k<k>_seed<s>).
+--depth D makes the column D deep (a whole number of 3 mm cells; 12 000 D/9 mm beads, the same
+real beads per area; cases k<k>_seed<s>_depth<D>mm).
 --analyse-only reads the cases already in DIR (the cost columns from their logs).
 --diagnose also prints the heights per snapshot, the solid-fraction profiles and the real mass
 across the depth.
@@ -52,7 +54,8 @@ ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 FOAM = os.path.join(ROOT, "scripts", "foam_env.sh")
 TUTORIAL = os.path.join(ROOT, "tutorials", "cfd-dem", "fluidisedBed")
 RHO_F, G = 1.2, 9.81
-AREA = 0.06 * 0.009
+DEPTH = 0.009  # the column depth; --depth changes it (and AREA, NY)
+AREA = 0.06 * DEPTH
 FLUID_STEP = 3e-4
 INFLOW_START = 0.2  # 0/U: the inflow ramps up from 0.2 s
 
@@ -70,7 +73,18 @@ def dem_step(k):
 
 
 def case_dir(work, k, seed):
-    return os.path.join(work, f"k{k}_seed{seed}")
+    tail = "" if abs(DEPTH - 0.009) < 1e-12 else f"_depth{1e3 * DEPTH:g}mm"
+    return os.path.join(work, f"k{k}_seed{seed}{tail}")
+
+
+def set_depth(depth):
+    """The column DEPTH deep (a whole number of 3 mm cells): the fill's count, the walls, the
+    mesh and the analysis scale with it (the same real beads per area)."""
+    global DEPTH, AREA, NY
+    NY = round(depth / 0.003)
+    if NY < 1 or abs(NY * 0.003 - depth) > 1e-9:
+        sys.exit(f"fluidised_bed: --depth {depth} is not a whole number of 3 mm cells")
+    DEPTH, AREA = depth, 0.06 * depth
 
 
 def prepare(work, k, end, seed):
@@ -80,7 +94,8 @@ def prepare(work, k, end, seed):
         "particles", "processor*", "postProcessing", "log.*", "*.png", "[1-9]*", "0.[0-9]*"))
     dt, _ = dem_step(k)
     scene = os.path.join(case, "particles.yaml")
-    sub(scene, "    count: 12000\n", f"    count: {round(12000 / k**3)}\n    coarse_grain: {k}\n")
+    beads = 12000 * DEPTH / 0.009
+    sub(scene, "    count: 12000\n", f"    count: {round(beads / k**3)}\n    coarse_grain: {k}\n")
     sub(scene, "  step: 1.5e-5\n", f"  step: {dt:.17g}\n")
     sub(scene, "    seed: 1\n", f"    seed: {seed}\n")
     if k > 1:  # random insertion keeps centres k r inside the region: give the parcels room
@@ -88,6 +103,14 @@ def prepare(work, k, end, seed):
         # The longer fall lands them harder: at k = 2 a pair reached 20.3 % overlap in the pour.
         sub(scene, "  max_overlap: 0.2\n", "  max_overlap: 0.3\n")
     sub(os.path.join(case, "system", "controlDict"), "endTime         1.0;", f"endTime         {end:g};")
+    if abs(DEPTH - 0.009) > 1e-12:
+        y, mm = f"{DEPTH:g}", f"{1e3 * DEPTH:g}"
+        for old in ("max: [0.06, 0.009, 0.24]", "point: [0, 0.009, 0]", "max: [0.06, 0.009, 0."):
+            sub(scene, old, old.replace("0.009", y))
+        mesh = os.path.join(case, "system", "blockMeshDict")
+        sub(mesh, "(60 9 0) (0 9 0)", f"(60 {mm} 0) (0 {mm} 0)")
+        sub(mesh, "(60 9 240) (0 9 240)", f"(60 {mm} 240) (0 {mm} 240)")
+        sub(mesh, "(20 3 80)", f"(20 {NY} 80)")
     return case
 
 
@@ -178,8 +201,8 @@ def bubbles(case, t_from):
 def diagnose(case, t_from):
     """Print the heights per snapshot, the settled and the time-mean fluidised solid fraction
     per 3 mm layer (real mass spread over each sphere) and the real mass across the depth in
-    the lower bed (z 5-25 mm, nine 1 mm bins)."""
-    edges, yedges = np.arange(0, 0.0901, 0.003), np.linspace(0, 0.009, 10)
+    the lower bed (z 5-25 mm, 1 mm bins)."""
+    edges, yedges = np.arange(0, 0.0901, 0.003), np.linspace(0, DEPTH, round(DEPTH / 0.001) + 1)
 
     def spread(c, r, m, e):
         return (m[:, None] * np.diff(sphere_fraction_below((e[None, :] - c[:, None]) / r[:, None]), axis=1)).sum(0)
@@ -212,9 +235,11 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--analyse-only", action="store_true")
     ap.add_argument("--diagnose", action="store_true")
+    ap.add_argument("--depth", type=float, default=0.009)
     ap.add_argument("--work", default=os.path.join(ROOT, "build", "benchmarks", "coarse_grain_fluidised"))
     ap.add_argument("--build", default=os.environ.get("GRAINFLOW_BUILD_DIR", os.path.join(ROOT, "build")))
     args = ap.parse_args()
+    set_depth(args.depth)
     os.makedirs(args.work, exist_ok=True)
     env = dict(os.environ, LD_LIBRARY_PATH=os.path.join(args.build, "lib"))
     rows = []
@@ -233,7 +258,7 @@ def main():
         text = open(os.path.join(case, "log.grainFoam")).read()
         cpu = float(re.findall(r"ExecutionTime = (\S+) s", text)[-1])
         imbalance = max(float(x) for x in re.findall(r"relative imbalance (\S+)", text))
-        row = dict(k=k, seed=args.seed, **analyse(case, args.t_from), cpu_s=cpu, wall_s=wall,
+        row = dict(k=k, seed=args.seed, depth=DEPTH, **analyse(case, args.t_from), cpu_s=cpu, wall_s=wall,
                    cpu_per_simulated_s=cpu / args.end, worst_imbalance=imbalance)
         rows.append(row)
         if args.diagnose:
