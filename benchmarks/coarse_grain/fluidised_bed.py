@@ -9,11 +9,27 @@ for them, and time.max_overlap 0.3 instead of 0.2 for the harder landing), the D
 3e-4/7 s so that the fluid step, 3e-4 s for every k, is a whole number of DEM steps).
 
 Per k: the mean pressure drop over [--from, end] against the bed's buoyant weight
-N V_p (rho_p - rho_f) g / A (the plateau above U_mf), its standard deviation (bubbles), the
-mean bed height (95 % of the parcel centres below, over the snapshots in the window), and the
-cost: grainFoam's CPU seconds (ExecutionTime) per simulated second and its wall time.
+N V_p (rho_p - rho_f) g / A (the plateau above U_mf), its standard deviation (bubbles), three
+mean bed heights over the snapshots (fields) in the window (bed_height.py):
+  real      95 % of the real particles' mass below, each parcel's k^3 beads spread over its
+            sphere (the real-particle height, issue 23's measure);
+  centres   95 % of the parcel centres below (a parcel counts once, at its centre);
+  pressure  where the time-mean, horizontally averaged pressure has fallen to 5 % of the
+            drop above the outlet's (95 % of the weight the fluid carries lies below);
+and, from the last snapshot before the inflow (0.2 s), the settled bed's real-particle height
+and solid fraction (real volume over A times twice the mass-mean height); from the written void
+fractions, the bubble holdup (the fraction of the bed's cells with eps > 0.8) and the emulsion's
+mean eps (the bed's other cells);
+and the cost: grainFoam's CPU seconds (ExecutionTime) per simulated second and its wall time.
 
-usage: fluidised_bed.py [--ks 1,2,3] [--end 1.0] [--from 0.5] [--work DIR] [--build DIR]
+usage: fluidised_bed.py [--ks 1,2,3] [--end 1.0] [--from 0.5] [--seed 1] [--depth 0.009] [--work DIR]
+                        [--build DIR] [--analyse-only] [--diagnose]
+--seed sets the fill's random seed (another realisation of the same bed; cases k<k>_seed<s>).
+--depth D makes the column D deep (a whole number of 3 mm cells; 12 000 D/9 mm beads, the same
+real beads per area; cases k<k>_seed<s>_depth<D>mm).
+--analyse-only reads the cases already in DIR (the cost columns from their logs).
+--diagnose also prints the heights per snapshot, the solid-fraction profiles and the real mass
+across the depth.
 Prints one row per k and appends them to <work>/fluidised_bed.csv.
 """
 import argparse
@@ -30,13 +46,18 @@ import time
 import h5py
 import numpy as np
 
+from bed_height import (centre_height, foam_scalar_field, pressure_height, real_height,
+                        sphere_fraction_below)
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 FOAM = os.path.join(ROOT, "scripts", "foam_env.sh")
 TUTORIAL = os.path.join(ROOT, "tutorials", "cfd-dem", "fluidisedBed")
 RHO_F, G = 1.2, 9.81
-AREA = 0.06 * 0.009
+DEPTH = 0.009  # the column depth; --depth changes it (and AREA, NY)
+AREA = 0.06 * DEPTH
 FLUID_STEP = 3e-4
+INFLOW_START = 0.2  # 0/U: the inflow ramps up from 0.2 s
 
 
 def sub(path, old, new):
@@ -51,20 +72,45 @@ def dem_step(k):
     return FLUID_STEP / steps, steps
 
 
-def prepare(work, k, end):
-    case = os.path.join(work, f"k{k}")
+def case_dir(work, k, seed):
+    tail = "" if abs(DEPTH - 0.009) < 1e-12 else f"_depth{1e3 * DEPTH:g}mm"
+    return os.path.join(work, f"k{k}_seed{seed}{tail}")
+
+
+def set_depth(depth):
+    """The column DEPTH deep (a whole number of 3 mm cells): the fill's count, the walls, the
+    mesh and the analysis scale with it (the same real beads per area)."""
+    global DEPTH, AREA, NY
+    NY = round(depth / 0.003)
+    if NY < 1 or abs(NY * 0.003 - depth) > 1e-9:
+        sys.exit(f"fluidised_bed: --depth {depth} is not a whole number of 3 mm cells")
+    DEPTH, AREA = depth, 0.06 * depth
+
+
+def prepare(work, k, end, seed):
+    case = case_dir(work, k, seed)
     shutil.rmtree(case, ignore_errors=True)
     shutil.copytree(TUTORIAL, case, ignore=shutil.ignore_patterns(
         "particles", "processor*", "postProcessing", "log.*", "*.png", "[1-9]*", "0.[0-9]*"))
     dt, _ = dem_step(k)
     scene = os.path.join(case, "particles.yaml")
-    sub(scene, "    count: 12000\n", f"    count: {round(12000 / k**3)}\n    coarse_grain: {k}\n")
+    beads = 12000 * DEPTH / 0.009
+    sub(scene, "    count: 12000\n", f"    count: {round(beads / k**3)}\n    coarse_grain: {k}\n")
     sub(scene, "  step: 1.5e-5\n", f"  step: {dt:.17g}\n")
+    sub(scene, "    seed: 1\n", f"    seed: {seed}\n")
     if k > 1:  # random insertion keeps centres k r inside the region: give the parcels room
         sub(scene, "max: [0.06, 0.009, 0.082]", "max: [0.06, 0.009, 0.16]")
         # The longer fall lands them harder: at k = 2 a pair reached 20.3 % overlap in the pour.
         sub(scene, "  max_overlap: 0.2\n", "  max_overlap: 0.3\n")
     sub(os.path.join(case, "system", "controlDict"), "endTime         1.0;", f"endTime         {end:g};")
+    if abs(DEPTH - 0.009) > 1e-12:
+        y, mm = f"{DEPTH:g}", f"{1e3 * DEPTH:g}"
+        for old in ("max: [0.06, 0.009, 0.24]", "point: [0, 0.009, 0]", "max: [0.06, 0.009, 0."):
+            sub(scene, old, old.replace("0.009", y))
+        mesh = os.path.join(case, "system", "blockMeshDict")
+        sub(mesh, "(60 9 0) (0 9 0)", f"(60 {mm} 0) (0 {mm} 0)")
+        sub(mesh, "(60 9 240) (0 9 240)", f"(60 {mm} 240) (0 {mm} 240)")
+        sub(mesh, "(20 3 80)", f"(20 {NY} 80)")
     return case
 
 
@@ -80,11 +126,18 @@ def analyse(case, t_from):
     n = min(len(t), len(p_out))
     t, dp = t[:n], RHO_F * (p_in[:n] - p_out[:n])
     window = t >= t_from - 1e-9
-    heights = []
+    centres, reals, settled = [], [], None
     for s in sorted(glob.glob(os.path.join(case, "particles", "particles_*.h5"))):
         with h5py.File(s, "r") as f:
-            if float(f.attrs["time"]) >= t_from - 1e-9:
-                heights.append(np.percentile(f["position"][:, 2], 95))
+            ts = float(f.attrs["time"])
+            if ts >= t_from - 1e-9 or ts <= INFLOW_START + 1e-9:
+                z, r, m = f["position"][:, 2], 0.5 * f["diameter"][:], f["mass"][:]
+            if ts >= t_from - 1e-9:
+                centres.append(centre_height(z))
+                reals.append(real_height(z, r, m))
+            elif ts <= INFLOW_START + 1e-9:  # the last snapshot before the inflow: the settled bed
+                settled = (real_height(z, r, m), float(np.sum(4 / 3 * math.pi * r**3) / AREA
+                                                        / (2 * np.dot(m, z) / m.sum())))
             last = s
     with h5py.File(last, "r") as f:
         d, m = f["diameter"][:], f["mass"][:]
@@ -93,7 +146,85 @@ def analyse(case, t_from):
     weight = float(np.sum(m - RHO_F * v)) * G / AREA
     return dict(parcels=len(d), real=int(real), dp_mean=float(dp[window].mean()),
                 dp_std=float(dp[window].std()), weight=weight,
-                height=float(np.mean(heights)) if heights else float("nan"))
+                height=float(np.mean(reals)) if reals else float("nan"),
+                height_centres=float(np.mean(centres)) if centres else float("nan"),
+                height_sd=float(np.std(reals)) if reals else float("nan"),
+                height_pressure=pressure_profile_height(case, t_from, t, p_in[:n], p_out[:n]),
+                snapshots=len(reals), settled_height=settled[0] if settled else float("nan"),
+                settled_solid_fraction=settled[1] if settled else float("nan"),
+                **dict(zip(("bubble_holdup", "emulsion_voidfraction"), bubbles(case, t_from))))
+
+
+NX, NY, NZ, HEIGHT = 20, 3, 80, 0.24  # the uniform mesh of 3 mm cells, x fastest, z slowest
+
+
+def written_fields(case, t_from, name):
+    """(time, field as [z, y, x]) of each written field `name` from t_from on."""
+    out = []
+    for d in glob.glob(os.path.join(case, "[0-9]*")):
+        try:
+            tw = float(os.path.basename(d))
+        except ValueError:
+            continue
+        if tw >= t_from - 1e-9 and os.path.exists(os.path.join(d, name)):
+            out.append((tw, foam_scalar_field(os.path.join(d, name)).reshape(NZ, NY, NX)))
+    return sorted(out, key=lambda x: x[0])
+
+
+def pressure_profile_height(case, t_from, t, p_in, p_out):
+    """pressure_height of the time-mean profile: the written p fields averaged over each cell
+    layer, between the inlet's and the outlet's area-averaged p at the same times, averaged
+    over the write times from t_from on."""
+    profiles = []
+    for tw, p in written_fields(case, t_from, "p"):
+        i = int(np.argmin(abs(t - tw)))
+        if abs(t[i] - tw) <= 1e-6:
+            profiles.append(np.concatenate(([p_in[i]], p.mean(axis=(1, 2)), [p_out[i]])))
+    if not profiles:
+        return float("nan")
+    z = np.concatenate(([0.0], (np.arange(NZ) + 0.5) * HEIGHT / NZ, [HEIGHT]))
+    return pressure_height(z, np.mean(profiles, axis=0))
+
+
+def bubbles(case, t_from):
+    """Over the written void fractions from t_from on: the bubble holdup (the fraction of the
+    bed's cells with eps > 0.8; the bed: the cell layers whose mean eps is below 0.9) and the
+    emulsion's mean eps (the bed's other cells)."""
+    hold, emulsion = [], []
+    for _, e in written_fields(case, t_from, "voidfraction"):
+        bed = e[e.mean(axis=(1, 2)) < 0.9]
+        hold.append(float((bed > 0.8).mean()))
+        emulsion.append(float(bed[bed <= 0.8].mean()))
+    return (float(np.mean(hold)), float(np.mean(emulsion))) if hold else (float("nan"),) * 2
+
+
+def diagnose(case, t_from):
+    """Print the heights per snapshot, the settled and the time-mean fluidised solid fraction
+    per 3 mm layer (real mass spread over each sphere) and the real mass across the depth in
+    the lower bed (z 5-25 mm, 1 mm bins)."""
+    edges, yedges = np.arange(0, 0.0901, 0.003), np.linspace(0, DEPTH, round(DEPTH / 0.001) + 1)
+
+    def spread(c, r, m, e):
+        return (m[:, None] * np.diff(sphere_fraction_below((e[None, :] - c[:, None]) / r[:, None]), axis=1)).sum(0)
+    heights, fluid, depth, settled = [], [], [], None
+    for s in sorted(glob.glob(os.path.join(case, "particles", "particles_*.h5"))):
+        with h5py.File(s, "r") as f:
+            ts, x, r, m = float(f.attrs["time"]), f["position"][:], 0.5 * f["diameter"][:], f["mass"][:]
+        rho = float(m.sum() / np.sum(4 / 3 * math.pi * r**3))
+        layers = spread(x[:, 2], r, m, edges) / (rho * AREA * 0.003)
+        if ts <= INFLOW_START + 1e-9:
+            settled = (ts, layers)
+        elif ts >= t_from - 1e-9:
+            heights.append((ts, real_height(x[:, 2], r, m), centre_height(x[:, 2])))
+            fluid.append(layers)
+            low = (x[:, 2] > 0.005) & (x[:, 2] < 0.025)
+            depth.append(spread(x[low, 1], r[low], m[low], yedges) / m[low].sum())
+    print(f"  {os.path.basename(case)}: heights real/centres [mm] per snapshot: "
+          + " ".join(f"{ts:.2f}:{1e3 * a:.1f}/{1e3 * b:.1f}" for ts, a, b in heights))
+    print(f"    solid fraction per 3 mm layer, settled (t = {settled[0]:.2f} s): "
+          + " ".join(f"{v:.2f}" for v in settled[1]))
+    print("    solid fraction per 3 mm layer, fluidised (time mean): " + " ".join(f"{v:.2f}" for v in np.mean(fluid, 0)))
+    print("    real mass across the depth, z 5-25 mm, 1 mm bins: " + " ".join(f"{v:.3f}" for v in np.mean(depth, 0)))
 
 
 def main():
@@ -101,31 +232,46 @@ def main():
     ap.add_argument("--ks", default="1,2,3")
     ap.add_argument("--end", type=float, default=1.0)
     ap.add_argument("--from", dest="t_from", type=float, default=0.5)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--analyse-only", action="store_true")
+    ap.add_argument("--diagnose", action="store_true")
+    ap.add_argument("--depth", type=float, default=0.009)
     ap.add_argument("--work", default=os.path.join(ROOT, "build", "benchmarks", "coarse_grain_fluidised"))
     ap.add_argument("--build", default=os.environ.get("GRAINFLOW_BUILD_DIR", os.path.join(ROOT, "build")))
     args = ap.parse_args()
+    set_depth(args.depth)
     os.makedirs(args.work, exist_ok=True)
     env = dict(os.environ, LD_LIBRARY_PATH=os.path.join(args.build, "lib"))
     rows = []
     for k in (int(x) for x in args.ks.split(",")):
-        case = prepare(args.work, k, args.end)
-        started = time.monotonic()
-        for cmd, log in ((["blockMesh"], "log.blockMesh"),
-                         ([os.path.join(args.build, "bin", "grainFoam")], "log.grainFoam")):
-            with open(os.path.join(case, log), "w") as out:
-                if subprocess.call([FOAM] + cmd, cwd=case, stdout=out, stderr=subprocess.STDOUT, env=env):
-                    sys.exit(f"fluidised_bed: k = {k}: {cmd[0]} failed, see {case}/{log}")
-        wall = time.monotonic() - started
+        if args.analyse_only:
+            case, wall = case_dir(args.work, k, args.seed), float("nan")
+        else:
+            case = prepare(args.work, k, args.end, args.seed)
+            started = time.monotonic()
+            for cmd, log in ((["blockMesh"], "log.blockMesh"),
+                             ([os.path.join(args.build, "bin", "grainFoam")], "log.grainFoam")):
+                with open(os.path.join(case, log), "w") as out:
+                    if subprocess.call([FOAM] + cmd, cwd=case, stdout=out, stderr=subprocess.STDOUT, env=env):
+                        sys.exit(f"fluidised_bed: k = {k}: {cmd[0]} failed, see {case}/{log}")
+            wall = time.monotonic() - started
         text = open(os.path.join(case, "log.grainFoam")).read()
         cpu = float(re.findall(r"ExecutionTime = (\S+) s", text)[-1])
         imbalance = max(float(x) for x in re.findall(r"relative imbalance (\S+)", text))
-        row = dict(k=k, **analyse(case, args.t_from), cpu_s=cpu, wall_s=wall,
+        row = dict(k=k, seed=args.seed, depth=DEPTH, **analyse(case, args.t_from), cpu_s=cpu, wall_s=wall,
                    cpu_per_simulated_s=cpu / args.end, worst_imbalance=imbalance)
         rows.append(row)
+        if args.diagnose:
+            diagnose(case, args.t_from)
         print(f"k = {k}: {row['parcels']} parcels ({row['real']} beads), mean dp "
               f"{row['dp_mean']:.1f} Pa = {row['dp_mean'] / row['weight']:.4f} x weight "
-              f"{row['weight']:.1f} Pa, std {row['dp_std']:.1f} Pa, bed height "
-              f"{1e3 * row['height']:.1f} mm, CPU {cpu:.0f} s ({cpu / args.end:.0f} s per "
+              f"{row['weight']:.1f} Pa, std {row['dp_std']:.1f} Pa, bed height (real particles) "
+              f"{1e3 * row['height']:.2f} mm (sd over {row['snapshots']} snapshots "
+              f"{1e3 * row['height_sd']:.2f}), parcel centres {1e3 * row['height_centres']:.2f} mm, "
+              f"pressure {1e3 * row['height_pressure']:.2f} mm; settled before the inflow: real-particle "
+              f"height {1e3 * row['settled_height']:.2f} mm, solid fraction "
+              f"{row['settled_solid_fraction']:.3f}; bubble holdup {row['bubble_holdup']:.3f}, emulsion eps "
+              f"{row['emulsion_voidfraction']:.3f}; CPU {cpu:.0f} s ({cpu / args.end:.0f} s per "
               f"simulated s), wall {wall:.0f} s, exchange imbalance {imbalance:.1e}", flush=True)
     out = os.path.join(args.work, "fluidised_bed.csv")
     new = not os.path.exists(out)
@@ -137,7 +283,9 @@ def main():
     if rows and rows[0]["k"] == 1:
         base = rows[0]
         for r in rows[1:]:
-            print(f"k = {r['k']} vs k = 1: bed height {100 * (r['height'] / base['height'] - 1):+.1f} %, "
+            rel = {key: 100 * (r[key] / base[key] - 1) for key in ("height", "height_centres", "height_pressure")}
+            print(f"k = {r['k']} vs k = 1: bed height (real particles) {rel['height']:+.1f} %, "
+                  f"(parcel centres) {rel['height_centres']:+.1f} %, (pressure) {rel['height_pressure']:+.1f} %, "
                   f"std of dp {100 * (r['dp_std'] / base['dp_std'] - 1):+.1f} %, cost "
                   f"{base['cpu_s'] / r['cpu_s']:.1f}x less (k^3/2 = {r['k']**3 / 2:g})")
     return 0

@@ -34,3 +34,18 @@ if(GRAINFLOW_HOPPER_PYTHON)
     LABELS "accuracy_cost;coarse_grain"
     TIMEOUT 300)
 endif()
+
+# accuracy_cost.bed_height_measure (tests/dem_accuracy/bed_height_test.py): the bed heights of
+# benchmarks/coarse_grain/bed_height.py, which fluidised_bed.py reports, against closed forms:
+# a sphere's volume fraction below a plane (cap volume) and its inverse, one sphere, a stack of
+# touching spheres (95 % of the mass below 19 R, the centres' 95th percentile 18.1 R), a two-size
+# lattice (95 % of the mass below 0.95 H), a linear pressure profile, OpenFOAM field files
+# (ascii and binary). numpy only; under a second.
+grainflow_find_python(GRAINFLOW_BED_HEIGHT_PYTHON "numpy" "accuracy_cost.bed_height_measure is")
+if(GRAINFLOW_BED_HEIGHT_PYTHON)
+  add_test(NAME accuracy_cost.bed_height_measure
+           COMMAND ${GRAINFLOW_BED_HEIGHT_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/bed_height_test.py)
+  set_tests_properties(accuracy_cost.bed_height_measure PROPERTIES
+    LABELS "accuracy_cost;coarse_grain"
+    TIMEOUT 60)
+endif()
