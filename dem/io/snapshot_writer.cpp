@@ -6,11 +6,14 @@
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <stdexcept>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 #include "dem/io/hdf5_checksum.hpp"
 #include "dem/io/hdf5_errors.hpp"
@@ -155,16 +158,77 @@ struct Slice {
 };
 
 struct OpenFile {
-  hid_t file;
+  hid_t file;   // -1 on the ranks that hand their data to rank 0 (gather)
   hid_t dcpl;  // dataset creation: no fill values (every element is written)
   hid_t dxpl;  // transfer: collective MPI-IO
-  bool serial;  // one rank, HDF5's POSIX driver: chunks written directly (write_checksummed)
+  bool serial;  // one process writes the file through HDF5's POSIX driver, chunks directly
+  // Several ranks on one node: each dataset's slices are gathered on rank 0, which writes the
+  // file alone (serial is true there); the others make no HDF5 call.
+  bool gather;
+  MPI_Comm comm;
+  bool writes() const { return file >= 0 || !gather; }
 };
+
+// A dataset of `rows` rows from `data` (the file's bytes when the types agree), written by
+// one process: chunk by chunk with the checksums computed here when the memory's bytes are
+// the file's, else through HDF5's filter. Returns what failed (empty: nothing).
+std::string write_whole(const OpenFile& out, const SnapshotField& f, const std::string& dset_path,
+                        hsize_t rows, const void* data) {
+  const int rank = f.components == 1 ? 1 : 2;
+  const hsize_t dims[2] = {rows, static_cast<hsize_t>(f.components)};
+  const HdfTypes types = hdf_types(f.type);
+  Hid space(H5Screate_simple(rank, dims, nullptr), H5Sclose);
+  Hid dcpl(H5Pcopy(out.dcpl), H5Pclose);
+  if (!space.valid() || !dcpl.valid() ||
+      !add_checksum(dcpl.get(), rank, dims, H5Tget_size(types.file)))
+    return "setting the checksum of " + dset_path;
+  Hid dset(H5Dcreate2(out.file, dset_path.c_str(), types.file, space.get(), H5P_DEFAULT,
+                      dcpl.get(), H5P_DEFAULT),
+           H5Dclose);
+  if (!dset.valid()) return "creating dataset " + dset_path;
+  if (!write_string_attribute(dset.get(), "units", f.units))
+    return "writing the units attribute of " + dset_path;
+  const bool direct = H5Tequal(types.memory, types.file) > 0;
+  if (rows > 0 &&
+      !(direct ? write_checksummed(dset.get(), rank, dims, H5Tget_size(types.file), data)
+               : H5Dwrite(dset.get(), types.memory, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) >= 0))
+    return "writing dataset " + dset_path;
+  if (!dset.close()) return "closing dataset " + dset_path;
+  return {};
+}
+
+// OpenFile::gather: the ranks' slices (in rank order, as their offsets are) travel to rank 0,
+// which writes the whole dataset. Collective.
+void write_gathered(const OpenFile& out, Agreement& agreement, const SnapshotField& f,
+                    const Slice& slice, const void* data, const std::string& dset_path) {
+  int ranks = 1;
+  MPI_Comm_size(out.comm, &ranks);
+  const std::size_t row_bytes =
+      static_cast<std::size_t>(f.components) * H5Tget_size(hdf_types(f.type).memory);
+  if (slice.total > static_cast<hsize_t>(std::numeric_limits<int>::max()))
+    throw std::logic_error("SnapshotWriter: more than 2^31 rows gathered in one dataset");
+  const int local_rows = static_cast<int>(slice.count);
+  std::vector<int> counts(out.writes() ? ranks : 0), displacements(counts.size(), 0);
+  MPI_Gather(&local_rows, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, out.comm);
+  for (std::size_t r = 1; r < counts.size(); ++r)
+    displacements[r] = displacements[r - 1] + counts[r - 1];
+  std::vector<unsigned char> all(out.writes() ? slice.total * row_bytes : 0);
+  MPI_Datatype row;
+  MPI_Type_contiguous(static_cast<int>(row_bytes), MPI_BYTE, &row);
+  MPI_Type_commit(&row);
+  MPI_Gatherv(data, local_rows, row, all.data(), counts.data(), displacements.data(), row, 0,
+              out.comm);
+  MPI_Type_free(&row);
+  const std::string failed = out.writes() ? write_whole(out, f, dset_path, slice.total, all.data())
+                                          : std::string();
+  agreement.check(failed.empty(), failed);
+}
 
 // `group`: the group below the root holding the dataset (nullptr: the root).
 void write_dataset(const OpenFile& out, Agreement& agreement, const SnapshotField& f,
                    const Slice& slice, const void* data, const char* group = nullptr) {
   const std::string dset_path = (group ? std::string("/") + group : std::string()) + "/" + f.name;
+  if (out.gather) return write_gathered(out, agreement, f, slice, data, dset_path);
   const int rank = f.components == 1 ? 1 : 2;
   const hsize_t comps = static_cast<hsize_t>(f.components);
   const hsize_t file_dims[2] = {slice.total, comps};
@@ -225,12 +289,14 @@ std::int64_t write_contact_group(const OpenFile& out, Agreement& agreement, MPI_
   if (rank == 0) offset = 0;  // MPI_Exscan leaves rank 0's result undefined
   MPI_Allreduce(&n, &total, 1, MPI_INT64_T, MPI_SUM, comm);
   const std::string path = std::string("/") + group;
-  Hid g(H5Gcreate2(out.file, path.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
-  agreement.check(g.valid(), "creating group " + path);
+  const bool writes = out.writes();
+  Hid g(writes ? H5Gcreate2(out.file, path.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT) : -1,
+        H5Gclose);
+  agreement.check(!writes || g.valid(), "creating group " + path);
   const HdfTypes i64 = hdf_types(SnapshotField::Type::Int64);
-  agreement.check(write_scalar_attribute(g.get(), "count", i64, &total),
+  agreement.check(!writes || write_scalar_attribute(g.get(), "count", i64, &total),
                   "writing the count attribute of " + path);
-  agreement.check(g.close(), "closing group " + path);
+  agreement.check(!writes || g.close(), "closing group " + path);
   for (std::size_t k = 0; k < N; ++k) {
     const hsize_t rows = static_cast<hsize_t>(fields[k].rows);
     const Slice slice{rows * static_cast<hsize_t>(offset), rows * static_cast<hsize_t>(n),
@@ -256,6 +322,23 @@ SnapshotWriter::SnapshotWriter(MPI_Comm comm, std::string directory, std::string
       fields_(fields | snapshot_required_fields) {
   MPI_Comm_rank(comm_, &rank_);
   MPI_Comm_size(comm_, &size_);
+  // Ranks that share one node's memory hand their slices to rank 0, which writes each
+  // snapshot alone with direct chunks (hdf5_checksum.hpp): on one node the file system is one
+  // stream anyway, and parallel HDF5's collective filtered writes copy and sum every chunk in
+  // HDF5's slow path and need every rank running at once. Across nodes: collective MPI-IO.
+  // GRAINFLOW_SNAPSHOT_MPIIO=1 takes the MPI-IO route on one node too (its tests).
+  if (size_ > 1) {
+    MPI_Comm node;
+    MPI_Comm_split_type(comm_, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node);
+    int node_size = 0;
+    MPI_Comm_size(node, &node_size);
+    MPI_Comm_free(&node);
+    const char* forced = std::getenv("GRAINFLOW_SNAPSHOT_MPIIO");
+    const bool mpiio = forced && std::string(forced) == "1";
+    int one_node = node_size == size_ && !mpiio ? 1 : 0;
+    MPI_Allreduce(MPI_IN_PLACE, &one_node, 1, MPI_INT, MPI_MIN, comm_);
+    gather_ = one_node == 1;
+  }
 }
 
 std::size_t SnapshotWriter::continue_series(long up_to_step) {
@@ -365,7 +448,7 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step,
     Hid dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
     Hid dxpl(H5Pcreate(H5P_DATASET_XFER), H5Pclose);
     bool ok = fapl.valid() && dcpl.valid() && dxpl.valid();
-    if (size_ > 1) {
+    if (size_ > 1 && !gather_) {
       ok = ok && H5Pset_fapl_mpio(fapl.get(), comm_, MPI_INFO_NULL) >= 0;
       // Metadata written collectively instead of by rank 0 alone plus broadcasts (scales
       // better).
@@ -380,9 +463,12 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step,
     ok = ok && H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_NEVER) >= 0;
     agreement.check(ok, "setting up the MPI-IO property lists");
 
-    Hid file(H5Fcreate(partial.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose);
-    agreement.check(file.valid(), "creating the temporary file '" + partial + "'");
-    const OpenFile out{file.get(), dcpl.get(), dxpl.get(), size_ == 1};
+    // Gathering on rank 0 (several ranks on one node, gather_): rank 0 alone opens the file.
+    const bool opens = !gather_ || rank_ == 0;
+    Hid file(opens ? H5Fcreate(partial.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()) : -1,
+             H5Fclose);
+    agreement.check(!opens || file.valid(), "creating the temporary file '" + partial + "'");
+    const OpenFile out{file.get(), dcpl.get(), dxpl.get(), size_ == 1 || gather_, gather_, comm_};
 
     write_dataset(out, agreement, field("id"), slice, p.id.data());
     // A Vec3 is three contiguous doubles: its array is the (n, 3) dataset as it stands.
@@ -445,12 +531,12 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step,
 
     const HdfTypes f64 = hdf_types(SnapshotField::Type::Float64);
     const HdfTypes i64 = hdf_types(SnapshotField::Type::Int64);
-    ok = write_scalar_attribute(file.get(), "time", f64, &t) &&
-         write_scalar_attribute(file.get(), "step", i64, &s) &&
-         write_scalar_attribute(file.get(), "count", i64, &total) &&
-         write_string_attribute(file.get(), "grainflow_version", GRAINFLOW_VERSION);
+    ok = !opens || (write_scalar_attribute(file.get(), "time", f64, &t) &&
+                    write_scalar_attribute(file.get(), "step", i64, &s) &&
+                    write_scalar_attribute(file.get(), "count", i64, &total) &&
+                    write_string_attribute(file.get(), "grainflow_version", GRAINFLOW_VERSION));
     agreement.check(ok, "writing the root attributes (time, step, count)");
-    agreement.check(file.close(), "closing (flushing) the file");
+    agreement.check(!opens || file.close(), "closing (flushing) the file");
 
     const bool renamed = rank_ != 0 || std::rename(partial.c_str(), path.c_str()) == 0;
     const int rename_errno = errno;

@@ -82,6 +82,7 @@ class SnapshotWriter {
   MPI_Comm comm_;
   int rank_ = 0;
   int size_ = 1;
+  bool gather_ = false;  // several ranks on one node: rank 0 writes what they gather to it
   std::string directory_;
   std::string basename_;
   SnapshotFieldSet fields_;
