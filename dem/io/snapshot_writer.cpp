@@ -59,6 +59,11 @@ class Agreement {
   void check(bool ok, const std::string& what) {
     agree(ok ? std::string() : message(what, hdf5_reason()));
   }
+  // For a failure whose reason was read before later HDF5 calls cleared the error stack.
+  void check(const std::pair<std::string, std::string>& what_and_reason) {
+    const auto& [what, reason] = what_and_reason;
+    agree(what.empty() ? std::string() : message(what, reason));
+  }
   // For operating-system calls: the reason is errno's text.
   void check_os(bool ok, const std::string& what, int err) {
     agree(ok ? std::string() : message(what, std::strerror(err)));
@@ -161,7 +166,7 @@ struct OpenFile {
   hid_t file;   // -1 on the ranks that hand their data to rank 0 (gather)
   hid_t dcpl;  // dataset creation: no fill values (every element is written)
   hid_t dxpl;  // transfer: collective MPI-IO
-  bool serial;  // one process writes the file through HDF5's POSIX driver, chunks directly
+  bool serial;  // one process writes the file through HDF5's POSIX driver (write_whole)
   // Several ranks on one node: each dataset's slices are gathered on rank 0, which writes the
   // file alone (serial is true there); the others make no HDF5 call.
   bool gather;
@@ -169,11 +174,13 @@ struct OpenFile {
   bool writes() const { return file >= 0 || !gather; }
 };
 
-// A dataset of `rows` rows from `data` (the file's bytes when the types agree), written by
-// one process: chunk by chunk with the checksums computed here when the memory's bytes are
-// the file's, else through HDF5's filter. Returns what failed (empty: nothing).
-std::string write_whole(const OpenFile& out, const SnapshotField& f, const std::string& dset_path,
-                        hsize_t rows, const void* data) {
+// A dataset of `rows` rows from `data`, written by one process: chunk by chunk with the
+// checksums computed here when the memory's bytes are the file's, else through HDF5's filter.
+// Returns what failed and HDF5's reason, read before the handles close (empty: nothing).
+std::pair<std::string, std::string> write_whole(const OpenFile& out, const SnapshotField& f,
+                                                const std::string& dset_path, hsize_t rows,
+                                                const void* data) {
+  const auto failed = [](std::string what) { return std::pair{what, hdf5_reason()}; };
   const int rank = f.components == 1 ? 1 : 2;
   const hsize_t dims[2] = {rows, static_cast<hsize_t>(f.components)};
   const HdfTypes types = hdf_types(f.type);
@@ -181,19 +188,19 @@ std::string write_whole(const OpenFile& out, const SnapshotField& f, const std::
   Hid dcpl(H5Pcopy(out.dcpl), H5Pclose);
   if (!space.valid() || !dcpl.valid() ||
       !add_checksum(dcpl.get(), rank, dims, H5Tget_size(types.file)))
-    return "setting the checksum of " + dset_path;
+    return failed("setting the checksum of " + dset_path);
   Hid dset(H5Dcreate2(out.file, dset_path.c_str(), types.file, space.get(), H5P_DEFAULT,
                       dcpl.get(), H5P_DEFAULT),
            H5Dclose);
-  if (!dset.valid()) return "creating dataset " + dset_path;
+  if (!dset.valid()) return failed("creating dataset " + dset_path);
   if (!write_string_attribute(dset.get(), "units", f.units))
-    return "writing the units attribute of " + dset_path;
+    return failed("writing the units attribute of " + dset_path);
   const bool direct = H5Tequal(types.memory, types.file) > 0;
   if (rows > 0 &&
       !(direct ? write_checksummed(dset.get(), rank, dims, H5Tget_size(types.file), data)
                : H5Dwrite(dset.get(), types.memory, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) >= 0))
-    return "writing dataset " + dset_path;
-  if (!dset.close()) return "closing dataset " + dset_path;
+    return failed("writing dataset " + dset_path);
+  if (!dset.close()) return failed("closing dataset " + dset_path);
   return {};
 }
 
@@ -219,9 +226,8 @@ void write_gathered(const OpenFile& out, Agreement& agreement, const SnapshotFie
   MPI_Gatherv(data, local_rows, row, all.data(), counts.data(), displacements.data(), row, 0,
               out.comm);
   MPI_Type_free(&row);
-  const std::string failed = out.writes() ? write_whole(out, f, dset_path, slice.total, all.data())
-                                          : std::string();
-  agreement.check(failed.empty(), failed);
+  agreement.check(out.writes() ? write_whole(out, f, dset_path, slice.total, all.data())
+                                : std::pair<std::string, std::string>{});
 }
 
 // `group`: the group below the root holding the dataset (nullptr: the root).
@@ -229,6 +235,8 @@ void write_dataset(const OpenFile& out, Agreement& agreement, const SnapshotFiel
                    const Slice& slice, const void* data, const char* group = nullptr) {
   const std::string dset_path = (group ? std::string("/") + group : std::string()) + "/" + f.name;
   if (out.gather) return write_gathered(out, agreement, f, slice, data, dset_path);
+  // One rank: its slice is the whole dataset.
+  if (out.serial) return agreement.check(write_whole(out, f, dset_path, slice.total, data));
   const int rank = f.components == 1 ? 1 : 2;
   const hsize_t comps = static_cast<hsize_t>(f.components);
   const hsize_t file_dims[2] = {slice.total, comps};
@@ -265,14 +273,9 @@ void write_dataset(const OpenFile& out, Agreement& agreement, const SnapshotFiel
   // the write; total is global, so all ranks skip together. HDF5 also rejects a null buffer
   // when nothing is selected, and an empty vector may give one.
   static const std::int64_t nothing = 0;
-  // One rank whose values are already the file's bytes writes each chunk with its checksum
-  // itself (hdf5_checksum.hpp), the same file at a third of HDF5's filter cost.
-  const bool direct = out.serial && slice.count == slice.total && H5Tequal(types.memory, types.file) > 0;
   if (slice.total > 0)
-    agreement.check(direct ? write_checksummed(dset.get(), rank, file_dims,
-                                               H5Tget_size(types.file), data)
-                           : H5Dwrite(dset.get(), types.memory, mem_space.get(), file_space.get(),
-                                      out.dxpl, slice.count ? data : &nothing) >= 0,
+    agreement.check(H5Dwrite(dset.get(), types.memory, mem_space.get(), file_space.get(), out.dxpl,
+                             slice.count ? data : &nothing) >= 0,
                     "writing dataset " + dset_path);
   agreement.check(dset.close(), "closing dataset " + dset_path);
 }
