@@ -579,7 +579,8 @@ void DemLink::add_fluid(const FluidAtParticle& f) {
                                     vec(f.viscous_stress_divergence)});
   if (m.curl) m.pending_vorticity.push_back(vec(f.vorticity));
   if (m.self) {
-    SelfDisturbance sd{f.disturbance_cell, f.disturbance_spread, f.disturbance_screening};
+    SelfDisturbance sd{f.disturbance_cell, f.disturbance_spread, f.disturbance_screening,
+                       f.disturbance_smoothing};
     if (f.disturbance_placed) {
       sd.placed = true;
       for (int a = 0; a < 3; ++a) {

@@ -36,6 +36,8 @@ struct FluidAtParticle {
   double disturbance_cell = 0;
   double disturbance_spread = 0;
   double disturbance_screening = 0;
+  // diffusionBandwidth: the averaging's standard deviation per axis sigma = b / sqrt 2 [m].
+  double disturbance_smoothing = 0;
   // The footprint's weight marginal on each mesh axis over the cells at offsets -1, 0, 1 from
   // the particle's own (fractions of its weight), when the footprint reaches no further on
   // any axis (disturbance_placed; else the place-averaged disturbance is used).

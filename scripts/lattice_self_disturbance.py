@@ -44,8 +44,14 @@ phi -> 1/(2 Re_h) for large Re_h at s = 0 (the force carried off by the fluid cr
 cell's section, read half-way), the T_ij at Re_h = 0, s = 0 against direct lattice sums, the
 place average of the T_ij against phi, and the quadrature against a finer one.
 
+With diffusionBandwidth (coupling/foam/diffusionSmoothing.H) the deposit and the read-back are
+each averaged by the diffusion, whose symbol on the lattice is D(q) (smoothing_symbol()): the
+integrand gains D(q)^2. `--smoothed` writes those tables for sigma/h up to 2.5 into
+dem/fluid/lattice_self_disturbance_smoothed_table.hpp (checked first against direct lattice
+sums with D^2 and a finer quadrature).
+
 Usage: scripts/python.sh scripts/lattice_self_disturbance.py [--out PATH] [--check-only]
-(about 7 minutes on one core).
+(about 7 minutes on one core); ... --smoothed [--smoothed-out PATH] (about 5 minutes).
 """
 import argparse
 import os
@@ -62,6 +68,13 @@ OUT = os.path.join(HERE, "..", "dem", "fluid", "lattice_self_disturbance_table.h
 LOG_RE = (-3.0, 4.0, 3)     # log10 Re_h from, to, points per decade
 LOG_B = (-6.0, 4.0, 1.5)    # log10 b
 SPREAD = (0.0, 0.5, 8)      # s/h from, to, points per unit
+# diffusionBandwidth (sigma = b / sqrt 2 per axis): up to sigma/h = 1, the axis u = 12 T = 6 (sigma/h)^2
+# at half-integers (within u in [j, j + 1] the averaging does j full steps and one of (u - j)/12,
+# so phi is a quadratic in u there: interpolated exactly from u = j, j + 1/2, j + 1); beyond,
+# sigma/h in quarters (smooth: cubic in log phi).
+SMOOTH_U = (0.5, 6.0, 2)      # u from, to, points per unit
+SMOOTH_SIGMA = (1.25, 2.5, 4)  # sigma/h from, to, points per unit
+SMOOTHED_OUT = os.path.join(HERE, "..", "dem", "fluid", "lattice_self_disturbance_smoothed_table.hpp")
 
 
 # The transverse tables: pairs (i, j), i <= j, of the basis functions (basis()).
@@ -85,6 +98,19 @@ def coefficients(w):
     c1 = 2 * (wm * w0 + w0 * wp)
     c2 = 2 * wm * wp
     return np.array([c0 - c1 + c2, 2 * c1 - 8 * c2, 8 * c2])
+
+
+def smoothing_symbol(sigma, lam):
+    """The symbol of grainFoam's diffusion-based averaging (coupling/foam/diffusionSmoothing.C)
+    on a uniform cubic mesh of cell 1: pseudo-time T = sigma^2 / 2 in steps of the largest
+    stable size 1/12 (a cell gives away half its value) and one last step of the remainder,
+    D = (1 - lam/12)^(k-1) (1 - r lam), k = ceil(12 T), r = T - (k-1)/12; lam the 7-point
+    Laplacian's symbol. Continuous in sigma; on long runs of steps it tends to exp(-T lam)."""
+    if sigma == 0:
+        return 1.0
+    t = 0.5 * sigma * sigma
+    k = max(1, int(np.ceil(12 * t - 1e-9)))
+    return (1 - lam / 12) ** (k - 1) * (1 - (t - (k - 1) / 12) * lam)
 
 
 def T(c, q):
@@ -123,7 +149,8 @@ def Z(a, re, s, qz):
 
 
 class Quadrature:
-    def __init__(self, nt=12, nz=32, panels=8):
+    def __init__(self, nt=12, nz=32, panels=8, sigmas=(0.0,)):
+        self.sigmas = sigmas
         x, w = leggauss(nt)
         edges = np.concatenate([[0], np.pi * np.logspace(-5, 0, panels)])
         q = np.concatenate([0.5 * (hi + lo) + 0.5 * (hi - lo) * x for lo, hi in zip(edges[:-1], edges[1:])])
@@ -142,12 +169,15 @@ class Quadrature:
         self.wij = [0.5 * (fx[i] * fy[j] + fx[j] * fy[i]) * self.w for i, j in PAIRS]
 
     def phi(self, re, b, s):
-        """The place-averaged phi (A(q_x) A(q_y)) and the six transverse tables T_ij, i <= j."""
-        inner = self._inner(re, b, s)
+        """The place-averaged phi (A(q_x) A(q_y)) and the six transverse tables T_ij, i <= j;
+        with several smoothing widths (sigmas), an array [sigma][7]."""
         ap = (T(1 / s, self.qx) * T(1 / s, self.qy)) if s > 0 else 1.0
-        out = [float((ap * inner * self.w).sum())]
-        out += [float((wij * inner).sum()) for wij in self.wij]
-        return 8 * np.array(out) / (2 * np.pi) ** 3
+        rows = []
+        for inner in self._inner(re, b, s):
+            out = [float((ap * inner * self.w).sum())]
+            out += [float((wij * inner).sum()) for wij in self.wij]
+            rows.append(8 * np.array(out) / (2 * np.pi) ** 3)
+        return rows[0] if len(rows) == 1 else np.array(rows)
 
     def _inner(self, re, b, s):
         a0 = self.lp + b
@@ -159,9 +189,11 @@ class Quadrature:
         th = 0.5 * top * (1 + self.xz[None, :])
         qz = w0 * np.tan(th)
         wq = 0.5 * top * self.wz[None, :] * w0 / np.cos(th) ** 2
-        a = self.lp[:, None] + 4 * np.sin(qz / 2) ** 2 + b
+        lam = self.lp[:, None] + 4 * np.sin(qz / 2) ** 2
         p = 1 - np.sin(qz) ** 2 / (self.sp[:, None] + np.sin(qz) ** 2)
-        return (p * Z(a, re, s, qz) * wq).sum(axis=1)
+        # diffusionBandwidth: the deposit and the read-back are each averaged once (D^2).
+        base = p * Z(lam + b, re, s, qz) * wq
+        return [(base * smoothing_symbol(sg, lam) ** 2).sum(axis=1) for sg in self.sigmas]
 
 
 def axis(spec, log):
@@ -170,7 +202,7 @@ def axis(spec, log):
     return lo + np.arange(n) / per
 
 
-def lattice_sum(n, b):
+def lattice_sum(n, b, sigma=0.0):
     """T_ij(Re_h = 0, b, s = 0) as the lattice Green's function at the origin on a periodic
     lattice of n^3 cells, by a direct sum over its n^3 wavenumbers (the zero mode left out):
     (1/n^3) sum_q f_i(q_x) f_j(q_y) P_zz(q) / (Lambda(q) + b). Independent of the quadrature;
@@ -182,6 +214,7 @@ def lattice_sum(n, b):
     with np.errstate(invalid="ignore", divide="ignore"):
         p = np.where(ss > 0, 1 - np.sin(qz) ** 2 / np.where(ss > 0, ss, 1), 1.0)
         g = np.where(lam > 0, p / np.where(lam > 0, lam, 1), 0.0)
+    g = g * smoothing_symbol(sigma, lam - b) ** 2
     fx, fy = basis(qx), basis(qy)
     out = []
     for i, j in PAIRS:
@@ -242,12 +275,97 @@ def checks(quad):
     return ok and worst < 1e-3
 
 
+def smoothed_checks():
+    """diffusionBandwidth: the T_ij at Re_h = 0, s = 0 against direct lattice sums with D^2,
+    the quadrature against a finer one, and (printed) the continuous Gaussian limit: a
+    deposit-read kernel of variance 2 sigma^2 + 1/6 (D twice and the cell's box) gives
+    phi = (1/(3 pi)) sqrt(2/pi) ... = 0.0423142 / sigma_total at Re = 0, b = 0."""
+    sig = (0.5, 1.0, 2.0)
+    quad = Quadrature(sigmas=sig)
+    fine = Quadrature(24, 64, 12, sigmas=sig)
+    ok = True
+    for b in (0.0, 1.0):
+        v = quad.phi(0, b, 0)
+        for k, sg in enumerate(sig):
+            s1, s2 = lattice_sum(64, b, sg), lattice_sum(128, b, sg)
+            ref = 2 * s2 - s1 if b == 0 else s2
+            dev = np.abs(v[k][1:] / ref - 1).max()
+            print(f"sigma/h = {sg}, b = {b:g}: T_ij against lattice sums, largest relative "
+                  f"difference {dev:.1e}")
+            ok &= dev < 1e-3
+    for sg, row in zip(sig, quad.phi(0, 0, 0)):
+        cont = 0.0423142 / np.sqrt(2 * sg * sg + 1 / 6)
+        print(f"sigma/h = {sg}: phi(0, 0, 0) = {row[0]:.5f}, continuous Gaussian {cont:.5f} "
+              f"(lattice / continuous {row[0] / cont:.4f})")
+    worst = 0
+    for re in (0, 0.3, 3, 30, 300):
+        for b in (0, 1e-3, 1, 100):
+            for s in (0, 0.15, 0.5):
+                worst = max(worst, np.abs(quad.phi(re, b, s) / fine.phi(re, b, s) - 1).max())
+    print(f"smoothed: quadrature against a finer one: largest relative difference {worst:.1e}")
+    return ok and worst < 1e-3
+
+
+def write_header(path, names, notes, table, axes, comment, order, digits=7):
+    lines = ["#pragma once"] + comment + ["namespace grainflow::lattice_table {"] + axes
+    for name, note, t in zip(names, notes, table):
+        lines += [f"// {note}; {order}", f"inline constexpr double {name}[] = {{"]
+        flat = t.ravel()
+        for k in range(0, len(flat), 6):
+            lines.append("    " + ", ".join(f"{v:.{digits}e}" for v in flat[k:k + 6]) + ",")
+        lines += ["};"]
+    lines += ["}  // namespace grainflow::lattice_table", ""]
+    with open(path, "w") as f:
+        f.write("\n".join(lines))
+
+
+def main_smoothed(a):
+    if not a.skip_checks and not smoothed_checks():
+        sys.exit("lattice_self_disturbance: a smoothed check failed")
+    if a.check_only:
+        return
+    sg = np.concatenate([np.sqrt(axis(SMOOTH_U, False) / 6), axis(SMOOTH_SIGMA, False)])
+    quad = Quadrature(sigmas=tuple(sg))
+    lr, lb, sp = axis(LOG_RE, True), axis(LOG_B, True), axis(SPREAD, False)
+    t0 = time.time()
+    table = np.empty((1 + len(PAIRS), len(sg), len(sp), len(lr), len(lb)))
+    for k, s in enumerate(sp):
+        for i, r in enumerate(lr):
+            for j, b in enumerate(lb):
+                table[:, :, k, i, j] = np.log(quad.phi(10**r, 10**b, s)).T
+        print(f"s/h = {s:.2f} done ({time.time() - t0:.0f} s)", flush=True)
+    names = ["log_phi_smoothed"] + [f"log_t{i}{j}_smoothed" for i, j in PAIRS]
+    notes = ["the place-averaged factor, A(q_x) A(q_y)"] + [
+        f"T_{i}{j}: f_{i}(q_x) f_{j}(q_y) (symmetric in i, j)" for i, j in PAIRS]
+    write_header(
+        a.smoothed_out, names, notes, table,
+        [f"inline constexpr double smooth_u_lo = {SMOOTH_U[0]!r}, smooth_u_per_unit = {SMOOTH_U[2]!r};",
+         f"inline constexpr int n_smooth_u = {len(axis(SMOOTH_U, False))};",
+         f"inline constexpr double smooth_sigma_lo = {SMOOTH_SIGMA[0]!r}, "
+         f"smooth_sigma_per_unit = {SMOOTH_SIGMA[2]!r};",
+         f"inline constexpr int n_smooth_sigma = {len(axis(SMOOTH_SIGMA, False))};",
+         f"inline constexpr int n_smooth = {len(sg)};"],
+        ["// Generated by scripts/lattice_self_disturbance.py --smoothed: do not edit. The tables",
+         "// of lattice_self_disturbance_table.hpp with diffusionBandwidth's averaging of the",
+         "// deposit and of the read-back. Slices: first u = 6 (sigma/h)^2 = smooth_u_lo + i /",
+         "// smooth_u_per_unit (n_smooth_u), then sigma/h = smooth_sigma_lo + i /",
+         "// smooth_sigma_per_unit (n_smooth_sigma); the axes of Re_h, b and s/h are those of",
+         "// lattice_self_disturbance_table.hpp."],
+        "[smooth][spread][re][b]")
+    print(f"wrote {a.smoothed_out}: {table.size} values in {time.time() - t0:.0f} s")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", default=OUT)
+    ap.add_argument("--smoothed", action="store_true",
+                    help="write the tables with diffusionBandwidth's averaging instead")
+    ap.add_argument("--smoothed-out", default=SMOOTHED_OUT)
     ap.add_argument("--check-only", action="store_true")
     ap.add_argument("--skip-checks", action="store_true")
     a = ap.parse_args()
+    if a.smoothed:
+        return main_smoothed(a)
     quad = Quadrature()
     if not a.skip_checks and not checks(quad):
         sys.exit("lattice_self_disturbance: a check failed")

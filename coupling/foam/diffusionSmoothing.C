@@ -32,10 +32,15 @@ DiffusionSmoothing::DiffusionSmoothing(const Foam::fvMesh& mesh, double bandwidt
   rV_ = 1.0 / mesh.V().field();
   rate *= rV_;
   const double maxRate = gMax(rate);
-  // Pseudo-time T = b^2 / 4 in steps of at most 1 / (2 maxRate).
+  // Pseudo-time T = b^2 / 4: full steps of the largest size 1 / (2 maxRate) and one last step
+  // of the remainder. (The operator is then a continuous function of b: on a uniform mesh
+  // (1 - Lambda/12)^(k-1) (1 - r Lambda) in cell units, which the lattice self-disturbance
+  // tables with diffusionBandwidth assume; docs/models/undisturbed-velocity.md.)
   const double T = 0.25 * bandwidth * bandwidth;
-  steps_ = std::max(1, static_cast<int>(std::ceil(2 * T * maxRate - 1e-9)));
-  const double dtau = T / steps_;
+  const double full = 0.5 / maxRate;
+  steps_ = std::max(1, static_cast<int>(std::ceil(T / full - 1e-9)));
+  const double dtau = std::min(T, full);
+  lastScale_ = steps_ > 1 ? (T - (steps_ - 1) * full) / full : 1.0;
   stepRate_ = dtau * maxRate;
   internalCoeff_ *= dtau;
   forAll(patchCoeff_, patch) patchCoeff_[patch] *= dtau;
@@ -66,7 +71,10 @@ void DiffusionSmoothing::smooth(
       const labelUList& cells = mesh_.boundary()[patch].faceCells();
       forAll(cells, i) change[cells[i]] += c[i] * (other()[i] - phi[cells[i]]);
     }
-    forAll(phi, cell) phi[cell] += rV_[cell] * change[cell];
+    if (step + 1 < steps_ || lastScale_ == 1.0)
+      forAll(phi, cell) phi[cell] += rV_[cell] * change[cell];
+    else
+      forAll(phi, cell) phi[cell] += lastScale_ * rV_[cell] * change[cell];
   }
   field.correctBoundaryConditions();
 }

@@ -246,7 +246,6 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
                                  << exit(FatalIOError);
   if (bandwidth > 0) {
     const char* clash = sampling_ != Sampling::cell ? "sampling cellPoint"
-                        : undisturbed_              ? "undisturbedVelocity oseenBrinkman"
                         : sharpInterface_           ? "dragVoidFraction sharpInterface"
                                                     : nullptr;
     if (clash)
@@ -254,7 +253,7 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
           << "diffusionBandwidth " << bandwidth << " is not combined with " << clash
           << " (the averaging keeps the exchange balanced with sampling cell on the "
              "cells' own values); set diffusionBandwidth 0 or sampling cell, "
-             "undisturbedVelocity off, dragVoidFraction cell"
+             "dragVoidFraction cell"
           << exit(FatalIOError);
     smoothing_ = std::make_unique<DiffusionSmoothing>(mesh, bandwidth);
     Info << "grainFoam coupling: diffusionBandwidth b = " << bandwidth
@@ -898,9 +897,13 @@ void ParticleCoupling::deposit() {
   if (smoothing_) {
     // The averaging acts on the deposited fields before the clamp (it conserves their
     // volume integrals; a uniform eps stays uniform).
+    // undisturbedVelocity: the other particles' drag per volume at a particle is read from
+    // the deposit before the averaging (its own share, K W_c^2 / V_c, is taken off exactly).
+    if (undisturbed_) rawKsl_.setSize(eps.size());
     forAll(eps, c) {
       eps[c] = 1 - solid[c] / V[c];
       Ksl[c] = K[c] / V[c];
+      if (undisturbed_) rawKsl_[c] = Ksl[c];
       KslUs[c] = KU[c] / V[c];
       fExplicit[c] = F[c] / V[c];
     }
@@ -1356,7 +1359,7 @@ void ParticleCoupling::sample() {
       }
       a[13] += w;
       if (undisturbed_) {
-        a[14] += w * Ksl_[c];
+        a[14] += w * (smoothing_ ? rawKsl_[c] : Ksl_[c]);
         const double hc = std::cbrt(V[c]);
         a[16] += w * hc * hc;
         const double* centre = particles_.x(i);
@@ -1397,6 +1400,7 @@ void ParticleCoupling::sample() {
       // other particles' drag per volume.
       f.disturbance_cell = std::sqrt(a[16] * norm);
       f.disturbance_spread = footprintSpread_ * particles_.radius(i);
+      if (smoothing_) f.disturbance_smoothing = smoothing_->bandwidth() / std::sqrt(2.0);
       f.disturbance_screening =
           std::max(0.0, (a[14] - particles_.drag_coefficient(i) * a[15]) * norm);
       // The particle's place across its motion: its marginals, if they hold all its weight.

@@ -42,6 +42,7 @@ struct SelfDisturbance {
   double cell = 0;       // h [m]
   double spread = 0;     // s [m], standard deviation per axis of the footprint's points
   double screening = 0;  // beta [kg/m^3/s]
+  double smoothing = 0;  // sigma [m] of diffusionBandwidth's averaging (b / sqrt 2), 0 none
   // Per mesh axis x, y, z: the coefficients a_0..a_2 of the footprint's weight marginal on
   // the cells at offsets -1, 0, 1 from the particle's own (transverse_coefficients in
   // self_disturbance.hpp); the two axes across the motion are used. placed = false: not

@@ -280,7 +280,8 @@ class FluidForcesWith final : public ForceTerm {
     const double eps = f.void_fraction;
     const auto k = [&](double w) { return Law({d, w, eps, f.density, f.viscosity}); };
     const auto m = [&](double w) {
-      return lattice_self_mobility(sd.cell, sd.spread, w, rho_e, mu_e, sd.screening, ax, ay);
+      return lattice_self_mobility(sd.cell, sd.spread, w, rho_e, mu_e, sd.screening, ax, ay,
+                                   sd.smoothing);
     };
     bool limited = false;
     const double k0 = k(w_seen);

@@ -1,5 +1,6 @@
 #include "dem/fluid/self_disturbance.hpp"
 
+#include "dem/fluid/lattice_self_disturbance_smoothed_table.hpp"
 #include "dem/fluid/lattice_self_disturbance_table.hpp"
 
 #include <algorithm>
@@ -201,19 +202,107 @@ std::array<double, N> lattice_interpolate(const LatticeStencil& st,
   return lp;
 }
 
+// The N tables' values at the stencil from slice k of the diffusionBandwidth tables
+// ([smooth][spread][re][b]); k = -1: the tables without averaging.
+template <std::size_t N>
+std::array<double, N> slice_values(const LatticeStencil& st, int k,
+                                   const std::array<const double*, N>& plain,
+                                   const std::array<const double*, N>& smoothed) {
+  namespace t = lattice_table;
+  constexpr std::size_t slice = static_cast<std::size_t>(t::n_spread) * t::n_re * t::n_b;
+  std::array<const double*, N> logs;
+  for (std::size_t m = 0; m < N; ++m)
+    logs[m] = k < 0 ? plain[m] : smoothed[m] + static_cast<std::size_t>(k) * slice;
+  return lattice_interpolate<N>(st, logs);
+}
+
+// The N tables at sigma/h = g of diffusionBandwidth's averaging, 0 <= g <= 2.25.
+//   u = 6 g^2 <= 6: the averaging does floor(u) full steps and one of the rest, so within
+//     [j, j + 1] the tables are quadratics in u, interpolated exactly from u = j, j + 1/2, j + 1
+//     (slices 2j - 1, 2j, 2j + 1; u = 0 is the table without averaging);
+//   1 < g <= 2.25: Catmull-Rom in log over g = 0.75 (from u = 3.375), 1, 1.25, ..., 2.5.
+template <std::size_t N>
+std::array<double, N> smoothed_values(const LatticeStencil& st, double g,
+                                      const std::array<const double*, N>& plain,
+                                      const std::array<const double*, N>& smoothed) {
+  namespace t = lattice_table;
+  static_assert(t::smooth_u_lo == 0.5 && t::smooth_u_per_unit == 2 && t::n_smooth_u == 12);
+  static_assert(t::smooth_sigma_lo == 1.25 && t::smooth_sigma_per_unit == 4 && t::n_smooth_sigma == 6);
+  const auto at_u = [&](double u) {
+    const int j = std::min(static_cast<int>(u), 5);
+    const double f = u - j;
+    const std::array<double, N> v0 = slice_values<N>(st, 2 * j - 1, plain, smoothed);
+    const std::array<double, N> v1 = slice_values<N>(st, 2 * j, plain, smoothed);
+    const std::array<double, N> v2 = slice_values<N>(st, 2 * j + 1, plain, smoothed);
+    const double l0 = (2 * f - 1) * (f - 1), l1 = 4 * f * (1 - f), l2 = f * (2 * f - 1);
+    std::array<double, N> out;
+    for (std::size_t m = 0; m < N; ++m) out[m] = l0 * v0[m] + l1 * v1[m] + l2 * v2[m];
+    return out;
+  };
+  const double u = 6 * g * g;
+  if (u <= 6) return at_u(u);
+  // Nodes n = 0..7 at g = 0.75 + n / 4.
+  const auto node = [&](int n) {
+    return n == 0 ? at_u(3.375) : slice_values<N>(st, n == 1 ? 11 : 12 + (n - 2), plain, smoothed);
+  };
+  const double x = (std::min(g, 2.25) - 0.75) * 4;
+  const int i = std::clamp(static_cast<int>(x), 1, 5);
+  const double f = x - i;
+  const std::array<double, 4> w = {0.5 * (-f + 2 * f * f - f * f * f), 0.5 * (2 - 5 * f * f + 3 * f * f * f),
+                                   0.5 * (f + 4 * f * f - 3 * f * f * f), 0.5 * (-f * f + f * f * f)};
+  std::array<double, N> lp{};
+  for (int a = 0; a < 4; ++a) {
+    const std::array<double, N> v = node(i - 1 + a);
+    for (std::size_t m = 0; m < N; ++m) lp[m] += w[a] * std::log(v[m]);
+  }
+  for (double& v : lp) v = std::exp(v);
+  return lp;
+}
+
+// Beyond sigma/h = 2.25 the lattice has stopped mattering but for a few per cent: the
+// continuous Gaussian form (self_disturbance_factor) for the deposit-read kernel's standard
+// deviation sigma_t = sqrt(2 g^2 + 1/6 + 2 s^2) (D twice, the cell's box, the footprint's
+// spread; cell units), times the lattice's ratio to it at g = 2.25 raised to (2.25/g)^2 (the
+// lattice's excess falls as 1/g^2: 1.9 % at g = 2, 8 % at 1). The factor that multiplies
+// the tables' values at g = 2.25.
+double continuous_beyond(double re_h, double screening, double spread_over_h, double g,
+                         double lattice_at_end) {
+  const auto cont = [&](double gg) {
+    const double st = std::sqrt(2 * gg * gg + 1.0 / 6 + 2 * spread_over_h * spread_over_h);
+    return self_disturbance_table()(re_h * st, screening * st * st) / st;
+  };
+  const double end = cont(2.25);
+  const double ratio = lattice_at_end / end;
+  return cont(g) / end * std::pow(ratio, (2.25 / g) * (2.25 / g) - 1);
+}
+
 }  // namespace
 
-double lattice_self_disturbance(double re_h, double screening, double spread_over_h) {
-  return lattice_interpolate<1>(lattice_stencil(re_h, screening, spread_over_h),
-                                {lattice_table::log_phi})[0];
+double lattice_self_disturbance(double re_h, double screening, double spread_over_h,
+                                double smoothing_over_h) {
+  const LatticeStencil st = lattice_stencil(re_h, screening, spread_over_h);
+  const std::array<const double*, 1> plain = {lattice_table::log_phi};
+  if (smoothing_over_h <= 0) return lattice_interpolate<1>(st, plain)[0];
+  const std::array<const double*, 1> smoothed = {lattice_table::log_phi_smoothed};
+  const double phi = smoothed_values<1>(st, smoothing_over_h, plain, smoothed)[0];
+  if (smoothing_over_h <= 2.25) return phi;
+  return phi * continuous_beyond(re_h, screening, std::min(std::max(spread_over_h, 0.0), 0.5),
+                                 smoothing_over_h, phi);
 }
 
 double lattice_self_disturbance(double re_h, double screening, double spread_over_h,
-                                const std::array<double, 3>& ax, const std::array<double, 3>& ay) {
+                                const std::array<double, 3>& ax, const std::array<double, 3>& ay,
+                                double smoothing_over_h) {
   namespace t = lattice_table;
-  const std::array<double, 6> v =
-      lattice_interpolate<6>(lattice_stencil(re_h, screening, spread_over_h),
-                             {t::log_t00, t::log_t01, t::log_t02, t::log_t11, t::log_t12, t::log_t22});
+  const LatticeStencil st = lattice_stencil(re_h, screening, spread_over_h);
+  const std::array<const double*, 6> plain = {t::log_t00, t::log_t01, t::log_t02,
+                                              t::log_t11, t::log_t12, t::log_t22};
+  const std::array<const double*, 6> smoothed = {t::log_t00_smoothed, t::log_t01_smoothed,
+                                                 t::log_t02_smoothed, t::log_t11_smoothed,
+                                                 t::log_t12_smoothed, t::log_t22_smoothed};
+  const std::array<double, 6> v = smoothing_over_h > 0
+                                       ? smoothed_values<6>(st, smoothing_over_h, plain, smoothed)
+                                       : lattice_interpolate<6>(st, plain);
   // T_ij symmetric: T[i][j] = v[pair index].
   const double tt[3][3] = {{v[0], v[1], v[2]}, {v[1], v[3], v[4]}, {v[2], v[4], v[5]}};
   double phi = 0;
@@ -221,7 +310,11 @@ double lattice_self_disturbance(double re_h, double screening, double spread_ove
     for (int j = 0; j < 3; ++j) phi += ax[i] * ay[j] * tt[i][j];
   // The integral is positive; a sum that cancels to within the tables' interpolation error
   // (weights split over cells -1 and +1 with none between) is held at zero.
-  return std::max(phi, 0.0);
+  phi = std::max(phi, 0.0);
+  if (smoothing_over_h <= 2.25) return phi;
+  const double average = smoothed_values<1>(st, 2.25, {t::log_phi}, {t::log_phi_smoothed})[0];
+  return phi * continuous_beyond(re_h, screening, std::min(std::max(spread_over_h, 0.0), 0.5),
+                                 smoothing_over_h, average);
 }
 
 const SelfDisturbanceTable& self_disturbance_table() {

@@ -82,7 +82,17 @@ const SelfDisturbanceTable& self_disturbance_table();
 // held, above the upper ends extrapolated linearly in log-log (phi ~ 1/Re_h, 1/b). For
 // s/h > 1/2 (cells finer than about half the particle) the cell size is taken as 2 s, where
 // the lattice's own scale has stopped mattering: u' = -F phi_lat(Re_2s, b_2s, 1/2) / (2 mu_e s).
-double lattice_self_disturbance(double re_h, double screening, double spread_over_h);
+//
+// With diffusionBandwidth (coupling/foam/diffusionSmoothing.H) the deposit and the read-back are
+// each averaged by its diffusion, of standard deviation sigma per axis: the integrand gains
+// D(q)^2, D the averaging's symbol on the lattice, (1 - Lambda/12)^(k-1) (1 - r Lambda) for
+// pseudo-time T = sigma^2/2 (cell units) in k - 1 full steps of 1/12 and one of r. Tabulated
+// by scripts/lattice_self_disturbance.py --smoothed in lattice_self_disturbance_smoothed_table.hpp
+// for smoothing_over_h = sigma/h up to 2.5 (see smoothed_values in the .cpp for the
+// interpolation, exact in sigma up to sigma/h = 1); beyond 2.25 the continuous Gaussian form
+// joined to the lattice's. 0: no averaging.
+double lattice_self_disturbance(double re_h, double screening, double spread_over_h,
+                                double smoothing_over_h = 0);
 
 // The self-disturbance with the particle's actual place across its motion. The footprint's
 // weights, summed over the cells of one transverse axis (its marginal W_j on the cells at
@@ -108,20 +118,22 @@ inline std::array<double, 3> transverse_coefficients(double w_minus, double w_0,
 // phi_lat with the transverse coefficients ax, ay (transverse_coefficients) of the two axes
 // across the motion.
 double lattice_self_disturbance(double re_h, double screening, double spread_over_h,
-                                const std::array<double, 3>& ax, const std::array<double, 3>& ay);
+                                const std::array<double, 3>& ax, const std::array<double, 3>& ay,
+                                double smoothing_over_h = 0);
 
 // The mobility m = u' / F [s/kg] of a particle's self-disturbance on cells of size h [m]
 // with footprint spread s [m], at slip w [m/s], for the momentum equation with density rho_e,
 // viscosity mu_e and Brinkman coefficient beta [kg/m^3/s]. ax, ay: the transverse
 // coefficients of the particle's place across its motion; null: the place-averaged factor
-// (also used where s > h/2 and the cell size is taken as 2 s).
+// (also used where s > h/2 and the cell size is taken as 2 s). sigma [m]: diffusionBandwidth's
+// standard deviation per axis (b / sqrt 2), 0 for none.
 inline double lattice_self_mobility(double h, double s, double w, double rho_e, double mu_e,
                                     double beta, const std::array<double, 3>* ax = nullptr,
-                                    const std::array<double, 3>* ay = nullptr) {
+                                    const std::array<double, 3>* ay = nullptr, double sigma = 0) {
   const double l = 2 * s > h ? 2 * s : h;
   const double re = rho_e * w * l / mu_e, b = beta * l * l / mu_e;
-  const double phi = ax && ay && l == h ? lattice_self_disturbance(re, b, s / l, *ax, *ay)
-                                        : lattice_self_disturbance(re, b, s / l);
+  const double phi = ax && ay && l == h ? lattice_self_disturbance(re, b, s / l, *ax, *ay, sigma / l)
+                                        : lattice_self_disturbance(re, b, s / l, sigma / l);
   return phi / (mu_e * l);
 }
 

@@ -66,7 +66,7 @@ def write(path, cls, obj, body):
         f.write(HEADER.format(cls=cls, obj=obj) + body)
 
 
-def make_case(case, n, re_t, width, fall, footprint, sampling, correction, courant):
+def make_case(case, n, re_t, width, fall, footprint, sampling, correction, courant, bandwidth=None):
     mu = viscosity_for(re_t)
     u_t = terminal(mu)
     h = n * D
@@ -118,6 +118,8 @@ pRefCell 0; pRefValue 0; }
     write(f"{case}/constant/transportProperties", "dictionary", "transportProperties",
           f"rho {RHO_F}; nu {mu / RHO_F:.12g};\n")
     extra = "" if correction is None else f"undisturbedVelocity {correction};\n"
+    if bandwidth:
+        extra += f"diffusionBandwidth {bandwidth * D:.12g};\n"
     write(f"{case}/constant/couplingProperties", "dictionary", "couplingProperties",
           f'scene "particles.yaml"; voidFraction {footprint}; sampling {sampling};\n'
           f"minVoidFraction 0.3; ddtVoidFraction on;\n{extra}")
@@ -197,6 +199,8 @@ def main():
     ap.add_argument("--fall", type=float, default=40)
     ap.add_argument("--courant", type=float, default=0.05,
                     help="particle Courant number u_t dt / h of the fluid step (default 0.05)")
+    ap.add_argument("--bandwidth", type=float, default=None,
+                    help="diffusionBandwidth b in particle diameters (default: none)")
     ap.add_argument("--check", type=float, default=None,
                     help="exit 1 unless every |error| is within this many per cent")
     ap.add_argument("--work", default="/tmp/settling_cells")
@@ -205,18 +209,22 @@ def main():
     rows = []
     for n in (float(x) for x in a.cells.split(",")):
         name = f"re{a.re:g}_n{n:g}_{a.footprint}_{a.sampling}_{a.correction or 'off'}_w{a.width}_c{a.courant:g}"
+        if a.bandwidth:
+            name += f"_b{a.bandwidth:g}"
         case = os.path.join(a.work, name)
         subprocess.call(["rm", "-rf", case])
-        info = make_case(case, n, a.re, a.width, a.fall, a.footprint, a.sampling, a.correction, a.courant)
+        info = make_case(case, n, a.re, a.width, a.fall, a.footprint, a.sampling, a.correction, a.courant,
+                         a.bandwidth)
         cpu, imbalance = run(case, a.build)
         err, wobble, whole = measure(case, info)
         row = dict(re=a.re, cells_per_d=n, footprint=a.footprint, sampling=a.sampling,
-                   correction=a.correction or "off", mu=info["mu"], u_t=info["u_t"],
+                   correction=a.correction or "off", bandwidth_d=a.bandwidth or 0, mu=info["mu"], u_t=info["u_t"],
                    error_pct=100 * err, wobble_pct=100 * wobble, whole_cells_error_pct=100 * whole,
                    cpu_s=cpu, mesh_cells=info["cells"], imbalance=imbalance)
         rows.append(row)
         print(f"settling_cells: Re_t {a.re:g}, cells {n:g} d, {a.footprint}/{a.sampling}, "
-              f"correction {row['correction']}: error {100 * err:+.2f} % (wobble {100 * wobble:.2f} %; "
+              f"correction {row['correction']}"
+              f"{f', diffusionBandwidth {a.bandwidth:g} d' if a.bandwidth else ''}: error {100 * err:+.2f} % (wobble {100 * wobble:.2f} %; "
               f"over whole cells {100 * whole:+.2f} %), "
               f"{info['cells']} cells, {cpu:.0f} s, exchange imbalance {imbalance:.1e}", flush=True)
     out = os.path.join(a.work, "settling_cells.csv")

@@ -5,9 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <vector>
 
 namespace grainflow {
 namespace {
@@ -116,6 +118,84 @@ TEST(SelfDisturbance, LatticeTableFollowsTheQuadrature) {
                         Case{0.05, 50.0, 0.45, 0.0026446387912598037}})
     EXPECT_NEAR(lattice_self_disturbance(c.re, c.b, c.s) / c.phi, 1, 6e-3)
         << "Re_h " << c.re << ", b " << c.b << ", s/h " << c.s;
+}
+
+// diffusionBandwidth: the deposit and the read-back each averaged by the diffusion of standard
+// deviation sigma per axis (D(q)^2 in the integrand).
+
+// The lattice Green's function with D^2 at the origin, Re_h = 0, s = 0, by a direct sum over
+// the n^3 wavenumbers of a periodic lattice (no quadrature, no table): at s = 0 the transverse
+// and passage averages are 1, so this is phi (and T_00).
+double lattice_sum_smoothed(int n, double b, double g) {
+  const double t = 0.5 * g * g;
+  const int k = std::max(1, static_cast<int>(std::ceil(12 * t - 1e-9)));
+  const double r = t - (k - 1) / 12.0;
+  std::vector<double> s2(n), l(n);
+  for (int i = 0; i < n; ++i) {
+    const double q = 2 * pi * i / n;
+    s2[i] = std::sin(q) * std::sin(q);
+    l[i] = 4 * std::sin(q / 2) * std::sin(q / 2);
+  }
+  double sum = 0;
+  for (int x = 0; x < n; ++x)
+    for (int y = 0; y < n; ++y)
+      for (int z = 0; z < n; ++z) {
+        const double lam = l[x] + l[y] + l[z], ss = s2[x] + s2[y] + s2[z];
+        const double p = ss > 0 ? 1 - s2[z] / ss : 1;
+        const double d = std::pow(1 - lam / 12, k - 1) * (1 - r * lam);
+        sum += p * d * d / (lam + b);
+      }
+  return sum / (static_cast<double>(n) * n * n);
+}
+
+TEST(SelfDisturbance, SmoothedLatticeEqualsTheDirectLatticeSum) {
+  // Every regime of the interpolation in sigma: u = 6 (sigma/h)^2 below 1, within the full
+  // steps, at the u = 6 join, and on the sigma/h axis.
+  for (double g : {0.2, 0.45, 0.83, 1.0, 1.33, 1.9})
+    EXPECT_NEAR(lattice_self_disturbance(1e-4, 1.0, 0, g) / lattice_sum_smoothed(48, 1.0, g), 1, 4e-3)
+        << "sigma/h " << g;
+}
+
+TEST(SelfDisturbance, SmoothedLatticeFollowsTheQuadrature) {
+  struct Case {
+    double re, b, s, g, phi, t00, t11;
+  };
+  // scripts/lattice_self_disturbance.py: Quadrature(24, 64, 12, sigmas=(g,)).phi(re, b, s),
+  // the place average, T_00 and T_11.
+  const std::array<double, 3> one = {1, 0, 0}, half = {0, 1, 0};  // f_0 and f_1
+  for (const Case& c : {Case{0.37, 0.0, 0.07, 0.3, 0.09565159433787175, 0.1037328675356505, 0.05488435565484787},
+                        Case{5.3, 0.02, 0.11, 0.62, 0.014243910683352132, 0.015736746051826546, 0.009531692202372473},
+                        Case{42.0, 0.0, 0.19, 0.93, 0.0010284028525365772, 0.0011478093077545073, 0.0008469895136281511},
+                        Case{0.2, 0.001, 0.075, 1.333, 0.018870329123083975, 0.019058121477153956, 0.017829613268636885},
+                        Case{260.0, 3.0, 0.3, 1.7, 4.86816096298858e-05, 5.145886346117151e-05, 4.710095124757378e-05},
+                        Case{0.05, 5.0, 0.45, 2.1, 0.0002804877679842933, 0.00030077528051266944, 0.00028180594148306543}}) {
+    EXPECT_NEAR(lattice_self_disturbance(c.re, c.b, c.s, c.g) / c.phi, 1, 8e-3)
+        << "Re_h " << c.re << ", b " << c.b << ", s/h " << c.s << ", sigma/h " << c.g;
+    EXPECT_NEAR(lattice_self_disturbance(c.re, c.b, c.s, one, one, c.g) / c.t00, 1, 8e-3);
+    EXPECT_NEAR(lattice_self_disturbance(c.re, c.b, c.s, half, half, c.g) / c.t11, 1, 8e-3);
+  }
+}
+
+TEST(SelfDisturbance, SmoothedLatticeIsContinuousAndTendsToTheGaussianForm) {
+  // sigma -> 0 gives the tables without averaging; no jump where the interpolation changes
+  // (u = 6, sigma/h = 1; sigma/h = 2.25, where the continuous form takes over).
+  for (double re : {0.01, 3.0, 300.0}) {
+    EXPECT_NEAR(lattice_self_disturbance(re, 0.1, 0.1, 1e-6) / lattice_self_disturbance(re, 0.1, 0.1), 1, 1e-9);
+    for (double g : {1.0, 2.25})
+      EXPECT_NEAR(lattice_self_disturbance(re, 0.1, 0.1, g * (1 + 1e-9)) /
+                      lattice_self_disturbance(re, 0.1, 0.1, g * (1 - 1e-9)), 1, 1e-6)
+          << "Re_h " << re << ", sigma/h " << g;
+  }
+  // Wide averaging: the lattice no longer matters, and the Stokes value is that of a Gaussian
+  // deposit-read kernel of variance 2 sigma^2 + h^2/6 + 2 s^2 per axis,
+  // u' mu sigma_t / F = (2 pi^2)^-1 (2/3) sqrt(pi/2) (the closed form of the Stokeslet
+  // regularised by a Gaussian, read at its centre); the lattice's excess falls as 1/g^2, and
+  // 3e-3 is the continuous table's own interpolation.
+  const double closed = std::sqrt(pi / 2) / (3 * pi * pi);
+  for (double g : {2.0, 3.0, 6.0}) {
+    const double st = std::sqrt(2 * g * g + 1.0 / 6 + 2 * 0.1 * 0.1);
+    EXPECT_NEAR(lattice_self_disturbance(1e-4, 1e-7, 0.1, g) * st / closed, 1, 0.08 / (g * g) + 3e-3) << g;
+  }
 }
 
 TEST(SelfDisturbance, LatticeMobilityIsContinuousWhereTheFootprintOutgrowsTheCell) {
