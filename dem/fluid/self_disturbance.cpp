@@ -202,18 +202,37 @@ std::array<double, N> lattice_interpolate(const LatticeStencil& st,
   return lp;
 }
 
-// The N tables' values at the stencil from slice k of the diffusionBandwidth tables
-// ([smooth][spread][re][b]); k = -1: the tables without averaging.
-template <std::size_t N>
-std::array<double, N> slice_values(const LatticeStencil& st, int k,
-                                   const std::array<const double*, N>& plain,
-                                   const std::array<const double*, N>& smoothed) {
+// The N tables' values at the stencil from S slices ks[] of the diffusionBandwidth tables
+// ([smooth][spread][re][b]); a slice -1: the tables without averaging. One pass over the
+// stencil for all S (each slice summed in the order of lattice_interpolate).
+template <std::size_t N, std::size_t S>
+std::array<std::array<double, N>, S> slice_values(const LatticeStencil& st, const std::array<int, S>& ks,
+                                                  const std::array<const double*, N>& plain,
+                                                  const std::array<const double*, N>& smoothed) {
   namespace t = lattice_table;
   constexpr std::size_t slice = static_cast<std::size_t>(t::n_spread) * t::n_re * t::n_b;
-  std::array<const double*, N> logs;
-  for (std::size_t m = 0; m < N; ++m)
-    logs[m] = k < 0 ? plain[m] : smoothed[m] + static_cast<std::size_t>(k) * slice;
-  return lattice_interpolate<N>(st, logs);
+  std::array<std::array<const double*, N>, S> logs;
+  for (std::size_t k = 0; k < S; ++k)
+    for (std::size_t m = 0; m < N; ++m)
+      logs[k][m] = ks[k] < 0 ? plain[m] : smoothed[m] + static_cast<std::size_t>(ks[k]) * slice;
+  std::array<std::array<double, N>, S> lp{};
+  for (int c = 0; c < 4; ++c) {
+    if (st.wz[c] == 0) continue;
+    for (int a = 0; a < 4; ++a) {
+      if (st.wx[a] == 0) continue;
+      for (int e = 0; e < 4; ++e) {
+        if (st.wy[e] == 0) continue;
+        const double w = st.wz[c] * st.wx[a] * st.wy[e];
+        const std::size_t at =
+            (static_cast<std::size_t>(st.iz[c]) * t::n_re + st.ix[a]) * t::n_b + st.iy[e];
+        for (std::size_t k = 0; k < S; ++k)
+          for (std::size_t m = 0; m < N; ++m) lp[k][m] += w * logs[k][m][at];
+      }
+    }
+  }
+  for (auto& row : lp)
+    for (double& v : row) v = std::exp(v);
+  return lp;
 }
 
 // The N tables at sigma/h = g of diffusionBandwidth's averaging, 0 <= g <= 2.25.
@@ -231,31 +250,35 @@ std::array<double, N> smoothed_values(const LatticeStencil& st, double g,
   const auto at_u = [&](double u) {
     const int j = std::min(static_cast<int>(u), 5);
     const double f = u - j;
-    const std::array<double, N> v0 = slice_values<N>(st, 2 * j - 1, plain, smoothed);
-    const std::array<double, N> v1 = slice_values<N>(st, 2 * j, plain, smoothed);
-    const std::array<double, N> v2 = slice_values<N>(st, 2 * j + 1, plain, smoothed);
+    const auto v = slice_values<N, 3>(st, {2 * j - 1, 2 * j, 2 * j + 1}, plain, smoothed);
     const double l0 = (2 * f - 1) * (f - 1), l1 = 4 * f * (1 - f), l2 = f * (2 * f - 1);
     std::array<double, N> out;
-    for (std::size_t m = 0; m < N; ++m) out[m] = l0 * v0[m] + l1 * v1[m] + l2 * v2[m];
+    for (std::size_t m = 0; m < N; ++m) out[m] = l0 * v[0][m] + l1 * v[1][m] + l2 * v[2][m];
     return out;
   };
   const double u = 6 * g * g;
   if (u <= 6) return at_u(u);
-  // Nodes n = 0..7 at g = 0.75 + n / 4.
-  const auto node = [&](int n) {
-    return n == 0 ? at_u(3.375) : slice_values<N>(st, n == 1 ? 11 : 12 + (n - 2), plain, smoothed);
-  };
+  // Nodes n = 0..7 at g = 0.75 + n / 4: n = 0 from u = 3.375, n = 1 the slice u = 6, n >= 2
+  // the slices 12 + (n - 2).
   const double x = (std::min(g, 2.25) - 0.75) * 4;
   const int i = std::clamp(static_cast<int>(x), 1, 5);
   const double f = x - i;
   const std::array<double, 4> w = {0.5 * (-f + 2 * f * f - f * f * f), 0.5 * (2 - 5 * f * f + 3 * f * f * f),
                                    0.5 * (f + 4 * f * f - 3 * f * f * f), 0.5 * (-f * f + f * f * f)};
-  std::array<double, N> lp{};
-  for (int a = 0; a < 4; ++a) {
-    const std::array<double, N> v = node(i - 1 + a);
-    for (std::size_t m = 0; m < N; ++m) lp[m] += w[a] * std::log(v[m]);
+  const auto slice_of = [](int n) { return n == 1 ? 11 : 12 + (n - 2); };
+  std::array<std::array<double, N>, 4> v;
+  if (i == 1) {
+    v[0] = at_u(3.375);
+    const auto rest = slice_values<N, 3>(st, {slice_of(1), slice_of(2), slice_of(3)}, plain, smoothed);
+    for (int a = 1; a < 4; ++a) v[a] = rest[a - 1];
+  } else {
+    v = slice_values<N, 4>(st, {slice_of(i - 1), slice_of(i), slice_of(i + 1), slice_of(i + 2)}, plain,
+                           smoothed);
   }
-  for (double& v : lp) v = std::exp(v);
+  std::array<double, N> lp{};
+  for (int a = 0; a < 4; ++a)
+    for (std::size_t m = 0; m < N; ++m) lp[m] += w[a] * std::log(v[a][m]);
+  for (double& value : lp) value = std::exp(value);
   return lp;
 }
 
