@@ -164,6 +164,8 @@ pRefCell 0; pRefValue 0; }
     sc.write(f"{case}/constant/transportProperties", "dictionary", "transportProperties",
              f"rho {sc.RHO_F}; nu {nu:.12g};\n")
     extra = "" if a.correction == "off" else f"undisturbedVelocity {a.correction};\n"
+    if a.bandwidth:
+        extra += f"diffusionBandwidth {a.bandwidth * sc.D:.12g};\n"
     sc.write(f"{case}/constant/couplingProperties", "dictionary", "couplingProperties",
              'scene "particles.yaml"; voidFraction divided; sampling cell;\n'
              f"minVoidFraction 0.3; ddtVoidFraction on; meanPressureGradient suspensionWeight;\n"
@@ -259,7 +261,7 @@ def walls_speed(case, info, n):
 def make_walls_case(case, a):
     correction = None if a.correction == "off" else a.correction
     info = sc.make_case(case, a.cells, a.re, a.width, a.fall, "divided", "cell", correction,
-                        a.courant)
+                        a.courant, a.bandwidth or None)
     # settling_cells puts the single sphere a quarter cell off the box's centre line; the
     # pair sits at +-l/2 about that point along x.
     with open(os.path.join(case, "particle.csv")) as f:
@@ -290,6 +292,8 @@ def main():
                     help="periodic: the speed is measured over this many cells of fall")
     ap.add_argument("--courant", type=float, default=0.05)
     ap.add_argument("--correction", default="oseenBrinkman")
+    ap.add_argument("--bandwidth", type=float, default=0.0,
+                    help="diffusionBandwidth b in particle diameters (default: none)")
     ap.add_argument("--check", type=float, default=None)
     ap.add_argument("--work", default="/tmp/settling_pair")
     ap.add_argument("--build", default=os.path.join(sc.ROOT, "build"))
@@ -301,7 +305,7 @@ def main():
     runs, worst = {}, 0.0
     for n in (1, 2):
         a.n = n
-        tag = f"{a.box}_re{a.re:g}_n{a.cells:g}_l{a.spacing:g}_w{a.width}_{a.correction}_{n}"
+        tag = f"{a.box}_re{a.re:g}_n{a.cells:g}_l{a.spacing:g}_w{a.width}_{a.correction}_b{a.bandwidth:g}_{n}"
         case = os.path.join(a.work, tag)
         subprocess.call(["rm", "-rf", case])
         if a.box == "periodic":
