@@ -22,12 +22,13 @@ against the closed form, the void fraction of each layer and the law at that voi
 
 Usage: bed_surface.py [--laws gidaspow,koch_hill] [--cells 6,4,3] [--surface cell,sharpInterface]
                       [--pressure linear] [--ranks 1] [--profile] [--plot FILE.png]
-                      [--check PERCENT] [--end 0.06] [--work DIR] [--build DIR]
+                      [--check PERCENT] [--end 0.06] [--bandwidth B] [--work DIR] [--build DIR]
 --cells: cells across the 12 mm column (6, 4, 3: cells of 2, 3, 4 d).
 --surface: couplingProperties dragVoidFraction, comma-separated (cell: the key is left out,
            the default; sharpInterface).
 --pressure: couplingProperties facePressure for every run (linear: the key is left out, the
             default; dragSeries).
+--bandwidth: couplingProperties diffusionBandwidth, in particle diameters (default none).
 --check: exit 1 unless every run with a surface treatment is within PERCENT of the closed
          form and every exchange imbalance printed is below 1e-12.
 Appends one row per run to <work>/bed_surface.csv.
@@ -150,6 +151,8 @@ def main():
     ap.add_argument("--surface", default="cell")
     ap.add_argument("--pressure", default="linear")
     ap.add_argument("--ranks", type=int, default=1)
+    ap.add_argument("--bandwidth", type=float, default=0.0,
+                    help="couplingProperties diffusionBandwidth b in particle diameters (0: none)")
     ap.add_argument("--profile", action="store_true")
     ap.add_argument("--plot", default="")
     ap.add_argument("--check", type=float, default=0)
@@ -172,7 +175,7 @@ def main():
         for cells in (int(c) for c in args.cells.split(",")):
             h = 0.012 / cells
             for surface in args.surface.split(","):
-                name = f"bed_{law}_c{cells}_{surface}" + (f"_{args.pressure}" if args.pressure != "linear" else "") + (f"_np{args.ranks}" if args.ranks > 1 else "")
+                name = f"bed_{law}_c{cells}_{surface}" + (f"_{args.pressure}" if args.pressure != "linear" else "") + (f"_b{args.bandwidth:g}" if args.bandwidth else "") + (f"_np{args.ranks}" if args.ranks > 1 else "")
                 case = cs.bed_case(args.work, name, snapshot, cells, "divided", "cell", 20, u=U_S,
                                    end=args.end)
                 cs.sub(f"{case}/particles.yaml", r"^  drag: \S+", f"  drag: {law}")
@@ -183,6 +186,9 @@ def main():
                 if args.pressure != "linear":
                     with open(f"{case}/constant/couplingProperties", "a") as f:
                         f.write(f"facePressure {args.pressure};\n")
+                if args.bandwidth:
+                    with open(f"{case}/constant/couplingProperties", "a") as f:
+                        f.write(f"diffusionBandwidth {args.bandwidth * d:.12g};\n")
                 cost = run_case(case, args.build, name, args.ranks)
                 dp = cs.bed_dp(case, args.end / 2)
                 worst = imbalance(case)
