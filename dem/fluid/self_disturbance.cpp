@@ -178,33 +178,9 @@ LatticeStencil lattice_stencil(double re_h, double screening, double spread_over
   return st;
 }
 
-// Interpolates the tables `logs` (each [spread][re][b] in log) on one stencil: out[m] the
-// value of table m.
-template <std::size_t N>
-std::array<double, N> lattice_interpolate(const LatticeStencil& st,
-                                          const std::array<const double*, N>& logs) {
-  namespace t = lattice_table;
-  std::array<double, N> lp{};
-  for (int c = 0; c < 4; ++c) {
-    if (st.wz[c] == 0) continue;
-    for (int a = 0; a < 4; ++a) {
-      if (st.wx[a] == 0) continue;
-      for (int e = 0; e < 4; ++e) {
-        if (st.wy[e] == 0) continue;
-        const double w = st.wz[c] * st.wx[a] * st.wy[e];
-        const std::size_t at =
-            (static_cast<std::size_t>(st.iz[c]) * t::n_re + st.ix[a]) * t::n_b + st.iy[e];
-        for (std::size_t m = 0; m < N; ++m) lp[m] += w * logs[m][at];
-      }
-    }
-  }
-  for (double& v : lp) v = std::exp(v);
-  return lp;
-}
-
 // The N tables' values at the stencil from S slices ks[] of the diffusionBandwidth tables
 // ([smooth][spread][re][b]); a slice -1: the tables without averaging. One pass over the
-// stencil for all S (each slice summed in the order of lattice_interpolate).
+// stencil for all S; lattice_interpolate is the one slice -1.
 template <std::size_t N, std::size_t S>
 std::array<std::array<double, N>, S> slice_values(const LatticeStencil& st, const std::array<int, S>& ks,
                                                   const std::array<const double*, N>& plain,
@@ -233,6 +209,14 @@ std::array<std::array<double, N>, S> slice_values(const LatticeStencil& st, cons
   for (auto& row : lp)
     for (double& v : row) v = std::exp(v);
   return lp;
+}
+
+// Interpolates the tables `logs` (each [spread][re][b] in log) on one stencil: out[m] the
+// value of table m.
+template <std::size_t N>
+std::array<double, N> lattice_interpolate(const LatticeStencil& st,
+                                          const std::array<const double*, N>& logs) {
+  return slice_values<N, 1>(st, {-1}, logs, logs)[0];
 }
 
 // The N tables at sigma/h = g of diffusionBandwidth's averaging, 0 <= g <= 2.25.
