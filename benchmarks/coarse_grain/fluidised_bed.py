@@ -23,10 +23,13 @@ mean eps (the bed's other cells);
 and the cost: grainFoam's CPU seconds (ExecutionTime) per simulated second and its wall time.
 
 usage: fluidised_bed.py [--ks 1,2,3] [--end 1.0] [--from 0.5] [--seed 1] [--depth 0.009] [--work DIR]
-                        [--build DIR] [--analyse-only] [--diagnose]
+                        [--build DIR] [--pp-restitution E] [--analyse-only] [--diagnose]
 --seed sets the fill's random seed (another realisation of the same bed; cases k<k>_seed<s>).
 --depth D makes the column D deep (a whole number of 3 mm cells; 12 000 D/9 mm beads, the same
 real beads per area; cases k<k>_seed<s>_depth<D>mm).
+--pp-restitution E sets the restitution between the beads (parcels) to E, against the walls
+kept at 0.9 (cases k<k>_seed<s>_epp<E>): kinetic theory's collisional dissipation per volume
+falls as 1/k for parcels, restored by 1 - E^2 = k (1 - 0.9^2) (docs/accuracy-vs-cost-coupled.md).
 --analyse-only reads the cases already in DIR (the cost columns from their logs).
 --diagnose also prints the heights per snapshot, the solid-fraction profiles and the real mass
 across the depth.
@@ -72,8 +75,13 @@ def dem_step(k):
     return FLUID_STEP / steps, steps
 
 
+PP_RESTITUTION = None  # --pp-restitution: the beads' (parcels') restitution against each other
+
+
 def case_dir(work, k, seed):
     tail = "" if abs(DEPTH - 0.009) < 1e-12 else f"_depth{1e3 * DEPTH:g}mm"
+    if PP_RESTITUTION is not None:
+        tail += f"_epp{PP_RESTITUTION:g}"
     return os.path.join(work, f"k{k}_seed{seed}{tail}")
 
 
@@ -98,6 +106,10 @@ def prepare(work, k, end, seed):
     sub(scene, "    count: 12000\n", f"    count: {round(beads / k**3)}\n    coarse_grain: {k}\n")
     sub(scene, "  step: 1.5e-5\n", f"  step: {dt:.17g}\n")
     sub(scene, "    seed: 1\n", f"    seed: {seed}\n")
+    if PP_RESTITUTION is not None:
+        sub(scene, "interaction_defaults: {restitution: 0.9, friction: 0.3}\n",
+            "interaction_defaults: {restitution: 0.9, friction: 0.3}\n"
+            f"interactions:\n  - {{materials: [glass, glass], restitution: {PP_RESTITUTION:.6g}, friction: 0.3}}\n")
     if k > 1:  # random insertion keeps centres k r inside the region: give the parcels room
         sub(scene, "max: [0.06, 0.009, 0.082]", "max: [0.06, 0.009, 0.16]")
         # The longer fall lands them harder: at k = 2 a pair reached 20.3 % overlap in the pour.
@@ -236,10 +248,13 @@ def main():
     ap.add_argument("--analyse-only", action="store_true")
     ap.add_argument("--diagnose", action="store_true")
     ap.add_argument("--depth", type=float, default=0.009)
+    ap.add_argument("--pp-restitution", type=float, default=None)
     ap.add_argument("--work", default=os.path.join(ROOT, "build", "benchmarks", "coarse_grain_fluidised"))
     ap.add_argument("--build", default=os.environ.get("GRAINFLOW_BUILD_DIR", os.path.join(ROOT, "build")))
     args = ap.parse_args()
     set_depth(args.depth)
+    global PP_RESTITUTION
+    PP_RESTITUTION = args.pp_restitution
     os.makedirs(args.work, exist_ok=True)
     env = dict(os.environ, LD_LIBRARY_PATH=os.path.join(args.build, "lib"))
     rows = []

@@ -105,7 +105,8 @@ def bulk_gradients(case, cells, h, face_pressure):
     """The cells' own -dp/dz in the bed's bulk at the last written time, as the run's
     momentum equation had it: Gauss linear (the mean of the two neighbours' pressures), or
     dragSeries (the face pressures of the half cells in series, resistance r = Ksl/(rho eps c),
-    c = eps: model A, a bulk cell read as one layer). Bulk: layers k whose neighbours k - 1 and
+    c = eps: model A, a bulk cell read as one layer; each half cell's r that of its layer: the
+    cell and its four neighbours across z, the column periodic sideways). Bulk: layers k whose neighbours k - 1 and
     k + 1 have a mean eps below 0.5, k >= 1. In each layer the fluid's steady balance holds for
     the eps-weighted mean of the cell gradients, sum eps g = the drag; the layer-mean gradient,
     which the pressure profile shows, exceeds it by -cov(eps, g) / mean(eps). Returns the spread
@@ -116,7 +117,8 @@ def bulk_gradients(case, cells, h, face_pressure):
     nz, n = int(round(cells * 5)), cells * cells
     read = lambda name: read_internal(os.path.join(case, last, name)).reshape(nz, n)
     p, e, k = read("p") * cs.RHO_F, read("voidfraction"), read("Ksl")
-    r = k / (cs.RHO_F * e * e)
+    r = (k / (cs.RHO_F * e * e)).reshape(nz, cells, cells)  # [z, y, x]
+    r = ((r + np.roll(r, 1, 1) + np.roll(r, -1, 1) + np.roll(r, 1, 2) + np.roll(r, -1, 2)) / 5).reshape(nz, n)
     rows = []
     for z in range(1, nz - 1):
         if max(e[z - 1].mean(), e[z].mean(), e[z + 1].mean()) >= 0.5:
@@ -208,7 +210,8 @@ def main():
                 if args.profile or args.plot:
                     p, e_cell = layer_profile(case, cells)
                     p_inlet = inlet_pressure(case)
-                    profiles.append((law, cells, surface, h, p, e_cell, p_inlet, gradient, height))
+                    label = surface + (f" + {args.pressure}" if args.pressure != "linear" else "")
+                    profiles.append((law, cells, label, h, p, e_cell, p_inlet, gradient, height))
                     print_profile(law, d, h, p, e_cell, p_inlet, gradient, height)
                     bulk = bulk_gradients(case, cells, h, args.pressure)
                     if bulk is not None:
@@ -283,19 +286,21 @@ def plot(path, profiles, d):
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(6.4, 4.0), dpi=80)
     height = profiles[0][-1]
-    for law, cells, surface, h, p, e_cell, p_inlet, gradient, _ in profiles:
+    for i, (law, cells, surface, h, p, e_cell, p_inlet, gradient, _) in enumerate(profiles):
         zf = np.concatenate(([h / 4], np.arange(1, len(p)) * h))
         grad = np.concatenate(([(p_inlet - p[0]) / (h / 2)], -np.diff(p) / h))
         keep = zf < height + 3 * h
-        ax.plot(zf[keep] / d, grad[keep] / gradient, "o-", ms=4,
-                label=f"{law}, cells {h / d:g} d, {surface}")
-    h = profiles[0][3]
-    zf = np.concatenate(([h / 4], np.arange(1, len(profiles[0][4])) * h))
-    lo = np.concatenate(([0.0], zf[1:] - h / 2))
-    hi = np.concatenate(([h / 2], zf[1:] + h / 2))
-    inside = np.clip((height - lo) / (hi - lo), 0, 1)
-    keep = zf < height + 3 * h
-    ax.plot(zf[keep] / d, inside[keep], "k--", lw=1, label="closed form over the same spans")
+        line, = ax.plot(zf[keep] / d, grad[keep] / gradient, "o-", ms=4,
+                        label=f"{law}, cells {h / d:g} d, {surface}")
+        # The closed form over the same spans: the fraction of each span below the bed's
+        # mass-equivalent height (the first span from the inlet to the first cell centre).
+        lo = np.concatenate(([0.0], zf[1:] - h / 2))
+        hi = np.concatenate(([h / 2], zf[1:] + h / 2))
+        inside = np.clip((height - lo) / (hi - lo), 0, 1)
+        same = any(q[3] == h for q in profiles[:i])
+        if not same:
+            ax.plot(zf[keep] / d, inside[keep], "--", lw=1, color="k" if len({q[3] for q in profiles}) == 1 else line.get_color(),
+                    label=f"closed form over the same spans ({h / d:g} d)")
     ax.axvline(height / d, color="k", ls=":", lw=1)
     ax.set_xlabel("z / d  (dotted: the bed's mass-equivalent height)")
     ax.set_ylabel("-dp/dz / closed form at the core eps")
