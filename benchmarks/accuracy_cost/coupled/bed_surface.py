@@ -22,13 +22,16 @@ against the closed form, the void fraction of each layer and the law at that voi
 
 Usage: bed_surface.py [--laws gidaspow,koch_hill] [--cells 6,4,3] [--surface cell,sharpInterface]
                       [--pressure linear] [--ranks 1] [--profile] [--plot FILE.png]
-                      [--check PERCENT] [--end 0.06] [--bandwidth B] [--work DIR] [--build DIR]
+                      [--check PERCENT] [--end 0.06] [--bandwidth B] [--pour-seed 7] [--work DIR]
+                      [--build DIR]
 --cells: cells across the 12 mm column (6, 4, 3: cells of 2, 3, 4 d).
 --surface: couplingProperties dragVoidFraction, comma-separated (cell: the key is left out,
            the default; sharpInterface).
 --pressure: couplingProperties facePressure for every run (linear: the key is left out, the
             default; dragSeries).
 --bandwidth: couplingProperties diffusionBandwidth, in particle diameters (default none).
+--pour-seed: the seed of the pour's fill (7, ergunPackedBed's): another seed pours the same bed
+  anew (its own core eps, height and surface).
 --check: exit 1 unless every run with a surface treatment is within PERCENT of the closed
          form and every exchange imbalance printed is below 1e-12.
 Appends one row per run to <work>/bed_surface.csv.
@@ -159,12 +162,14 @@ def main():
     ap.add_argument("--plot", default="")
     ap.add_argument("--check", type=float, default=0)
     ap.add_argument("--end", type=float, default=0.06)
+    ap.add_argument("--pour-seed", type=int, default=7,
+                    help="the pour's fill seed (7: ergunPackedBed's; another: another pour of the bed)")
     ap.add_argument("--work", default=os.path.join(ROOT, "build", "accuracy_cost", "bed_surface"))
     ap.add_argument("--build", default=os.environ.get("GRAINFLOW_BUILD_DIR", os.path.join(ROOT, "build")))
     args = ap.parse_args()
     os.makedirs(args.work, exist_ok=True)
     started = time.time()
-    snapshot = cs.pour(args.work, args.build)
+    snapshot = cs.pour(args.work, args.build, args.pour_seed)
     d, eps, height, top, solid = bed_geometry(snapshot)
     print(f"bed_surface: {solid / (math.pi * d**3 / 6):.0f} particles, d = {d * 1e3:.3f} mm, core eps = "
           f"{eps:.4f}, mass-equivalent height {height * 1e3:.2f} mm, highest particle top "
@@ -177,7 +182,7 @@ def main():
         for cells in (int(c) for c in args.cells.split(",")):
             h = 0.012 / cells
             for surface in args.surface.split(","):
-                name = f"bed_{law}_c{cells}_{surface}" + (f"_{args.pressure}" if args.pressure != "linear" else "") + (f"_b{args.bandwidth:g}" if args.bandwidth else "") + (f"_np{args.ranks}" if args.ranks > 1 else "")
+                name = (f"seed{args.pour_seed}_" if args.pour_seed != 7 else "") + f"bed_{law}_c{cells}_{surface}" + (f"_{args.pressure}" if args.pressure != "linear" else "") + (f"_b{args.bandwidth:g}" if args.bandwidth else "") + (f"_np{args.ranks}" if args.ranks > 1 else "")
                 case = cs.bed_case(args.work, name, snapshot, cells, "divided", "cell", 20, u=U_S,
                                    end=args.end)
                 cs.sub(f"{case}/particles.yaml", r"^  drag: \S+", f"  drag: {law}")

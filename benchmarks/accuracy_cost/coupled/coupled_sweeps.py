@@ -88,8 +88,10 @@ def ergun(u, d, eps, height):
                      1.75 * RHO_F * u**2 * (1 - eps) / (eps**3 * d))
 
 
-def pour(work, build):
-    case = os.path.join(work, "pour")
+def pour(work, build, seed=7):
+    """The poured bed of ergunPackedBed (its fill's seed 7, or another seed: another pour of
+    the same bed, in pour_seed<seed>)."""
+    case = os.path.join(work, "pour" if seed == 7 else f"pour_seed{seed}")
     snap = glob.glob(os.path.join(case, "particles", "particles_*.h5"))
     if snap:
         return sorted(snap)[-1]
@@ -97,6 +99,8 @@ def pour(work, build):
     shutil.copytree(os.path.join(ROOT, "tutorials", "cfd-dem", "ergunPackedBed"), case,
                     ignore=shutil.ignore_patterns("particles", "processor*", "postProcessing", "log.*", "*.png"))
     sub(f"{case}/system/controlDict", r"^endTime .*?;", "endTime 0.15;")
+    if seed != 7:
+        sub(f"{case}/particles.yaml", r"seed: 7\n", f"seed: {seed}\n")
     with open(f"{case}/system/shortRun.U", "w") as f:
         f.write("superficialVelocity constant (0 0 0);\n")
     print("coupled_sweeps: pouring the bed (0.15 s) ...", flush=True)
