@@ -22,7 +22,8 @@ against the closed form, the void fraction of each layer and the law at that voi
 
 Usage: bed_surface.py [--laws gidaspow,koch_hill] [--cells 6,4,3] [--surface cell,sharpInterface]
                       [--pressure linear] [--ranks 1] [--profile] [--plot FILE.png]
-                      [--check PERCENT] [--end 0.06] [--bandwidth B] [--pour-seed 7] [--work DIR]
+                      [--check PERCENT] [--end 0.06] [--bandwidth B] [--pour-seed 7] [--footprint divided]
+                      [--model A] [--work DIR]
                       [--build DIR]
 --cells: cells across the 12 mm column (6, 4, 3: cells of 2, 3, 4 d).
 --surface: couplingProperties dragVoidFraction, comma-separated (cell: the key is left out,
@@ -30,6 +31,7 @@ Usage: bed_surface.py [--laws gidaspow,koch_hill] [--cells 6,4,3] [--surface cel
 --pressure: couplingProperties facePressure for every run (linear: the key is left out, the
             default; dragSeries).
 --bandwidth: couplingProperties diffusionBandwidth, in particle diameters (default none).
+--footprint, --model: couplingProperties voidFraction (divided) and the scene's fluid model (A).
 --pour-seed: the seed of the pour's fill (7, ergunPackedBed's): another seed pours the same bed
   anew (its own core eps, height and surface).
 --check: exit 1 unless every run with a surface treatment is within PERCENT of the closed
@@ -162,6 +164,8 @@ def main():
     ap.add_argument("--plot", default="")
     ap.add_argument("--check", type=float, default=0)
     ap.add_argument("--end", type=float, default=0.06)
+    ap.add_argument("--footprint", default="divided", help="couplingProperties voidFraction")
+    ap.add_argument("--model", default="A", choices=("A", "B"), help="the scene's fluid model")
     ap.add_argument("--pour-seed", type=int, default=7,
                     help="the pour's fill seed (7: ergunPackedBed's; another: another pour of the bed)")
     ap.add_argument("--work", default=os.path.join(ROOT, "build", "accuracy_cost", "bed_surface"))
@@ -182,10 +186,14 @@ def main():
         for cells in (int(c) for c in args.cells.split(",")):
             h = 0.012 / cells
             for surface in args.surface.split(","):
-                name = (f"seed{args.pour_seed}_" if args.pour_seed != 7 else "") + f"bed_{law}_c{cells}_{surface}" + (f"_{args.pressure}" if args.pressure != "linear" else "") + (f"_b{args.bandwidth:g}" if args.bandwidth else "") + (f"_np{args.ranks}" if args.ranks > 1 else "")
-                case = cs.bed_case(args.work, name, snapshot, cells, "divided", "cell", 20, u=U_S,
+                name = ((f"seed{args.pour_seed}_" if args.pour_seed != 7 else "") + f"bed_{law}_c{cells}_{surface}"
+                        + (f"_{args.footprint}" if args.footprint != "divided" else "")
+                        + (f"_model{args.model}" if args.model != "A" else "")) + (f"_{args.pressure}" if args.pressure != "linear" else "") + (f"_b{args.bandwidth:g}" if args.bandwidth else "") + (f"_np{args.ranks}" if args.ranks > 1 else "")
+                case = cs.bed_case(args.work, name, snapshot, cells, args.footprint, "cell", 20, u=U_S,
                                    end=args.end)
                 cs.sub(f"{case}/particles.yaml", r"^  drag: \S+", f"  drag: {law}")
+                if args.model != "A":
+                    cs.sub(f"{case}/particles.yaml", r"^  model: A", f"  model: {args.model}")
                 cs.sub(f"{case}/system/controlDict", r"^writeInterval .*?;", f"writeInterval {args.end / 2:g};")
                 if surface != "cell":
                     with open(f"{case}/constant/couplingProperties", "a") as f:
