@@ -650,6 +650,31 @@ void ParticleCoupling::continueVoidFraction() {
                          "system/controlDict for exact restarts"
                       << endl;
   }
+
+  // Ksl likewise: the first fluid samples after the restart read it (the face pressures of
+  // facePressure dragSeries, the Brinkman term of undisturbedVelocity) before the next
+  // deposit, so the uninterrupted run's sum order is taken where the written field is the
+  // deposit to round-off.
+  IOobject kslIo("Ksl", mesh_.time().timeName(), mesh_, IOobject::MUST_READ, IOobject::NO_WRITE,
+                 false);
+  if (!kslIo.typeHeaderOk<volScalarField>(true)) return;
+  const volScalarField writtenKsl(kslIo, mesh_);
+  const scalar kslScale = max(gMax(mag(Ksl_.primitiveField())()), VSMALL);
+  const scalar kslDifference =
+      gMax(mag(writtenKsl.primitiveField() - Ksl_.primitiveField())()) / kslScale;
+  if (kslDifference <= 1e-9) {
+    Ksl_.primitiveFieldRef() = writtenKsl.primitiveField();
+    Info << "grainFoam coupling: restart Ksl: the written field and the particles' deposit "
+            "differ by "
+         << kslDifference << " of its largest value; continuing with the written one" << endl;
+  } else {
+    Info << "grainFoam coupling: restart Ksl: the written field differs from the particles' "
+            "deposit by "
+         << kslDifference
+         << " of its largest value: continuing from the deposit (the first samples after "
+            "the restart may differ in the last digits)"
+         << endl;
+  }
 }
 
 ParticleCoupling::~ParticleCoupling() = default;

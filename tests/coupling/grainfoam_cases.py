@@ -449,7 +449,7 @@ def read_foam_binary_or_ascii(case, folder, name):
     return text[start:end]
 
 
-def restart(runner, checks):
+def restart(runner, checks, coupling_keys="", other_rank_count=True):
     """Restart of a coupled run: cases/periodic_box in a flow of (0.05 0.02 0) m/s under
     10 g, so that the 307 beads rain through the water onto the floor, with over a hundred
     frictional contacts by the end. 400 fluid steps of 10 DEM steps, written every 200
@@ -467,6 +467,9 @@ def restart(runner, checks):
              ("system/controlDict", "endTime         2e-4;", "endTime         4e-2;"),
              ("system/controlDict", "writeInterval   1;", "writeInterval   200;"),
              ("system/controlDict", "writeFormat     ascii;", "writeFormat     binary;")]
+    if coupling_keys:
+        edits.append(("constant/couplingProperties", "ddtVoidFraction on;",
+                      "ddtVoidFraction on;\n" + coupling_keys))
     finals = {}
     for ranks in (1, 2):
         whole = runner.fresh_case("periodic_box", f"restart_whole_np{ranks}", edits)
@@ -515,6 +518,8 @@ def restart(runner, checks):
                     read_foam_binary_or_ascii(part, end_time, field))
             checks.expect(same, f"np {ranks}: {field} at t = {end_time} equal byte for byte")
         finals[ranks] = a[1]
+    if not other_rank_count:
+        return
 
     # Another rank count: the 1-rank checkpoint restarted on 2 ranks.
     case = os.path.join(runner.work, "restart_np1_to_np2")
@@ -547,6 +552,16 @@ def restart(runner, checks):
     log = runner.run(case, "grainFoam.missing", runner.solver, expect_failure=True)
     checks.expect("restart from time 0.02" in log and checkpoint in log,
                   "a missing DEM checkpoint: refused; the message names the time and the file")
+
+
+def restart_bed_surface(runner, checks):
+    """coupling.restart's bit-identical restarts on 1 and 2 ranks with the bed-surface keys
+    dragVoidFraction sharpInterface and facePressure dragSeries (docs/models/bed-surface.md):
+    the beads pile on the floor, so cells are read as two layers and the face pressures
+    follow the layers' resistances, which the first samples after the restart read from Ksl
+    (taken as written, in the uninterrupted run's sum order)."""
+    restart(runner, checks, "dragVoidFraction sharpInterface;\nfacePressure dragSeries;\n",
+            other_rank_count=False)
 
 
 # --- coupling.stop_signal ---------------------------------------------------------------
@@ -1251,7 +1266,7 @@ def diffusion_smoothing(runner, checks):
 
 TESTS = {f.__name__: f for f in (void_fraction_volume, exchange_balance, neutrally_buoyant,
                                   cellpoint_ranks,
-                                 refuses_bad_setup, restart, stop_signal, nan_guard,
+                                 refuses_bad_setup, restart, restart_bed_surface, stop_signal, nan_guard,
                                  scene_output, heat_equilibrium, heat_balance,
                                  heat_front, balanced_decomposition,
                                  diffusion_smoothing)}

@@ -25,6 +25,9 @@
 #       U, p, phi, voidfraction bit-identical; a 1-rank checkpoint restarted on 2 ranks
 #       continues the same flow (centre of mass within 2 % of its fall); a missing DEM
 #       checkpoint is refused naming the file. About 45 s.
+#   coupling.restart_bed_surface   the same restarts with dragVoidFraction sharpInterface and
+#       facePressure dragSeries (the beads pile on the floor): bit-identical on 1 and 2 ranks
+#       (Ksl taken as written at the restart, as the void fraction is). About 25 s.
 #   coupling.stop_signal           the same case, SIGTERM mid-run (on 2 ranks to one rank only):
 #       exit 0 with the message, the time written with its checkpoint; restarted, it ends
 #       bit-identical to a run stopped at that time by endTime and restarted. About 25 s.
@@ -157,6 +160,8 @@ grainflow_coupling_test(cellpoint_ranks 2)
 grainflow_coupling_test(refuses_bad_setup 2)
 grainflow_coupling_test(restart 2)
 set_tests_properties(coupling.restart PROPERTIES TIMEOUT 600)  # ~45 s on a quiet machine
+grainflow_coupling_test(restart_bed_surface 2)
+set_tests_properties(coupling.restart_bed_surface PROPERTIES TIMEOUT 600)
 grainflow_coupling_test(stop_signal 2)
 grainflow_coupling_test(nan_guard 2)
 grainflow_coupling_test(scene_output 1)
