@@ -40,6 +40,14 @@ std::string cutsText(const coupling::ProcessorGrid& grid) {
 
 namespace {
 
+// The mesh axis a face's area vector is most aligned with (0, 1, 2: x, y, z).
+int dominantAxis(const Foam::vector& s) {
+  int a = 0;
+  for (int b = 1; b < 3; ++b)
+    if (std::abs(s[b]) > std::abs(s[a])) a = b;
+  return a;
+}
+
 using Clock = std::chrono::steady_clock;
 
 double processCpuSeconds() {
@@ -1029,9 +1037,7 @@ void ParticleCoupling::reconstructLayers() {
   const scalarField& eps = voidFraction_.primitiveField();
   sides_.assign(12 * static_cast<std::size_t>(n), 0.0);
   const auto add = [this](label c, const vector& outward, double phi) {
-    int a = 0;
-    for (int b = 1; b < 3; ++b)
-      if (std::abs(outward[b]) > std::abs(outward[a])) a = b;
+    const int a = dominantAxis(outward);
     const double area = mag(outward);
     double* s = &sides_[12 * static_cast<std::size_t>(c) + 4 * a + (outward[a] > 0 ? 2 : 0)];
     s[0] += area * phi;
@@ -1109,12 +1115,6 @@ Foam::tmp<Foam::volVectorField> ParticleCoupling::seriesGradient(
   const vectorField& Sf = mesh_.Sf().primitiveField();
   const labelUList& owner = mesh_.owner();
   const labelUList& neighbour = mesh_.neighbour();
-  const auto axisOf = [](const vector& s) {
-    int a = 0;
-    for (int b = 1; b < 3; ++b)
-      if (std::abs(s[b]) > std::abs(s[a])) a = b;
-    return a;
-  };
   // Per cell and axis b: the sum over its faces along b of |S| r beyond, of |S| with a
   // neighbour, and of |S| of every face (walls too).
   std::vector<double> around(9 * static_cast<std::size_t>(n), 0.0);
@@ -1127,7 +1127,7 @@ Foam::tmp<Foam::volVectorField> ParticleCoupling::seriesGradient(
     s[2] += area;
   };
   forAll(neighbour, f) {
-    const int b = axisOf(Sf[f]);
+    const int b = dominantAxis(Sf[f]);
     const double area = mag(Sf[f]);
     add(owner[f], b, area, r[neighbour[f]], true);
     add(neighbour[f], b, area, r[owner[f]], true);
@@ -1137,9 +1137,9 @@ Foam::tmp<Foam::volVectorField> ParticleCoupling::seriesGradient(
     const vectorField& S = mesh_.Sf().boundaryField()[patch];
     if (r.boundaryField()[patch].coupled()) {
       const tmp<scalarField> rN = r.boundaryField()[patch].patchNeighbourField();
-      forAll(cells, i) add(cells[i], axisOf(S[i]), mag(S[i]), rN()[i], true);
+      forAll(cells, i) add(cells[i], dominantAxis(S[i]), mag(S[i]), rN()[i], true);
     } else {
-      forAll(cells, i) add(cells[i], axisOf(S[i]), mag(S[i]), 0.0, false);
+      forAll(cells, i) add(cells[i], dominantAxis(S[i]), mag(S[i]), 0.0, false);
     }
   }
   // The layer's resistance per axis a, exchanged across coupled patches like r.
@@ -1169,7 +1169,7 @@ Foam::tmp<Foam::volVectorField> ParticleCoupling::seriesGradient(
     return gP + gN > 0 ? (gP * pP + gN * pN) / (gP + gN) : linear;
   };
   forAll(owner, f) {
-    const volScalarField& ra = layer[axisOf(Sf[f])];
+    const volScalarField& ra = layer[dominantAxis(Sf[f])];
     pf[f] = series(w[f], ra[owner[f]], ra[neighbour[f]], p[owner[f]], p[neighbour[f]], pf[f]);
   }
   forAll(pf.boundaryField(), patch) {
@@ -1183,7 +1183,7 @@ Foam::tmp<Foam::volVectorField> ParticleCoupling::seriesGradient(
     for (int a = 0; a < 3; ++a) rN[a] = layer[a].boundaryField()[patch].patchNeighbourField();
     scalarField& pfb = pf.boundaryFieldRef()[patch];
     forAll(cells, i) {
-      const int a = axisOf(S[i]);
+      const int a = dominantAxis(S[i]);
       pfb[i] = series(wb[i], layer[a][cells[i]], rN[a]()[i], p[cells[i]], pN()[i], pfb[i]);
     }
   }
