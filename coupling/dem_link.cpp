@@ -477,7 +477,7 @@ DemLink::SampleRecords DemLink::fluid_samples() {
     m.pending_vorticity = m.fluid->take_spare_vorticity();
     m.pending_vorticity.resize(n);
   }
-  if (m.self) {  // the records carry no disturbance: these particles get no correction
+  if (m.self) {  // the records carry no disturbance: set_fluid_disturbance, or no correction
     m.pending_disturbance = m.fluid->take_spare_disturbance();
     m.pending_disturbance.assign(n, SelfDisturbance{});
   }
@@ -573,23 +573,42 @@ std::array<double, 2> DemLink::thermal_energy() const {
   return {sums[0], sums[1]};
 }
 
+namespace {
+
+SelfDisturbance disturbance_of(const FluidAtParticle& f) {
+  SelfDisturbance sd{f.disturbance_cell, f.disturbance_spread, f.disturbance_screening,
+                     f.disturbance_smoothing};
+  if (f.disturbance_placed) {
+    sd.placed = true;
+    for (int a = 0; a < 3; ++a) {
+      const std::array<double, 3>& w = f.disturbance_weights[a];
+      sd.transverse[a] = transverse_coefficients(w[0], w[1], w[2]);
+    }
+  }
+  if (f.disturbance_cell_point) {
+    sd.cell_point = true;
+    sd.place = f.disturbance_place;
+    sd.marginals = f.disturbance_weights;
+  }
+  return sd;
+}
+
+}  // namespace
+
 void DemLink::add_fluid(const FluidAtParticle& f) {
   Impl& m = *impl_;
   m.pending.push_back(CoupledSample{vec(f.velocity), f.void_fraction, vec(f.pressure_gradient),
                                     vec(f.viscous_stress_divergence)});
   if (m.curl) m.pending_vorticity.push_back(vec(f.vorticity));
-  if (m.self) {
-    SelfDisturbance sd{f.disturbance_cell, f.disturbance_spread, f.disturbance_screening,
-                       f.disturbance_smoothing};
-    if (f.disturbance_placed) {
-      sd.placed = true;
-      for (int a = 0; a < 3; ++a) {
-        const std::array<double, 3>& w = f.disturbance_weights[a];
-        sd.transverse[a] = transverse_coefficients(w[0], w[1], w[2]);
-      }
-    }
-    m.pending_disturbance.push_back(sd);
-  }
+  if (m.self) m.pending_disturbance.push_back(disturbance_of(f));
+}
+
+void DemLink::set_fluid_disturbance(std::size_t i, const FluidAtParticle& f) {
+  Impl& m = *impl_;
+  if (!m.self || i >= m.pending_disturbance.size())
+    throw std::logic_error("DemLink::set_fluid_disturbance: no correction, or no record " +
+                           std::to_string(i));
+  m.pending_disturbance[i] = disturbance_of(f);
 }
 
 void DemLink::end_fluid(std::function<FluidAtParticle(const std::array<double, 3>&)> late) {

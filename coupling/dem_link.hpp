@@ -43,6 +43,10 @@ struct FluidAtParticle {
   // any axis (disturbance_placed; else the place-averaged disturbance is used).
   std::array<std::array<double, 3>, 3> disturbance_weights{};
   bool disturbance_placed = false;
+  // sampling cellPoint: the particle reads at its centre, at disturbance_place from its
+  // cell's centre per mesh axis [cells] (self_disturbance.hpp, lattice_self_disturbance_cellpoint).
+  bool disturbance_cell_point = false;
+  std::array<double, 3> disturbance_place{};
   double temperature = 0;  // T_f [K] (coupled heat; see DemLink::heat_on)
 };
 
@@ -220,6 +224,9 @@ class DemLink {
     double* vorticity;  // 3 per particle, or null: no force reads it
   };
   SampleRecords fluid_samples();
+  // With fluid_samples() and the self-disturbance correction on: local particle i's
+  // disturbance (the disturbance_* members of f), which the records do not carry.
+  void set_fluid_disturbance(std::size_t i, const FluidAtParticle& f);
   // Heat on: the fluid temperature at each local particle, in the order of the samples;
   // given before each end_fluid().
   void set_fluid_temperatures(std::vector<double> temperatures);

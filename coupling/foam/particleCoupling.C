@@ -194,11 +194,6 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
                                     "particle's own disturbance, docs/models/"
                                     "undisturbed-velocity.md)"
                                  << exit(FatalIOError);
-  if (undisturbed_ && sampling_ != Sampling::cell)
-    FatalIOErrorInFunction(dict) << "undisturbedVelocity oseenBrinkman needs sampling cell "
-                                    "(the disturbance of the cellPoint interpolation is not "
-                                    "modelled yet); set sampling cell or undisturbedVelocity off"
-                                 << exit(FatalIOError);
 
   const word meanGradP = dict.lookupOrDefault<word>("meanPressureGradient", "off");
   if (meanGradP == "suspensionWeight")
@@ -1396,6 +1391,7 @@ void ParticleCoupling::sample() {
       sampleCellPoint<13>();
     else
       sampleCellPoint<10>();
+    if (undisturbed_) sampleDisturbance();
     return;
   }
   // Footprint-weighted cell values; ghosts' shares go back to their owners. With
@@ -1424,8 +1420,6 @@ void ParticleCoupling::sample() {
   dem_->begin_fluid();
   const std::size_t W = undisturbed_ ? 26 : 14;
   std::vector<double> acc(W * particles_.size(), 0.0);
-  const scalarField& V = mesh_.V().field();
-  const vectorField& cellCentres = mesh_.C().primitiveField();
   std::vector<PointInCell> cellsOfParticle;  // a footprint's weight per cell
   for (std::size_t i = 0; i < particles_.size(); ++i) {
     double* a = &acc[W * i];
@@ -1452,28 +1446,9 @@ void ParticleCoupling::sample() {
         if (curl) a[10 + d] += w * (*Cc)[c][d];
       }
       a[13] += w;
-      if (undisturbed_) {
-        a[14] += w * (smoothing_ ? rawKsl_[c] : Ksl_[c]);
-        const double hc = std::cbrt(V[c]);
-        a[16] += w * hc * hc;
-        const double* centre = particles_.x(i);
-        for (int d = 0; d < 3; ++d) {
-          const double o = std::floor((cellCentres[c][d] - centre[d]) / hc + 0.5);
-          if (o >= -1 && o <= 1) a[18 + 3 * d + static_cast<int>(o)] += w;
-        }
-        bool found = false;
-        for (PointInCell& q : cellsOfParticle)
-          if (q.cell == c) {
-            q.weight += w;
-            found = true;
-            break;
-          }
-        if (!found) cellsOfParticle.push_back({c, w});
-      }
+      if (undisturbed_) addDisturbancePoint(i, c, w, a + 13, cellsOfParticle);
     }
-    // The particle's own share of the Ksl it read: K W_c^2 / V_c summed over its cells.
-    if (undisturbed_)
-      for (const PointInCell& q : cellsOfParticle) a[15] += q.weight * q.weight / V[q.cell];
+    if (undisturbed_) addOwnShare(cellsOfParticle, a + 13);
   }
   const std::vector<double> sums = dem_->sum_onto_owners(acc, W);
   for (std::size_t i = 0; i < local; ++i) {
@@ -1487,25 +1462,93 @@ void ParticleCoupling::sample() {
       f.vorticity[d] = a[10 + d] * norm;
     }
     f.void_fraction = a[13] > 0 ? a[3] * norm : 1.0;
-    if (undisturbed_ && a[13] > 0) {
-      // The disturbance read is that of the mesh's lattice (self_disturbance.hpp,
-      // lattice_self_disturbance): cells of size h = <V^(2/3)>^(1/2) over the footprint,
-      // the footprint's own spread (its points' standard deviation per axis) and the
-      // other particles' drag per volume.
-      f.disturbance_cell = std::sqrt(a[16] * norm);
-      f.disturbance_spread = footprintSpread_ * particles_.radius(i);
-      if (smoothing_) f.disturbance_smoothing = smoothing_->bandwidth() / std::sqrt(2.0);
-      f.disturbance_screening =
-          std::max(0.0, (a[14] - particles_.drag_coefficient(i) * a[15]) * norm);
-      // The particle's place across its motion: its marginals, if they hold all its weight.
-      f.disturbance_placed = true;
-      for (int d = 0; d < 3; ++d) {
-        const double* m = &a[17 + 3 * d];
-        if (m[0] + m[1] + m[2] < a[13] * (1 - 1e-9)) f.disturbance_placed = false;
-        for (int k = 0; k < 3; ++k) f.disturbance_weights[d][k] = m[k] * norm;
-      }
-    }
+    if (undisturbed_) setDisturbance(i, a + 13, f);
     dem_->add_fluid(f);
+  }
+}
+
+// With undisturbedVelocity, per footprint point (cell c, weight w) of particle i: into b[0..12]
+// (b[0] the weight sum, added by the caller) the other particles' drag per volume there
+// (b[1]), the cells' size V^(2/3) (b[3]), and the footprint's weight marginal on each axis
+// over the cells at offsets -1, 0, 1 from the particle's own (b[4 + 3 a + 1 + offset]): the
+// offset of a cell along a is round((C_a - x_a) / h_c), h_c = V^(1/3), from the particle's
+// (or its periodic image's) centre, the same on every rank. `cells` gathers the footprint's
+// weight per cell for addOwnShare.
+void ParticleCoupling::addDisturbancePoint(std::size_t i, Foam::label c, double w, double* b,
+                                           std::vector<PointInCell>& cells) const {
+  const double V = mesh_.V()[c];
+  const Foam::vector& C = mesh_.C()[c];
+  b[1] += w * (smoothing_ ? rawKsl_[c] : Ksl_[c]);
+  const double hc = std::cbrt(V);
+  b[3] += w * hc * hc;
+  const double* centre = particles_.x(i);
+  for (int d = 0; d < 3; ++d) {
+    const double o = std::floor((C[d] - centre[d]) / hc + 0.5);
+    if (o >= -1 && o <= 1) b[5 + 3 * d + static_cast<int>(o)] += w;
+  }
+  for (PointInCell& q : cells)
+    if (q.cell == c) {
+      q.weight += w;
+      return;
+    }
+  cells.push_back({c, w});
+}
+
+// The particle's own share of the Ksl it read: K W_c^2 / V_c summed over its cells (b[2]).
+void ParticleCoupling::addOwnShare(const std::vector<PointInCell>& cells, double* b) const {
+  for (const PointInCell& q : cells) b[2] += q.weight * q.weight / mesh_.V()[q.cell];
+}
+
+// The disturbance of local particle i from its summed b[0..12] (addDisturbancePoint). The
+// disturbance read is that of the mesh's lattice (self_disturbance.hpp,
+// lattice_self_disturbance): cells of size h = <V^(2/3)>^(1/2) over the footprint, the
+// footprint's own spread (its points' standard deviation per axis) and the other particles'
+// drag per volume; the particle's place across its motion from its marginals, if they hold
+// all its weight. With sampling cellPoint also its offset from the centre of the cell that
+// holds it.
+void ParticleCoupling::setDisturbance(std::size_t i, const double* b,
+                                      coupling::FluidAtParticle& f) const {
+  if (b[0] <= 0) return;
+  const double norm = 1 / b[0];
+  f.disturbance_cell = std::sqrt(b[3] * norm);
+  f.disturbance_spread = footprintSpread_ * particles_.radius(i);
+  if (smoothing_) f.disturbance_smoothing = smoothing_->bandwidth() / std::sqrt(2.0);
+  f.disturbance_screening = std::max(0.0, (b[1] - particles_.drag_coefficient(i) * b[2]) * norm);
+  f.disturbance_placed = true;
+  for (int d = 0; d < 3; ++d) {
+    const double* m = &b[4 + 3 * d];
+    if (m[0] + m[1] + m[2] < b[0] * (1 - 1e-9)) f.disturbance_placed = false;
+    for (int k = 0; k < 3; ++k) f.disturbance_weights[d][k] = m[k] * norm;
+  }
+  if (sampling_ == Sampling::cellPoint && centreCell_[i] >= 0) {
+    const Foam::label c = centreCell_[i];
+    const double hc = std::cbrt(mesh_.V()[c]);
+    f.disturbance_cell_point = true;
+    for (int d = 0; d < 3; ++d)
+      f.disturbance_place[d] = (particles_.x(i)[d] - mesh_.C()[c][d]) / hc;
+  }
+}
+
+// sample() with cellPoint and undisturbedVelocity: the footprint's sums of the disturbance
+// (as the cell path gathers them with its samples), onto the DEM's records.
+void ParticleCoupling::sampleDisturbance() {
+  constexpr std::size_t W = 13;
+  std::vector<double> acc(W * particles_.size(), 0.0);
+  std::vector<PointInCell> cellsOfParticle;
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    double* b = &acc[W * i];
+    cellsOfParticle.clear();
+    for (std::size_t j = first_[i]; j < first_[i + 1]; ++j) {
+      b[0] += points_[j].weight;
+      addDisturbancePoint(i, points_[j].cell, points_[j].weight, b, cellsOfParticle);
+    }
+    addOwnShare(cellsOfParticle, b);
+  }
+  const std::vector<double> sums = dem_->sum_onto_owners(acc, W);
+  for (std::size_t i = 0; i < particles_.local(); ++i) {
+    coupling::FluidAtParticle f;
+    setDisturbance(i, &sums[W * i], f);
+    dem_->set_fluid_disturbance(i, f);
   }
 }
 

@@ -50,6 +50,12 @@ struct SelfDisturbance {
   // axis; the place-averaged factor is used.
   std::array<std::array<double, 3>, 3> transverse{};
   bool placed = false;
+  // sampling cellPoint (lattice_self_disturbance_cellpoint): the particle reads at its centre.
+  // place: its offset from its cell's centre per mesh axis [cells]; marginals: the
+  // footprint's weight marginal per axis on the cells -1, 0, 1 (weights, not coefficients).
+  bool cell_point = false;
+  std::array<double, 3> place{};
+  std::array<std::array<double, 3>, 3> marginals{};
 };
 
 class CoupledFluid {

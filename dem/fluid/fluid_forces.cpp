@@ -269,9 +269,10 @@ class FluidForcesWith final : public ForceTerm {
   double undisturbed(const SelfDisturbance& sd, double d, const Vec3& slip, const FluidSample& f) {
     const double w_seen = slip.norm();
     const std::array<double, 3>*ax = nullptr, *ay = nullptr;
+    int along = 2;
     if (sd.placed) {
       const Vec3 a = slip.cwiseAbs();
-      const int along = a[0] >= a[1] ? (a[0] >= a[2] ? 0 : 2) : (a[1] >= a[2] ? 1 : 2);
+      along = a[0] >= a[1] ? (a[0] >= a[2] ? 0 : 2) : (a[1] >= a[2] ? 1 : 2);
       ax = &sd.transverse[(along + 1) % 3];
       ay = &sd.transverse[(along + 2) % 3];
     }
@@ -280,6 +281,12 @@ class FluidForcesWith final : public ForceTerm {
     const double eps = f.void_fraction;
     const auto k = [&](double w) { return Law({d, w, eps, f.density, f.viscosity}); };
     const auto m = [&](double w) {
+      if (ax && sd.cell_point) {
+        const int ta = (along + 1) % 3, tb = (along + 2) % 3;
+        return lattice_self_mobility_cellpoint(sd.cell, sd.spread, w, rho_e, mu_e, sd.screening,
+                                               sd.place[ta], sd.place[tb], sd.marginals[ta],
+                                               sd.marginals[tb]);
+      }
       return lattice_self_mobility(sd.cell, sd.spread, w, rho_e, mu_e, sd.screening, ax, ay,
                                    sd.smoothing);
     };

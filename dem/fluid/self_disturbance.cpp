@@ -1,5 +1,6 @@
 #include "dem/fluid/self_disturbance.hpp"
 
+#include "dem/fluid/lattice_self_disturbance_cellpoint_table.hpp"
 #include "dem/fluid/lattice_self_disturbance_smoothed_table.hpp"
 #include "dem/fluid/lattice_self_disturbance_table.hpp"
 
@@ -178,6 +179,24 @@ LatticeStencil lattice_stencil(double re_h, double screening, double spread_over
   return st;
 }
 
+// Calls f(weight, index) for each point of the stencil with a non-zero weight, the index into
+// a [spread][re][b] table.
+template <class F>
+void for_stencil(const LatticeStencil& st, F&& f) {
+  namespace t = lattice_table;
+  for (int c = 0; c < 4; ++c) {
+    if (st.wz[c] == 0) continue;
+    for (int a = 0; a < 4; ++a) {
+      if (st.wx[a] == 0) continue;
+      for (int e = 0; e < 4; ++e) {
+        if (st.wy[e] == 0) continue;
+        f(st.wz[c] * st.wx[a] * st.wy[e],
+          (static_cast<std::size_t>(st.iz[c]) * t::n_re + st.ix[a]) * t::n_b + st.iy[e]);
+      }
+    }
+  }
+}
+
 // The N tables' values at the stencil from S slices ks[] of the diffusionBandwidth tables
 // ([smooth][spread][re][b]); a slice -1: the tables without averaging. One pass over the
 // stencil for all S; lattice_interpolate is the one slice -1.
@@ -192,20 +211,10 @@ std::array<std::array<double, N>, S> slice_values(const LatticeStencil& st, cons
     for (std::size_t m = 0; m < N; ++m)
       logs[k][m] = ks[k] < 0 ? plain[m] : smoothed[m] + static_cast<std::size_t>(ks[k]) * slice;
   std::array<std::array<double, N>, S> lp{};
-  for (int c = 0; c < 4; ++c) {
-    if (st.wz[c] == 0) continue;
-    for (int a = 0; a < 4; ++a) {
-      if (st.wx[a] == 0) continue;
-      for (int e = 0; e < 4; ++e) {
-        if (st.wy[e] == 0) continue;
-        const double w = st.wz[c] * st.wx[a] * st.wy[e];
-        const std::size_t at =
-            (static_cast<std::size_t>(st.iz[c]) * t::n_re + st.ix[a]) * t::n_b + st.iy[e];
-        for (std::size_t k = 0; k < S; ++k)
-          for (std::size_t m = 0; m < N; ++m) lp[k][m] += w * logs[k][m][at];
-      }
-    }
-  }
+  for_stencil(st, [&](double w, std::size_t at) {
+    for (std::size_t k = 0; k < S; ++k)
+      for (std::size_t m = 0; m < N; ++m) lp[k][m] += w * logs[k][m][at];
+  });
   for (auto& row : lp)
     for (double& v : row) v = std::exp(v);
   return lp;
@@ -322,6 +331,77 @@ double lattice_self_disturbance(double re_h, double screening, double spread_ove
   const double average = smoothed_values<1>(st, 2.25, {t::log_phi}, {t::log_phi_smoothed})[0];
   return phi * continuous_beyond(re_h, screening, std::min(std::max(spread_over_h, 0.0), 0.5),
                                  smoothing_over_h, average);
+}
+
+namespace {
+
+// sum of w * table over the stencil (one [spread][re][b] table, no exponential).
+double stencil_sum(const LatticeStencil& st, const double* table) {
+  double v = 0;
+  for_stencil(st, [&](double w, std::size_t at) { v += w * table[at]; });
+  return v;
+}
+
+}  // namespace
+
+double lattice_self_disturbance_cellpoint(double re_h, double screening, double spread_over_h,
+                                          double place_a, double place_b,
+                                          std::array<double, 3> da, std::array<double, 3> db) {
+  namespace t = lattice_table;
+  static_assert(t::cp_n_places == 15 && t::cp_place_per_unit == 8);
+  // The cube's symmetries: a place on the negative side mirrors the marginals; the table
+  // holds place_a >= place_b.
+  if (place_a < 0) {
+    place_a = -place_a;
+    std::swap(da[0], da[2]);
+  }
+  if (place_b < 0) {
+    place_b = -place_b;
+    std::swap(db[0], db[2]);
+  }
+  place_a = std::min(place_a, 0.5);
+  place_b = std::min(place_b, 0.5);
+  if (place_a < place_b) {
+    std::swap(place_a, place_b);
+    std::swap(da, db);
+  }
+  const LatticeStencil st = lattice_stencil(re_h, screening, spread_over_h);
+  // The ratios tend to constants past the table's upper ends: held there.
+  const double top = std::pow(10.0, t::log_re_lo + (t::n_re - 1) / t::log_re_per_decade);
+  const double top_b = std::pow(10.0, t::log_b_lo + (t::n_b - 1) / t::log_b_per_decade);
+  const LatticeStencil held =
+      lattice_stencil(std::min(re_h, top), std::min(screening, top_b), spread_over_h);
+  constexpr std::size_t slice = static_cast<std::size_t>(t::n_spread) * t::n_re * t::n_b;
+  const double x = place_a * t::cp_place_per_unit, y = place_b * t::cp_place_per_unit;
+  const int i0 = std::min(static_cast<int>(x), 3), j0 = std::min(static_cast<int>(y), 3);
+  const double fx = x - i0, fy = y - j0;
+  double phi = 0;
+  for (int di = 0; di < 2; ++di)
+    for (int dj = 0; dj < 2; ++dj) {
+      const double w = (di ? fx : 1 - fx) * (dj ? fy : 1 - fy);
+      if (w == 0) continue;
+      int i = i0 + di, j = j0 + dj;
+      // Above the diagonal: the place (j, i) with the transverse axes exchanged.
+      const bool transposed = j > i;
+      if (transposed) std::swap(i, j);
+      const std::size_t place = static_cast<std::size_t>(i * (i + 1) / 2 + j);
+      const double u00 = std::exp(stencil_sum(st, t::cp_log_u00 + place * slice));
+      double sum = 0;
+      int other = 0;  // the ratio tables skip j' = (0, 0)
+      for (int k = 0; k < 9; ++k) {
+        const int ja = t::cp_offsets[k][0], jb = t::cp_offsets[k][1];
+        const double deposit = transposed ? da[jb + 1] * db[ja + 1] : da[ja + 1] * db[jb + 1];
+        if (ja == 0 && jb == 0) {
+          sum += deposit;
+          continue;
+        }
+        const std::size_t at = (place * 8 + static_cast<std::size_t>(other++)) * slice;
+        if (deposit != 0) sum += deposit * stencil_sum(held, t::cp_ratio + at);
+      }
+      phi += w * u00 * sum;
+    }
+  // The integral is positive; a sum that cancels to within the interpolation is held at 0.
+  return std::max(phi, 0.0);
 }
 
 const SelfDisturbanceTable& self_disturbance_table() {

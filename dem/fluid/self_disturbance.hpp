@@ -121,6 +121,29 @@ double lattice_self_disturbance(double re_h, double screening, double spread_ove
                                 const std::array<double, 3>& ax, const std::array<double, 3>& ay,
                                 double smoothing_over_h = 0);
 
+// The self-disturbance read through OpenFOAM's cellPoint interpolation (sampling cellPoint).
+// The particle deposits with its footprint as above but reads the velocity at its centre: the
+// cell value and three point values of the tetrahedron (cell centre, face triangle) holding
+// it, each point value the mean of its eight cells. On a uniform cubic mesh that puts on the
+// cell whose centre lies at z from the particle a continuous, piecewise-linear weight R(z),
+// not separable per axis. With the particle's place (place_a, place_b) across its motion (its
+// offset from its cell's centre in cells, |place| <= 1/2) fixed during the passage and the
+// footprint's marginals da, db on the transverse cells -1, 0, 1 (weights, sum 1),
+//     phi = sum_j' da[j'_a] db[j'_b] U_j'(Re_h, b, s/h; place),
+//     U_j' = (2 pi)^-3 int_BZ sum_j cos(q_perp . (j - j')) P_zz(q)
+//            sum_G rho_j^(k) g_d(k) Re 1/(Lambda(q) + b + i Re_h k) d^3q,
+// rho_j^ the Fourier transform along the motion of the read-back's weight on the transverse
+// cell j (the two diagonals of each face averaged: the cube's symmetries), g_d(k) = sinc(k/2)
+// / (1 + s^2 k^2 / 2) the deposit's box widened by the footprint's spread (only the deposit
+// is spread now). Tabulated by scripts/lattice_self_disturbance_cellpoint.py (checked against
+// direct lattice sums, 4.4e-4, and the Oseen limit Re_h U_j' -> <rho_j'>/2) over the axes of
+// the cell tables and the place on a grid of 1/8 (y_a >= y_b >= 0, the rest by symmetry):
+// log U_00 and the ratios U_j'/U_00 (which change sign), tricubic in (Re_h, b, s/h) as the
+// cell tables (the ratios held at the ends), bilinear in the place.
+double lattice_self_disturbance_cellpoint(double re_h, double screening, double spread_over_h,
+                                          double place_a, double place_b,
+                                          std::array<double, 3> da, std::array<double, 3> db);
+
 // The mobility m = u' / F [s/kg] of a particle's self-disturbance on cells of size h [m]
 // with footprint spread s [m], at slip w [m/s], for the momentum equation with density rho_e,
 // viscosity mu_e and Brinkman coefficient beta [kg/m^3/s]. ax, ay: the transverse
@@ -135,6 +158,18 @@ inline double lattice_self_mobility(double h, double s, double w, double rho_e, 
   const double phi = ax && ay && l == h ? lattice_self_disturbance(re, b, s / l, *ax, *ay, sigma / l)
                                         : lattice_self_disturbance(re, b, s / l, sigma / l);
   return phi / (mu_e * l);
+}
+
+// lattice_self_mobility for sampling cellPoint: the place and the footprint's marginals on the
+// two transverse axes. Where the footprint's spread exceeds half a cell (2 s > h) the cell
+// size is taken as 2 s and the place-averaged cell factor is used, as for sampling cell.
+inline double lattice_self_mobility_cellpoint(double h, double s, double w, double rho_e,
+                                              double mu_e, double beta, double place_a,
+                                              double place_b, const std::array<double, 3>& da,
+                                              const std::array<double, 3>& db) {
+  if (2 * s > h) return lattice_self_mobility(h, s, w, rho_e, mu_e, beta);
+  const double re = rho_e * w * h / mu_e, b = beta * h * h / mu_e;
+  return lattice_self_disturbance_cellpoint(re, b, s / h, place_a, place_b, da, db) / (mu_e * h);
 }
 
 // The undisturbed slip for drag: given the slip the particle sees (sampled fluid minus

@@ -66,7 +66,8 @@ def write(path, cls, obj, body):
         f.write(HEADER.format(cls=cls, obj=obj) + body)
 
 
-def make_case(case, n, re_t, width, fall, footprint, sampling, correction, courant, bandwidth=None):
+def make_case(case, n, re_t, width, fall, footprint, sampling, correction, courant, bandwidth=None,
+              tau_fraction=1.0):
     mu = viscosity_for(re_t)
     u_t = terminal(mu)
     h = n * D
@@ -79,7 +80,7 @@ def make_case(case, n, re_t, width, fall, footprint, sampling, correction, coura
     height_cells = int(math.ceil((2 * h + 2 * (transient + fall_len) + 3 * h) / h))
     L, H = width * h, height_cells * h
     end = (transient + fall_len) / u_t
-    dt_f = min(courant * h / u_t, tau)
+    dt_f = min(courant * h / u_t, tau_fraction * tau)
     steps = max(1, int(math.ceil(end / dt_f)))
     dt_f = end / steps
     dt_dem = dt_f / 5
@@ -201,6 +202,9 @@ def main():
                     help="particle Courant number u_t dt / h of the fluid step (default 0.05)")
     ap.add_argument("--bandwidth", type=float, default=None,
                     help="diffusionBandwidth b in particle diameters (default: none)")
+    ap.add_argument("--tau-fraction", type=float, default=1.0,
+                    help="the fluid step at most this fraction of the particle's relaxation "
+                         "time tau (default 1; at Re_t 0.1 tau, not --courant, sets the step)")
     ap.add_argument("--check", type=float, default=None,
                     help="exit 1 unless every |error| is within this many per cent")
     ap.add_argument("--work", default="/tmp/settling_cells")
@@ -211,10 +215,12 @@ def main():
         name = f"re{a.re:g}_n{n:g}_{a.footprint}_{a.sampling}_{a.correction or 'off'}_w{a.width}_c{a.courant:g}"
         if a.bandwidth:
             name += f"_b{a.bandwidth:g}"
+        if a.tau_fraction != 1:
+            name += f"_t{a.tau_fraction:g}"
         case = os.path.join(a.work, name)
         subprocess.call(["rm", "-rf", case])
         info = make_case(case, n, a.re, a.width, a.fall, a.footprint, a.sampling, a.correction, a.courant,
-                         a.bandwidth)
+                         a.bandwidth, a.tau_fraction)
         cpu, imbalance = run(case, a.build)
         err, wobble, whole = measure(case, info)
         row = dict(re=a.re, cells_per_d=n, footprint=a.footprint, sampling=a.sampling,

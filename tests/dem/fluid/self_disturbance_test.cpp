@@ -306,6 +306,75 @@ TEST(SelfDisturbance, LatticeMobilityWithPlaceIsThePlaceAveragedOneBeyondHalfACe
             lattice_self_mobility(h, 0.2 * h, w, rho, mu, beta));
 }
 
+// sampling cellPoint (lattice_self_disturbance_cellpoint): U_j' for a unit deposit in the
+// transverse cell j' = (ja, jb), the particle at `place` across its motion.
+double cell_point_u(double re, double b, double s, double pa, double pb, int ja, int jb) {
+  std::array<double, 3> da{}, db{};
+  da[ja + 1] = 1;
+  db[jb + 1] = 1;
+  return lattice_self_disturbance_cellpoint(re, b, s, pa, pb, da, db);
+}
+
+TEST(SelfDisturbance, CellPointEqualsTheDirectLatticeSum) {
+  // Re_h = 0, b = 1, s = 0 against the passage average (400 midpoints) of the cellPoint
+  // read-back of the static lattice Green's function on 64^3 periodic cells (7-point
+  // Laplacian, collocated projection; scripts/lattice_self_disturbance_cellpoint.py,
+  // green() and kernel()), for deposits in the own transverse cell and in neighbours.
+  struct Case {
+    double pa, pb;
+    std::array<double, 6> u;  // j' = (0,0), (1,0), (-1,0), (0,1), (1,1), (-1,-1)
+    double tol;
+  };
+  const std::array<std::array<int, 2>, 6> js = {{{0, 0}, {1, 0}, {-1, 0}, {0, 1}, {1, 1}, {-1, -1}}};
+  // On the table's places (1/8): the tables' own accuracy, 1e-3 of U_00; between them the
+  // bilinear interpolation in place, which reads the concave U_00 up to 1.9 % low.
+  const Case cases[] = {
+      {0.0, 0.0, {0.069753, 0.017467, 0.017467, 0.017467, 0.007847, 0.007847}, 1e-3},
+      {0.25, 0.125, {0.058771, 0.022233, 0.011527, 0.019556, 0.013892, 0.004588}, 1e-3},
+      {0.3, 0.2, {0.053939, 0.023045, 0.010198, 0.020904, 0.016235, 0.003831}, 2.5e-2},
+      {0.45, 0.1, {0.034170, 0.025199, 0.005929, 0.017705, 0.016435, 0.002790}, 2.5e-2},
+      {0.1, 0.35, {0.048228, 0.018457, 0.014175, 0.023810, 0.014853, 0.003689}, 2.5e-2},
+  };
+  for (const Case& c : cases)
+    for (std::size_t k = 0; k < js.size(); ++k) {
+      const double u = cell_point_u(0, 1, 0, c.pa, c.pb, js[k][0], js[k][1]);
+      EXPECT_NEAR(u, c.u[k], c.tol * c.u[0]) << "place " << c.pa << " " << c.pb << ", j' " << js[k][0]
+                                              << " " << js[k][1];
+    }
+}
+
+TEST(SelfDisturbance, CellPointKeepsTheCubesSymmetries) {
+  const std::array<double, 3> da = {0.1, 0.7, 0.2}, db = {0.3, 0.6, 0.1};
+  const std::array<double, 3> da_mirror = {0.2, 0.7, 0.1};
+  const double u = lattice_self_disturbance_cellpoint(4, 0.3, 0.1, 0.3, 0.2, da, db);
+  EXPECT_DOUBLE_EQ(lattice_self_disturbance_cellpoint(4, 0.3, 0.1, -0.3, 0.2, da_mirror, db), u);
+  EXPECT_DOUBLE_EQ(lattice_self_disturbance_cellpoint(4, 0.3, 0.1, 0.2, 0.3, db, da), u);
+  // The deposit's weights enter linearly.
+  const double parts = 0.7 * 0.6 * cell_point_u(4, 0.3, 0.1, 0.3, 0.2, 0, 0);
+  EXPECT_GT(u, parts);
+}
+
+TEST(SelfDisturbance, CellPointOseenLimitIsTheReadBacksWeightOnTheDepositsCell) {
+  // Re_h U_j' -> <rho_j'>/2: the force carried off through one cell's section, read with the
+  // read-back's passage-averaged weight on the deposit's cell (the cell sampling's 1/2 times
+  // the share of the cellPoint stencil in that column: 5/8 on the cell's axis, where each
+  // point value takes a quarter from the particle's own column).
+  const double re = 1e5;
+  EXPECT_NEAR(re * cell_point_u(re, 0, 0, 0, 0, 0, 0), 0.3125, 2e-3);
+  EXPECT_NEAR(re * cell_point_u(re, 0, 0, 0.25, 0.125, 0, 0), 0.265625, 2e-3);
+  EXPECT_NEAR(re * cell_point_u(re, 0, 0, 0.25, 0.125, 1, 0), 0.0703125, 2e-3);
+}
+
+TEST(SelfDisturbance, CellPointReadsLessOfItselfThanTheCell) {
+  // The stencil reaches the neighbours (each point value is the mean of eight cells): a
+  // particle at its cell's centre reads less of a deposit in its own cell than sampling cell.
+  const std::array<double, 3> one = {0, 1, 0};
+  const std::array<double, 3> a = transverse_coefficients(0, 1, 0);
+  for (const double re : {0.01, 1.0, 100.0})
+    EXPECT_LT(lattice_self_disturbance_cellpoint(re, 0, 0, 0, 0, one, one),
+              lattice_self_disturbance(re, 0, 0, a, a));
+}
+
 TEST(SelfDisturbance, UndisturbedFactorSolvesTheFixedPoint) {
   bool limited = true;
   // Constant k and m: 1 / (1 - k m).
