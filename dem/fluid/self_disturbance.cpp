@@ -367,8 +367,8 @@ double lattice_self_disturbance_cellpoint(double re_h, double screening, double 
   }
   const LatticeStencil st = lattice_stencil(re_h, screening, spread_over_h);
   // The ratios tend to constants past the table's upper ends: held there.
-  const double top = std::pow(10.0, t::log_re_lo + (t::n_re - 1) / t::log_re_per_decade);
-  const double top_b = std::pow(10.0, t::log_b_lo + (t::n_b - 1) / t::log_b_per_decade);
+  static const double top = std::pow(10.0, t::log_re_lo + (t::n_re - 1) / t::log_re_per_decade);
+  static const double top_b = std::pow(10.0, t::log_b_lo + (t::n_b - 1) / t::log_b_per_decade);
   const LatticeStencil held =
       lattice_stencil(std::min(re_h, top), std::min(screening, top_b), spread_over_h);
   constexpr std::size_t slice = static_cast<std::size_t>(t::n_spread) * t::n_re * t::n_b;

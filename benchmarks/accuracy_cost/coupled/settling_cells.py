@@ -210,6 +210,8 @@ def main():
     ap.add_argument("--work", default="/tmp/settling_cells")
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     a = ap.parse_args()
+    if not 0 < a.tau_fraction <= 1:
+        ap.error(f"--tau-fraction {a.tau_fraction:g}: must be in (0, 1]")
     rows = []
     for n in (float(x) for x in a.cells.split(",")):
         name = f"re{a.re:g}_n{n:g}_{a.footprint}_{a.sampling}_{a.correction or 'off'}_w{a.width}_c{a.courant:g}"

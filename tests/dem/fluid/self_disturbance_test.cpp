@@ -349,9 +349,12 @@ TEST(SelfDisturbance, CellPointKeepsTheCubesSymmetries) {
   const double u = lattice_self_disturbance_cellpoint(4, 0.3, 0.1, 0.3, 0.2, da, db);
   EXPECT_DOUBLE_EQ(lattice_self_disturbance_cellpoint(4, 0.3, 0.1, -0.3, 0.2, da_mirror, db), u);
   EXPECT_DOUBLE_EQ(lattice_self_disturbance_cellpoint(4, 0.3, 0.1, 0.2, 0.3, db, da), u);
-  // The deposit's weights enter linearly.
-  const double parts = 0.7 * 0.6 * cell_point_u(4, 0.3, 0.1, 0.3, 0.2, 0, 0);
-  EXPECT_GT(u, parts);
+  // The deposit's weights enter linearly: the sum over the nine single-cell deposits.
+  double parts = 0;
+  for (int ja = -1; ja <= 1; ++ja)
+    for (int jb = -1; jb <= 1; ++jb)
+      parts += da[ja + 1] * db[jb + 1] * cell_point_u(4, 0.3, 0.1, 0.3, 0.2, ja, jb);
+  EXPECT_NEAR(u, parts, 1e-12 * u);
 }
 
 TEST(SelfDisturbance, CellPointOseenLimitIsTheReadBacksWeightOnTheDepositsCell) {
