@@ -1,8 +1,8 @@
 #pragma once
 // Where a coupled run's settings sit on the measured accuracy-versus-cost curves
 // (docs/accuracy-vs-cost-coupled.md), for grainFoam's start-up report. The numbers are copied
-// from benchmarks/accuracy_cost/coupled/coupled_results.csv (measured 2026-12-01, branch
-// h-coupling; the test tests/coupling/accuracy_table_test.cpp fails if the two disagree).
+// from benchmarks/accuracy_cost/coupled/coupled_results.csv (measured 2026-12-04, main; the
+// test tests/coupling/accuracy_table_test.cpp fails if the two disagree).
 // Each table holds for the case it was measured on (regime, drag law, and the settings it
 // kept fixed); a run is quoted a table only when it matches all of them. C++17.
 #include <string>
@@ -38,24 +38,24 @@ struct IntervalAccuracy {
 inline constexpr const char* kFootprintDrag = "gidaspow";
 inline constexpr int kFootprintSteps = 20;
 inline constexpr FootprintAccuracy kFootprintAccuracy[] = {
-    {"centre", "cell", 2, -0.1253, 0.040},
-    {"centre", "cell", 3, -0.1202, 0.046},
-    {"centre", "cell", 4, -0.1123, 0.038},
-    {"centre", "cellPoint", 2, -0.1540, 0.039},
-    {"centre", "cellPoint", 3, -0.1377, 0.032},
-    {"centre", "cellPoint", 4, -0.1428, 0.028},
-    {"divided", "cell", 2, -0.0726, 0.103},
-    {"divided", "cell", 3, -0.1256, 0.117},
-    {"divided", "cell", 4, -0.1163, 0.116},
-    {"divided", "cellPoint", 2, -0.0882, 0.105},
-    {"divided", "cellPoint", 3, -0.1379, 0.126},
-    {"divided", "cellPoint", 4, -0.1424, 0.110},
-    {"smoothed", "cell", 2, -0.0807, 0.617},
-    {"smoothed", "cell", 3, -0.1262, 0.439},
-    {"smoothed", "cell", 4, -0.1205, 0.439},
-    {"smoothed", "cellPoint", 2, -0.0926, 0.345},
-    {"smoothed", "cellPoint", 3, -0.1378, 0.375},
-    {"smoothed", "cellPoint", 4, -0.1444, 0.381},
+    {"centre", "cell", 2, -0.1370, 0.039},
+    {"centre", "cell", 3, -0.1340, 0.045},
+    {"centre", "cell", 4, -0.1109, 0.044},
+    {"centre", "cellPoint", 2, -0.1719, 0.044},
+    {"centre", "cellPoint", 3, -0.1543, 0.033},
+    {"centre", "cellPoint", 4, -0.1466, 0.030},
+    {"divided", "cell", 2, -0.0751, 0.088},
+    {"divided", "cell", 3, -0.1326, 0.079},
+    {"divided", "cell", 4, -0.1126, 0.080},
+    {"divided", "cellPoint", 2, -0.0922, 0.075},
+    {"divided", "cellPoint", 3, -0.1476, 0.070},
+    {"divided", "cellPoint", 4, -0.1450, 0.066},
+    {"smoothed", "cell", 2, -0.0800, 0.222},
+    {"smoothed", "cell", 3, -0.1304, 0.226},
+    {"smoothed", "cell", 4, -0.1217, 0.207},
+    {"smoothed", "cellPoint", 2, -0.0932, 0.194},
+    {"smoothed", "cellPoint", 3, -0.1451, 0.212},
+    {"smoothed", "cellPoint", 4, -0.1510, 0.218},
 };
 
 // A coupling-interval sweep: the case and the settings it kept fixed.
@@ -73,13 +73,13 @@ struct IntervalSweep {
 
 // Packed bed (error: pressure drop vs Ergun).
 inline constexpr IntervalAccuracy kIntervalAccuracy[] = {
-    {2, -0.0555, 301}, {5, -0.0617, 153},  {10, -0.0671, 106},
-    {20, -0.0726, 81}, {50, -0.0797, 65}, {100, -0.0845, 61},
+    {2, -0.0566, 452}, {5, -0.0639, 243}, {10, -0.0695, 161},
+    {20, -0.0751, 127}, {50, -0.0819, 108}, {100, -0.0864, 105},
 };
 // The settlingParticle tutorial (error: mean settling speed vs Schiller-Naumann terminal).
 inline constexpr IntervalAccuracy kSettlingIntervalAccuracy[] = {
-    {1, 0.01103, 691}, {5, 0.01104, 148},  {10, 0.01106, 81},
-    {20, 0.01108, 46}, {50, 0.01119, 21}, {100, 0.01142, 13},
+    {1, 0.01103, 1102}, {5, 0.01104, 260}, {10, 0.01106, 145},
+    {20, 0.01108, 85}, {50, 0.01119, 38}, {100, 0.01142, 21},
 };
 inline constexpr IntervalSweep kIntervalSweeps[] = {
     {"packed-bed", Regime::packed_bed, "gidaspow", "divided", "cell", 2, "packed-bed pressure drop vs Ergun",

@@ -52,6 +52,7 @@ struct DemLink::Impl {
   bool self = false;                                  // correct_self_disturbance()
   bool heat = false;                     // heat_on()
   std::vector<double> pending_temperature;  // set_fluid_temperatures()
+  std::vector<Vec3> pending_cell_velocity;  // set_fluid_cell_velocities()
   // The coupling's sampler of late arrivals (end_fluid), and whether the CoupledFluid's
   // sampler calls it already.
   std::function<FluidAtParticle(const std::array<double, 3>&)> late;
@@ -500,6 +501,13 @@ void DemLink::set_fluid_temperatures(std::vector<double> temperatures) {
   impl_->pending_temperature = std::move(temperatures);
 }
 
+void DemLink::set_fluid_cell_velocities(std::vector<std::array<double, 3>> velocities) {
+  Impl& m = *impl_;
+  m.pending_cell_velocity = m.fluid->take_spare_cell_velocity();
+  m.pending_cell_velocity.resize(velocities.size());
+  for (std::size_t i = 0; i < velocities.size(); ++i) m.pending_cell_velocity[i] = vec(velocities[i]);
+}
+
 void DemLink::heat_exchange(int steps, HeatExchange& out) const {
   const Impl& m = *impl_;
   const Simulation& sim = m.simulation();
@@ -634,11 +642,16 @@ void DemLink::end_fluid() {
   if (m.heat && m.pending_temperature.size() != p.size())
     throw std::logic_error("DemLink: " + std::to_string(m.pending_temperature.size()) +
                            " fluid temperatures for " + std::to_string(p.size()) + " particles");
+  if (!m.pending_cell_velocity.empty() && m.pending_cell_velocity.size() != p.size())
+    throw std::logic_error("DemLink: " + std::to_string(m.pending_cell_velocity.size()) +
+                           " cell velocities for " + std::to_string(p.size()) + " particles");
   m.fluid->set(p.id, std::move(m.pending),
                m.curl ? std::move(m.pending_vorticity) : std::vector<Vec3>{},
                m.self ? std::move(m.pending_disturbance) : std::vector<SelfDisturbance>{},
-               m.heat ? std::move(m.pending_temperature) : std::vector<double>{});
+               m.heat ? std::move(m.pending_temperature) : std::vector<double>{},
+               std::move(m.pending_cell_velocity));
   m.pending_temperature = {};
+  m.pending_cell_velocity = {};
   m.pending = {};  // moved from: empty
   m.pending_vorticity = {};
   m.pending_disturbance = {};

@@ -230,6 +230,12 @@ class DemLink {
   // Heat on: the fluid temperature at each local particle, in the order of the samples;
   // given before each end_fluid().
   void set_fluid_temperatures(std::vector<double> temperatures);
+  // sampling cellPoint: the footprint-weighted cell velocity [m/s] at each local particle,
+  // in the order of the samples, given before each end_fluid(). The fluid's implicit
+  // exchange takes K (v - U_fp) from the footprint's cells; the DEM returns the rest of the
+  // drag, K (u_f - U_fp), through the explicit exchange force, so that the fluid gets
+  // exactly the drag the particles feel (docs/coupling.md, "Sampling"). Empty: no such term.
+  void set_fluid_cell_velocities(std::vector<std::array<double, 3>> velocities);
   // Heat on, after advance(steps): each particle's convective heat of the advance and its
   // response to the fluid temperature (HeatExchange). Collective.
   void heat_exchange(int steps, HeatExchange& out) const;

@@ -173,9 +173,9 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
     sampling_ = Sampling::cellPoint;
   else
     FatalIOErrorInFunction(dict) << "sampling " << sampling
-                                 << " is not one of: cell (footprint-weighted cell values, "
-                                    "exact exchange balance), cellPoint (interpolated at the "
-                                    "particle centre)"
+                                 << " is not one of: cell (footprint-weighted cell values), "
+                                    "cellPoint (interpolated at the particle centre; the "
+                                    "exchange is balanced with either, docs/coupling.md)"
                                  << exit(FatalIOError);
   minVoidFraction_ = dict.lookupOrDefault<scalar>("minVoidFraction", 0.2);
   if (minVoidFraction_ < 0.2 || minVoidFraction_ >= 1)
@@ -248,15 +248,19 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
                                     "for none"
                                  << exit(FatalIOError);
   if (bandwidth > 0) {
-    const char* clash = sampling_ != Sampling::cell ? "sampling cellPoint"
-                        : sharpInterface_           ? "dragVoidFraction sharpInterface"
-                                                    : nullptr;
-    if (clash)
+    if (sharpInterface_)
       FatalIOErrorInFunction(dict)
-          << "diffusionBandwidth " << bandwidth << " is not combined with " << clash
-          << " (the averaging keeps the exchange balanced with sampling cell on the "
-             "cells' own values); set diffusionBandwidth 0 or sampling cell, "
-             "dragVoidFraction cell"
+          << "diffusionBandwidth " << bandwidth << " is not combined with dragVoidFraction "
+             "sharpInterface (the layers are read from the cells' own void fractions, which "
+             "the averaging spreads); set diffusionBandwidth 0 or dragVoidFraction cell"
+          << exit(FatalIOError);
+    if (sampling_ == Sampling::cellPoint && undisturbed_)
+      FatalIOErrorInFunction(dict)
+          << "diffusionBandwidth " << bandwidth << " with sampling cellPoint is not combined "
+             "with undisturbedVelocity oseenBrinkman (the self-disturbance tables for the "
+             "cellPoint read of averaged fields are not built, docs/models/"
+             "undisturbed-velocity.md); use sampling cell with diffusionBandwidth, or "
+             "cellPoint without it"
           << exit(FatalIOError);
     smoothing_ = std::make_unique<DiffusionSmoothing>(mesh, bandwidth);
     Info << "grainFoam coupling: diffusionBandwidth b = " << bandwidth
@@ -1317,6 +1321,24 @@ void ParticleCoupling::sample() {
   if (curl) tCurlU = fvc::curl(U_);
   const std::size_t local = particles_.local();
   if (sampling_ == Sampling::cellPoint) {
+    // diffusionBandwidth: the fields are averaged before the interpolation, as the cell path
+    // reads them (the deposit's adjoint); the non-coupled patches keep the field's own
+    // boundary values (a wall's no-slip U), the coupled ones the averaged neighbours.
+    const auto averaged = [this](volVectorField& work,
+                                 const volVectorField& from) -> const volVectorField& {
+      work.primitiveFieldRef() = from.primitiveField();
+      smoothing_->apply(work);
+      work.correctBoundaryConditions();
+      forAll(work.boundaryField(), patch)
+        if (!work.boundaryField()[patch].coupled())
+          work.boundaryFieldRef()[patch] = from.boundaryField()[patch];
+      return work;
+    };
+    const volVectorField& Uf = smoothing_ ? averaged(*smoothU_, U_) : U_;
+    const volVectorField& Gf = smoothing_ ? averaged(*smoothGradP_, gradP) : gradP;
+    const volVectorField& Tf = smoothing_ ? averaged(*smoothDivTau_, divTau) : divTau;
+    const volVectorField* Cf = nullptr;
+    if (curl) Cf = smoothing_ ? &averaged(*smoothCurlU_, tCurlU()) : &tCurlU();
     // OpenFOAM's cellPoint interpolation (interpolationCellPoint): the point values as
     // volPointInterpolation makes them (pointInterpolation.H: to the last bit, all fields in
     // one pass; or volPointInterpolation itself), the tetrahedron and its weights by
@@ -1325,7 +1347,7 @@ void ParticleCoupling::sample() {
     // The fields side by side, one record per cell and per point (U 0-2, grad p 3-5,
     // div tau 6-8, eps 9, curl U 10-12), so that a stencil reads four records.
     const int width = curl ? 13 : 10;
-    const UList<vector>* cellCurl = curl ? &tCurlU().primitiveField() : nullptr;
+    const UList<vector>* cellCurl = curl ? &Cf->primitiveField() : nullptr;
     const auto pack = [width](double* records, label k, const vector& U, const vector& G,
                               const vector& T, scalar E, const vector* C) {
       double* r = records + static_cast<std::size_t>(width) * k;
@@ -1343,14 +1365,14 @@ void ParticleCoupling::sample() {
       const std::vector<PointInterpolation::Face>& faces = pointInterpolation_->faces();
       cellRecords_.resize(static_cast<std::size_t>(width) * (nCells + faces.size()));
       for (label k = 0; k < nCells; ++k)
-        pack(cellRecords_.data(), k, U_[k], gradP[k], divTau[k], voidFraction_[k],
+        pack(cellRecords_.data(), k, Uf[k], Gf[k], Tf[k], voidFraction_[k],
              curl ? &(*cellCurl)[k] : nullptr);
       for (std::size_t i = 0; i < faces.size(); ++i) {
         const label patch = faces[i].patch, f = faces[i].face;
-        pack(cellRecords_.data(), nCells + static_cast<label>(i), U_.boundaryField()[patch][f],
-             gradP.boundaryField()[patch][f], divTau.boundaryField()[patch][f],
+        pack(cellRecords_.data(), nCells + static_cast<label>(i), Uf.boundaryField()[patch][f],
+             Gf.boundaryField()[patch][f], Tf.boundaryField()[patch][f],
              voidFraction_.boundaryField()[patch][f],
-             curl ? &tCurlU().boundaryField()[patch][f] : nullptr);
+             curl ? &Cf->boundaryField()[patch][f] : nullptr);
       }
       pointRecords_.resize(static_cast<std::size_t>(width) * mesh_.nPoints());
       static const std::vector<int> vectors10 = {0, 3, 6}, vectors13 = {0, 3, 6, 10};
@@ -1373,14 +1395,14 @@ void ParticleCoupling::sample() {
         toPoints.interpolate(field, *store);
         return *store;
       };
-      const pointVectorField& pU = points(pointU_, U_);
-      const pointVectorField& pG = points(pointGradP_, gradP);
-      const pointVectorField& pT = points(pointDivTau_, divTau);
+      const pointVectorField& pU = points(pointU_, Uf);
+      const pointVectorField& pG = points(pointGradP_, Gf);
+      const pointVectorField& pT = points(pointDivTau_, Tf);
       const pointScalarField& pE = points(pointEps_, voidFraction_);
-      const pointVectorField* pC = curl ? &points(pointCurlU_, tCurlU()) : nullptr;
+      const pointVectorField* pC = curl ? &points(pointCurlU_, *Cf) : nullptr;
       cellRecords_.resize(static_cast<std::size_t>(width) * nCells);
       for (label k = 0; k < nCells; ++k)
-        pack(cellRecords_.data(), k, U_[k], gradP[k], divTau[k], voidFraction_[k],
+        pack(cellRecords_.data(), k, Uf[k], Gf[k], Tf[k], voidFraction_[k],
              curl ? &(*cellCurl)[k] : nullptr);
       pointRecords_.resize(static_cast<std::size_t>(width) * mesh_.nPoints());
       forAll(pU, k)
@@ -1391,7 +1413,7 @@ void ParticleCoupling::sample() {
       sampleCellPoint<13>();
     else
       sampleCellPoint<10>();
-    if (undisturbed_) sampleDisturbance();
+    sampleFootprint();
     return;
   }
   // Footprint-weighted cell values; ghosts' shares go back to their owners. With
@@ -1529,27 +1551,41 @@ void ParticleCoupling::setDisturbance(std::size_t i, const double* b,
   }
 }
 
-// sample() with cellPoint and undisturbedVelocity: the footprint's sums of the disturbance
-// (as the cell path gathers them with its samples), onto the DEM's records.
-void ParticleCoupling::sampleDisturbance() {
-  constexpr std::size_t W = 13;
+// sample() with cellPoint: per particle over its footprint, the cell velocity U_fp as the
+// implicit exchange takes it (the deposit's weights, as checkBalance reads it), for the DEM
+// to return the drag's remainder K (u_f - U_fp) explicitly; with
+// undisturbedVelocity also the disturbance's sums (as the cell path gathers them with its
+// samples). One gather, onto the DEM's records.
+void ParticleCoupling::sampleFootprint() {
+  const std::size_t W = undisturbed_ ? 16 : 4;  // weight, [disturbance 1-12], U_fp sums
+  const Foam::vectorField& Up = sampledU();
   std::vector<double> acc(W * particles_.size(), 0.0);
   std::vector<PointInCell> cellsOfParticle;
   for (std::size_t i = 0; i < particles_.size(); ++i) {
     double* b = &acc[W * i];
     cellsOfParticle.clear();
     for (std::size_t j = first_[i]; j < first_[i + 1]; ++j) {
-      b[0] += points_[j].weight;
-      addDisturbancePoint(i, points_[j].cell, points_[j].weight, b, cellsOfParticle);
+      const Foam::label c = points_[j].cell;
+      const double w = points_[j].weight;
+      b[0] += w;
+      for (int d = 0; d < 3; ++d) b[W - 3 + d] += w * Up[c][d];
+      if (undisturbed_) addDisturbancePoint(i, c, w, b, cellsOfParticle);
     }
-    addOwnShare(cellsOfParticle, b);
+    if (undisturbed_) addOwnShare(cellsOfParticle, b);
   }
   const std::vector<double> sums = dem_->sum_onto_owners(acc, W);
+  std::vector<std::array<double, 3>> cellVelocity(particles_.local());
   for (std::size_t i = 0; i < particles_.local(); ++i) {
-    coupling::FluidAtParticle f;
-    setDisturbance(i, &sums[W * i], f);
-    dem_->set_fluid_disturbance(i, f);
+    const double* b = &sums[W * i];
+    const double norm = b[0] > 0 ? 1 / b[0] : 0;
+    for (int d = 0; d < 3; ++d) cellVelocity[i][d] = b[W - 3 + d] * norm;
+    if (undisturbed_) {
+      coupling::FluidAtParticle f;
+      setDisturbance(i, b, f);
+      dem_->set_fluid_disturbance(i, f);
+    }
   }
+  dem_->set_fluid_cell_velocities(std::move(cellVelocity));
 }
 
 coupling::FluidAtParticle ParticleCoupling::sampleAt(const std::array<double, 3>& x) const {

@@ -72,6 +72,11 @@ class CoupledFluid {
     const double* temperature = nullptr;
     const std::size_t* entry = nullptr;
     std::size_t size = 0;
+    // sampling cellPoint: the footprint-weighted cell velocity U_fp at each particle, null
+    // otherwise. The fluid's implicit exchange takes K (v - U_fp) from the cells; the rest of
+    // the particle's drag, K (u_f - U_fp), goes back through exchange_force, so that the
+    // fluid gets exactly the drag the particle feels.
+    const Vec3* cell_velocity = nullptr;
   };
 
   void set_constants(double density, double viscosity) {
@@ -83,15 +88,17 @@ class CoupledFluid {
   // Replaces the previous set.
   // With `temperature` (one per id; coupled heat), the set also keeps, per entry, the
   // convective heat the particle took from the fluid during the DEM steps until the next
-  // set (add_heat), where it last took it, and its last conductance h A.
+  // set (add_heat), where it last took it, and its last conductance h A. With
+  // `cell_velocity` (one per id; sampling cellPoint) the footprint's cell velocity (View).
   void set(std::vector<GlobalId> ids, std::vector<CoupledSample> samples,
            std::vector<Vec3> vorticity = {}, std::vector<SelfDisturbance> disturbance = {},
-           std::vector<double> temperature = {});
+           std::vector<double> temperature = {}, std::vector<Vec3> cell_velocity = {});
   // The storage of the set before the last set() (its values stale), for the next set to
   // be written into without a new allocation each fluid step; empty if taken already.
   std::vector<CoupledSample> take_spare() { return std::move(spare_); }
   std::vector<Vec3> take_spare_vorticity() { return std::move(spare_vorticity_); }
   std::vector<SelfDisturbance> take_spare_disturbance() { return std::move(spare_disturbance_); }
+  std::vector<Vec3> take_spare_cell_velocity() { return std::move(spare_cell_velocity_); }
   void set_sampler(Sampler sampler) { sampler_ = std::move(sampler); }
   // The samples in the current order of `p` (cheap when the order has not changed).
   View at_particles(const Particles& p);
@@ -140,6 +147,7 @@ class CoupledFluid {
   std::vector<Vec3> spare_vorticity_;
   std::vector<SelfDisturbance> spare_disturbance_;
   std::vector<double> temperature_, spare_temperature_;  // empty, or one per entry
+  std::vector<Vec3> cell_velocity_, spare_cell_velocity_;  // empty, or one per entry
   std::vector<double> heat_, heat_conductance_;         // coupled heat, per entry
   std::vector<Vec3> heat_x_;
   std::unordered_map<GlobalId, std::size_t> index_;  // built on the first re-map after set()
@@ -151,6 +159,7 @@ class CoupledFluid {
   std::vector<Vec3> mapped_vorticity_;
   std::vector<SelfDisturbance> mapped_disturbance_;
   std::vector<double> mapped_temperature_;
+  std::vector<Vec3> mapped_cell_velocity_;
   std::vector<std::size_t> mapped_entry_;
   Sampler sampler_;
   long late_ = 0;

@@ -255,6 +255,11 @@ class FluidForcesWith final : public ForceTerm {
                                            p.mass[i], p.force[i], f.material_derivative, scale);
         drag.coefficient[i] *= scale;
       }
+      // sampling cellPoint: the fluid's implicit exchange takes K (v - U_fp) at the
+      // footprint's cells; the drag's remainder K (u_f - U_fp) goes back explicitly.
+      if (samples.cell_velocity && drag.coefficient[i] > 0)
+        coupled_->exchange_force[i] +=
+            drag.coefficient[i] * (drag.fluid_velocity[i] - samples.cell_velocity[i]);
     }
   }
 

@@ -13,6 +13,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <functional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -236,45 +238,107 @@ const char* kParcelScene =
     "        pressure: {hydrostatic: false},\n"
     "        forces: [drag, pressure_gradient, viscous, buoyancy]}\n";
 
-TEST(DemLink, ParcelsCarryTheRealDragTimesK3AndTheirOwnVolume) {
-  const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "dem_link_parcels";
-  fs::create_directories(dir);
-  const fs::path scene = dir / "parcels.yaml";
-  std::ofstream(scene) << kParcelScene;
-  const double rho = 1000, mu = 1e-3, r = 3e-4, pi = std::acos(-1.0);
-  DemLink link(scene.string(), rho, mu, MPI_COMM_WORLD);
-  link.initialise();
-  const std::array<double, 3> u{0.004, -0.003, 0.012}, grad_p{20, -10, -150}, div_tau{0.5, 1, -2};
-  FluidAtParticle f;
-  f.velocity = u;
-  f.void_fraction = 0.7;
-  f.pressure_gradient = grad_p;
-  f.viscous_stress_divergence = div_tau;
-  const ParticleSet set = link.particles(false);
-  link.begin_fluid();
-  for (std::size_t i = 0; i < set.local; ++i) link.add_fluid(f);
-  link.end_fluid([f](const std::array<double, 3>&) { return f; });
-  link.advance(1, (dir / "diagnostics").string());  // K and the forces of the first step: v = 0
+// kParcelScene after one DEM step from rest (v = 0: K and the forces of the first step) with
+// the same fluid at every particle; `cell_velocity` (by particle id), when given, is handed
+// to the DEM as the footprint's cell velocities (sampling cellPoint).
+struct ParcelStep {
+  static constexpr double rho = 1000, mu = 1e-3, r = 3e-4;
+  static constexpr std::array<double, 3> u{0.004, -0.003, 0.012}, grad_p{20, -10, -150},
+      div_tau{0.5, 1, -2};
+  std::unique_ptr<DemLink> link;
   ParticleView view;
-  link.view(view);
-  const double speed = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-  const double d = 2 * r, re = rho * d * speed / mu;
-  const double k_real = 3 * pi * mu * d * (1 + 0.15 * std::pow(re, 0.687));
+  ParticleSet after;  // the view's order, with the ids
+
+  ParcelStep(const std::string& name,
+             std::function<std::array<double, 3>(long long)> cell_velocity = nullptr) {
+    const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / name;
+    fs::create_directories(dir);
+    const fs::path scene = dir / "parcels.yaml";
+    std::ofstream(scene) << kParcelScene;
+    link = std::make_unique<DemLink>(scene.string(), rho, mu, MPI_COMM_WORLD);
+    link->initialise();
+    const FluidAtParticle f = fluid();
+    const ParticleSet set = link->particles(false);
+    link->begin_fluid();
+    std::vector<std::array<double, 3>> cells;
+    for (std::size_t i = 0; i < set.local; ++i) {
+      link->add_fluid(f);
+      if (cell_velocity) cells.push_back(cell_velocity(set.id[i]));
+    }
+    if (cell_velocity) link->set_fluid_cell_velocities(cells);
+    link->end_fluid([f](const std::array<double, 3>&) { return f; });
+    link->advance(1, (dir / "diagnostics").string());
+    link->view(view);
+    after = link->particles(false);
+  }
+  FluidAtParticle fluid() const {
+    FluidAtParticle f;
+    f.velocity = u;
+    f.void_fraction = 0.7;
+    f.pressure_gradient = grad_p;
+    f.viscous_stress_divergence = div_tau;
+    return f;
+  }
+  // Schiller & Naumann's K of a real particle at slip u.
+  double k_real() const {
+    const double pi = std::acos(-1.0), d = 2 * r;
+    const double re = rho * d * std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]) / mu;
+    return 3 * pi * mu * d * (1 + 0.15 * std::pow(re, 0.687));
+  }
+  // The explicit force the fluid gets back from the pressure and viscous forces.
+  double carried(double volume, int c) const { return -volume * grad_p[c] + volume * div_tau[c]; }
+};
+
+TEST(DemLink, ParcelsCarryTheRealDragTimesK3AndTheirOwnVolume) {
+  const ParcelStep step("dem_link_parcels");
+  const double r = ParcelStep::r, pi = std::acos(-1.0);
   int parcels = 0, reals = 0;
-  for (std::size_t i = 0; i < view.local(); ++i) {
-    const double k = view.radius(i) / r;  // 2 for a parcel, 1 for a real particle
-    ASSERT_TRUE(std::abs(k - 2) < 1e-12 || std::abs(k - 1) < 1e-12) << view.radius(i);
+  for (std::size_t i = 0; i < step.view.local(); ++i) {
+    const double k = step.view.radius(i) / r;  // 2 for a parcel, 1 for a real particle
+    ASSERT_TRUE(std::abs(k - 2) < 1e-12 || std::abs(k - 1) < 1e-12) << step.view.radius(i);
     (k > 1.5 ? parcels : reals) += 1;
-    EXPECT_NEAR(view.drag_coefficient(i) / (k * k * k * k_real), 1, 1e-13) << "k = " << k;
+    EXPECT_NEAR(step.view.drag_coefficient(i) / (k * k * k * step.k_real()), 1, 1e-13) << "k = " << k;
     const double volume = 4.0 / 3.0 * pi * std::pow(k * r, 3);
-    const std::array<double, 3> carried = view.exchange_force(i);
+    const std::array<double, 3> carried = step.view.exchange_force(i);
     for (int c = 0; c < 3; ++c)
-      EXPECT_NEAR(carried[c], -volume * grad_p[c] + volume * div_tau[c],
-                  1e-13 * volume * std::abs(grad_p[2]))
+      EXPECT_NEAR(carried[c], step.carried(volume, c), 1e-13 * volume * std::abs(step.grad_p[2]))
           << "k = " << k << ", component " << c;
   }
   EXPECT_EQ(parcels, 10);
   EXPECT_EQ(reals, 10);
+}
+
+// sampling cellPoint: the fluid's implicit term takes K (v - U_fp) at the footprint's cells,
+// so the particle's exchange force must carry the rest of its drag, K (u_f - U_fp), or the
+// fluid would not get the drag the particle feels. Reference: K from Schiller & Naumann's
+// closed form (times k^3 for the parcels) at the first step (v = 0), U_fp chosen per particle
+// from its id (so that a value served to the wrong particle shows).
+TEST(DemLink, CellPointReturnsTheDragsRemainderExplicitly) {
+  constexpr std::array<double, 3> u = ParcelStep::u;
+  const auto cell_velocity = [u](long long id) {
+    const double x = static_cast<double>(id);
+    return std::array<double, 3>{u[0] - 1e-4 * x, u[1] + 2e-4, u[2] - 3e-5 * x};
+  };
+  const ParcelStep step("dem_link_cell_velocity", cell_velocity);
+  const double r = ParcelStep::r, pi = std::acos(-1.0);
+  ASSERT_EQ(step.view.local(), 20u);
+  ASSERT_EQ(step.after.local, 20u);
+  for (std::size_t i = 0; i < step.view.local(); ++i) {
+    const double k = step.view.radius(i) / r;
+    const double K = k * k * k * step.k_real(), volume = 4.0 / 3.0 * pi * std::pow(k * r, 3);
+    const std::array<double, 3> uc = cell_velocity(step.after.id[i]);
+    const std::array<double, 3> carried = step.view.exchange_force(i);
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(carried[c], step.carried(volume, c) + K * (u[c] - uc[c]),
+                  1e-12 * volume * std::abs(step.grad_p[2]))
+          << "particle " << step.after.id[i] << ", component " << c;
+  }
+  // A count that does not match the particles is refused at end_fluid().
+  const FluidAtParticle f = step.fluid();
+  step.link->begin_fluid();
+  for (std::size_t i = 0; i < step.after.local; ++i) step.link->add_fluid(f);
+  step.link->set_fluid_cell_velocities(std::vector<std::array<double, 3>>(3));
+  EXPECT_THROW(step.link->end_fluid(), std::logic_error);
 }
 
 // The fluidisedBed tutorial's beads (d = 1.14-1.26 mm glass in air, cells of 3 mm) as parcels

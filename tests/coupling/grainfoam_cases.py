@@ -1199,7 +1199,9 @@ def diffusion_smoothing(runner, checks):
        exchange balanced to 1e-12 (the particles read the fluid smoothed by the same,
        self-adjoint operator), sum (1 - eps) V = the beads' volume to 1e-12, and eps on 2
        ranks = eps on 1 rank to 1e-12.
-    3. Refused: a negative bandwidth, and diffusionBandwidth with sampling cellPoint."""
+    3. Refused: a negative bandwidth, and diffusionBandwidth with sampling cellPoint and
+       undisturbedVelocity together (no tables for that read; cellPoint with the averaging
+       alone runs: coupling.hindered_settling_cellpoint_smoothed)."""
     b, h = 1.6e-3, 2e-3
     case = runner.fresh_case("neutral_particle", "smoothing_kernel", [
         ("constant/couplingProperties", "voidFraction    divided;",
@@ -1252,8 +1254,10 @@ def diffusion_smoothing(runner, checks):
 
     for name, text, expected in (
             ("smoothing_negative", "diffusionBandwidth -1e-3;", "diffusionBandwidth -0.001 is negative"),
-            ("smoothing_cellpoint", "diffusionBandwidth 1e-3;\nsampling        cellPoint;",
-             "diffusionBandwidth 0.001 is not combined with sampling cellPoint")):
+            ("smoothing_cellpoint_undisturbed",
+             "diffusionBandwidth 1e-3;\nsampling        cellPoint;\nundisturbedVelocity oseenBrinkman;",
+             "diffusionBandwidth 0.001 with sampling cellPoint is not combined with "
+             "undisturbedVelocity oseenBrinkman")):
         case = runner.fresh_case("periodic_box", name, [
             ("constant/couplingProperties", "sampling        cell;", text if "cellPoint" in text
              else text + "\nsampling        cell;")])

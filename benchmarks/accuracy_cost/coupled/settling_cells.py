@@ -8,13 +8,17 @@ cubes of n particle diameters. The box is `--width` cells wide (walls all round)
 enough for the particle to fall `--fall` diameters (at least 6 cells) after reaching its
 terminal speed. Error: the mean settling speed over the second half of the fall against u_t
 from Schiller & Naumann (1933), C_D = 24/Re (1 + 0.15 Re^0.687); also printed: the fall over
-the whole cells crossed in that half over its time.
+the whole cells crossed in that half over its time, and the fluid's share of the particle's
+fluid force at the end (the last exchange against m a + the submerged weight, a from the last
+two snapshots; 1 when the fluid gets exactly the drag the particle feels).
 
 Usage: settling_cells.py [--re 2] [--cells 3,5,10] [--correction oseenBrinkman]
                          [--footprint divided] [--sampling cell] [--width 16] [--fall 40]
-                         [--courant 0.05] [--check PERCENT] [--work DIR] [--build DIR]
+                         [--courant 0.05] [--check PERCENT [--check-force PERCENT]]
+                         [--work DIR] [--build DIR]
 Prints one line per case and appends to <work>/settling_cells.csv; with --check, exit 1 unless
-every |error| is within PERCENT. The tables of docs/models/undisturbed-velocity.md come from
+every |error| is within PERCENT (and, with --check-force, the fluid's share within PERCENT
+of 1). The tables of docs/models/undisturbed-velocity.md come from
 --courant 0.02 --width 16 at Re_t 0.1, 2 and 50, with and without --correction.
 """
 import argparse
@@ -157,13 +161,14 @@ def run(case, build):
             rc = subprocess.call([FOAM] + cmd, cwd=case, stdout=out, stderr=subprocess.STDOUT, env=env)
         if rc != 0:
             sys.exit(f"settling_cells: {cmd[0]} failed, see {case}/{log}")
-    cpu, imbalance = 0.0, 0.0
+    cpu, imbalance, fluid_z = 0.0, 0.0, float("nan")
     for line in open(os.path.join(case, "log.grainFoam")):
         if line.startswith("ExecutionTime"):
             cpu = float(line.split()[2])
         if "relative imbalance" in line:
             imbalance = max(imbalance, float(line.split()[-1]))
-    return cpu, imbalance
+            fluid_z = float(line.split("fluid (")[1].split(")")[0].split()[2])
+    return cpu, imbalance, fluid_z
 
 
 def measure(case, info):
@@ -174,6 +179,10 @@ def measure(case, info):
             z.append(h5["position"][0][2])
             w.append(-h5["velocity"][0][2])
     t, z, w = np.array(t), np.array(z), np.array(w)
+    # The particle's fluid force at the end (the last exchange): m a + the submerged weight,
+    # a from the last two snapshots.
+    mass = RHO_P * math.pi * D**3 / 6
+    end_force = (RHO_P - RHO_F) * math.pi * D**3 / 6 * G - mass * (w[-1] - w[-2]) / (t[-1] - t[-2])
     start = info["transient"] / info["u_t"]
     late = t > start + 0.5 * (info["end"] - start)
     # The fall over the whole cells crossed in the window over its time (the times the centre
@@ -186,7 +195,7 @@ def measure(case, info):
     if len(faces) > 1:
         tc = np.interp(-faces, -zl, tl)
         whole = (faces[0] - faces[-1]) / (tc[-1] - tc[0]) / info["u_t"] - 1
-    return w[late].mean() / info["u_t"] - 1, w[late].std() / info["u_t"], whole
+    return w[late].mean() / info["u_t"] - 1, w[late].std() / info["u_t"], whole, end_force
 
 
 def main():
@@ -207,11 +216,16 @@ def main():
                          "time tau (default 1; at Re_t 0.1 tau, not --courant, sets the step)")
     ap.add_argument("--check", type=float, default=None,
                     help="exit 1 unless every |error| is within this many per cent")
+    ap.add_argument("--check-force", type=float, default=None,
+                    help="with --check: also exit 1 unless the fluid's share of the particle's "
+                         "fluid force at the end is within this many per cent of 1")
     ap.add_argument("--work", default="/tmp/settling_cells")
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     a = ap.parse_args()
     if not 0 < a.tau_fraction <= 1:
         ap.error(f"--tau-fraction {a.tau_fraction:g}: must be in (0, 1]")
+    if a.check_force is not None and (a.check is None or not a.check_force > 0):
+        ap.error("--check-force PERCENT: needs --check and a positive PERCENT")
     rows = []
     for n in (float(x) for x in a.cells.split(",")):
         name = f"re{a.re:g}_n{n:g}_{a.footprint}_{a.sampling}_{a.correction or 'off'}_w{a.width}_c{a.courant:g}"
@@ -223,18 +237,23 @@ def main():
         subprocess.call(["rm", "-rf", case])
         info = make_case(case, n, a.re, a.width, a.fall, a.footprint, a.sampling, a.correction, a.courant,
                          a.bandwidth, a.tau_fraction)
-        cpu, imbalance = run(case, a.build)
-        err, wobble, whole = measure(case, info)
+        cpu, imbalance, fluid_z = run(case, a.build)
+        err, wobble, whole, end_force = measure(case, info)
+        # The fluid's share of the particle's fluid force at the end: 1 when the fluid gets
+        # exactly the drag (and the returned forces) the particle feels.
+        share = -fluid_z / end_force
         row = dict(re=a.re, cells_per_d=n, footprint=a.footprint, sampling=a.sampling,
                    correction=a.correction or "off", bandwidth_d=a.bandwidth or 0, mu=info["mu"], u_t=info["u_t"],
                    error_pct=100 * err, wobble_pct=100 * wobble, whole_cells_error_pct=100 * whole,
-                   cpu_s=cpu, mesh_cells=info["cells"], imbalance=imbalance)
+                   cpu_s=cpu, mesh_cells=info["cells"], imbalance=imbalance,
+                   fluid_share=share)
         rows.append(row)
         print(f"settling_cells: Re_t {a.re:g}, cells {n:g} d, {a.footprint}/{a.sampling}, "
               f"correction {row['correction']}"
               f"{f', diffusionBandwidth {a.bandwidth:g} d' if a.bandwidth else ''}: error {100 * err:+.2f} % (wobble {100 * wobble:.2f} %; "
               f"over whole cells {100 * whole:+.2f} %), "
-              f"{info['cells']} cells, {cpu:.0f} s, exchange imbalance {imbalance:.1e}", flush=True)
+              f"{info['cells']} cells, {cpu:.0f} s, exchange imbalance {imbalance:.1e}, the fluid gets "
+              f"{share:.4f} of the particle's fluid force", flush=True)
     out = os.path.join(a.work, "settling_cells.csv")
     new = not os.path.exists(out)
     with open(out, "a", newline="") as f:
@@ -243,9 +262,12 @@ def main():
             wr.writeheader()
         wr.writerows(rows)
     if a.check is not None:
-        bad = [r for r in rows if abs(r["error_pct"]) > a.check or r["imbalance"] > 1e-12]
+        force = a.check_force
+        bad = [r for r in rows if abs(r["error_pct"]) > a.check or r["imbalance"] > 1e-12
+               or (force is not None and not abs(r["fluid_share"] - 1) <= force / 100)]
         print(f"settling_cells: {len(rows) - len(bad)} of {len(rows)} within {a.check:g} % "
-              f"with the exchange balanced to 1e-12: "
+              f"with the exchange balanced to 1e-12"
+              f"{f' and the fluid given its share within {force:g} %' if force is not None else ''}: "
               f"{'ok' if not bad else 'FAILED'}")
         sys.exit(1 if bad else 0)
 

@@ -137,5 +137,39 @@ TEST(CoupledFluid, ConstantsAndVorticityReachTheirParticles) {
                std::invalid_argument);
 }
 
+// sampling cellPoint: each particle's cell velocity U_fp follows it through a reorder; a late
+// arrival's is its sample (it is sampled in the cell holding it); a set without them serves
+// none.
+TEST(CoupledFluid, CellVelocityFollowsItsParticle) {
+  Particles p = fourParticles();
+  CoupledFluid fluid;
+  std::vector<CoupledSample> samples;
+  std::vector<Vec3> cells;
+  for (GlobalId id : p.id) {
+    samples.push_back(sampleOf(id));
+    cells.push_back(Vec3(0, static_cast<double>(id), 1));
+  }
+  fluid.set(p.id, samples, {}, {}, {}, cells);
+  fluid.set_sampler([](const Vec3& x) {
+    FluidSample f;
+    f.velocity = Vec3(std::round(x[0] / 0.01), 0, 0);
+    return f;
+  });
+  p.permute({2, 3, 1, 0});
+  p.add(42, Vec3(0.42, 0, 0), Vec3::Zero(), Vec3::Zero(), 1e-3, 0, 2500);
+  const CoupledFluid::View v = fluid.at_particles(p);
+  ASSERT_NE(v.cell_velocity, nullptr);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const Vec3 expected =
+        p.id[i] == 42 ? Vec3(42, 0, 0) : Vec3(0, static_cast<double>(p.id[i]), 1);
+    EXPECT_EQ(v.cell_velocity[i], expected) << "particle " << p.id[i];
+  }
+  EXPECT_THROW(fluid.set(p.id, std::vector<CoupledSample>(p.size()), {}, {}, {},
+                         std::vector<Vec3>(2)),
+               std::invalid_argument);
+  setFor(fluid, p, 1);
+  EXPECT_EQ(fluid.at_particles(p).cell_velocity, nullptr);
+}
+
 }  // namespace
 }  // namespace grainflow
