@@ -138,7 +138,7 @@ endif()
 # y and z (12^3 cells of 3 d, meanPressureGradient suspensionWeight), Re_t = 0.05,
 # undisturbedVelocity oseenBrinkman, against one sphere in the same box: the pair falls faster,
 # U_pair / U_single within 1 point of Hasimoto's (1959) periodic Stokeslet summed in Python by
-# Ewald's split (1.0249; measured 1.0183: the lattice carries 0.79 of the other sphere's induced
+# Ewald's split (1.0249; measured 1.0193: the lattice carries 0.79 of the other sphere's induced
 # velocity two cells away), and the exchange balanced to 1e-12. About 40 s CPU for the two runs
 # (docs/models/undisturbed-velocity.md, "two spheres side by side").
 grainflow_find_python(GRAINFLOW_PAIR_PYTHON "h5py,numpy,scipy" "coupling.settling_pair is")

@@ -312,7 +312,7 @@ def main():
             info = make_periodic_case(case, a)
         else:
             info = make_walls_case(case, a)
-        cpu, imbalance = sc.run(case, a.build)
+        cpu, imbalance, _ = sc.run(case, a.build)
         worst = max(worst, imbalance)
         runs[n] = (periodic_speed if a.box == "periodic" else walls_speed)(case, info, n)
         print(f"settling_pair: {a.box}, {n} sphere(s), Re_t {a.re:g}, cells {a.cells:g} d, "
