@@ -597,6 +597,14 @@ SelfDisturbance disturbance_of(const FluidAtParticle& f) {
     sd.cell_point = true;
     sd.place = f.disturbance_place;
     sd.marginals = f.disturbance_weights;
+    if (sd.smoothing > 0 && sd.cell > 0) {
+      for (int along = 0; along < 3; ++along) {
+        const int ta = (along + 1) % 3, tb = (along + 2) % 3;
+        sd.cell_point_reads[along] = cell_point_read(sd.place[ta], sd.place[tb], sd.marginals[ta],
+                                                     sd.marginals[tb], sd.spread / sd.cell);
+      }
+      sd.cell_point_reads_set = true;
+    }
   }
   return sd;
 }

@@ -254,14 +254,6 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
              "sharpInterface (the layers are read from the cells' own void fractions, which "
              "the averaging spreads); set diffusionBandwidth 0 or dragVoidFraction cell"
           << exit(FatalIOError);
-    if (sampling_ == Sampling::cellPoint && undisturbed_)
-      FatalIOErrorInFunction(dict)
-          << "diffusionBandwidth " << bandwidth << " with sampling cellPoint is not combined "
-             "with undisturbedVelocity oseenBrinkman (the self-disturbance tables for the "
-             "cellPoint read of averaged fields are not built, docs/models/"
-             "undisturbed-velocity.md); use sampling cell with diffusionBandwidth, or "
-             "cellPoint without it"
-          << exit(FatalIOError);
     smoothing_ = std::make_unique<DiffusionSmoothing>(mesh, bandwidth);
     Info << "grainFoam coupling: diffusionBandwidth b = " << bandwidth
          << " m: eps, Ksl, KslUs, fParticles and the fluid the particles read are averaged "

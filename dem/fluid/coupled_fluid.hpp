@@ -18,6 +18,7 @@
 
 #include "dem/core/particles.hpp"
 #include "dem/fluid/fluid_sample.hpp"
+#include "dem/fluid/self_disturbance.hpp"
 
 namespace grainflow {
 
@@ -56,6 +57,10 @@ struct SelfDisturbance {
   bool cell_point = false;
   std::array<double, 3> place{};
   std::array<std::array<double, 3>, 3> marginals{};
+  // sampling cellPoint with diffusionBandwidth: the read's geometry for motion along each
+  // mesh axis (cell_point_read), set with the rest (cell_point_reads_set).
+  std::array<CellPointRead, 3> cell_point_reads{};
+  bool cell_point_reads_set = false;
 };
 
 class CoupledFluid {

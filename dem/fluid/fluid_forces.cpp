@@ -286,11 +286,14 @@ class FluidForcesWith final : public ForceTerm {
     const double eps = f.void_fraction;
     const auto k = [&](double w) { return Law({d, w, eps, f.density, f.viscosity}); };
     const auto m = [&](double w) {
+      if (ax && sd.cell_point && sd.cell_point_reads_set)
+        return lattice_self_mobility_cellpoint(sd.cell, sd.spread, w, rho_e, mu_e, sd.screening,
+                                               sd.cell_point_reads[along], sd.smoothing);
       if (ax && sd.cell_point) {
         const int ta = (along + 1) % 3, tb = (along + 2) % 3;
         return lattice_self_mobility_cellpoint(sd.cell, sd.spread, w, rho_e, mu_e, sd.screening,
                                                sd.place[ta], sd.place[tb], sd.marginals[ta],
-                                               sd.marginals[tb]);
+                                               sd.marginals[tb], sd.smoothing);
       }
       return lattice_self_mobility(sd.cell, sd.spread, w, rho_e, mu_e, sd.screening, ax, ay,
                                    sd.smoothing);

@@ -344,10 +344,143 @@ double stencil_sum(const LatticeStencil& st, const double* table) {
 
 }  // namespace
 
+namespace {
+
+// The cellPoint weights of a point at y (|y_a| <= 1/2, cell units from its cell's centre) on
+// the cells at offsets (-1..1)^3, each face's two triangulations averaged: f(offset, weight).
+// The tetrahedron (centre, face triangle) of the face the largest |y_a| points to: the
+// centre's weight 1 - t (t = 2 |y_a|), each triangle corner's t times its barycentric weight
+// on the face, a corner's value the mean of its eight cells.
+template <class F>
+void cell_point_kernel(const std::array<double, 3>& y, F&& f) {
+  int a = 0;
+  for (int d = 1; d < 3; ++d)
+    if (std::abs(y[d]) > std::abs(y[a])) a = d;
+  const double t = 2 * std::abs(y[a]);
+  f(std::array<int, 3>{0, 0, 0}, 1 - t);
+  if (t == 0) return;
+  const int sig = y[a] > 0 ? 1 : -1;
+  const int b = (a + 1) % 3, c = (a + 2) % 3;
+  const double u = 2 * y[b] / t, v = 2 * y[c] / t;
+  for (int diagonal = 0; diagonal < 2; ++diagonal) {
+    // The triangle of the split along (-,-)..(+,+) holding (uu, v); the other diagonal is
+    // that split mirrored in u.
+    const double uu = diagonal ? -u : u;
+    struct Corner {
+      int su, sv;
+      double w;
+    };
+    const std::array<Corner, 3> tri =
+        uu >= v ? std::array<Corner, 3>{{{-1, -1, (1 - uu) / 2}, {1, -1, (uu - v) / 2}, {1, 1, (1 + v) / 2}}}
+                : std::array<Corner, 3>{{{-1, -1, (1 - v) / 2}, {-1, 1, (v - uu) / 2}, {1, 1, (1 + uu) / 2}}};
+    for (const Corner& k : tri) {
+      const int su = diagonal ? -k.su : k.su;
+      const double share = t * k.w / 16;
+      for (int oa = 0; oa < 2; ++oa)
+        for (int ob = 0; ob < 2; ++ob)
+          for (int oc = 0; oc < 2; ++oc) {
+            std::array<int, 3> o{};
+            o[a] = oa * sig;
+            o[b] = ob * su;
+            o[c] = oc * k.sv;
+            f(o, share);
+          }
+    }
+  }
+}
+
+}  // namespace
+
+CellPointPassage cell_point_passage(double place_a, double place_b) {
+  // Along the passage (y_z from -1/2 to 1/2) every weight is linear between the places where
+  // the tetrahedron changes (|y_z| = |place_a|, |place_b|, 0): Simpson's rule on each piece is
+  // exact for the weights and for their second moments (cubic).
+  std::array<double, 7> cuts = {-0.5, 0.5, 0, place_a, -place_a, place_b, -place_b};
+  for (double& c : cuts) c = std::clamp(c, -0.5, 0.5);
+  std::sort(cuts.begin(), cuts.end());
+  CellPointPassage out{};
+  double total = 0, moment = 0;
+  const auto add = [&](double yz, double weight) {
+    cell_point_kernel({place_a, place_b, yz}, [&](const std::array<int, 3>& o, double w) {
+      if (w == 0) return;
+      out.rho[o[0] + 1][o[1] + 1] += weight * w;
+      total += weight * w;
+      moment += weight * w * (o[2] - yz) * (o[2] - yz);
+    });
+  };
+  for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
+    const double lo = cuts[k], hi = cuts[k + 1], len = hi - lo;
+    if (len <= 0) continue;
+    add(lo, len / 6);
+    add(0.5 * (lo + hi), 4 * len / 6);
+    add(hi, len / 6);
+  }
+  out.variance = moment / total;
+  return out;
+}
+
+CellPointRead cell_point_read(double place_a, double place_b, const std::array<double, 3>& da,
+                              const std::array<double, 3>& db, double spread_over_h) {
+  const CellPointPassage p =
+      cell_point_passage(std::clamp(place_a, -0.5, 0.5), std::clamp(place_b, -0.5, 0.5));
+  CellPointRead r{};
+  // The cosine series of deposit and read-back across the motion: the weight of
+  // cos(a q_a) cos(c q_b).
+  for (int ja = -1; ja <= 1; ++ja)
+    for (int jb = -1; jb <= 1; ++jb) {
+      const double deposit = da[ja + 1] * db[jb + 1];
+      if (deposit == 0) continue;
+      for (int ra = -1; ra <= 1; ++ra)
+        for (int rb = -1; rb <= 1; ++rb)
+          r.cosines[std::abs(ra - ja)][std::abs(rb - jb)] += deposit * p.rho[ra + 1][rb + 1];
+    }
+  // Along the motion: the cell tables' deposit and read-back (a cell each, each widened by
+  // the spread s_e) with the variance of the cellPoint pair, 1/12 + s^2 (the deposit) plus
+  // the stencil's.
+  const double s2 = spread_over_h * spread_over_h;
+  r.spread_over_h = std::sqrt(std::max(0.0, 0.5 * (s2 + p.variance - 1.0 / 12)));
+  return r;
+}
+
+double lattice_self_disturbance_cellpoint(double re_h, double screening, const CellPointRead& r,
+                                          double smoothing_over_h) {
+  namespace t = lattice_table;
+  const LatticeStencil st = lattice_stencil(re_h, screening, r.spread_over_h);
+  const std::array<const double*, 6> plain = {t::log_t00, t::log_t01, t::log_t02,
+                                              t::log_t11, t::log_t12, t::log_t22};
+  const std::array<const double*, 6> smoothed = {t::log_t00_smoothed, t::log_t01_smoothed,
+                                                 t::log_t02_smoothed, t::log_t11_smoothed,
+                                                 t::log_t12_smoothed, t::log_t22_smoothed};
+  const std::array<double, 6> v = smoothed_values<6>(st, smoothing_over_h, plain, smoothed);
+  const double tt[3][3] = {{v[0], v[1], v[2]}, {v[1], v[3], v[4]}, {v[2], v[4], v[5]}};
+  // cos(a q) in the basis f_0, f_1, f_2 of the tables: 1 = f_0, cos q = 2 f_1 - f_0,
+  // cos 2q = 8 f_2 - 8 f_1 + f_0; the integral with cos(a q_a) cos(c q_b) is
+  // sum_ij basis[a][i] basis[c][j] T_ij.
+  constexpr double basis[3][3] = {{1, 0, 0}, {-1, 2, 0}, {1, -8, 8}};
+  double phi = 0;
+  for (int a = 0; a < 3; ++a)
+    for (int c = 0; c < 3; ++c) {
+      if (r.cosines[a][c] == 0) continue;
+      double e = 0;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) e += basis[a][i] * basis[c][j] * tt[i][j];
+      phi += r.cosines[a][c] * e;
+    }
+  phi = std::max(phi, 0.0);
+  if (smoothing_over_h <= 2.25) return phi;
+  const double average = smoothed_values<1>(st, 2.25, {t::log_phi}, {t::log_phi_smoothed})[0];
+  return phi * continuous_beyond(re_h, screening, std::min(r.spread_over_h, 0.5), smoothing_over_h,
+                                 average);
+}
+
 double lattice_self_disturbance_cellpoint(double re_h, double screening, double spread_over_h,
                                           double place_a, double place_b,
-                                          std::array<double, 3> da, std::array<double, 3> db) {
+                                          std::array<double, 3> da, std::array<double, 3> db,
+                                          double smoothing_over_h) {
   namespace t = lattice_table;
+  if (smoothing_over_h > 0)
+    return lattice_self_disturbance_cellpoint(
+        re_h, screening, cell_point_read(place_a, place_b, da, db, spread_over_h), smoothing_over_h);
   static_assert(t::cp_n_places == 15 && t::cp_place_per_unit == 8);
   // The cube's symmetries: a place on the negative side mirrors the marginals; the table
   // holds place_a >= place_b.

@@ -1199,9 +1199,7 @@ def diffusion_smoothing(runner, checks):
        exchange balanced to 1e-12 (the particles read the fluid smoothed by the same,
        self-adjoint operator), sum (1 - eps) V = the beads' volume to 1e-12, and eps on 2
        ranks = eps on 1 rank to 1e-12.
-    3. Refused: a negative bandwidth, and diffusionBandwidth with sampling cellPoint and
-       undisturbedVelocity together (no tables for that read; cellPoint with the averaging
-       alone runs: coupling.hindered_settling_cellpoint_smoothed)."""
+    3. Refused: a negative bandwidth, with the allowed range in the message."""
     b, h = 1.6e-3, 2e-3
     case = runner.fresh_case("neutral_particle", "smoothing_kernel", [
         ("constant/couplingProperties", "voidFraction    divided;",
@@ -1252,19 +1250,14 @@ def diffusion_smoothing(runner, checks):
         diff = float(np.max(np.abs(eps[(1, folder)] - eps[(2, folder)])))
         checks.expect(diff < ROUND_OFF, f"t = {folder}: max |eps(np 1) - eps(np 2)| = {diff:.3g}")
 
-    for name, text, expected in (
-            ("smoothing_negative", "diffusionBandwidth -1e-3;", "diffusionBandwidth -0.001 is negative"),
-            ("smoothing_cellpoint_undisturbed",
-             "diffusionBandwidth 1e-3;\nsampling        cellPoint;\nundisturbedVelocity oseenBrinkman;",
-             "diffusionBandwidth 0.001 with sampling cellPoint is not combined with "
-             "undisturbedVelocity oseenBrinkman")):
-        case = runner.fresh_case("periodic_box", name, [
-            ("constant/couplingProperties", "sampling        cell;", text if "cellPoint" in text
-             else text + "\nsampling        cell;")])
-        runner.run(case, "blockMesh", "blockMesh")
-        log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
-        checks.expect(expected in log, f"{name}: refused ('{expected}')")
-
+    case = runner.fresh_case("periodic_box", "smoothing_negative", [
+        ("constant/couplingProperties", "sampling        cell;",
+         "diffusionBandwidth -1e-3;\nsampling        cell;")])
+    runner.run(case, "blockMesh", "blockMesh")
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    expected = "diffusionBandwidth -0.001 is negative"
+    checks.expect(expected in log and "0 for none" in log,
+                  f"smoothing_negative: refused ('{expected}', naming 0 for none)")
 
 TESTS = {f.__name__: f for f in (void_fraction_volume, exchange_balance, neutrally_buoyant,
                                   cellpoint_ranks,
