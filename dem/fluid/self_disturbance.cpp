@@ -306,21 +306,39 @@ double lattice_self_disturbance(double re_h, double screening, double spread_ove
                                  smoothing_over_h, phi);
 }
 
-double lattice_self_disturbance(double re_h, double screening, double spread_over_h,
-                                const std::array<double, 3>& ax, const std::array<double, 3>& ay,
-                                double smoothing_over_h) {
+namespace {
+
+// The six transverse tables at the stencil, without averaging (g = 0) or with the averaging's
+// sigma/h = g, as the symmetric T[i][j].
+std::array<std::array<double, 3>, 3> transverse_tables(const LatticeStencil& st, double g) {
   namespace t = lattice_table;
-  const LatticeStencil st = lattice_stencil(re_h, screening, spread_over_h);
   const std::array<const double*, 6> plain = {t::log_t00, t::log_t01, t::log_t02,
                                               t::log_t11, t::log_t12, t::log_t22};
   const std::array<const double*, 6> smoothed = {t::log_t00_smoothed, t::log_t01_smoothed,
                                                  t::log_t02_smoothed, t::log_t11_smoothed,
                                                  t::log_t12_smoothed, t::log_t22_smoothed};
-  const std::array<double, 6> v = smoothing_over_h > 0
-                                       ? smoothed_values<6>(st, smoothing_over_h, plain, smoothed)
-                                       : lattice_interpolate<6>(st, plain);
-  // T_ij symmetric: T[i][j] = v[pair index].
-  const double tt[3][3] = {{v[0], v[1], v[2]}, {v[1], v[3], v[4]}, {v[2], v[4], v[5]}};
+  const std::array<double, 6> v =
+      g > 0 ? smoothed_values<6>(st, g, plain, smoothed) : lattice_interpolate<6>(st, plain);
+  return {{{v[0], v[1], v[2]}, {v[1], v[3], v[4]}, {v[2], v[4], v[5]}}};
+}
+
+// Beyond sigma/h = 2.25 (transverse_tables holds the values at 2.25 there): the factor that
+// continues them by the continuous form (continuous_beyond, joined at the place-averaged
+// table's value).
+double transverse_beyond(const LatticeStencil& st, double re_h, double screening,
+                         double spread_over_h, double g) {
+  namespace t = lattice_table;
+  const double average = smoothed_values<1>(st, 2.25, {t::log_phi}, {t::log_phi_smoothed})[0];
+  return continuous_beyond(re_h, screening, std::min(std::max(spread_over_h, 0.0), 0.5), g, average);
+}
+
+}  // namespace
+
+double lattice_self_disturbance(double re_h, double screening, double spread_over_h,
+                                const std::array<double, 3>& ax, const std::array<double, 3>& ay,
+                                double smoothing_over_h) {
+  const LatticeStencil st = lattice_stencil(re_h, screening, spread_over_h);
+  const auto tt = transverse_tables(st, smoothing_over_h);
   double phi = 0;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) phi += ax[i] * ay[j] * tt[i][j];
@@ -328,9 +346,7 @@ double lattice_self_disturbance(double re_h, double screening, double spread_ove
   // (weights split over cells -1 and +1 with none between) is held at zero.
   phi = std::max(phi, 0.0);
   if (smoothing_over_h <= 2.25) return phi;
-  const double average = smoothed_values<1>(st, 2.25, {t::log_phi}, {t::log_phi_smoothed})[0];
-  return phi * continuous_beyond(re_h, screening, std::min(std::max(spread_over_h, 0.0), 0.5),
-                                 smoothing_over_h, average);
+  return phi * transverse_beyond(st, re_h, screening, spread_over_h, smoothing_over_h);
 }
 
 namespace {
@@ -444,15 +460,8 @@ CellPointRead cell_point_read(double place_a, double place_b, const std::array<d
 
 double lattice_self_disturbance_cellpoint(double re_h, double screening, const CellPointRead& r,
                                           double smoothing_over_h) {
-  namespace t = lattice_table;
   const LatticeStencil st = lattice_stencil(re_h, screening, r.spread_over_h);
-  const std::array<const double*, 6> plain = {t::log_t00, t::log_t01, t::log_t02,
-                                              t::log_t11, t::log_t12, t::log_t22};
-  const std::array<const double*, 6> smoothed = {t::log_t00_smoothed, t::log_t01_smoothed,
-                                                 t::log_t02_smoothed, t::log_t11_smoothed,
-                                                 t::log_t12_smoothed, t::log_t22_smoothed};
-  const std::array<double, 6> v = smoothed_values<6>(st, smoothing_over_h, plain, smoothed);
-  const double tt[3][3] = {{v[0], v[1], v[2]}, {v[1], v[3], v[4]}, {v[2], v[4], v[5]}};
+  const auto tt = transverse_tables(st, smoothing_over_h);
   // cos(a q) in the basis f_0, f_1, f_2 of the tables: 1 = f_0, cos q = 2 f_1 - f_0,
   // cos 2q = 8 f_2 - 8 f_1 + f_0; the integral with cos(a q_a) cos(c q_b) is
   // sum_ij basis[a][i] basis[c][j] T_ij.
@@ -468,9 +477,7 @@ double lattice_self_disturbance_cellpoint(double re_h, double screening, const C
     }
   phi = std::max(phi, 0.0);
   if (smoothing_over_h <= 2.25) return phi;
-  const double average = smoothed_values<1>(st, 2.25, {t::log_phi}, {t::log_phi_smoothed})[0];
-  return phi * continuous_beyond(re_h, screening, std::min(r.spread_over_h, 0.5), smoothing_over_h,
-                                 average);
+  return phi * transverse_beyond(st, re_h, screening, r.spread_over_h, smoothing_over_h);
 }
 
 double lattice_self_disturbance_cellpoint(double re_h, double screening, double spread_over_h,
