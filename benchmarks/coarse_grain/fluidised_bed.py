@@ -22,11 +22,17 @@ fractions, the bubble holdup (the fraction of the bed's cells with eps > 0.8) an
 mean eps (the bed's other cells);
 and the cost: grainFoam's CPU seconds (ExecutionTime) per simulated second and its wall time.
 
-usage: fluidised_bed.py [--ks 1,2,3] [--end 1.0] [--from 0.5] [--seed 1] [--depth 0.009] [--work DIR]
-                        [--build DIR] [--pp-restitution E] [--analyse-only] [--diagnose]
+usage: fluidised_bed.py [--ks 1,2,3] [--end 1.0] [--from 0.5] [--seed 1] [--depth 0.009]
+                        [--cells 0.003] [--bandwidth B] [--work DIR] [--build DIR]
+                        [--pp-restitution E] [--analyse-only] [--diagnose]
+--ks takes any factors >= 1 (1.26 is about 2 beads per parcel; cases k<k>_seed<s>).
+--end sets both the scene's time.end and controlDict's endTime (grainFoam stops at the earlier).
 --seed sets the fill's random seed (another realisation of the same bed; cases k<k>_seed<s>).
---depth D makes the column D deep (a whole number of 3 mm cells; 12 000 D/9 mm beads, the same
+--depth D makes the column D deep (a whole number of cells; 12 000 D/9 mm beads, the same
 real beads per area; cases k<k>_seed<s>_depth<D>mm).
+--cells C makes the cells C wide in x and z (dividing 60 and 240 mm), with a whole number of
+them across the depth, or one when the depth is under 1.5 C (cases ..._cells<C>mm).
+--bandwidth B adds couplingProperties' diffusionBandwidth B [m] (docs/coupling.md; cases ..._b<B>mm).
 --pp-restitution E sets the restitution between the beads (parcels) to E, against the walls
 kept at 0.9 (cases k<k>_seed<s>_epp<E>): kinetic theory's collisional dissipation per volume
 falls as 1/k for parcels, restored by 1 - E^2 = k (1 - 0.9^2) (docs/accuracy-vs-cost-coupled.md).
@@ -58,6 +64,7 @@ FOAM = os.path.join(ROOT, "scripts", "foam_env.sh")
 TUTORIAL = os.path.join(ROOT, "tutorials", "cfd-dem", "fluidisedBed")
 RHO_F, G = 1.2, 9.81
 DEPTH = 0.009  # the column depth; --depth changes it (and AREA, NY)
+CELL = 0.003  # the cells' width in x and z; --cells changes it (and NX, NZ, NY)
 AREA = 0.06 * DEPTH
 FLUID_STEP = 3e-4
 INFLOW_START = 0.2  # 0/U: the inflow ramps up from 0.2 s
@@ -76,23 +83,41 @@ def dem_step(k):
 
 
 PP_RESTITUTION = None  # --pp-restitution: the beads' (parcels') restitution against each other
+BANDWIDTH = None  # --bandwidth: couplingProperties' diffusionBandwidth [m]
+
+
+def parse_k(text):
+    """A coarse-graining factor from --ks: 2 stays 2 (case k2_...), 1.5 is 1.5 (case k1.5_...)."""
+    k = float(text)
+    if not k >= 1:
+        sys.exit(f"fluidised_bed: --ks: {text} is not a coarse-graining factor >= 1")
+    return int(k) if k.is_integer() else k
 
 
 def case_dir(work, k, seed):
     tail = "" if abs(DEPTH - 0.009) < 1e-12 else f"_depth{1e3 * DEPTH:g}mm"
+    if abs(CELL - 0.003) > 1e-12:
+        tail += f"_cells{1e3 * CELL:g}mm"
     if PP_RESTITUTION is not None:
         tail += f"_epp{PP_RESTITUTION:g}"
+    if BANDWIDTH is not None:
+        tail += f"_b{1e3 * BANDWIDTH:g}mm"
     return os.path.join(work, f"k{k}_seed{seed}{tail}")
 
 
-def set_depth(depth):
-    """The column DEPTH deep (a whole number of 3 mm cells): the fill's count, the walls, the
-    mesh and the analysis scale with it (the same real beads per area)."""
-    global DEPTH, AREA, NY
-    NY = round(depth / 0.003)
-    if NY < 1 or abs(NY * 0.003 - depth) > 1e-9:
-        sys.exit(f"fluidised_bed: --depth {depth} is not a whole number of 3 mm cells")
-    DEPTH, AREA = depth, 0.06 * depth
+def set_mesh(depth, cell):
+    """The column DEPTH deep and its cells CELL wide in x and z (the tutorial: 9 mm, 3 mm).
+    The fill's count, the walls, the mesh and the analysis scale with the depth (the same real
+    beads per area); the depth holds a whole number of cells, or one cell when it is less than
+    1.5 cells (a pseudo-2D mesh, one cell across the depth)."""
+    global DEPTH, AREA, CELL, NX, NY, NZ
+    NX, NZ = round(0.06 / cell), round(HEIGHT / cell)
+    if abs(NX * cell - 0.06) > 1e-9 or abs(NZ * cell - HEIGHT) > 1e-9:
+        sys.exit(f"fluidised_bed: --cells {cell} does not divide the 60 x 240 mm column")
+    NY = max(1, round(depth / cell))
+    if NY > 1 and abs(NY * cell - depth) > 1e-9:
+        sys.exit(f"fluidised_bed: --depth {depth} is not a whole number of {cell} m cells")
+    DEPTH, AREA, CELL = depth, 0.06 * depth, cell
 
 
 def prepare(work, k, end, seed):
@@ -114,15 +139,21 @@ def prepare(work, k, end, seed):
         sub(scene, "max: [0.06, 0.009, 0.082]", "max: [0.06, 0.009, 0.16]")
         # The longer fall lands them harder: at k = 2 a pair reached 20.3 % overlap in the pour.
         sub(scene, "  max_overlap: 0.2\n", "  max_overlap: 0.3\n")
+    if BANDWIDTH is not None:
+        with open(os.path.join(case, "constant", "couplingProperties"), "a") as f:
+            f.write(f"diffusionBandwidth {BANDWIDTH:.6g};\n")
+    # grainFoam stops at the earlier of the two ends: both are set.
     sub(os.path.join(case, "system", "controlDict"), "endTime         1.0;", f"endTime         {end:g};")
+    sub(scene, "  end: 1.0 ", f"  end: {end:g} ")
+    mesh = os.path.join(case, "system", "blockMeshDict")
     if abs(DEPTH - 0.009) > 1e-12:
         y, mm = f"{DEPTH:g}", f"{1e3 * DEPTH:g}"
         for old in ("max: [0.06, 0.009, 0.24]", "point: [0, 0.009, 0]", "max: [0.06, 0.009, 0."):
             sub(scene, old, old.replace("0.009", y))
-        mesh = os.path.join(case, "system", "blockMeshDict")
         sub(mesh, "(60 9 0) (0 9 0)", f"(60 {mm} 0) (0 {mm} 0)")
         sub(mesh, "(60 9 240) (0 9 240)", f"(60 {mm} 240) (0 {mm} 240)")
-        sub(mesh, "(20 3 80)", f"(20 {NY} 80)")
+    if (NX, NY, NZ) != (20, 3, 80):
+        sub(mesh, "(20 3 80)", f"({NX} {NY} {NZ})")
     return case
 
 
@@ -167,7 +198,7 @@ def analyse(case, t_from):
                 **dict(zip(("bubble_holdup", "emulsion_voidfraction"), bubbles(case, t_from))))
 
 
-NX, NY, NZ, HEIGHT = 20, 3, 80, 0.24  # the uniform mesh of 3 mm cells, x fastest, z slowest
+NX, NY, NZ, HEIGHT = 20, 3, 80, 0.24  # the uniform mesh (3 mm cells; set_mesh), x fastest, z slowest
 
 
 def written_fields(case, t_from, name):
@@ -248,17 +279,21 @@ def main():
     ap.add_argument("--analyse-only", action="store_true")
     ap.add_argument("--diagnose", action="store_true")
     ap.add_argument("--depth", type=float, default=0.009)
+    ap.add_argument("--cells", type=float, default=0.003)
     ap.add_argument("--pp-restitution", type=float, default=None)
+    ap.add_argument("--bandwidth", type=float, default=None)
     ap.add_argument("--work", default=os.path.join(ROOT, "build", "benchmarks", "coarse_grain_fluidised"))
     ap.add_argument("--build", default=os.environ.get("GRAINFLOW_BUILD_DIR", os.path.join(ROOT, "build")))
     args = ap.parse_args()
-    set_depth(args.depth)
+    set_mesh(args.depth, args.cells)
     global PP_RESTITUTION
     PP_RESTITUTION = args.pp_restitution
+    global BANDWIDTH
+    BANDWIDTH = args.bandwidth
     os.makedirs(args.work, exist_ok=True)
     env = dict(os.environ, LD_LIBRARY_PATH=os.path.join(args.build, "lib"))
     rows = []
-    for k in (int(x) for x in args.ks.split(",")):
+    for k in (parse_k(x) for x in args.ks.split(",")):
         if args.analyse_only:
             case, wall = case_dir(args.work, k, args.seed), float("nan")
         else:
