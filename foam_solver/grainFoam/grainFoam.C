@@ -105,6 +105,9 @@ void solve(const Foam::argList& args) {
   const grainflow::StopSignals stopSignals(true);
 
   // The run ends at the earlier of system/controlDict's endTime and the scene's time.end.
+  // When the scene's is earlier, the last line says so again: a log read from its tail should
+  // not look like a run to controlDict's endTime.
+  std::string sceneCut;
   {
     const scalar sceneEnd = particles.sceneEndTime(), foamEnd = runTime.endTime().value();
     // As typed (6 digits), not at the case's writePrecision.
@@ -118,6 +121,9 @@ void solve(const Foam::argList& args) {
            << particles.sceneEndTimeSource().c_str() << "), before system/controlDict's endTime "
            << text(foamEnd).c_str() << " s" << endl;
       runTime.setEndTime(sceneEnd);
+      sceneCut = "grainFoam: stopped at the scene's time.end, t = " + text(sceneEnd) + " s (" +
+                 particles.sceneEndTimeSource() + "), before system/controlDict's endTime " +
+                 text(foamEnd) + " s; to run longer, raise both";
     } else {
       Info << "grainFoam: ends at t = " << text(foamEnd).c_str()
            << " s, system/controlDict's endTime (the scene's time.end, "
@@ -258,6 +264,7 @@ void solve(const Foam::argList& args) {
       return;
     }
   }
+  if (!sceneCut.empty()) Info << sceneCut.c_str() << endl;
   Info << "End\n" << endl;
 }
 

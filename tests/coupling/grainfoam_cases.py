@@ -774,6 +774,9 @@ def scene_output(runner, checks):
                   f"t = {steps[-1] if steps else None} (30, 0.03)")
     checks.expect(re.search(r"grainFoam: ends at t = 0.03 s, the scene's time.end \(\S*particle\.yaml:9\)", log)
                   is not None, "the log says the run ends at the scene's time.end, particle.yaml:9")
+    checks.expect(re.search(r"grainFoam: stopped at the scene's time.end, t = 0.03 s \(\S*particle\.yaml:9\), "
+                            r"before system/controlDict's endTime 0.1 s; to run longer, raise both\nEnd", log)
+                  is not None, "the log's last lines say the scene's time.end stopped the run before endTime")
 
     case = runner.fresh_case("neutral_particle", "log_interval", [
         ("particle.yaml", "fluid:\n", "output:\n  log_interval: 0.01\nfluid:\n")])
