@@ -24,7 +24,7 @@ and the cost: grainFoam's CPU seconds (ExecutionTime) per simulated second and i
 
 usage: fluidised_bed.py [--ks 1,2,3] [--end 1.0] [--from 0.5] [--seed 1] [--depth 0.009]
                         [--cells 0.003] [--bandwidth B] [--work DIR] [--build DIR]
-                        [--pp-restitution E] [--analyse-only] [--diagnose]
+                        [--pp-restitution E] [--analyse-only] [--diagnose] [--plot PNG]
 --ks takes any factors >= 1 (1.26 is about 2 beads per parcel; cases k<k>_seed<s>).
 --end sets both the scene's time.end and controlDict's endTime (grainFoam stops at the earlier).
 --seed sets the fill's random seed (another realisation of the same bed; cases k<k>_seed<s>).
@@ -40,6 +40,8 @@ falls as 1/k for parcels, restored by 1 - E^2 = k (1 - 0.9^2) (docs/accuracy-vs-
 --diagnose also prints the heights per snapshot, the solid-fraction profiles and the real mass
 across the depth.
 Prints one row per k and appends them to <work>/fluidised_bed.csv.
+--plot PNG runs nothing: it plots the bed height and the CPU per simulated second against k from
+that table (the 9 mm column, one series per mesh; docs/accuracy-vs-cost-coupled.md).
 """
 import argparse
 import csv
@@ -270,6 +272,57 @@ def diagnose(case, t_from):
     print("    real mass across the depth, z 5-25 mm, 1 mm bins: " + " ".join(f"{v:.3f}" for v in np.mean(depth, 0)))
 
 
+def plot(table, path):
+    """--plot: from the rows of `table` (every run of this script in its work directory), the
+    real-particle bed height and the CPU per simulated second against k, for the column 9 mm
+    deep without averaging or a changed restitution, one series per mesh; a fill is a dot, the
+    mean over the fills a line."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    rows = {}
+    with open(table) as f:
+        for r in csv.DictReader(f):
+            if abs(float(r["depth"]) - 0.009) < 1e-9 and not r["bandwidth"] and not r["pp_restitution"]:
+                rows[(float(r["k"]), int(r["seed"]), float(r["cells"]))] = r  # the last run of each
+    if not rows:
+        sys.exit(f"fluidised_bed: no runs of the 9 mm column in {table}")
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(10, 4.2))
+    base, marked = None, False
+    for i, cell in enumerate(sorted({key[2] for key in rows})):
+        ks = sorted({key[0] for key in rows if key[2] == cell})
+        fills = {k: [r for key, r in rows.items() if key[0] == k and key[2] == cell] for k in ks}
+        label = f"{1e3 * cell:g} mm cells"
+        height = [np.mean([1e3 * float(r["height"]) for r in fills[k]]) for k in ks]
+        cpu = [np.mean([float(r["cpu_s"]) / float(r["simulated_s"]) for r in fills[k]]) for k in ks]
+        for k in ks:
+            ax.plot([k] * len(fills[k]), [1e3 * float(r["height"]) for r in fills[k]], ".", color=f"C{i}", alpha=0.5)
+        ax.plot(ks, height, "o-", color=f"C{i}", label=label)
+        # A bed the gas does not carry (a plug, or gas passing by): mean dp off the weight by > 5 %.
+        stuck = [j for j, k in enumerate(ks)
+                 if abs(np.mean([float(r["dp_mean"]) / float(r["weight"]) for r in fills[k]]) - 1) > 0.05]
+        ax.plot([ks[j] for j in stuck], [height[j] for j in stuck], "kx", ms=9,
+                label="not fluidised (mean dp off the weight by > 5 %)" if stuck and not marked else None)
+        marked = marked or bool(stuck)
+        bx.plot(ks, cpu, "o-", color=f"C{i}", label=label)
+        if abs(cell - 0.003) < 1e-9 and ks[0] == 1:
+            base = (height[0], cpu[0])
+    if base:
+        ax.axhspan(0.95 * base[0], 1.05 * base[0], color="0.85", label="beads on 3 mm cells ± 5 %")
+        kk = np.linspace(1, 3, 50)
+        bx.plot(kk, base[1] / (kk**3 / 2), "k:", label="beads on 3 mm cells / (k³/2)")
+    ax.set(xlabel="coarse-graining factor k", ylabel="bed height, real particles [mm]",
+           title="fluidisedBed: bed height (dots: fills)")
+    bx.set(xlabel="coarse-graining factor k", ylabel="grainFoam CPU s per simulated s", yscale="log",
+           title="cost")
+    ax.legend(fontsize=8)
+    bx.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    print(f"fluidised_bed: wrote {path}")
+    return 0
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--ks", default="1,2,3")
@@ -282,9 +335,12 @@ def main():
     ap.add_argument("--cells", type=float, default=0.003)
     ap.add_argument("--pp-restitution", type=float, default=None)
     ap.add_argument("--bandwidth", type=float, default=None)
+    ap.add_argument("--plot", default=None, metavar="PNG")
     ap.add_argument("--work", default=os.path.join(ROOT, "build", "benchmarks", "coarse_grain_fluidised"))
     ap.add_argument("--build", default=os.environ.get("GRAINFLOW_BUILD_DIR", os.path.join(ROOT, "build")))
     args = ap.parse_args()
+    if args.plot:
+        return plot(os.path.join(args.work, "fluidised_bed.csv"), args.plot)
     set_mesh(args.depth, args.cells)
     global PP_RESTITUTION
     PP_RESTITUTION = args.pp_restitution
@@ -307,9 +363,13 @@ def main():
             wall = time.monotonic() - started
         text = open(os.path.join(case, "log.grainFoam")).read()
         cpu = float(re.findall(r"ExecutionTime = (\S+) s", text)[-1])
+        simulated = float(re.findall(r"^Time = (\S+)$", text, re.MULTILINE)[-1])  # the run's own end
         imbalance = max(float(x) for x in re.findall(r"relative imbalance (\S+)", text))
-        row = dict(k=k, seed=args.seed, depth=DEPTH, **analyse(case, args.t_from), cpu_s=cpu, wall_s=wall,
-                   cpu_per_simulated_s=cpu / args.end, worst_imbalance=imbalance)
+        row = dict(k=k, seed=args.seed, depth=DEPTH, cells=CELL,
+                   bandwidth="" if BANDWIDTH is None else BANDWIDTH,
+                   pp_restitution="" if PP_RESTITUTION is None else PP_RESTITUTION,
+                   **analyse(case, args.t_from), cpu_s=cpu, wall_s=wall,
+                   simulated_s=simulated, cpu_per_simulated_s=cpu / simulated, worst_imbalance=imbalance)
         rows.append(row)
         if args.diagnose:
             diagnose(case, args.t_from)
@@ -321,7 +381,7 @@ def main():
               f"pressure {1e3 * row['height_pressure']:.2f} mm; settled before the inflow: real-particle "
               f"height {1e3 * row['settled_height']:.2f} mm, solid fraction "
               f"{row['settled_solid_fraction']:.3f}; bubble holdup {row['bubble_holdup']:.3f}, emulsion eps "
-              f"{row['emulsion_voidfraction']:.3f}; CPU {cpu:.0f} s ({cpu / args.end:.0f} s per "
+              f"{row['emulsion_voidfraction']:.3f}; CPU {cpu:.0f} s ({cpu / simulated:.0f} s per "
               f"simulated s), wall {wall:.0f} s, exchange imbalance {imbalance:.1e}", flush=True)
     out = os.path.join(args.work, "fluidised_bed.csv")
     new = not os.path.exists(out)
