@@ -385,6 +385,13 @@ def main():
               f"simulated s), wall {wall:.0f} s, exchange imbalance {imbalance:.1e}", flush=True)
     out = os.path.join(args.work, "fluidised_bed.csv")
     new = not os.path.exists(out)
+    if not new:  # a table with other columns (an older version of this script): kept aside
+        with open(out) as f:
+            header = next(csv.reader(f), [])
+        if header != list(rows[0].keys()):
+            os.replace(out, out + ".old")
+            print(f"fluidised_bed: {out} had other columns; moved to {out}.old")
+            new = True
     with open(out, "a", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
         if new:
