@@ -113,6 +113,8 @@ def set_mesh(depth, cell):
     beads per area); the depth holds a whole number of cells, or one cell when it is less than
     1.5 cells (a pseudo-2D mesh, one cell across the depth)."""
     global DEPTH, AREA, CELL, NX, NY, NZ
+    if not (cell > 0 and depth > 0):
+        sys.exit(f"fluidised_bed: --cells {cell} and --depth {depth} must be lengths > 0 [m]")
     NX, NZ = round(0.06 / cell), round(HEIGHT / cell)
     if abs(NX * cell - 0.06) > 1e-9 or abs(NZ * cell - HEIGHT) > 1e-9:
         sys.exit(f"fluidised_bed: --cells {cell} does not divide the 60 x 240 mm column")
@@ -346,6 +348,8 @@ def main():
     PP_RESTITUTION = args.pp_restitution
     global BANDWIDTH
     BANDWIDTH = args.bandwidth
+    if BANDWIDTH is not None and not BANDWIDTH >= 0:
+        sys.exit(f"fluidised_bed: --bandwidth {BANDWIDTH} must be a length >= 0 [m] (0: no averaging)")
     os.makedirs(args.work, exist_ok=True)
     env = dict(os.environ, LD_LIBRARY_PATH=os.path.join(args.build, "lib"))
     rows = []
