@@ -227,7 +227,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   guard_finite(sim, has_non_finite(sim.particles()), dir, comm);
 
   SnapshotWriter snapshots(comm, dir, "particles", scene.output.fields);
-  snapshots.set_coarse_grain(scene.coarse_grain_table());
+  snapshots.set_coarse_grain(scene.coarse_grain_table(), scene.real_material_table());
   const std::string log_path = (std::filesystem::path(dir) / "log.csv").string();
   std::optional<LogTable> log_table;
   if (options.restart) {

@@ -462,7 +462,33 @@ void read_snapshot_entry(const Scene& scene, const WallSet* walls, const Inserti
   // up to half a skin outside that range: such a centre is the same sphere as its image
   // inside, and is moved there. Farther out (a snapshot of another domain) is an error.
   Particles& q = snap.particles;
+  // A snapshot of parcels: its material indices are those of the scene that wrote it; the
+  // parser gave this scene the same parcel classes (Insertion::material_map).
+  if (!ins.material_map.empty())
+    for (std::size_t i = 0; i < q.size(); ++i) {
+      const int m = q.material[i];
+      if (m < 0 || static_cast<std::size_t>(m) >= ins.material_map.size())
+        throw StateError(ins.snapshot_file + ": error: dataset '/material', index " +
+                         std::to_string(i) + " (particle id " + std::to_string(q.id[i]) +
+                         "): the material index " + std::to_string(m) + " is not one of the " +
+                         std::to_string(ins.material_map.size()) +
+                         " materials of the scene that wrote it (root attribute "
+                         "material_coarse_grain); the snapshot (insertion at " +
+                         ins.source + ") was changed or damaged after it was written");
+      q.material[i] = ins.material_map[static_cast<std::size_t>(m)];
+    }
   check_snapshot_records(scene, ins, q);
+  // Each particle's k, when the file lists it, is its class's.
+  for (std::size_t i = 0; i < snap.coarse_grain.size(); ++i) {
+    const Material& m = scene.materials[static_cast<std::size_t>(q.material[i])];
+    if (snap.coarse_grain[i] != m.coarse_grain)
+      throw StateError(ins.snapshot_file + ": error: dataset '/coarse_grain', index " +
+                       std::to_string(i) + " (particle id " + std::to_string(q.id[i]) +
+                       "): k = " + format_number(snap.coarse_grain[i]) + ", but its material '" +
+                       m.name + "' has k = " + format_number(m.coarse_grain) +
+                       "; the snapshot (insertion at " + ins.source +
+                       ") was changed or damaged after it was written");
+  }
   // Temperatures: the entry's `temperature` for all, else the file's (heat on).
   if (scene.heat) {
     if (ins.temperature)

@@ -109,7 +109,56 @@ Snapshot read_snapshot(const std::string& path) {
   } else {
     p.temperature.assign(n, 0.0);
   }
+  if (H5Lexists(f.id, "/coarse_grain", H5P_DEFAULT) > 0 &&
+      read(f.id, path, "/coarse_grain", 1, H5T_NATIVE_DOUBLE, s.coarse_grain) != n)
+    throw SnapshotReadError(path +
+                            ": error: dataset '/coarse_grain' has a different particle "
+                            "count than '/id'");
   return s;
+}
+
+namespace {
+// A one-dimensional numeric root attribute, empty when the file has none.
+template <class T>
+std::vector<T> array_attribute(hid_t file, const std::string& path, const char* name, hid_t type) {
+  std::vector<T> out;
+  if (H5Aexists(file, name) <= 0) return out;
+  const hid_t a = H5Aopen(file, name, H5P_DEFAULT);
+  const hid_t space = a < 0 ? -1 : H5Aget_space(a);
+  const hssize_t n = space < 0 ? -1 : H5Sget_simple_extent_npoints(space);
+  if (space >= 0) H5Sclose(space);
+  bool ok = n >= 0;
+  if (ok) {
+    out.resize(static_cast<std::size_t>(n));
+    ok = out.empty() || H5Aread(a, type, out.data()) >= 0;
+  }
+  if (a >= 0) H5Aclose(a);
+  if (!ok)
+    throw SnapshotDamagedError(path + ": error: cannot read the root attribute '" + name + "'");
+  return out;
+}
+}  // namespace
+
+SnapshotClasses read_snapshot_classes(const std::string& path) {
+  Quiet quiet;
+  File f{H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT)};
+  if (f.id < 0)
+    throw SnapshotReadError(path + ": error: cannot open as an HDF5 file; check the path");
+  SnapshotClasses c;
+  c.k = array_attribute<double>(f.id, path, "material_coarse_grain", H5T_NATIVE_DOUBLE);
+  c.real = array_attribute<int>(f.id, path, "material_real", H5T_NATIVE_INT);
+  if (c.k.size() != c.real.size())
+    throw SnapshotReadError(path + ": error: the root attributes material_coarse_grain (" +
+                            std::to_string(c.k.size()) + " values) and material_real (" +
+                            std::to_string(c.real.size()) +
+                            " values) should hold one value per material of the scene that "
+                            "wrote the snapshot");
+  if (c.k.empty() && H5Lexists(f.id, "/coarse_grain", H5P_DEFAULT) > 0) {
+    std::vector<double> k;
+    read(f.id, path, "/coarse_grain", 1, H5T_NATIVE_DOUBLE, k);
+    for (double v : k) c.parcels_without_classes |= v != 1;
+  }
+  return c;
 }
 
 }  // namespace grainflow

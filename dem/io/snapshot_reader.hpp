@@ -4,6 +4,7 @@
 // that calls it reads the whole file.
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "dem/core/particles.hpp"
 
@@ -24,8 +25,22 @@ struct Snapshot {
   Particles particles;  // id, x, v, omega, radius, mass, material; inertia = 2/5 m r^2
   double time = 0;
   bool has_temperature = false;  // the file holds temperatures (else particles' are 0)
+  std::vector<double> coarse_grain;  // each particle's k, when the file has the dataset
 };
 
 Snapshot read_snapshot(const std::string& path);
+
+// The parcel classes of the scene that wrote a snapshot (docs/models/coarse-graining.md): for
+// each material index of that scene its factor k and its listed material, from the root
+// attributes material_coarse_grain and material_real. Both empty for a snapshot of real
+// particles, and for one written before snapshots carried the classes: then
+// `parcels_without_classes` tells whether its coarse_grain dataset holds a k != 1. Throws
+// SnapshotReadError when the file cannot be opened or the attributes disagree in length.
+struct SnapshotClasses {
+  std::vector<double> k;
+  std::vector<int> real;
+  bool parcels_without_classes = false;
+};
+SnapshotClasses read_snapshot_classes(const std::string& path);
 
 }  // namespace grainflow

@@ -155,6 +155,18 @@ bool write_scalar_attribute(hid_t loc, const char* name, HdfTypes types, const v
   return attr.close();
 }
 
+// A one-dimensional attribute of n values.
+bool write_array_attribute(hid_t loc, const char* name, HdfTypes types, std::size_t n,
+                           const void* values) {
+  const hsize_t dims[1] = {n};
+  Hid space(H5Screate_simple(1, dims, nullptr), H5Sclose);
+  if (!space.valid()) return false;
+  Hid attr(H5Acreate2(loc, name, types.file, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  if (!attr.valid()) return false;
+  if (H5Awrite(attr.get(), types.memory, values) < 0) return false;
+  return attr.close();
+}
+
 // This rank's slice of the global arrays: elements [offset, offset + count) of N = total.
 struct Slice {
   hsize_t offset;
@@ -539,6 +551,14 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step,
                     write_scalar_attribute(file.get(), "count", i64, &total) &&
                     write_string_attribute(file.get(), "grainflow_version", GRAINFLOW_VERSION));
     agreement.check(ok, "writing the root attributes (time, step, count)");
+    if (!coarse_grain_.empty()) {
+      const std::vector<std::int64_t> real(real_material_.begin(), real_material_.end());
+      ok = !opens ||
+           (write_array_attribute(file.get(), "material_coarse_grain", f64, coarse_grain_.size(),
+                                  coarse_grain_.data()) &&
+            write_array_attribute(file.get(), "material_real", i64, real.size(), real.data()));
+      agreement.check(ok, "writing the root attributes material_coarse_grain, material_real");
+    }
     agreement.check(!opens || file.close(), "closing (flushing) the file");
 
     const bool renamed = rank_ != 0 || std::rename(partial.c_str(), path.c_str()) == 0;

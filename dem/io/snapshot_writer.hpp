@@ -71,14 +71,18 @@ class SnapshotWriter {
   std::string index_path() const;
   SnapshotFieldSet fields() const { return fields_; }
 
-  // Each material's coarse-graining factor (Scene::coarse_grain_table) for the fields
-  // coarse_grain and real_count; empty (the default): every particle is a real one.
-  void set_coarse_grain(std::vector<double> per_material) {
+  // Each material's coarse-graining factor and listed material (Scene::coarse_grain_table,
+  // Scene::real_material_table) for the fields coarse_grain and real_count, and for the root
+  // attributes material_coarse_grain and material_real, by which a snapshot insertion maps
+  // the parcel classes to its own scene's; empty (the default): every particle is a real one.
+  void set_coarse_grain(std::vector<double> per_material, std::vector<int> real_material) {
     coarse_grain_ = std::move(per_material);
+    real_material_ = std::move(real_material);
   }
 
  private:
   std::vector<double> coarse_grain_;
+  std::vector<int> real_material_;
   MPI_Comm comm_;
   int rank_ = 0;
   int size_ = 1;

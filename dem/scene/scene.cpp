@@ -31,6 +31,15 @@ std::vector<double> Scene::coarse_grain_table() const {
   return k;
 }
 
+std::vector<int> Scene::real_material_table() const {
+  std::vector<int> real;
+  if (coarse_grain_table().empty()) return real;
+  for (std::size_t m = 0; m < materials.size(); ++m)
+    real.push_back(materials[m].real_material < 0 ? static_cast<int>(m)
+                                                  : materials[m].real_material);
+  return real;
+}
+
 const MaterialPair& Scene::pair(int a, int b) const {
   if (a > b) std::swap(a, b);
   const int n = static_cast<int>(materials.size());

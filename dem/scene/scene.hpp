@@ -183,6 +183,13 @@ struct Insertion {
   // snapshot: a grainflow HDF5 snapshot (dem/io/snapshot_reader.hpp)
   std::string snapshot_file;  // resolved relative to the scene file's folder
   bool keep_velocity = true;  // false: particles start at rest
+  // A snapshot of parcels: the writing scene's parcel classes (its root attributes
+  // material_coarse_grain and material_real, one entry per material index), and for each of
+  // its material indices this scene's (the parser adds a class per (real material, k) the
+  // snapshot holds). Empty: a snapshot of real particles, read with its material indices.
+  std::vector<double> snapshot_class_k;
+  std::vector<int> snapshot_class_real;
+  std::vector<int> material_map;
   // fill
   Region region;
   std::optional<long> count;              // number of particles, or
@@ -196,7 +203,8 @@ struct Insertion {
   std::string source;    // "file:line" of this entry, for messages
   // fill, stream: coarse-graining factor k >= 1 (`coarse_grain`); with k != 1 the parser has
   // already set `material` to the parcel class (Material::coarse_grain) and multiplied
-  // `radius` by k, so every particle inserted is a parcel.
+  // `radius` by k, so every particle inserted is a parcel. snapshot: the largest k of the
+  // parcel classes the file holds (1: real particles only).
   double coarse_grain = 1;
   // Heat on: the particles' initial temperature [K] (fill, stream; csv rows without a `T`
   // column; snapshots without a temperature dataset). Absent when heat is off.
@@ -277,6 +285,9 @@ struct Scene {
   // Every material's coarse-graining factor k (Material::coarse_grain), indexed by material;
   // empty when every particle is a real one (k = 1 for all).
   std::vector<double> coarse_grain_table() const;
+  // Every material's listed material (its own index for a listed one, Material::real_material
+  // for a parcel class), indexed by material; empty like coarse_grain_table().
+  std::vector<int> real_material_table() const;
   const MaterialPair& pair(int a, int b) const;       // precondition: complete table
 };
 

@@ -31,6 +31,7 @@
 #include <utility>
 #include <vector>
 
+#include "dem/io/snapshot_reader.hpp"
 #include "dem/io/xdmf_index.hpp"
 #include "dem/scene/fluid_section.hpp"
 #include "dem/scene/yaml_reader.hpp"
@@ -715,12 +716,60 @@ void parse_stream(const Map& m, const Scene& scene, Insertion& ins) {
     ins.seed = static_cast<unsigned>(s->integer(Range{0, double(UINT_MAX), true, true}));
 }
 
-void parse_snapshot(const Map& m, Insertion& ins) {
+// A snapshot of coarse-grained parcels carries the parcel classes of the scene that wrote it
+// (SnapshotClasses); the parser gives this scene the same classes (add_parcel_classes). A file
+// that cannot be read is reported when the insertion reads it (exit code 2 or 1).
+void parse_snapshot_classes(const Field& file, const Scene& scene, Insertion& ins) {
+  SnapshotClasses c;
+  try {
+    c = read_snapshot_classes(ins.snapshot_file);
+  } catch (const SnapshotReadError&) {
+    return;
+  }
+  if (c.parcels_without_classes)
+    file.fail("the snapshot '" + ins.snapshot_file +
+              "' holds coarse-grained parcels (its dataset /coarse_grain has k != 1) but not "
+              "their classes (the root attributes material_coarse_grain and material_real, "
+              "which an older grainflow did not write): its material indices cannot be mapped to "
+              "parcel classes of this scene. "
+              "Continue that run from one of its checkpoints (grain run --restart), or rerun "
+              "its scene with this grainflow and insert from the new snapshot");
+  const std::size_t listed = scene.materials.size();
+  for (std::size_t m = 0; m < c.k.size(); ++m) {
+    const bool listed_here = c.real[m] >= 0 && static_cast<std::size_t>(c.real[m]) < listed;
+    if (!(c.k[m] >= 1 && c.k[m] <= 1e3) || c.real[m] < 0 || (c.k[m] == 1 && c.real[m] != int(m)))
+      file.fail("the snapshot '" + ins.snapshot_file + "' has a broken parcel class: material " +
+                std::to_string(m) + " with k = " + format_number(c.k[m]) + " and listed material " +
+                std::to_string(c.real[m]) +
+                " (root attributes material_coarse_grain, material_real; allowed: k in [1, "
+                "1000], a listed material's own index for k = 1); the file was changed or "
+                "damaged after it was written");
+    if (!listed_here)
+      file.fail("the snapshot '" + ins.snapshot_file + "' holds material " + std::to_string(m) +
+                (c.k[m] == 1 ? std::string()
+                             : " (parcels of k = " + format_number(c.k[m]) + " of material " +
+                                   std::to_string(c.real[m]) + ")") +
+                ", but this scene lists " + std::to_string(listed) +
+                " material(s) (allowed: 0 to " + std::to_string(listed - 1) +
+                "); list the materials in the order of the scene that wrote it");
+    ins.coarse_grain = std::max(ins.coarse_grain, c.k[m]);
+  }
+  if (ins.coarse_grain != 1 && scene.heat)
+    file.fail("the snapshot '" + ins.snapshot_file + "' holds coarse-grained parcels (k up to " +
+              format_number(ins.coarse_grain) +
+              "), which are not available with heat transfer yet (" + scene.heat->source +
+              "); insert real particles or switch heat off");
+  ins.snapshot_class_k = std::move(c.k);
+  ins.snapshot_class_real = std::move(c.real);
+}
+
+void parse_snapshot(const Map& m, const Scene& scene, Insertion& ins) {
   refuse_coarse_grain(m, "snapshot");
   m.allow_only({"type", "file", "keep_velocity", "temperature"}, " (a snapshot insertion)");
-  ins.snapshot_file =
-      existing_file(m.get("file", "add `file: <particles_000020.h5>`"), "snapshot file");
+  const Field file = m.get("file", "add `file: <particles_000020.h5>`");
+  ins.snapshot_file = existing_file(file, "snapshot file");
   if (const auto k = m.find("keep_velocity")) ins.keep_velocity = k->boolean();
+  parse_snapshot_classes(file, scene, ins);
 }
 
 // The initial temperature of an insertion's particles: required with heat on for fill and
@@ -757,7 +806,9 @@ std::vector<Insertion> parse_insertions(const Field& f, const Scene& scene) {
       case Insertion::Kind::fill: parse_fill(m, scene, ins); break;
       case Insertion::Kind::csv: parse_csv(m, scene, ins); break;
       case Insertion::Kind::stream: parse_stream(m, scene, ins); break;
-      case Insertion::Kind::snapshot: parse_snapshot(m, ins); break;
+      case Insertion::Kind::snapshot:
+        parse_snapshot(m, scene, ins);
+        break;
     }
     parse_insertion_temperature(m, scene, ins);
     out.push_back(std::move(ins));
@@ -875,22 +926,29 @@ bool contacts_possible(const Scene& s) {
 // same indices (snapshots and checkpoints store the index).
 void add_parcel_classes(Scene& s) {
   const std::size_t listed = s.materials.size();
-  for (Insertion& ins : s.insertions) {
-    if (ins.coarse_grain == 1) continue;
-    int found = -1;
+  const auto parcel_class = [&](int real, double k) {
     for (std::size_t c = listed; c < s.materials.size(); ++c)
-      if (s.materials[c].real_material == ins.material &&
-          s.materials[c].coarse_grain == ins.coarse_grain)
-        found = static_cast<int>(c);
-    if (found < 0) {
-      Material parcel = s.materials[static_cast<std::size_t>(ins.material)];
-      parcel.name += "[k=" + format_number(ins.coarse_grain) + "]";
-      parcel.coarse_grain = ins.coarse_grain;
-      parcel.real_material = ins.material;
-      s.materials.push_back(parcel);
-      found = static_cast<int>(s.materials.size() - 1);
+      if (s.materials[c].real_material == real && s.materials[c].coarse_grain == k)
+        return static_cast<int>(c);
+    Material parcel = s.materials[static_cast<std::size_t>(real)];
+    parcel.name += "[k=" + format_number(k) + "]";
+    parcel.coarse_grain = k;
+    parcel.real_material = real;
+    s.materials.push_back(parcel);
+    return static_cast<int>(s.materials.size() - 1);
+  };
+  for (Insertion& ins : s.insertions) {
+    if (ins.kind == Insertion::Kind::snapshot) {
+      // The writer's material indices, in its order of classes, to this scene's.
+      const std::vector<double>& k = ins.snapshot_class_k;
+      ins.material_map.clear();
+      for (std::size_t m = 0; m < k.size(); ++m)
+        ins.material_map.push_back(k[m] == 1 ? static_cast<int>(m)
+                                             : parcel_class(ins.snapshot_class_real[m], k[m]));
+      continue;
     }
-    ins.material = found;
+    if (ins.coarse_grain == 1) continue;
+    ins.material = parcel_class(ins.material, ins.coarse_grain);
   }
   if (s.materials.size() == listed) return;
   const auto real = [&](int m) {
@@ -917,8 +975,12 @@ void check_coarse_grain_models(Scene& s, const Map& top) {
   const Insertion* first = nullptr;
   for (const Insertion& ins : s.insertions)
     if (ins.coarse_grain != 1 && first == nullptr) first = &ins;
-  const std::string where = "coarse_grain " + format_number(first->coarse_grain) +
-                            " (the insertion at " + first->source + ")";
+  const std::string where = first->kind == Insertion::Kind::snapshot
+                                ? "the parcels (k up to " + format_number(first->coarse_grain) +
+                                      ") of the snapshot '" + first->snapshot_file +
+                                      "' (the insertion at " + first->source + ")"
+                                : "coarse_grain " + format_number(first->coarse_grain) +
+                                      " (the insertion at " + first->source + ")";
   const Map contact = top.get("contact").map();
   if (s.contact.cohesion != CohesionModel::none)
     contact.get("cohesion").fail_at_key(

@@ -19,10 +19,12 @@
 // 5. Parser: k < 1, a non-number, coarse_grain on a csv insertion, with cohesion and with
 //    a lift force are refused naming file:line, the key and what is allowed.
 // 6. Output: a run's snapshots hold coarse_grain = k and real_count = k^3 for every parcel.
+// 7. Continuing from a snapshot of parcels (below).
 #include <gtest/gtest.h>
 #include <hdf5.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <numbers>
@@ -319,6 +321,132 @@ TEST(CoarseGrain, SnapshotsCarryTheFactorAndTheRealCount) {
   EXPECT_NE(log.str().find("1 parcels of k = 2.5 stand for 15.625 real particles"),
             std::string::npos)
       << log.str();
+}
+
+// 7. A snapshot of parcels continues as parcels: a scene with a `type: snapshot` insertion
+//    gets the parcel classes of the scene that wrote the file (its root attributes
+//    material_coarse_grain and material_real), shared with its own insertions of the same
+//    (material, k). The continued parcel still settles at the real bead's terminal velocity
+//    (Schiller-Naumann, solved here), not at that of a bead of the parcel's size. A snapshot
+//    of parcels without the classes, and one whose coarse_grain dataset disagrees with its
+//    class, are refused naming the file.
+TEST(CoarseGrain, SnapshotOfParcelsContinuesAsParcels) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "coarse_grain_continue";
+  fs::remove_all(dir);
+  const double d = 0.2e-3, ut = terminal_velocity(d);
+  const double re = kRhoF * d * ut / kMu;
+  const double tau = kRhoP * d * d / (18 * kMu) / (1 + 0.15 * std::pow(re, 0.687));
+  Scene writer = parse_scene(
+      scene_text(lone_parcel(d / 2, "    coarse_grain: 2\n"), tau / 20,
+                 "output: {snapshot_interval: " + num(2 * tau) + ", progress: false}\n"),
+      "writer.yaml");
+  writer.time.end = 2 * tau;
+  RunOptions options;
+  options.output_directory = dir.string();
+  options.progress = false;
+  options.handle_stop_signals = false;
+  std::ostringstream log;
+  run_scene(writer, options, MPI_COMM_WORLD, log);
+  const std::string file = (dir / "particles_000001.h5").string();
+  ASSERT_TRUE(fs::exists(file)) << log.str();
+
+  // The reading scene: a snapshot insertion, then optionally a fill of parcels.
+  const auto reader = [&](const std::string& file_name, const std::string& fill_k) {
+    std::string text = scene_text("", tau / 20);
+    text.replace(text.find("  - type: fill\n"), 15,
+                 "  - type: snapshot\n    file: " + file_name + "\n");
+    if (!fill_k.empty())
+      text +=
+          "  - type: fill\n    region: {box: {min: [0.02, 0.02, 0.02], max: [0.03, 0.03, "
+          "0.03]}}\n    count: 1\n    material: glass\n    radius: {distribution: constant, "
+          "value: " +
+          num(d / 2) + "}\n    coarse_grain: " + fill_k + "\n";
+    return text;
+  };
+  {
+    const Scene s = parse_scene(reader(file, ""), "reader.yaml");
+    ASSERT_EQ(s.materials.size(), 2u);
+    EXPECT_EQ(s.materials[1].name, "glass[k=2]");
+    EXPECT_EQ(s.materials[1].coarse_grain, 2);
+    Simulation sim(s, true, MPI_COMM_SELF);
+    ASSERT_EQ(sim.particles().size(), 1u);
+    EXPECT_EQ(sim.particles().material[0], 1);
+    EXPECT_NEAR(sim.particles().radius[0], d, 1e-15);
+    sim.add_force_term(make_fluid_forces(*s.fluid, s.gravity, s.domain, MPI_COMM_SELF));
+    sim.advance_to(sim.time() + 12 * tau);
+    const double v = -sim.particles().v[0].z();
+    std::printf(
+        "continued parcel of k = 2: %.6g m/s, the real bead's u_t %.6g m/s (the parcel's "
+        "size as a bead: %.6g m/s)\n",
+        v, ut, terminal_velocity(2 * d));
+    EXPECT_NEAR(v / ut, 1, 0.005);
+  }
+  // With a fill of the same k the class is shared; with another k, both exist.
+  EXPECT_EQ(parse_scene(reader(file, "2"), "reader.yaml").materials.size(), 2u);
+  const Scene two = parse_scene(reader(file, "3"), "reader.yaml");
+  ASSERT_EQ(two.materials.size(), 3u);
+  EXPECT_EQ(two.materials[1].name, "glass[k=2]");
+  EXPECT_EQ(two.materials[2].name, "glass[k=3]");
+
+  // A copy whose coarse_grain dataset says 3 for the k = 2 parcel.
+  const std::string tampered = (dir / "tampered.h5").string();
+  fs::copy_file(file, tampered);
+  {
+    const hid_t f = H5Fopen(tampered.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    const hid_t ds = H5Dopen2(f, "/coarse_grain", H5P_DEFAULT);
+    const double three = 3;
+    H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, &three);
+    H5Dclose(ds);
+    H5Fclose(f);
+  }
+  std::string e = "no error";
+  try {
+    Simulation sim(parse_scene(reader(tampered, ""), "reader.yaml"), true, MPI_COMM_SELF);
+  } catch (const std::exception& x) {
+    e = x.what();
+  }
+  std::printf("%s\n", e.c_str());
+  EXPECT_NE(e.find(tampered + ": error: dataset '/coarse_grain', index 0"), std::string::npos) << e;
+  EXPECT_NE(e.find("k = 3, but its material 'glass[k=2]' has k = 2"), std::string::npos) << e;
+
+  // A copy whose parcel class copies a material this scene does not list (the writer's
+  // second listed material, say).
+  const std::string other = (dir / "other_material.h5").string();
+  fs::copy_file(file, other);
+  {
+    const hid_t f = H5Fopen(other.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    const hid_t a = H5Aopen(f, "material_real", H5P_DEFAULT);
+    const std::int64_t real[2] = {0, 1};
+    H5Awrite(a, H5T_NATIVE_INT64, real);
+    H5Aclose(a);
+    H5Fclose(f);
+  }
+  e = error_of(reader(other, ""));
+  std::printf("%s\n", e.c_str());
+  EXPECT_NE(e.find("cg.yaml:16:"), std::string::npos) << e;
+  EXPECT_NE(e.find("holds material 1 (parcels of k = 2 of material 1), but this scene lists 1 "
+                   "material(s) (allowed: 0 to 0); list the materials in the order of the scene "
+                   "that wrote it"),
+            std::string::npos)
+      << e;
+
+  // A copy without the classes, as an older grainflow wrote them.
+  const std::string old = (dir / "old.h5").string();
+  fs::copy_file(file, old);
+  {
+    const hid_t f = H5Fopen(old.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    H5Adelete(f, "material_coarse_grain");
+    H5Adelete(f, "material_real");
+    H5Fclose(f);
+  }
+  e = error_of(reader(old, ""));
+  std::printf("%s\n", e.c_str());
+  EXPECT_NE(e.find("cg.yaml:16:"), std::string::npos) << e;
+  EXPECT_NE(e.find("holds coarse-grained parcels (its dataset /coarse_grain has k != 1) but not "
+                   "their classes"),
+            std::string::npos)
+      << e;
 }
 
 }  // namespace
