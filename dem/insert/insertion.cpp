@@ -477,7 +477,23 @@ void read_snapshot_entry(const Scene& scene, const WallSet* walls, const Inserti
                          ins.source + ") was changed or damaged after it was written");
       q.material[i] = ins.material_map[static_cast<std::size_t>(m)];
     }
+  // Masses the writing scene left out (output.fields) follow from the radius and the
+  // material, as they would be checked: rho (4/3) pi r^3.
+  if (!snap.has_mass)
+    for (std::size_t i = 0; i < q.size(); ++i) {
+      const int m = q.material[i];
+      if (m < 0 || m >= static_cast<int>(scene.materials.size())) continue;  // reported next
+      q.mass[i] = scene.materials[static_cast<std::size_t>(m)].density * sphere_volume(q.radius[i]);
+      q.inertia[i] = 0.4 * q.mass[i] * q.radius[i] * q.radius[i];
+    }
   check_snapshot_records(scene, ins, q);
+  if (ins.keep_velocity && !(snap.has_velocity && snap.has_angular_velocity))
+    throw InsertionError(
+        ins.snapshot_file + ": error: no dataset '/" +
+        (snap.has_velocity ? "angular_velocity" : "velocity") +
+        "': the scene that wrote this snapshot left it out of output.fields, so the particles' "
+        "motion is not known; start them at rest with `keep_velocity: false` (insertion at " +
+        ins.source + "), or list velocity and angular_velocity in that scene's output.fields");
   // Each particle's k, when the file lists it, is its class's.
   for (std::size_t i = 0; i < snap.coarse_grain.size(); ++i) {
     const Material& m = scene.materials[static_cast<std::size_t>(q.material[i])];

@@ -78,13 +78,42 @@ Snapshot read_snapshot(const std::string& path) {
   Particles& p = s.particles;
   static_assert(std::is_same_v<GlobalId, std::int64_t>);
   const std::size_t n = read(f.id, path, "/id", 1, H5T_NATIVE_INT64, p.id);
-  const std::size_t counts[] = {
-      read(f.id, path, "/position", 3, H5T_NATIVE_DOUBLE, p.x),
-      read(f.id, path, "/velocity", 3, H5T_NATIVE_DOUBLE, p.v),
-      read(f.id, path, "/angular_velocity", 3, H5T_NATIVE_DOUBLE, p.omega),
-      read(f.id, path, "/radius", 1, H5T_NATIVE_DOUBLE, p.radius),
-      read(f.id, path, "/mass", 1, H5T_NATIVE_DOUBLE, p.mass),
-      read(f.id, path, "/material", 1, H5T_NATIVE_INT, p.material)};
+  // Every grainflow snapshot has /id and /position; the other datasets are fields the
+  // writing scene's output.fields may leave out.
+  const auto has = [&](const char* name) { return H5Lexists(f.id, name, H5P_DEFAULT) > 0; };
+  const auto left_out = [&](const std::string& what) {
+    return SnapshotFieldsError(
+        path + ": error: " + what +
+        ": the scene that wrote this snapshot left it out of output.fields, and a snapshot "
+        "insertion needs it; list it there (the default fields include it) and insert from a "
+        "new snapshot, or continue that run from a checkpoint (grain run --restart)");
+  };
+  if (!has("/material")) throw left_out("no dataset '/material' (field material)");
+  if (!has("/radius") && !has("/diameter"))
+    throw left_out("neither dataset '/radius' nor '/diameter' (field radius or diameter)");
+  std::vector<std::size_t> counts = {read(f.id, path, "/position", 3, H5T_NATIVE_DOUBLE, p.x),
+                                     read(f.id, path, "/material", 1, H5T_NATIVE_INT, p.material)};
+  if (has("/radius")) {
+    counts.push_back(read(f.id, path, "/radius", 1, H5T_NATIVE_DOUBLE, p.radius));
+  } else {  // d = 2 r exactly, so d / 2 is the radius the writer had
+    counts.push_back(read(f.id, path, "/diameter", 1, H5T_NATIVE_DOUBLE, p.radius));
+    for (double& r : p.radius) r *= 0.5;
+  }
+  s.has_velocity = has("/velocity");
+  s.has_angular_velocity = has("/angular_velocity");
+  s.has_mass = has("/mass");
+  if (s.has_velocity)
+    counts.push_back(read(f.id, path, "/velocity", 3, H5T_NATIVE_DOUBLE, p.v));
+  else
+    p.v.assign(n, Vec3::Zero());
+  if (s.has_angular_velocity)
+    counts.push_back(read(f.id, path, "/angular_velocity", 3, H5T_NATIVE_DOUBLE, p.omega));
+  else
+    p.omega.assign(n, Vec3::Zero());
+  if (s.has_mass)
+    counts.push_back(read(f.id, path, "/mass", 1, H5T_NATIVE_DOUBLE, p.mass));
+  else
+    p.mass.assign(n, 0.0);  // set by the reader's caller from the materials
   for (std::size_t c : counts)
     if (c != n)
       throw SnapshotReadError(path + ": error: datasets have different particle counts (" +

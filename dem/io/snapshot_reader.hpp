@@ -20,10 +20,21 @@ class SnapshotDamagedError : public SnapshotReadError {
   using SnapshotReadError::SnapshotReadError;
 };
 
+// A grainflow snapshot without a dataset a snapshot insertion needs (material, radius or
+// diameter): the writing scene's output.fields left it out.
+class SnapshotFieldsError : public SnapshotReadError {
+  using SnapshotReadError::SnapshotReadError;
+};
+
 // The values are not checked here: insert_particles checks them (restored_state.hpp).
 struct Snapshot {
   Particles particles;  // id, x, v, omega, radius, mass, material; inertia = 2/5 m r^2
   double time = 0;
+  // Fields the writing scene may have left out (output.fields): absent velocities read as
+  // zero, an absent mass as 0 (and the inertia with it) for the caller to set.
+  bool has_velocity = true;
+  bool has_angular_velocity = true;
+  bool has_mass = true;
   bool has_temperature = false;  // the file holds temperatures (else particles' are 0)
   std::vector<double> coarse_grain;  // each particle's k, when the file has the dataset
 };
