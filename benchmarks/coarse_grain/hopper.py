@@ -143,23 +143,14 @@ output:
 
 
 def discharge_scene(k):
-    # A stream that starts after the end inserts nothing; it only declares the parcel class
-    # glass[k] so that the snapshot's material indices mean the same as in the fill scene.
-    cls = "" if k == 1 else f"""  - type: stream
-    face: {{disc: {{centre: [0, 0, 0.1], normal: [0, 0, -1], radius: 0.02}}}}
-    count_rate: 1
-    start: {DISCHARGE_END + 1}
-    stop: {DISCHARGE_END + 2}
-    material: glass
-    radius: {{distribution: uniform, min: {R_MIN}, max: {R_MAX}}}
-    coarse_grain: {k}
-"""
+    # The settled snapshot carries its parcel class glass[k=k] (root attributes
+    # material_coarse_grain, material_real): the discharge scene gets the same class from it.
     return common(k, DISCHARGE_END) + f"""walls:
   - {{type: cylinder, name: bin, axis_point: [0, 0, 0], axis: [0, 0, 1], radius: {R_BIN}, material: steel}}
   - {{type: mesh, name: floor, file: floor.stl, material: steel}}
 insert:
   - {{type: snapshot, file: settled.h5}}
-{cls}output:
+output:
   directory: discharge
   snapshot_interval: {SNAP}
   log_interval: {SNAP}
