@@ -134,6 +134,31 @@ void check_checkpoint(const CheckpointData& d, const Scene& scene, std::size_t w
 
   if (d.grid) check_grid(*d.grid, scene.domain, {d.file, "/decomposition/", src.advice});
 
+  // The parcel classes: a material index must mean the same k and listed material as when the
+  // checkpoint was written (a changed coarse_grain would keep the parcels' radii and masses,
+  // which pass every rule below, and give them another k).
+  const std::size_t common = std::min(d.material_coarse_grain.size(), scene.materials.size());
+  for (std::size_t m = 0; m < common; ++m) {
+    const Material& mat = scene.materials[m];
+    const int real = mat.real_material < 0 ? static_cast<int>(m) : mat.real_material;
+    if (d.material_coarse_grain[m] == mat.coarse_grain && d.material_real[m] == real) continue;
+    const auto what = [](double k, int listed, std::size_t index) {
+      return k == 1 && listed == static_cast<int>(index)
+                 ? std::string("a listed material (k = 1)")
+                 : "parcels of k = " + number(k) + " of listed material " + std::to_string(listed);
+    };
+    throw StateError(d.file +
+                     ": error: attributes 'material_coarse_grain', 'material_real' of "
+                     "the root group: material index " +
+                     std::to_string(m) + " was " +
+                     what(d.material_coarse_grain[m], d.material_real[m], m) +
+                     " when the checkpoint was written, but in " + scene.file + " it is '" +
+                     mat.name + "', " + what(mat.coarse_grain, real, m) +
+                     ": the scene's materials or coarse_grain changed since, so its particles "
+                     "would continue as something else; restart with the scene the checkpoint "
+                     "was written with, or start the changed scene afresh");
+  }
+
   const Particles& p = d.particles;
   check_particle_records(p, scene, src, true);
 

@@ -651,6 +651,11 @@ void Simulation::write_checkpoint(const std::string& path) {
   d.next_id = next_id_;
   d.particles = p_;
   d.has_temperature = heat_ != nullptr;
+  for (std::size_t m = 0; m < scene_.materials.size(); ++m) {
+    const Material& mat = scene_.materials[m];
+    d.material_coarse_grain.push_back(mat.coarse_grain);
+    d.material_real.push_back(mat.real_material < 0 ? static_cast<int>(m) : mat.real_material);
+  }
   if (!terms_.empty()) {
     d.drag_coefficient = drag_.coefficient;
     d.drag_fluid_velocity = drag_.fluid_velocity;

@@ -73,6 +73,11 @@ struct CheckpointData {
   std::optional<std::string> streams;
   // The processor grid (taken from rank 0 when writing); absent in format 1 and 2 files.
   std::optional<CheckpointGrid> grid;
+  // Each material index's coarse-graining factor and listed material (Scene's materials:
+  // Material::coarse_grain, Material::real_material or the index itself), written as root
+  // attributes; empty in a file written before they were, which is then not checked for them.
+  std::vector<double> material_coarse_grain;
+  std::vector<int> material_real;
   std::string file;  // set by read_checkpoint: where it came from, for messages
 };
 

@@ -19,7 +19,7 @@
 // 5. Parser: k < 1, a non-number, coarse_grain on a csv insertion, with cohesion and with
 //    a lift force are refused naming file:line, the key and what is allowed.
 // 6. Output: a run's snapshots hold coarse_grain = k and real_count = k^3 for every parcel.
-// 7. Continuing from a snapshot of parcels (below).
+// 7. Continuing from a snapshot of parcels, 8. a restart with a changed k (below).
 #include <gtest/gtest.h>
 #include <hdf5.h>
 
@@ -447,6 +447,52 @@ TEST(CoarseGrain, SnapshotOfParcelsContinuesAsParcels) {
                    "their classes"),
             std::string::npos)
       << e;
+}
+
+// 8. A restart whose scene changed coarse_grain since the checkpoint: the parcels would keep
+//    their radii and masses (which every record rule accepts) and continue with another k.
+//    Refused naming the checkpoint, the attributes and the material index; the unchanged
+//    scene restarts and ends.
+TEST(CoarseGrain, RestartRefusesAChangedFactor) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "coarse_grain_restart";
+  fs::remove_all(dir);
+  const auto scene = [](const std::string& k) {
+    Scene s =
+        parse_scene(scene_text(lone_parcel(1e-4, "    coarse_grain: " + k + "\n"), 1e-4,
+                               "output: {snapshot_interval: 0.001, checkpoint_interval: 0.001, "
+                               "progress: false}\n"),
+                    "restart.yaml");
+    s.time.end = 0.002;
+    return s;
+  };
+  RunOptions options;
+  options.output_directory = dir.string();
+  options.progress = false;
+  options.handle_stop_signals = false;
+  std::ostringstream log;
+  run_scene(scene("2"), options, MPI_COMM_WORLD, log);
+  std::string checkpoint;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().filename().string().rfind("checkpoint_", 0) == 0) checkpoint = e.path().string();
+  ASSERT_FALSE(checkpoint.empty()) << log.str();
+  options.restart = checkpoint;
+  std::string e = "no error";
+  try {
+    run_scene(scene("3"), options, MPI_COMM_WORLD, log);
+  } catch (const std::exception& x) {
+    e = x.what();
+  }
+  std::printf("%s\n", e.c_str());
+  EXPECT_NE(e.find(checkpoint + ": error: attributes 'material_coarse_grain', 'material_real' of "
+                                "the root group: material index 1 was parcels of k = 2 of listed "
+                                "material 0 when the checkpoint was written, but in restart.yaml "
+                                "it is 'glass[k=3]', parcels of k = 3 of listed material 0"),
+            std::string::npos)
+      << e;
+  std::ostringstream again;
+  EXPECT_NO_THROW(run_scene(scene("2"), options, MPI_COMM_WORLD, again));
+  EXPECT_NE(again.str().find("done: "), std::string::npos) << again.str();
 }
 
 }  // namespace
