@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "dem/io/hdf5_attributes.hpp"
 #include "dem/io/hdf5_checksum.hpp"
 #include "dem/io/hdf5_errors.hpp"
 
@@ -194,20 +195,15 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
                  write_attribute(fail, f.id(), "next_id", H5T_NATIVE_LLONG, next),
              "writing the attributes time, dt, step, next_id");
   if (fail.ok() && !d.material_coarse_grain.empty()) {
-    const hsize_t count[1] = {d.material_coarse_grain.size()};
     const std::vector<long long> real(d.material_real.begin(), d.material_real.end());
-    const auto array = [&](const char* name, hid_t type, const void* values) {
-      const hid_t space = H5Screate_simple(1, count, nullptr);
-      const hid_t attr = H5Acreate2(f.id(), name, type, space, H5P_DEFAULT, H5P_DEFAULT);
-      const bool ok = attr >= 0 && H5Awrite(attr, type, values) >= 0;
-      if (!ok) fail.capture();
-      if (attr >= 0) H5Aclose(attr);
-      H5Sclose(space);
-      return ok;
-    };
-    fail.check(array("material_coarse_grain", H5T_NATIVE_DOUBLE, d.material_coarse_grain.data()) &&
-                   array("material_real", H5T_NATIVE_LLONG, real.data()),
-               "writing the attributes material_coarse_grain, material_real");
+    const std::size_t materials = d.material_coarse_grain.size();
+    const bool written =
+        write_array_attribute(f.id(), "material_coarse_grain", H5T_NATIVE_DOUBLE, H5T_NATIVE_DOUBLE,
+                              materials, d.material_coarse_grain.data()) &&
+        write_array_attribute(f.id(), "material_real", H5T_NATIVE_LLONG, H5T_NATIVE_LLONG,
+                              materials, real.data());
+    if (!written) fail.capture();
+    fail.check(written, "writing the attributes material_coarse_grain, material_real");
   }
   std::vector<long long> ids(p.id.begin(), p.id.end());
   std::vector<int> mats(p.material.begin(), p.material.end());
@@ -397,19 +393,11 @@ CheckpointData read_checkpoint(const std::string& path) {
     d.next_id = next;
     if (error.empty() && H5Aexists(f, "format") <= 0) error = "it is not a grainflow checkpoint";
     // Optional (written since the parcel classes are checked on restart).
-    const auto array = [&](const char* name, hid_t type, auto& out) {
-      if (!error.empty() || H5Aexists(f, name) <= 0) return;
-      const hid_t a = H5Aopen(f, name, H5P_DEFAULT);
-      const hid_t space = a < 0 ? -1 : H5Aget_space(a);
-      const hssize_t count = space < 0 ? -1 : H5Sget_simple_extent_npoints(space);
-      if (space >= 0) H5Sclose(space);
-      if (count >= 0) out.resize(static_cast<std::size_t>(count));
-      if (count < 0 || (count > 0 && H5Aread(a, type, out.data()) < 0))
-        error = std::string("attribute '") + name + "' cannot be read";
-      if (a >= 0) H5Aclose(a);
-    };
-    array("material_coarse_grain", H5T_NATIVE_DOUBLE, d.material_coarse_grain);
-    array("material_real", H5T_NATIVE_INT, d.material_real);
+    if (error.empty() && !read_array_attribute(f, "material_coarse_grain", H5T_NATIVE_DOUBLE,
+                                               d.material_coarse_grain))
+      error = "attribute 'material_coarse_grain' cannot be read";
+    if (error.empty() && !read_array_attribute(f, "material_real", H5T_NATIVE_INT, d.material_real))
+      error = "attribute 'material_real' cannot be read";
     if (error.empty() && d.material_coarse_grain.size() != d.material_real.size())
       error = "attributes 'material_coarse_grain' and 'material_real' differ in length";
     std::size_t n = static_cast<std::size_t>(-1), m = static_cast<std::size_t>(-1);

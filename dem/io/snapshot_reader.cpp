@@ -7,6 +7,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "dem/io/hdf5_attributes.hpp"
 #include "dem/io/hdf5_checksum.hpp"
 
 namespace grainflow {
@@ -29,10 +30,13 @@ class Quiet {
 };
 
 struct File {
-  hid_t id;
+  explicit File(hid_t i) : id(i) {}
+  File(const File&) = delete;
+  File& operator=(const File&) = delete;
   ~File() {
     if (id >= 0) H5Fclose(id);
   }
+  hid_t id;
 };
 
 // Reads dataset `name` with `comps` components per particle straight into `out` (a Vec3
@@ -66,13 +70,19 @@ std::size_t read(hid_t file, const std::string& path, const char* name, int comp
   return dims[0];
 }
 
+// Opens a snapshot for reading (a prvalue: no copy, one close).
+File open_snapshot(const std::string& path) {
+  const hid_t id = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (id < 0)
+    throw SnapshotReadError(path + ": error: cannot open as an HDF5 file; check the path");
+  return File(id);
+}
+
 }  // namespace
 
 Snapshot read_snapshot(const std::string& path) {
   Quiet quiet;
-  File f{H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT)};
-  if (f.id < 0)
-    throw SnapshotReadError(path + ": error: cannot open as an HDF5 file; check the path");
+  const File f = open_snapshot(path);
   // Read straight into the particle arrays: no second copy of the file's data.
   Snapshot s;
   Particles& p = s.particles;
@@ -151,18 +161,7 @@ namespace {
 template <class T>
 std::vector<T> array_attribute(hid_t file, const std::string& path, const char* name, hid_t type) {
   std::vector<T> out;
-  if (H5Aexists(file, name) <= 0) return out;
-  const hid_t a = H5Aopen(file, name, H5P_DEFAULT);
-  const hid_t space = a < 0 ? -1 : H5Aget_space(a);
-  const hssize_t n = space < 0 ? -1 : H5Sget_simple_extent_npoints(space);
-  if (space >= 0) H5Sclose(space);
-  bool ok = n >= 0;
-  if (ok) {
-    out.resize(static_cast<std::size_t>(n));
-    ok = out.empty() || H5Aread(a, type, out.data()) >= 0;
-  }
-  if (a >= 0) H5Aclose(a);
-  if (!ok)
+  if (!read_array_attribute(file, name, type, out))
     throw SnapshotDamagedError(path + ": error: cannot read the root attribute '" + name + "'");
   return out;
 }
@@ -170,9 +169,7 @@ std::vector<T> array_attribute(hid_t file, const std::string& path, const char* 
 
 SnapshotClasses read_snapshot_classes(const std::string& path) {
   Quiet quiet;
-  File f{H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT)};
-  if (f.id < 0)
-    throw SnapshotReadError(path + ": error: cannot open as an HDF5 file; check the path");
+  const File f = open_snapshot(path);
   SnapshotClasses c;
   c.k = array_attribute<double>(f.id, path, "material_coarse_grain", H5T_NATIVE_DOUBLE);
   c.real = array_attribute<int>(f.id, path, "material_real", H5T_NATIVE_INT);

@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "dem/io/hdf5_attributes.hpp"
 #include "dem/io/hdf5_checksum.hpp"
 #include "dem/io/hdf5_errors.hpp"
 #include "grainflow_version.hpp"
@@ -152,18 +153,6 @@ bool write_scalar_attribute(hid_t loc, const char* name, HdfTypes types, const v
   Hid attr(H5Acreate2(loc, name, types.file, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
   if (!attr.valid()) return false;
   if (H5Awrite(attr.get(), types.memory, value) < 0) return false;
-  return attr.close();
-}
-
-// A one-dimensional attribute of n values.
-bool write_array_attribute(hid_t loc, const char* name, HdfTypes types, std::size_t n,
-                           const void* values) {
-  const hsize_t dims[1] = {n};
-  Hid space(H5Screate_simple(1, dims, nullptr), H5Sclose);
-  if (!space.valid()) return false;
-  Hid attr(H5Acreate2(loc, name, types.file, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
-  if (!attr.valid()) return false;
-  if (H5Awrite(attr.get(), types.memory, values) < 0) return false;
   return attr.close();
 }
 
@@ -554,9 +543,10 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step,
     if (!coarse_grain_.empty()) {
       const std::vector<std::int64_t> real(real_material_.begin(), real_material_.end());
       ok = !opens ||
-           (write_array_attribute(file.get(), "material_coarse_grain", f64, coarse_grain_.size(),
-                                  coarse_grain_.data()) &&
-            write_array_attribute(file.get(), "material_real", i64, real.size(), real.data()));
+           (write_array_attribute(file.get(), "material_coarse_grain", f64.file, f64.memory,
+                                  coarse_grain_.size(), coarse_grain_.data()) &&
+            write_array_attribute(file.get(), "material_real", i64.file, i64.memory, real.size(),
+                                  real.data()));
       agreement.check(ok, "writing the root attributes material_coarse_grain, material_real");
     }
     agreement.check(!opens || file.close(), "closing (flushing) the file");
