@@ -21,6 +21,9 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+#if defined(__AVX__)
+#include <immintrin.h>
+#endif
 
 // Every function here is inlined: that a Lanes4 would be passed in AVX registers by an
 // out-of-line call, and in memory without AVX, does not matter.
@@ -30,8 +33,8 @@
 namespace grainflow {
 
 // Vectors of doubles (GCC/Clang vector extension: +, -, *, / per lane, and a scalar operand
-// is applied to every lane). Without AVX a Lanes4 is two SSE2 registers. A comparison gives a
-// mask of 64-bit integers, all bits set or clear.
+// is applied to every lane). Without AVX a Lanes4 is two SSE2 registers, with AVX one. A
+// comparison gives a mask of 64-bit integers, all bits set or clear.
 using Lanes2 = double __attribute__((vector_size(16)));
 using Lanes4 = double __attribute__((vector_size(32)));
 using Mask2 = decltype(Lanes2{} < Lanes2{});
@@ -100,8 +103,12 @@ inline constexpr int lane_count = std::is_same_v<V, double> ? 1 : sizeof(V) / si
 #endif
 }
 [[gnu::always_inline]] inline Lanes4 lane_sqrt(Lanes4 a) {
+#if defined(__AVX__)
+  return _mm256_sqrt_pd(a);
+#else
   const Lanes2 lo = lane_sqrt(Lanes2{a[0], a[1]}), hi = lane_sqrt(Lanes2{a[2], a[3]});
   return Lanes4{lo[0], lo[1], hi[0], hi[1]};
+#endif
 }
 template <int K>
 [[gnu::always_inline]] inline Lanes2xK<K> lane_sqrt(const Lanes2xK<K>& a) {

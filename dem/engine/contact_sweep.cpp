@@ -65,10 +65,21 @@ template <class V, class Get>
           gather<V>([&](int l) { return get(l).friction; })};
 }
 
-// The lane type of the pair sweeps: four pairs at a time as two SSE2 chains side by side
-// (Lanes2x2). Measured on the settled bed (CPU time of 1000 steps): Lanes2 2.93 s, Lanes2x2
-// 2.69 s, Lanes2xK<3> 3.09 s and <4> 2.94 s (registers spill), GCC's Lanes4 without AVX 3.46 s.
+// The lane type of the pair sweeps. Baseline x86-64 (SSE2): four pairs at a time as two SSE2
+// chains side by side (Lanes2x2). Measured on the settled bed (CPU time of 1000 steps): Lanes2
+// 2.93 s, Lanes2x2 2.69 s, Lanes2xK<3> 3.09 s and <4> 2.94 s (registers spill), GCC's Lanes4
+// without AVX 3.46 s. With AVX (GRAINFLOW_AVX, CMakeLists.txt) four pairs in one 256-bit
+// chain (Lanes4): its sixteen registers hold twice the lanes and its three-operand
+// instructions need no copies, so the kernel runs 598 instead of 915 instructions per
+// particle-step, 48 instead of 85 of them spills to the stack. CPU time of 700 steps on an AMD
+// EPYC (Zen 4), 4 alternating rounds: Lanes2x2 2.65-2.99 s, Lanes4 2.33-2.36 s, two Lanes4
+// chains side by side 2.50-2.75 s; Lanes2x2 with AVX's encoding alone 2.52-2.59 s
+// (docs/performance.md).
+#if defined(__AVX__)
+using PairLanes = Lanes4;
+#else
 using PairLanes = Lanes2x2;
+#endif
 
 // Whether a listed pair is apart: the Verlet lists hold every pair within the skin, and in
 // a packed bed about three in four of them do not touch. This test comes first, on the

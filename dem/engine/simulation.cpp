@@ -73,6 +73,16 @@ Simulation::Simulation(const Scene& scene, bool insert, MPI_Comm comm,
   constants_.hooke_kn = scene.contact.hooke_kn.value_or(0.0);
   constants_.hooke_kt = scene.contact.hooke_kt.value_or(constants_.hooke_kn);
   constants_.epsd_damping_ratio = scene.contact.epsd_damping_ratio;
+#if defined(GRAINFLOW_AVX_SWEEP)
+  // The contact sweep is compiled for AVX (GRAINFLOW_AVX, CMakeLists.txt): refused here rather
+  // than stopped by an illegal instruction in the first step.
+  if (!__builtin_cpu_supports("avx"))
+    throw SetupError(
+        "grain: error: this build's contact sweep needs a processor with AVX (GRAINFLOW_AVX was "
+        "AUTO or ON on the machine that built it), and this processor has none; rebuild on this "
+        "machine, or anywhere with `cmake -DGRAINFLOW_AVX=OFF` for any x86-64 (the results are "
+        "the same to the last bit)");
+#endif
   sweep_ = select_sweep(scene.contact, scene.parallel.reproducible);
   try {
     walls_ = WallSet(scene_);  // reads STL meshes

@@ -165,6 +165,8 @@ TEST(ContactLanes, EveryLaneGivesTheScalarResultToTheLastBit) {
     check_lanes<Lanes2x2>(cases, alone, {k, (k + 3) % n, (k + 5) % n, (k + 11) % n}, pc, dt);
     check_lanes<Lanes2x2>(cases, alone, {(k + 2) % n, (k + 9) % n, k, (k + 4) % n}, pc, dt);
     check_lanes<Lanes2x2>(cases, alone, {k, k, k, k}, pc, dt);
+    check_lanes<Lanes4>(cases, alone, {k, (k + 3) % n, (k + 5) % n, (k + 11) % n}, pc, dt);
+    check_lanes<Lanes4>(cases, alone, {(k + 2) % n, (k + 9) % n, k, (k + 4) % n}, pc, dt);
   }
 }
 
@@ -189,6 +191,8 @@ TEST(ContactLanes, PredictedDashpotGivesTheScalarResultToTheLastBit) {
     check_lanes<Lanes2x2, PredictedLaw>(cases, alone, {k, (k + 3) % n, (k + 5) % n, (k + 11) % n},
                                         pc, dt);
     check_lanes<Lanes2x2, PredictedLaw>(cases, alone, {k, k, k, k}, pc, dt);
+    check_lanes<Lanes4, PredictedLaw>(cases, alone, {k, (k + 3) % n, (k + 5) % n, (k + 11) % n}, pc,
+                                      dt);
   }
 }
 
