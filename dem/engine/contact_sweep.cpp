@@ -352,6 +352,98 @@ void local_pair_sweep(ContactSweep& s, int a_first, int a_end) {
   }
 }
 
+}  // namespace
+
+template <class Law>
+void apply_wall_contacts(ContactSweep& s, int material, const WallHit* hits, int m,
+                         std::vector<ContactHistory>& history) {
+  Particles& p = s.p;
+  if constexpr (!Law::lanes) {
+    ContactHistory unused;
+    for (int c = 0; c < m; ++c)
+      apply_wall_contact<Law>(s, hits[c].i, hits[c].t, material,
+                              Law::has_history ? history[hits[c].k] : unused);
+  } else {
+    // W contacts at a time in the lanes of the pair kernel (the last group filled up with
+    // copies of the last contact, whose results are discarded), with the geometry of
+    // wall_geometry() lane by lane: the same operations, so the same bits.
+    using V = PairLanes;
+    constexpr int W = lane_count<V>;
+    static_assert(!Law::needs_roll_inertia && !Law::keeps_rolling);
+    const Vec3* v = p.v.data();
+    const Vec3* w = p.omega.data();
+    const Vec3* vp = p.v_pred.data();
+    const Vec3* wp = p.omega_pred.data();
+    const double* radius = p.radius.data();
+    const double* mass = p.mass.data();
+    const int* material_of = p.material.data();
+    Vec3* force = p.force.data();
+    Vec3* torque = p.torque.data();
+    for (int c = 0; c < m; c += W) {
+      const WallHit* h[W];
+#pragma GCC unroll 4
+      for (int l = 0; l < W; ++l) h[l] = &hits[std::min(c + l, m - 1)];
+      ContactGeometryT<V> g;
+      g.n = gather3<V>([&](int l) -> const Vec3& { return h[l]->t.n; });
+      g.overlap = gather<V>([&](int l) { return h[l]->t.overlap; });
+      const V r = gather<V>([&](int l) { return radius[h[l]->i]; });
+      g.distance = r - g.overlap;
+      g.r_i = r;
+      g.r_j = V{};
+      g.arm_i = g.distance;
+      g.arm_j = V{};
+      g.r_star = r;
+      g.m_star = gather<V>([&](int l) { return mass[h[l]->i]; });
+      g.wall = true;
+      const V3<V> wall_v =
+          gather3<V>([&](int l) -> const Vec3& { return h[l]->t.surface_velocity; });
+      const V3<V> vi = gather3<V>([&](int l) -> const Vec3& { return v[h[l]->i]; });
+      if constexpr (Law::needs_spin) {
+        const V3<V> wi = gather3<V>([&](int l) -> const Vec3& { return w[h[l]->i]; });
+        g.v_rel = vi - wall_v - g.arm_i * cross(wi, g.n);
+        g.w_rel = wi;
+        if constexpr (Law::predicted_dashpot) {
+          const V3<V> wpi = gather3<V>([&](int l) -> const Vec3& { return wp[h[l]->i]; });
+          g.v_pred = gather3<V>([&](int l) -> const Vec3& { return vp[h[l]->i]; }) - wall_v -
+                     g.arm_i * cross(wpi, g.n);
+          g.w_pred = wpi;
+        } else {
+          g.v_pred = g.v_rel;
+          g.w_pred = g.w_rel;
+        }
+      } else if constexpr (Law::predicted_dashpot) {
+        g.v_rel = vi - wall_v;
+        g.v_pred = gather3<V>([&](int l) -> const Vec3& { return vp[h[l]->i]; }) - wall_v;
+      } else {
+        g.v_pred = vi - wall_v;
+      }
+      const PairCoefficientLanes<V> pc =
+          gather_coefficients<V>([&](int l) -> const PairCoefficients& {
+            return s.table(material_of[h[l]->i], material);
+          });
+      V3<V> ht = zero3<V>(), hr = zero3<V>();
+      if constexpr (Law::keeps_tangential)
+        ht = gather3<V>([&](int l) -> const Vec3& { return history[h[l]->k].tangential; });
+      const ContactResultT<V> res = Law::evaluate(g, pc, s.constants, ht, hr, s.dt, s.spring_dt);
+#pragma GCC unroll 4
+      for (int l = 0; l < W; ++l) {
+        if (c + l == m) break;
+        const int i = h[l]->i;
+        if constexpr (Law::keeps_tangential) history[h[l]->k].tangential = lane(ht, l);
+        force[i] += lane(res.force, l);
+        if constexpr (Law::needs_spin) torque[i] += lane(res.torque_i, l);
+        ++s.contacts;
+        if (const double ratio = g.overlap[l] / radius[i]; ratio > s.max_overlap_ratio)
+          s.worst.consider(ratio, s.max_overlap_ratio, p.id[i], -1,
+                           -lane(g.v_pred, l).dot(lane(g.n, l)), g.r_star[l], g.m_star[l],
+                           s.table(material_of[i], material).y_star);
+      }
+    }
+  }
+}
+
+namespace {
+
 template <class Law>
 void ghost_pair_sweep(ContactSweep& s, int a_first, int a_end) {
   Particles& p = s.p;

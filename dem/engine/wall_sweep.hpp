@@ -68,26 +68,52 @@ void apply_wall_contact(ContactSweep& s, std::size_t i, const WallTouch& t, int 
                      s.table(p.material[i], material).y_star);
 }
 
+// A contact of a plane or cylinder wall found touching, waiting to be evaluated with the
+// wall's other contacts.
+struct WallHit {
+  int i;  // particle
+  int k;  // its entry of the wall's list: the history slot
+  WallTouch t;
+};
+constexpr int kWallBatch = 32;
+
+// Evaluates the contacts hits[0, m) with a wall of `material`, in order, and adds their
+// forces and torques; history[k] holds each one's springs. Defined in contact_sweep.cpp: in
+// the lanes of the pair kernel when the law can, else one by one (apply_wall_contact).
+template <class Law>
+void apply_wall_contacts(ContactSweep& s, int material, const WallHit* hits, int m,
+                         std::vector<ContactHistory>& history);
+
 // A plane or a cylinder, against the particles of its neighbour list (all of them when
 // `list.all`; the others cannot touch it before the next rebuild). `history` holds the
-// springs in list order (one per particle when `list.all`; wall_neighbours.hpp).
+// springs in list order (one per particle when `list.all`; wall_neighbours.hpp). The touching
+// ones are gathered kWallBatch at a time and evaluated together; each particle appears once
+// per wall, so its forces are summed in the same order as contact by contact.
 template <class Law, class Touch>
 void wall_sweep_one(ContactSweep& s, const WallSet::Entry& wall, const WallNeighbours::List& list,
                     std::vector<ContactHistory>& history, Touch touch) {
   Particles& p = s.p;
-  ContactHistory unused;
+  WallHit hits[kWallBatch];
+  int m = 0;
   const std::size_t n = list.all ? p.size() : list.i.size();
   for (std::size_t k = 0; k < n; ++k) {
     const std::size_t i = list.all ? k : static_cast<std::size_t>(list.i[k]);
-    WallTouch t;
-    if (!touch(p.x[i], p.radius[i], t)) {
+    WallHit& hit = hits[m];
+    if (!touch(p.x[i], p.radius[i], hit.t)) {
       if constexpr (Law::has_history) history[k] = ContactHistory{};
       continue;
     }
     if (wall.pose.moving())
-      t.surface_velocity += wall.pose.velocity_at(p.x[i] - (p.radius[i] - t.overlap) * t.n);
-    apply_wall_contact<Law>(s, i, t, wall.material, Law::has_history ? history[k] : unused);
+      hit.t.surface_velocity +=
+          wall.pose.velocity_at(p.x[i] - (p.radius[i] - hit.t.overlap) * hit.t.n);
+    hit.i = static_cast<int>(i);
+    hit.k = static_cast<int>(k);
+    if (++m == kWallBatch) {
+      apply_wall_contacts<Law>(s, wall.material, hits, m, history);
+      m = 0;
+    }
   }
+  if (m > 0) apply_wall_contacts<Law>(s, wall.material, hits, m, history);
 }
 
 // A mesh contact found in the body frame, in the world: normal, overlap and the wall's
