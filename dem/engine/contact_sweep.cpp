@@ -342,9 +342,36 @@ void local_pair_sweep(ContactSweep& s, int a_first, int a_end) {
   // kernel inlined.
   const int* owner = s.local_list.owner.data();
   const int entries = n > 0 ? offsets[a_end] : 0;
+  // Beyond the last-level cache (a rank holding more than kPrefetchAbove particles), the
+  // entry test asks for the partner's position, velocities, force and torque (those the law
+  // reads) and for the springs kAhead entries (about 23 particles) before the sweep reaches them:
+  // the partners above a particle lie one layer of bins ahead in memory, a stream among a dozen
+  // that the hardware prefetchers do not follow. The bed of 10^6 spheres (benchmarks/million, 1
+  // rank) ran 1.10x faster with it (8.25e6 -> 9.05e6 particle-steps/s), one of 307 200 1.10x and
+  // one of 92 160 1.05x; the 30 720-sphere bed, in cache, 0.93x: below the threshold the
+  // test is made once per entry and never passes.
+  constexpr int kAhead = 96;
+  constexpr int kPrefetchAbove = 50000;
+  const int prefetch_end = n > kPrefetchAbove ? entries - kAhead : 0;
   for (int k = n > 0 ? offsets[a_first] : 0; k < entries;) {
     int m = 0;
     for (const int stop = std::min(entries, k + kBatch); k < stop; ++k) {
+      if (k < prefetch_end) {  // the partner and spring of the entry kAhead on
+        const int q = partner[k + kAhead];
+        __builtin_prefetch(&x[q]);
+        __builtin_prefetch(&v[q]);
+        __builtin_prefetch(&force[q], 1);
+        if constexpr (Law::needs_spin) {
+          __builtin_prefetch(&w[q]);
+          __builtin_prefetch(&torque[q], 1);
+        }
+        if constexpr (Law::predicted_dashpot) {
+          __builtin_prefetch(&vp[q]);
+          if constexpr (Law::needs_spin) __builtin_prefetch(&wp[q]);
+        }
+        if constexpr (Law::keeps_tangential) __builtin_prefetch(&springs_t[k + kAhead], 1);
+        if constexpr (Law::keeps_rolling) __builtin_prefetch(&springs_r[k + kAhead], 1);
+      }
       const int i = owner[k], j = partner[k];
       const bool touching = !apart(x[i] - x[j], radius[i] + radius[j]);
       batch[m] = {i, k};

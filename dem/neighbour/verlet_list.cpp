@@ -57,6 +57,25 @@ BinGrid::BinGrid(const Vec3& lo, const Vec3& hi, double bin_edge) : lo_(lo), hi_
     n_[a] = static_cast<int>(std::clamp(std::floor(length[a] / bin_edge), 1.0, kMaxPerAxis));
     inv_edge_[a] = n_[a] / length[a];
   }
+  choose_axes();
+}
+
+void BinGrid::choose_axes() {
+  // The key's slowest axis is z, the usual height of a bed, unless x or y has more than
+  // twice its bins: then that axis (the one with more bins). Particles next to each other
+  // along the slowest axis are one layer of the two others apart in memory, so the layer
+  // should be small: in a wide, flat bed (10^6 spheres, 147 x 147 x 30 bins) the z-major
+  // order put a particle 21 600 bins (about 5 MB of particle data) from its partners above
+  // it, beyond the L2 cache; the x-major order, 4 400 bins. Another order sums each
+  // particle's forces in another order (rounding), so it is taken only where the layer
+  // shrinks at least twofold: nearly cubic lattices and columns keep the z-major order.
+  int slow = 2;
+  for (int a = 1; a >= 0; --a)
+    if (n_[a] > 2 * n_[2] && n_[a] > n_[slow]) slow = a;
+  int k = 0;
+  for (int a = 0; a < 3; ++a)
+    if (a != slow) axis_[k++] = a;
+  axis_[2] = slow;
 }
 
 BinGrid BinGrid::anchored(const Vec3& lo, const Vec3& hi, double bin_edge) {
@@ -71,6 +90,7 @@ BinGrid BinGrid::anchored(const Vec3& lo, const Vec3& hi, double bin_edge) {
     grid.n_[a] = static_cast<int>(bins) + 2;
     grid.inv_edge_[a] = bins / length[a];
   }
+  grid.choose_axes();
   return grid;
 }
 
@@ -80,8 +100,9 @@ std::uint64_t BinGrid::key_of(const Vec3& x) const {
     const double k = std::floor((x[a] - lo_[a]) * inv_edge_[a]);
     c[a] = static_cast<std::uint64_t>(std::clamp(k, 0.0, n_[a] - 1.0));
   }
-  return (c[2] * static_cast<std::uint64_t>(n_[1]) + c[1]) * static_cast<std::uint64_t>(n_[0]) +
-         c[0];
+  const int f = axis_[0], m = axis_[1], s = axis_[2];
+  return (c[s] * static_cast<std::uint64_t>(n_[m]) + c[m]) * static_cast<std::uint64_t>(n_[f]) +
+         c[f];
 }
 
 std::vector<std::size_t> BinGrid::sort_permutation(const Particles& p) {
@@ -121,7 +142,8 @@ void BinGrid::build(const Particles& p, const Ghosts& g, double skin, NeighbourL
   local.j.clear();
   ghost.offsets.assign(n + 1, 0);
   ghost.j.clear();
-  const std::uint64_t nx = n_[0], ny = n_[1], nz = n_[2];
+  // Along the key's axes (axis_: fastest first), named x, y, z below for the usual order.
+  const std::uint64_t nx = n_[axis_[0]], ny = n_[axis_[1]], nz = n_[axis_[2]];
   // For each of the nine rows (dz, dy) of the 27 bins, the range of sorted locals and of
   // sorted ghosts in the row's three bins. The particles come in key order, so each
   // range's ends only move forward: all rows of all particles cost O(N + ghosts).

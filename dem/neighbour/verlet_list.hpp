@@ -17,8 +17,9 @@
 //   - `ghost`: local-ghost pairs, each once per local particle (the rank that owns
 //     the ghost lists the same pair from its side: forces are computed twice, once
 //     per owner, bit-identically — see dem/parallel/ghosts.hpp).
-// A particle's partners are listed bin by bin in key order (z, then y, then x), within a
-// bin in sorted order (locals) or exchange order (ghosts).
+// A particle's partners are listed bin by bin in key order, within a bin in sorted order
+// (locals) or exchange order (ghosts). The key orders bins by z, then y, then x, unless x
+// or y has more than twice z's bins: then that axis comes first (choose_axes()).
 // Periodicity is handled by ghosts (images), not here.
 #include <array>
 #include <cstddef>
@@ -66,7 +67,9 @@ class BinGrid {
   // every decomposition has the same lattice, so a particle's bin (its key for
   // CanonicalOrder) depends on its position only.
   static BinGrid anchored(const Vec3& lo, const Vec3& hi, double bin_edge);
-  // Key of the bin holding x: (k_z n_y + k_y) n_x + k_x, each k clamped to the lattice.
+  // Key of the bin holding x: (k_s n_m + k_m) n_f + k_f, each k clamped to the lattice,
+  // over the axes slow, middle, fast (axes(); (z, y, x) unless x or y has more than twice
+  // z's bins).
   std::uint64_t key_of(const Vec3& x) const;
   // Permutation that orders local particles by bin key, then by global id.
   std::vector<std::size_t> sort_permutation(const Particles& p);
@@ -74,13 +77,16 @@ class BinGrid {
   void build(const Particles& p, const Ghosts& g, double skin, NeighbourList& local,
              NeighbourList& ghost);
   const std::array<int, 3>& bins() const { return n_; }  // the lattice, per axis
+  const std::array<int, 3>& axes() const { return axis_; }  // the key's axes, fastest first
   // Bytes held by the grid between builds (its work arrays): O(particles + ghosts).
   std::size_t memory_bytes() const;
 
  private:
   Vec3 lo_, hi_;
   std::array<int, 3> n_{};
+  std::array<int, 3> axis_{0, 1, 2};  // the key's axes, fastest first
   Vec3 inv_edge_;
+  void choose_axes();
   // Work arrays, kept between builds so that a rebuild does not allocate.
   std::vector<std::uint64_t> key_, key_tmp_;
   std::vector<int> order_, order_tmp_;

@@ -72,6 +72,58 @@ TEST_P(ContactCombination, ConservesMomentumAndStaysFinite) {
   EXPECT_EQ(sim.particles().size(), 64u);
 }
 
+// A rank holding more than 50 000 particles runs the pair sweep that prefetches the
+// partners and springs ahead (local_pair_sweep, kPrefetchAbove): the same conservation of
+// linear and angular momentum, for the four-lane law and for the scalar one (EPSD rolling
+// springs), in a cluster of 40^3 spheres with random velocities and spins.
+TEST(ContactCombinationLarge, PrefetchingSweepConservesMomentum) {
+  for (const RollingModel rolling : {RollingModel::none, RollingModel::epsd}) {
+    Scene s = test::one_material_scene(1e7, 0.3, 2500, 0.5, 0.4, 0.05, 2e4);
+    s.contact.normal = NormalModel::hertz;
+    s.contact.tangential = TangentialModel::history;
+    s.contact.rolling = rolling;
+    Simulation sim(s, false);
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> u(-1, 1);
+    GlobalId id = 1;
+    constexpr int kSide = 40;
+    for (int i = 0; i < kSide; ++i)
+      for (int j = 0; j < kSide; ++j)
+        for (int k = 0; k < kSide; ++k)
+          sim.particles().add(id++, Vec3(i, j, k) * 2.05e-3 + 2e-5 * Vec3(u(rng), u(rng), u(rng)),
+                              0.5 * Vec3(u(rng), u(rng), u(rng)),
+                              100 * Vec3(u(rng), u(rng), u(rng)), 1e-3 * (1 + 0.05 * u(rng)), 0,
+                              2500);
+    sim.set_dt(1e-6);
+    sim.initialise();
+    const Particles& p = sim.particles();
+    auto momenta = [&] {
+      Vec3 lin = Vec3::Zero(), ang = Vec3::Zero();
+      double l_scale = 0, a_scale = 0;
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        lin += p.mass[i] * p.v[i];
+        ang += p.x[i].cross(p.mass[i] * p.v[i]) + p.inertia[i] * p.omega[i];
+        l_scale += p.mass[i] * p.v[i].norm();
+        a_scale += p.inertia[i] * p.omega[i].norm() + p.x[i].norm() * p.mass[i] * p.v[i].norm();
+      }
+      return std::tuple{lin, ang, l_scale, a_scale};
+    };
+    const auto [l0, a0, l_scale, a_scale] = momenta();
+    long touching = 0;
+    for (int k = 0; k < 5; ++k) {
+      sim.step();
+      touching += sim.counters().contacts;
+    }
+    ASSERT_GT(touching, 5 * 20000) << "too few contacts to test anything";
+    const auto [l1, a1, l_end, a_end] = momenta();
+    EXPECT_LT((l1 - l0).norm() / l_scale, 1e-12);
+    EXPECT_LT((a1 - a0).norm() / a_scale, 1e-12);
+    ASSERT_EQ(p.size(), static_cast<std::size_t>(kSide * kSide * kSide));
+    for (std::size_t i = 0; i < p.size(); ++i)
+      ASSERT_TRUE(p.x[i].allFinite() && p.v[i].allFinite() && p.omega[i].allFinite());
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(
     AllSlots, ContactCombination,
     ::testing::Combine(::testing::Values(NormalModel::hertz, NormalModel::hooke),

@@ -136,6 +136,65 @@ TEST(VerletLists, ClusteredHeapInAHugeDomain) {
   EXPECT_LE(grid.memory_bytes(), 48 * held);
 }
 
+// A flat or long lattice orders its bins along its widest axis first when that axis has
+// more than twice z's bins (BinGrid::choose_axes: the memory layer between a particle and its
+// partners along the slowest axis is then the smaller one); other lattices keep z, y, x. The
+// lists stay exactly those of the brute-force search (brute_force_pairs), and the sort puts
+// the particles in order of their bin along the chosen slowest axis.
+TEST(VerletLists, WideLatticesTakeTheirWidestAxisFirst) {
+  struct Shape {
+    Vec3 hi;
+    std::array<bool, 3> periodic;
+    std::array<int, 3> axes;  // expected, fastest first
+  };
+  const double r = 5e-4, skin = 2e-4, cutoff = 2 * r + skin;
+  for (const Shape& shape : {
+           Shape{Vec3(0.06, 0.03, 0.006), {true, true, false}, {1, 2, 0}},    // flat, wide in x
+           Shape{Vec3(0.012, 0.06, 0.008), {false, true, false}, {0, 2, 1}},  // long in y
+           Shape{Vec3(0.02, 0.02, 0.06), {false, false, false}, {0, 1, 2}},   // a column
+           Shape{Vec3(0.02, 0.02, 0.012), {false, false, false}, {0, 1, 2}},  // under twice
+       }) {
+    Domain d;
+    d.lo = Vec3::Zero();
+    d.hi = shape.hi;
+    d.periodic = shape.periodic;
+    const Box box(d);
+    Decomposition decomposition(MPI_COMM_SELF, d);
+    Exchange exchange(decomposition);
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> u(0, 1), ur(0.6 * r, r);
+    Particles p;
+    for (int i = 0; i < 4000; ++i)
+      p.add(1 + i, d.hi.cwiseProduct(Vec3(u(rng), u(rng), u(rng))), Vec3::Zero(), Vec3::Zero(),
+            ur(rng), 0, 1000);
+    const Vec3 lo = d.lo - Vec3::Constant(cutoff), hi = d.hi + Vec3::Constant(cutoff);
+    BinGrid grid(lo, hi, cutoff);
+    EXPECT_EQ(grid.axes(), shape.axes) << "domain " << d.hi.transpose();
+    p.permute(grid.sort_permutation(p));
+    const int slow = grid.axes()[2];
+    const double inv = grid.bins()[slow] / (hi[slow] - lo[slow]);
+    for (std::size_t i = 1; i < p.size(); ++i)
+      ASSERT_LE(std::floor((p.x[i - 1][slow] - lo[slow]) * inv),
+                std::floor((p.x[i][slow] - lo[slow]) * inv));
+    Ghosts g;
+    exchange.borders(p, cutoff, g);
+    NeighbourList local, ghost;
+    grid.build(p, g, skin, local, ghost);
+    std::set<std::pair<GlobalId, GlobalId>> all;
+    std::size_t entries = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      for (int k = local.offsets[i]; k < local.offsets[i + 1]; ++k, ++entries)
+        all.emplace(std::min(p.id[i], p.id[local.j[k]]), std::max(p.id[i], p.id[local.j[k]]));
+      for (int k = ghost.offsets[i]; k < ghost.offsets[i + 1]; ++k)
+        all.emplace(std::min(p.id[i], g.id[ghost.j[k]]), std::max(p.id[i], g.id[ghost.j[k]]));
+    }
+    const auto expected = brute_force_pairs(p, box, skin);
+    ASSERT_GT(expected.size(), 1000u);
+    EXPECT_EQ(std::vector(all.begin(), all.end()), expected) << "domain " << d.hi.transpose();
+    EXPECT_EQ(entries, local.j.size());  // each local pair once
+  }
+}
+
 // The lists hold the same entries in the same order as a dense array of all the lattice's
 // bins gives (the binning before the keyed bins, when its bin count stayed under its cap):
 // particles by bin, then id; each particle's partners bin by bin, z then y then x. The order
