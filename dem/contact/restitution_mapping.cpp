@@ -3,6 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "dem/core/lanes.hpp"
+
 namespace grainflow {
 namespace {
 
@@ -42,6 +44,53 @@ ScaledImpact integrate_scaled_impact(double b) {
   return {0.0, t};
 }
 
+// The restitution at kChains values of b at once: integrate_scaled_impact in the lanes of
+// Lanes2x2 (dem/core/lanes.hpp), each lane the same IEEE operations in the same order, so the
+// same bits. An RK4 stage waits on two square roots in a row; four lanes in two SSE2 chains
+// take about the time of one. A lane's result is taken at its own crossing.
+constexpr int kChains = 4;
+void scaled_restitutions(const double (&b)[kChains], double (&restitution)[kChains]) {
+  using V = Lanes2x2;
+  const auto lanes = [](const double(&a)[kChains]) {
+    V r;
+    for (int l = 0; l < kChains; ++l) r.part[l / 2][l % 2] = a[l];
+    return r;
+  };
+  double c_of[kChains];
+  for (int l = 0; l < kChains; ++l) c_of[l] = std::sqrt(5.0) * b[l];
+  const V c = lanes(c_of);
+  const auto acc = [&c](const V& xx, const V& vv) {
+    const V xp = select(xx > 0.0, xx, V{});
+    return -xp * lane_sqrt(xp) - c * lane_sqrt(lane_sqrt(xp)) * vv;
+  };
+  const double h = 2e-5;
+  V x{}, v = lanes({1.0, 1.0, 1.0, 1.0});
+  bool done[kChains] = {};
+  for (int l = 0; l < kChains; ++l) restitution[l] = 0.0;
+  int left = kChains;
+  double t = 0;  // the same in every lane
+  for (long k = 0; k < static_cast<long>(50 / h) && left > 0; ++k) {
+    const V k1x = v, k1v = acc(x, v);
+    const V k2x = v + 0.5 * h * k1v, k2v = acc(x + 0.5 * h * k1x, v + 0.5 * h * k1v);
+    const V k3x = v + 0.5 * h * k2v, k3v = acc(x + 0.5 * h * k2x, v + 0.5 * h * k2v);
+    const V k4x = v + h * k3v, k4v = acc(x + h * k3x, v + h * k3v);
+    const V xn = x + h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x);
+    const V vn = v + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
+    if (t > 0)
+      for (int l = 0; l < kChains; ++l)
+        if (!done[l] && xn[l] <= 0) {
+          const double xl = x[l], vl = v[l];
+          const double s = xl / (xl - xn[l]);
+          restitution[l] = -(vl + s * (vn[l] - vl));
+          done[l] = true;
+          --left;
+        }
+    x = xn;  // a lane past its crossing goes on, unread
+    v = vn;
+    t += h;
+  }
+}
+
 }  // namespace
 
 double hertz_restitution(double b) { return integrate_scaled_impact(b).restitution; }
@@ -54,9 +103,21 @@ double hertz_damping_for_restitution(double e) {
   // hertz_restitution is monotone decreasing in b; bracket, then bisect.
   double lo = 0, hi = 0.25;
   while (hertz_restitution(hi) > e) hi *= 2;
-  for (int it = 0; it < 60 && hi - lo > 1e-12 * hi; ++it) {
+  // Two halvings per round: the midpoint and the two quarter points are evaluated at once
+  // (scaled_restitutions), and the quarter point on the side the midpoint's test keeps is the
+  // next midpoint, the same expression 0.5 (lo + hi) of the same bounds. So the halvings, and
+  // the b returned, are those of one halving per evaluation, to the bit (RestitutionMapping
+  // test): 0.17 instead of 0.26 s for e = 0.5, paid at start-up for each restitution.
+  for (int it = 0; it < 60 && hi - lo > 1e-12 * hi;) {
     const double mid = 0.5 * (lo + hi);
-    (hertz_restitution(mid) > e ? lo : hi) = mid;
+    const double b[kChains] = {mid, 0.5 * (lo + mid), 0.5 * (mid + hi), mid};
+    double r[kChains];
+    scaled_restitutions(b, r);
+    const bool above = r[0] > e;
+    (above ? lo : hi) = mid;
+    if (!(++it < 60 && hi - lo > 1e-12 * hi)) break;
+    (r[above ? 2 : 1] > e ? lo : hi) = b[above ? 2 : 1];
+    ++it;
   }
   return 0.5 * (lo + hi);
 }

@@ -112,6 +112,24 @@ TEST(ElasticHertzImpact, ScaledContactTimeConstant) {
   EXPECT_NEAR(hertz_scaled_contact_time(0.0), 2.9432 * std::pow(1.25, 0.4), 2e-3);
 }
 
+// hertz_damping_for_restitution halves its bracket twice per round, evaluating the midpoint
+// and both quarter points at once in lanes; its b must be, to the bit, what one halving per
+// evaluation of the scalar hertz_restitution gives (the bisection written out here), and its
+// restitution the one asked for (to the integration's 1e-9).
+TEST(RestitutionMapping, LaneBisectionIsTheScalarBisection) {
+  for (const double e : {0.999, 0.5, 0.07}) {
+    double lo = 0, hi = 0.25;
+    while (hertz_restitution(hi) > e) hi *= 2;
+    for (int it = 0; it < 60 && hi - lo > 1e-12 * hi; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (hertz_restitution(mid) > e ? lo : hi) = mid;
+    }
+    const double b = hertz_damping_for_restitution(e);
+    EXPECT_EQ(b, 0.5 * (lo + hi)) << "e = " << e;
+    EXPECT_NEAR(hertz_restitution(b), e, 1e-9) << "e = " << e;
+  }
+}
+
 class DampedImpact : public ::testing::TestWithParam<double> {};
 
 TEST_P(DampedImpact, HertzWallRestitutionAsRequested) {
