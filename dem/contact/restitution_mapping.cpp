@@ -13,69 +13,66 @@ struct ScaledImpact {
   double duration;
 };
 
+constexpr double kStep = 2e-5;  // h of the scaled time
+
+// One RK4 step of x'' = -x^{3/2} - c x^{1/4} x' from (x, v) to (xn, vn), for V = double or
+// lanes of it (dem/core/lanes.hpp: the same IEEE operations in each lane, so the same bits).
+template <class V>
+[[gnu::always_inline]] inline void rk4_step(const V& c, const V& x, const V& v, V& xn, V& vn) {
+  const auto acc = [&c](const V& xx, const V& vv) {
+    const V xp = select(xx > 0.0, xx, V{});
+    return -xp * lane_sqrt(xp) - c * lane_sqrt(lane_sqrt(xp)) * vv;
+  };
+  const double h = kStep;
+  const V k1x = v, k1v = acc(x, v);
+  const V k2x = v + 0.5 * h * k1v, k2v = acc(x + 0.5 * h * k1x, v + 0.5 * h * k1v);
+  const V k3x = v + 0.5 * h * k2v, k3v = acc(x + 0.5 * h * k2x, v + 0.5 * h * k2v);
+  const V k4x = v + h * k3v, k4v = acc(x + h * k3x, v + h * k3v);
+  xn = x + h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x);
+  vn = v + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
+}
+
 // RK4 on the scaled equation until the overlap returns to zero; the crossing is
 // located by linear interpolation within the last step. h = 2e-5 gives the
-// restitution to ~1e-9 (checked by halving h).
+// restitution to ~1e-9 (checked by halving h). Heavy damping makes the overlap creep back to
+// zero without a rebound; past 50 scaled time units (~15 elastic contact durations) the
+// restitution is 0 to ~1e-6.
+constexpr long kMaxSteps = static_cast<long>(50 / kStep);
 ScaledImpact integrate_scaled_impact(double b) {
   const double c = std::sqrt(5.0) * b;
-  auto acc = [c](double x, double v) {
-    const double xp = x > 0 ? x : 0;
-    return -xp * std::sqrt(xp) - c * std::sqrt(std::sqrt(xp)) * v;
-  };
-  const double h = 2e-5;
   double x = 0, v = 1, t = 0;
-  // Heavy damping makes the overlap creep back to zero without a rebound; past 50
-  // scaled time units (~15 elastic contact durations) the restitution is 0 to ~1e-6.
-  for (long k = 0; k < static_cast<long>(50 / h); ++k) {
-    const double k1x = v, k1v = acc(x, v);
-    const double k2x = v + 0.5 * h * k1v, k2v = acc(x + 0.5 * h * k1x, v + 0.5 * h * k1v);
-    const double k3x = v + 0.5 * h * k2v, k3v = acc(x + 0.5 * h * k2x, v + 0.5 * h * k2v);
-    const double k4x = v + h * k3v, k4v = acc(x + h * k3x, v + h * k3v);
-    const double xn = x + h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x);
-    const double vn = v + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
+  for (long k = 0; k < kMaxSteps; ++k) {
+    double xn, vn;
+    rk4_step(c, x, v, xn, vn);
     if (t > 0 && xn <= 0) {
       const double s = x / (x - xn);
-      return {-(v + s * (vn - v)), t + s * h};
+      return {-(v + s * (vn - v)), t + s * kStep};
     }
     x = xn;
     v = vn;
-    t += h;
+    t += kStep;
   }
   return {0.0, t};
 }
 
 // The restitution at kChains values of b at once: integrate_scaled_impact in the lanes of
-// Lanes2x2 (dem/core/lanes.hpp), each lane the same IEEE operations in the same order, so the
-// same bits. An RK4 stage waits on two square roots in a row; four lanes in two SSE2 chains
-// take about the time of one. A lane's result is taken at its own crossing.
+// Lanes2x2, so the same bits. An RK4 stage waits on two square roots in a row; four lanes in
+// two SSE2 chains take about the time of one. A lane's result is taken at its own crossing.
 constexpr int kChains = 4;
 void scaled_restitutions(const double (&b)[kChains], double (&restitution)[kChains]) {
   using V = Lanes2x2;
-  const auto lanes = [](const double(&a)[kChains]) {
-    V r;
-    for (int l = 0; l < kChains; ++l) r.part[l / 2][l % 2] = a[l];
-    return r;
-  };
-  double c_of[kChains];
-  for (int l = 0; l < kChains; ++l) c_of[l] = std::sqrt(5.0) * b[l];
-  const V c = lanes(c_of);
-  const auto acc = [&c](const V& xx, const V& vv) {
-    const V xp = select(xx > 0.0, xx, V{});
-    return -xp * lane_sqrt(xp) - c * lane_sqrt(lane_sqrt(xp)) * vv;
-  };
-  const double h = 2e-5;
-  V x{}, v = lanes({1.0, 1.0, 1.0, 1.0});
+  V c, x{}, v;
+  for (int l = 0; l < kChains; ++l) {
+    c.part[l / 2][l % 2] = std::sqrt(5.0) * b[l];
+    v.part[l / 2][l % 2] = 1.0;
+    restitution[l] = 0.0;
+  }
   bool done[kChains] = {};
-  for (int l = 0; l < kChains; ++l) restitution[l] = 0.0;
   int left = kChains;
   double t = 0;  // the same in every lane
-  for (long k = 0; k < static_cast<long>(50 / h) && left > 0; ++k) {
-    const V k1x = v, k1v = acc(x, v);
-    const V k2x = v + 0.5 * h * k1v, k2v = acc(x + 0.5 * h * k1x, v + 0.5 * h * k1v);
-    const V k3x = v + 0.5 * h * k2v, k3v = acc(x + 0.5 * h * k2x, v + 0.5 * h * k2v);
-    const V k4x = v + h * k3v, k4v = acc(x + h * k3x, v + h * k3v);
-    const V xn = x + h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x);
-    const V vn = v + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
+  for (long k = 0; k < kMaxSteps && left > 0; ++k) {
+    V xn, vn;
+    rk4_step(c, x, v, xn, vn);
     if (t > 0)
       for (int l = 0; l < kChains; ++l)
         if (!done[l] && xn[l] <= 0) {
@@ -87,7 +84,7 @@ void scaled_restitutions(const double (&b)[kChains], double (&restitution)[kChai
         }
     x = xn;  // a lane past its crossing goes on, unread
     v = vn;
-    t += h;
+    t += kStep;
   }
 }
 
