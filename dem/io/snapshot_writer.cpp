@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "dem/io/direct_write_driver.hpp"
 #include "dem/io/hdf5_attributes.hpp"
 #include "dem/io/hdf5_checksum.hpp"
 #include "dem/io/hdf5_errors.hpp"
@@ -461,7 +462,9 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step,
       ok = ok && H5Pset_dxpl_mpio(dxpl.get(), H5FD_MPIO_COLLECTIVE) >= 0;
     }
     // One rank writes through HDF5's default (POSIX) driver: the same file, without the
-    // collective filtered-chunk path of MPI-IO, which copies every chunk once more.
+    // collective filtered-chunk path of MPI-IO, which copies every chunk once more. Its
+    // large writes bypass the page cache (direct_write_driver.hpp); the bytes are the same.
+    if (size_ == 1 || gather_) ok = ok && set_direct_write_driver(fapl.get());
     // Parallel HDF5 allocates datasets at creation; without this it would also write fill
     // values there first, doubling the I/O.
     ok = ok && H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_NEVER) >= 0;
