@@ -878,10 +878,12 @@ void canonical_pair_sweep(ContactSweep& s) {
 template <class Law, bool Canonical>
 void sweep(ContactSweep& s) {
   if constexpr (Canonical) {
+    if (s.ghosts_ready) s.ghosts_ready();
     canonical_pair_sweep<Law>(s);
   } else {
     const int n = static_cast<int>(s.p.size());
     local_pair_sweep<Law>(s, 0, n);
+    if (s.ghosts_ready) s.ghosts_ready();
     ghost_pair_sweep<Law>(s, 0, n);
   }
   wall_sweep<Law>(s);

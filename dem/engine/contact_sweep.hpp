@@ -10,6 +10,7 @@
 // so both ranks apply exactly opposite forces (Newton's third law holds exactly
 // across rank boundaries, at the price of computing those pairs twice).
 #include <cmath>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -106,6 +107,10 @@ struct ContactSweep {
   // parallel.reproducible: the order of the pairs (set at each neighbour rebuild), for a
   // sweep of select_sweep(..., true); unused otherwise.
   CanonicalOrder* canonical = nullptr;
+  // Called before the sweep first reads a ghost (empty: the ghosts are ready). The simulation
+  // completes there the exchange of the ghosts' positions and velocities, which travel while
+  // the pairs of this rank's own particles are swept.
+  std::function<void()> ghosts_ready = {};
 };
 
 using SweepFunction = void (*)(ContactSweep&);

@@ -827,8 +827,10 @@ ContactGuards Simulation::compute_forces(bool advance_springs) {
       uniform_, 0,             0.0,              WorstContact{}, UnresolvedContact{}};
   // clang-format on
   s.canonical = &canonical_;
+  if (forward_pending_) s.ghosts_ready = [this] { finish_forward(); };
   // Before the sweep: it reads the springs as the sweep will, and leaves them unchanged.
   if (record_contacts_) {
+    finish_forward();
     sweep_.report(s, network_);
     network_recorded_ = true;
   } else if (network_recorded_) {
@@ -836,6 +838,7 @@ ContactGuards Simulation::compute_forces(bool advance_springs) {
     network_recorded_ = false;
   }
   sweep_.run(s);
+  finish_forward();  // when the sweep read no ghost
   // The fastest local particle bounds both the steps-per-contact gate and the travel guard;
   // kick_and_drift() has found it (in the same order) unless a rebuild came since.
   double v2_local = 0;
@@ -863,6 +866,12 @@ ContactGuards Simulation::compute_forces(bool advance_springs) {
     apply_force_terms();
   }
   return {s.worst, s.unresolved, fastest_particle(v2_local)};
+}
+
+void Simulation::finish_forward() {
+  if (!forward_pending_) return;
+  forward_pending_ = false;
+  exchange_->forward_end(p_, ghosts_);
 }
 
 FastParticle Simulation::fastest_particle(double v2_max) const {
@@ -1399,8 +1408,10 @@ void Simulation::step() {
   if (inserted || needs_rebuild()) {
     rebuild();
     fresh_from_kick_ = false;  // particles came, left or arrived from other ranks
-  } else
-    exchange_->forward(p_, ghosts_);
+  } else {
+    exchange_->forward_begin(p_, ghosts_);  // ended by compute_forces (finish_forward)
+    forward_pending_ = true;
+  }
   time_ += dt_;
   walls_.move_to(time_);
   const ContactGuards guards = compute_forces();

@@ -228,6 +228,7 @@ class Simulation {
   // Gravity, contacts, then the force terms. `advance_springs` false: the forces of the
   // initial state, whose contact springs have not moved (initialise()).
   ContactGuards compute_forces(bool advance_springs = true);
+  void finish_forward();
   void apply_force_terms();  // non-contact terms only
   // Heat on: the ghosts' temperatures from their owners, then HeatTransfer::step (collective).
   void advance_temperatures();
@@ -274,6 +275,9 @@ class Simulation {
 
   Scene scene_;
   MPI_Comm comm_;
+  // A forward exchange begun by step() and not yet ended: the ghosts' fields travel while
+  // compute_forces sweeps the local pairs; finish_forward() ends it (idempotent).
+  bool forward_pending_ = false;
   mutable double collective_wait_seconds_ = 0;  // see collective_wait_seconds()
   std::unique_ptr<Decomposition> decomp_;
   std::unique_ptr<Exchange> exchange_;

@@ -218,6 +218,7 @@ void Exchange::migrate(Particles& p, CarriedState& carried) {
 }
 
 void Exchange::borders(const Particles& p, double cutoff, Ghosts& g) {
+  complete_sends();  // their buffers and lists are about to change
   g.clear();
   swaps_.clear();
   nlocal_ = p.size();
@@ -289,62 +290,102 @@ void Exchange::borders(const Particles& p, double cutoff, Ghosts& g) {
   }
 }
 
-void Exchange::forward(const Particles& p, Ghosts& g) {
+Exchange::~Exchange() { complete_sends(); }
+
+void Exchange::complete_sends() {
+  if (sends_.empty()) return;
+  MPI_Waitall(static_cast<int>(sends_.size()), sends_.data(), MPI_STATUSES_IGNORE);
+  sends_.clear();
+}
+
+// Every step, so one message per swap: the sizes are those of borders(). The two swaps of an
+// axis go at once (their lists hold particles and ghosts of earlier axes only), the axes one
+// after the other (the y swaps forward ghosts received along x).
+bool Exchange::stage_talks(std::size_t first) const {
+  for (std::size_t w = first; w < first + 2 && w < swaps_.size(); ++w)
+    if (d_.neighbour(swaps_[w].axis, swaps_[w].dir) != MPI_PROC_NULL ||
+        d_.neighbour(swaps_[w].axis, 1 - swaps_[w].dir) != MPI_PROC_NULL)
+      return true;
+  return false;
+}
+
+void Exchange::forward_begin(const Particles& p, const Ghosts& g) {
+  complete_sends();  // the last step's, before their buffers are filled again
+  buffers_.resize(2 * swaps_.size());
+  // The stages before the first that talks receive nothing, so its lists hold local particles
+  // only (or ghosts of stages that have none).
+  begun_ = 0;
+  while (begun_ < swaps_.size() && !stage_talks(begun_)) begun_ += 2;
+  if (begun_ >= swaps_.size()) return;
   if (predicted_)
-    forward_fields<true>(p, g);
+    post_stage<true>(begun_, p, g);
   else
-    forward_fields<false>(p, g);
+    post_stage<false>(begun_, p, g);
+}
+
+void Exchange::forward_end(const Particles& p, Ghosts& g) {
+  for (std::size_t first = begun_; first < swaps_.size(); first += 2) {
+    if (!stage_talks(first)) continue;
+    if (predicted_) {
+      if (first != begun_) post_stage<true>(first, p, g);
+      finish_stage<true>(first, g);
+    } else {
+      if (first != begun_) post_stage<false>(first, p, g);
+      finish_stage<false>(first, g);
+    }
+  }
+  begun_ = swaps_.size();
 }
 
 template <bool Predicted>
-void Exchange::forward_fields(const Particles& p, Ghosts& g) {
-  // Every step, so one message per swap: the sizes are those of borders(). The two swaps of
-  // an axis go at once (their lists hold particles and ghosts of earlier axes only), the
-  // axes one after the other (the y swaps forward ghosts received along x).
+void Exchange::post_stage(std::size_t first, const Particles& p, const Ghosts& g) {
   // x, v, omega, and with the predicted dashpot velocities also v_pred, omega_pred.
   constexpr int kWidth = Predicted ? 15 : 9;
-  buffers_.resize(2 * swaps_.size());
-  for (std::size_t first = 0; first < swaps_.size(); first += 2) {
-    MPI_Request requests[4];
-    int n = 0;
-    for (std::size_t w = first; w < first + 2 && w < swaps_.size(); ++w) {
-      const Swap& s = swaps_[w];
-      const int to = d_.neighbour(s.axis, s.dir), from = d_.neighbour(s.axis, 1 - s.dir);
-      if (to == MPI_PROC_NULL && from == MPI_PROC_NULL) continue;
-      std::vector<double>& in = buffers_[2 * w];
-      std::vector<double>& out = buffers_[2 * w + 1];
-      in.resize(kWidth * s.recv_count);
-      out.resize(kWidth * s.send.size());
-      double* o = out.data();
-      for (int idx : s.send) {
-        const bool local = static_cast<std::size_t>(idx) < nlocal_;
-        const std::size_t k = local ? idx : idx - nlocal_;
-        for (const Vec3* q : {local ? &p.x[k] : &g.x[k], local ? &p.v[k] : &g.v[k],
-                              local ? &p.omega[k] : &g.omega[k]})
+  receives_.clear();
+  for (std::size_t w = first; w < first + 2 && w < swaps_.size(); ++w) {
+    const Swap& s = swaps_[w];
+    const int to = d_.neighbour(s.axis, s.dir), from = d_.neighbour(s.axis, 1 - s.dir);
+    if (to == MPI_PROC_NULL && from == MPI_PROC_NULL) continue;
+    std::vector<double>& in = buffers_[2 * w];
+    std::vector<double>& out = buffers_[2 * w + 1];
+    in.resize(kWidth * s.recv_count);
+    out.resize(kWidth * s.send.size());
+    double* o = out.data();
+    for (int idx : s.send) {
+      const bool local = static_cast<std::size_t>(idx) < nlocal_;
+      const std::size_t k = local ? idx : idx - nlocal_;
+      for (const Vec3* q : {local ? &p.x[k] : &g.x[k], local ? &p.v[k] : &g.v[k],
+                            local ? &p.omega[k] : &g.omega[k]})
+        for (int c = 0; c < 3; ++c) *o++ = (*q)[c];
+      if constexpr (Predicted)
+        for (const Vec3* q :
+             {local ? &p.v_pred[k] : &g.v_pred[k], local ? &p.omega_pred[k] : &g.omega_pred[k]})
           for (int c = 0; c < 3; ++c) *o++ = (*q)[c];
-        if constexpr (Predicted)
-          for (const Vec3* q : {local ? &p.v_pred[k] : &g.v_pred[k],
-                                local ? &p.omega_pred[k] : &g.omega_pred[k]})
-            for (int c = 0; c < 3; ++c) *o++ = (*q)[c];
-      }
-      const int tag = 300 + 2 * s.axis + s.dir;
-      MPI_Irecv(in.data(), static_cast<int>(in.size()), MPI_DOUBLE, from, tag, d_.comm(),
-                &requests[n++]);
-      MPI_Isend(out.data(), static_cast<int>(out.size()), MPI_DOUBLE, to, tag, d_.comm(),
-                &requests[n++]);
     }
-    MPI_Waitall(n, requests, MPI_STATUSES_IGNORE);
-    for (std::size_t w = first; w < first + 2 && w < swaps_.size(); ++w) {
-      const Swap& s = swaps_[w];
-      const double* q = buffers_[2 * w].data();
-      for (std::size_t k = s.recv_first; k < s.recv_first + s.recv_count; ++k, q += kWidth) {
-        g.x[k] = Vec3(q[0], q[1], q[2]);
-        g.v[k] = Vec3(q[3], q[4], q[5]);
-        g.omega[k] = Vec3(q[6], q[7], q[8]);
-        if constexpr (Predicted) {
-          g.v_pred[k] = Vec3(q[9], q[10], q[11]);
-          g.omega_pred[k] = Vec3(q[12], q[13], q[14]);
-        }
+    const int tag = 300 + 2 * s.axis + s.dir;
+    MPI_Request r;
+    MPI_Irecv(in.data(), static_cast<int>(in.size()), MPI_DOUBLE, from, tag, d_.comm(), &r);
+    receives_.push_back(r);
+    MPI_Isend(out.data(), static_cast<int>(out.size()), MPI_DOUBLE, to, tag, d_.comm(), &r);
+    sends_.push_back(r);
+  }
+}
+
+template <bool Predicted>
+void Exchange::finish_stage(std::size_t first, Ghosts& g) {
+  constexpr int kWidth = Predicted ? 15 : 9;
+  MPI_Waitall(static_cast<int>(receives_.size()), receives_.data(), MPI_STATUSES_IGNORE);
+  receives_.clear();
+  for (std::size_t w = first; w < first + 2 && w < swaps_.size(); ++w) {
+    const Swap& s = swaps_[w];
+    const double* q = buffers_[2 * w].data();
+    for (std::size_t k = s.recv_first; k < s.recv_first + s.recv_count; ++k, q += kWidth) {
+      g.x[k] = Vec3(q[0], q[1], q[2]);
+      g.v[k] = Vec3(q[3], q[4], q[5]);
+      g.omega[k] = Vec3(q[6], q[7], q[8]);
+      if constexpr (Predicted) {
+        g.v_pred[k] = Vec3(q[9], q[10], q[11]);
+        g.omega_pred[k] = Vec3(q[12], q[13], q[14]);
       }
     }
   }

@@ -48,7 +48,23 @@ class Exchange {
 
   // Refreshes ghost positions, velocities and spins (and the predicted ones) along the
   // recorded lists.
-  void forward(const Particles& p, Ghosts& ghosts);
+  void forward(const Particles& p, Ghosts& ghosts) {
+    forward_begin(p, ghosts);
+    forward_end(p, ghosts);
+  }
+  // forward() in two halves, so that work on this rank's own particles runs while the
+  // fields travel: forward_begin packs and sends the fields of the first axis that has
+  // neighbours and posts their receives; forward_end waits for those, unpacks them, and
+  // exchanges the further axes whole (they forward ghosts of the first). Between the two
+  // the ghosts' fields are stale and `p`'s listed fields must not change. The sends
+  // complete later (at the next exchange that reuses their buffers): a rank that has its
+  // ghosts goes on without waiting for its neighbours to take theirs.
+  void forward_begin(const Particles& p, const Ghosts& ghosts);
+  void forward_end(const Particles& p, Ghosts& ghosts);
+
+  ~Exchange();
+  Exchange(const Exchange&) = delete;
+  Exchange& operator=(const Exchange&) = delete;
 
   // Sends `width` doubles per particle along the same lists as forward(): `local` holds
   // width values for each of this rank's particles (in local order), and `ghost` is
@@ -72,13 +88,23 @@ class Exchange {
     Vec3 shift;             // added to the image offset of what is sent
     std::size_t recv_first = 0, recv_count = 0;
   };
+  // The forward exchange of the swaps first, first + 1 (one axis): packs and posts
+  // (post_stage), then waits for the receives and unpacks (finish_stage).
   template <bool Predicted>
-  void forward_fields(const Particles& p, Ghosts& g);
+  void post_stage(std::size_t first, const Particles& p, const Ghosts& g);
+  template <bool Predicted>
+  void finish_stage(std::size_t first, Ghosts& g);
+  bool stage_talks(std::size_t first) const;
+  // Waits for the forward sends still in flight (before their buffers change).
+  void complete_sends();
 
   const Decomposition& d_;
   bool predicted_;
   std::vector<Swap> swaps_;                   // per axis the swaps of dir 0 and 1, axis after axis
   std::vector<std::vector<double>> buffers_;  // forward(): per swap, what it receives and sends
+  std::vector<MPI_Request> sends_;            // forward sends not known to be complete
+  std::vector<MPI_Request> receives_;         // the receives of the stage posted last
+  std::size_t begun_ = 0;                     // forward_begin's stage (swaps_.size(): none)
   std::size_t nlocal_ = 0;
   long sent_ = 0;
 };
