@@ -9,11 +9,11 @@
 //
 // Why: a write into the page cache must first obtain a fresh page for every 4 KiB, and on
 // virtual machines whose free memory goes back to the host (virtio-balloon free page
-// reporting, as on this project's reference machine) that ran at 165-230 MB/s against
-// 1.2-2.6 GB/s for direct writes of 1 MiB blocks (docs/performance.md, "Snapshot writes").
-// On a file system that refuses O_DIRECT (tmpfs, some network file systems) the second
-// descriptor does not open, or its first write fails with EINVAL, and every byte takes
-// the buffered path: the same file, at the page cache's speed.
+// reporting, likely the cause on this project's reference machine) that ran at 163-247 MB/s
+// against 1.2-2.6 GB/s for direct writes of 1-8 MiB blocks (docs/performance.md, "Snapshot
+// writes and the page cache"). On a file system that refuses O_DIRECT (some network file
+// systems; older tmpfs) the second descriptor does not open, or its first write fails with
+// EINVAL, and every byte takes the buffered path: the same file, at the page cache's speed.
 #include <hdf5.h>
 
 #include <cstddef>
@@ -24,7 +24,11 @@ namespace grainflow {
 inline constexpr std::size_t kDirectWriteMin = 256 * 1024;
 
 // Sets the driver on a file-access property list (registering it with HDF5 on first use).
-// False when HDF5 refused (the list keeps its previous driver).
+// False when HDF5 refused (the list keeps its previous driver). With the environment variable
+// GRAINFLOW_BUFFERED_WRITES=1 it leaves the list as it is (true): every write through the
+// page cache, which returns at memory speed and reaches the disk in the background - faster
+// where the disk is slower than the page cache can take fresh pages (a spinning disk, some
+// network file systems), slower on guests like this project's (docs/performance.md).
 bool set_direct_write_driver(hid_t fapl);
 
 // Bytes written with O_DIRECT by this process since it started (all files; for tests and the

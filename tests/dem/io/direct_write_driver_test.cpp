@@ -154,6 +154,18 @@ TEST(DirectWriteDriver, FileReadsBackThroughTheDefaultDriverWithItsChecksums) {
   fs::remove_all(path.parent_path());
 }
 
+TEST(DirectWriteDriver, BufferedWritesAskedForKeepHdf5sPosixDriver) {
+  const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+  setenv("GRAINFLOW_BUFFERED_WRITES", "1", 1);
+  EXPECT_TRUE(set_direct_write_driver(fapl));
+  EXPECT_EQ(H5Pget_driver(fapl), H5FD_SEC2);
+  setenv("GRAINFLOW_BUFFERED_WRITES", "0", 1);
+  EXPECT_TRUE(set_direct_write_driver(fapl));
+  EXPECT_NE(H5Pget_driver(fapl), H5FD_SEC2);
+  unsetenv("GRAINFLOW_BUFFERED_WRITES");
+  H5Pclose(fapl);
+}
+
 TEST(DirectWriteDriver, AFileThatCannotBeCreatedFailsWithTheSystemsReason) {
   QuietHdf5Errors quiet;
   const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
