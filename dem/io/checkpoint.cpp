@@ -176,11 +176,14 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
            std::to_string(d.drag_coefficient.size()) + " drag entries for " + std::to_string(n) +
            " particles)";
   // Large writes around the page cache (direct_write_driver.hpp): the same file, faster on
-  // machines where fresh page-cache pages are slow to come by. The default driver when HDF5
-  // refuses it.
+  // machines where fresh page-cache pages are slow to come by.
   const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-  const bool direct = fapl >= 0 && set_direct_write_driver(fapl);
-  File f(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, direct ? fapl : H5P_DEFAULT));
+  if (!fail.check(fapl >= 0 && set_direct_write_driver(fapl),
+                  "choosing how '" + path + "' is written")) {
+    if (fapl >= 0) H5Pclose(fapl);
+    return fail.error();
+  }
+  File f(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl));
   const bool created = fail.check(f.id() >= 0, "creating '" + path + "'");
   if (fapl >= 0) H5Pclose(fapl);  // after the check: any HDF5 call clears the error stack
   if (!created) return fail.error();

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <string>
 #include <string_view>
 
 namespace grainflow {
@@ -238,7 +239,21 @@ H5FD_class_t make_class() {
 
 }  // namespace
 
+std::string buffered_writes_error() {
+  const char* value = std::getenv("GRAINFLOW_BUFFERED_WRITES");
+  if (!value || !*value || std::string_view(value) == "0" || std::string_view(value) == "1")
+    return {};
+  return std::string("the environment variable GRAINFLOW_BUFFERED_WRITES is '") + value +
+         "'; allowed values: 0 (large writes around the page cache, the default) or 1 (every "
+         "write through the page cache)";
+}
+
 bool set_direct_write_driver(hid_t fapl) {
+  if (const std::string error = buffered_writes_error(); !error.empty()) {
+    H5Epush2(H5E_DEFAULT, __FILE__, "set_direct_write_driver", __LINE__, H5E_ERR_CLS, H5E_VFL,
+             H5E_BADVALUE, "%s", error.c_str());
+    return false;
+  }
   if (const char* buffered = std::getenv("GRAINFLOW_BUFFERED_WRITES");
       buffered && std::string_view(buffered) == "1")
     return true;

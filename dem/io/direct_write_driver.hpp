@@ -17,6 +17,7 @@
 #include <hdf5.h>
 
 #include <cstddef>
+#include <string>
 
 namespace grainflow {
 
@@ -24,12 +25,17 @@ namespace grainflow {
 inline constexpr std::size_t kDirectWriteMin = 256 * 1024;
 
 // Sets the driver on a file-access property list (registering it with HDF5 on first use).
-// False when HDF5 refused (the list keeps its previous driver). With the environment variable
-// GRAINFLOW_BUFFERED_WRITES=1 it leaves the list as it is (true): every write through the
-// page cache, which returns at memory speed and reaches the disk in the background - faster
-// where the disk is slower than the page cache can take fresh pages (a spinning disk, some
-// network file systems), slower on guests like this project's (docs/performance.md).
+// False when HDF5 refused (the list keeps its previous driver), or when the environment variable
+// GRAINFLOW_BUFFERED_WRITES holds a value other than 0 or 1 (HDF5's error stack then says so,
+// for hdf5_reason()). With GRAINFLOW_BUFFERED_WRITES=1 it leaves the list as it is (true): every
+// write through the page cache, which returns at memory speed and reaches the disk in the
+// background - faster where the disk is slower than the page cache can take fresh pages (a spinning
+// disk, some network file systems), slower on guests like this project's (docs/performance.md).
 bool set_direct_write_driver(hid_t fapl);
+
+// The message for a value of GRAINFLOW_BUFFERED_WRITES other than 0 or 1 (naming it and the
+// allowed values); empty when it is unset, empty, 0 or 1.
+std::string buffered_writes_error();
 
 // Bytes written with O_DIRECT by this process since it started (all files; for tests and the
 // benchmark's report).

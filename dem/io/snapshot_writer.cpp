@@ -464,11 +464,16 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step,
     // One rank writes through HDF5's default (POSIX) driver: the same file, without the
     // collective filtered-chunk path of MPI-IO, which copies every chunk once more. Its
     // large writes bypass the page cache (direct_write_driver.hpp); the bytes are the same.
-    if (size_ == 1 || gather_) ok = ok && set_direct_write_driver(fapl.get());
     // Parallel HDF5 allocates datasets at creation; without this it would also write fill
     // values there first, doubling the I/O.
     ok = ok && H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_NEVER) >= 0;
     agreement.check(ok, "setting up the MPI-IO property lists");
+    if (size_ == 1 || gather_) {
+      const std::string setting = buffered_writes_error();
+      agreement.agree(setting.empty() ? setting
+                                      : "cannot write snapshot '" + path + "': " + setting);
+      agreement.check(set_direct_write_driver(fapl.get()), "choosing how the file is written");
+    }
 
     // Gathering on rank 0 (several ranks on one node, gather_): rank 0 alone opens the file.
     const bool opens = !gather_ || rank_ == 0;

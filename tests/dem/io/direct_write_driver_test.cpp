@@ -166,6 +166,19 @@ TEST(DirectWriteDriver, BufferedWritesAskedForKeepHdf5sPosixDriver) {
   H5Pclose(fapl);
 }
 
+TEST(DirectWriteDriver, ANonsenseValueOfTheVariableIsRefusedWithTheAllowedValues) {
+  QuietHdf5Errors quiet;
+  const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+  setenv("GRAINFLOW_BUFFERED_WRITES", "yes", 1);
+  const bool set = set_direct_write_driver(fapl);
+  const std::string reason = hdf5_reason();  // before any other HDF5 call clears the stack
+  unsetenv("GRAINFLOW_BUFFERED_WRITES");
+  H5Pclose(fapl);
+  EXPECT_FALSE(set);
+  EXPECT_NE(reason.find("GRAINFLOW_BUFFERED_WRITES is 'yes'"), std::string::npos) << reason;
+  EXPECT_NE(reason.find("allowed values: 0"), std::string::npos) << reason;
+}
+
 TEST(DirectWriteDriver, AFileThatCannotBeCreatedFailsWithTheSystemsReason) {
   QuietHdf5Errors quiet;
   const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
