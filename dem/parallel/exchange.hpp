@@ -6,8 +6,8 @@
 // - borders(): at rebuilds, builds the ghosts of every face, edge and corner (axis
 //   by axis: the y exchange forwards ghosts received along x, and so on) and
 //   records which particles go where;
-// - forward(): every step, refreshes the ghosts' positions and velocities along
-//   those records.
+// - forward_begin() / forward_end(): every step, refresh the ghosts' positions and
+//   velocities along those records.
 // Periodic axes work the same way with one or more ranks: the neighbour across a
 // periodic side may be this rank itself, and what crosses gets an image shift.
 #include <string>
@@ -46,13 +46,8 @@ class Exchange {
   // Rebuilds `ghosts` for interaction range `cutoff` and records the send lists.
   void borders(const Particles& p, double cutoff, Ghosts& ghosts);
 
-  // Refreshes ghost positions, velocities and spins (and the predicted ones) along the
-  // recorded lists.
-  void forward(const Particles& p, Ghosts& ghosts) {
-    forward_begin(p, ghosts);
-    forward_end(p, ghosts);
-  }
-  // forward() in two halves, so that work on this rank's own particles runs while the
+  // Refresh the ghosts' positions, velocities and spins (and the predicted ones) along the
+  // recorded lists, in two halves, so that work on this rank's own particles runs while the
   // fields travel: forward_begin packs and sends the fields of the first axis that has
   // neighbours and posts their receives; forward_end waits for those, unpacks them, and
   // exchanges the further axes whole (they forward ghosts of the first). Between the two
@@ -66,7 +61,7 @@ class Exchange {
   Exchange(const Exchange&) = delete;
   Exchange& operator=(const Exchange&) = delete;
 
-  // Sends `width` doubles per particle along the same lists as forward(): `local` holds
+  // Sends `width` doubles per particle along the same lists as forward_begin(): `local` holds
   // width values for each of this rank's particles (in local order), and `ghost` is
   // resized and filled with the values of each ghost (in ghost order). Collective. Used
   // by the coupling to give ghosts their owner's drag coefficient and exchange force.
@@ -101,7 +96,8 @@ class Exchange {
   const Decomposition& d_;
   bool predicted_;
   std::vector<Swap> swaps_;                   // per axis the swaps of dir 0 and 1, axis after axis
-  std::vector<std::vector<double>> buffers_;  // forward(): per swap, what it receives and sends
+  std::vector<std::vector<double>>
+      buffers_;  // forward_begin(): per swap, what it receives and sends
   std::vector<MPI_Request> sends_;            // forward sends not known to be complete
   std::vector<MPI_Request> receives_;         // the receives of the stage posted last
   std::size_t begun_ = 0;                     // forward_begin's stage (swaps_.size(): none)
