@@ -514,7 +514,7 @@ void ghost_pair_sweep(ContactSweep& s, int a_first, int a_end) {
   // A touching entry in canonical orientation (the lower global id first) and the two bodies'
   // displacement. The bodies' fields are read where they are, the local particle's or the
   // ghost's, by the orientation (copying both bodies into the entry and gathering from the
-  // copies took a third of this sweep's time).
+  // copies made this sweep take a third longer).
   struct Pair {
     int i, q, k;
     bool local_first;
