@@ -110,7 +110,17 @@ Simulation::Simulation(const Scene& scene, bool insert, MPI_Comm comm,
   constants_.hooke_kn = scene.contact.hooke_kn.value_or(0.0);
   constants_.hooke_kt = scene.contact.hooke_kt.value_or(constants_.hooke_kn);
   constants_.epsd_damping_ratio = scene.contact.epsd_damping_ratio;
-#if defined(GRAINFLOW_AVX_SWEEP)
+#if defined(GRAINFLOW_AVX512_SWEEP)
+  // The contact sweep is compiled for AVX-512 F and VL (GRAINFLOW_AVX, CMakeLists.txt): refused
+  // here rather than stopped by an illegal instruction in the first step.
+  if (!__builtin_cpu_supports("avx512f") || !__builtin_cpu_supports("avx512vl"))
+    throw SetupError(
+        "grain: error: this build's contact sweep needs a processor with AVX-512 F and VL "
+        "(GRAINFLOW_AVX was AUTO or AVX512 on the machine that built it), and this processor "
+        "lacks them; rebuild on this machine, or anywhere with `cmake -DGRAINFLOW_AVX=ON` for "
+        "processors with AVX or `-DGRAINFLOW_AVX=OFF` for any x86-64 (the results are the same "
+        "to the last bit)");
+#elif defined(GRAINFLOW_AVX_SWEEP)
   // The contact sweep is compiled for AVX (GRAINFLOW_AVX, CMakeLists.txt): refused here rather
   // than stopped by an illegal instruction in the first step.
   if (!__builtin_cpu_supports("avx"))
