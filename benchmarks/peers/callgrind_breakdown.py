@@ -8,7 +8,10 @@ Prints, per profile, the instructions of the time loop (run_scene minus set-up) 
 pair forces, walls, integration, neighbour lists, communication and the per-step checks,
 as inclusive counts of the functions that make each phase (callgrind_annotate --tree=calling).
 Instruction counts do not depend on the machine's load, unlike timings; time spent waiting
-in MPI is not an instruction count and shows up only in the timings.
+in MPI is not an instruction count and shows up only in the timings. Valgrind (3.19) does not
+decode AVX-512: profile a build configured with `-DGRAINFLOW_AVX=ON` (the AVX sweep, the same
+results); a build whose sweep is compiled for AVX-512 stops under valgrind before the first
+step with a message that names that option.
 """
 import re
 import subprocess
