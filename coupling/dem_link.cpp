@@ -790,4 +790,12 @@ std::vector<std::string> DemLink::parcel_cell_warnings(double smallest_cell,
   return grainflow::parcel_cell_warnings(classes, smallest_cell, typical_cell, "the fluid cells");
 }
 
+std::vector<std::string> DemLink::parcel_domain_warnings() const {
+  if (impl_->scene.coarse_grain_table().empty()) return {};
+  const std::vector<ParcelClass> classes =
+      parcel_classes(impl_->scene, impl_->simulation().particles(), impl_->dem_comm);
+  const Vec3 extent = impl_->scene.domain.hi - impl_->scene.domain.lo;
+  return grainflow::parcel_domain_warnings(classes, extent.minCoeff());
+}
+
 }  // namespace grainflow::coupling

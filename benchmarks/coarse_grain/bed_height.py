@@ -62,14 +62,31 @@ def pressure_height(z, p, q=0.95):
 
 def foam_scalar_field(path):
     """The internalField of an OpenFOAM volScalarField file, ascii or binary (double)."""
+    return foam_field(path, "scalar")
+
+
+def foam_vector_field(path):
+    """The internalField of an OpenFOAM volVectorField file as an (n, 3) array, ascii or binary."""
+    return foam_field(path, "vector")
+
+
+def foam_field(path, kind):
+    """The nonuniform internalField of an OpenFOAM field file of `kind` scalar or vector."""
     raw = open(path, "rb").read()
     start = raw.index(b"internalField")
     head = raw[start:start + 200]
     if b"nonuniform" not in head.split(b";")[0]:
         raise ValueError(f"{path}: internalField is not a nonuniform list")
-    i = raw.index(b"List<scalar>", start) + len(b"List<scalar>")
+    tag = f"List<{kind}>".encode()
+    i = raw.index(tag, start) + len(tag)
     j = raw.index(b"(", i)
     n = int(raw[i:j].split()[0])
+    width = 1 if kind == "scalar" else 3
     if re.search(rb"format\s+binary", raw[:start]):
-        return np.frombuffer(raw[j + 1:j + 1 + 8 * n], dtype="<f8").copy()
-    return np.array(raw[j + 1:raw.index(b")", j)].split(), dtype=float)
+        values = np.frombuffer(raw[j + 1:j + 1 + 8 * width * n], dtype="<f8").copy()
+    elif kind == "scalar":
+        values = np.array(raw[j + 1:raw.index(b")", j)].split(), dtype=float)
+    else:  # ascii vectors: n lines "(x y z)" between the list's brackets
+        vectors = re.findall(rb"\(([^()]*)\)", raw[j + 1:])[:n]
+        values = np.array(b" ".join(vectors).split(), dtype=float)
+    return values if width == 1 else values.reshape(n, 3)

@@ -5,8 +5,9 @@ The `tutorials/cfd-dem/fluidisedBed` case (12 000 glass beads, d = 1.14-1.26 mm,
 60 x 9 x 240 mm column of 3 mm cells, air at 2.0 U_mf after a ramp 0.2-0.3 s) run with the
 beads as parcels of k = 1, 2, 3: the fill's count is 12 000 / k^3 parcels (the real beads'
 number; for k > 1 filled into 2-160 mm instead of 2-82 mm, where random insertion finds room
-for them, and time.max_overlap 0.3 instead of 0.2 for the harder landing), the DEM step k x 1.5e-5 s (the contact time grows as k; for k = 3 rounded down to
-3e-4/7 s so that the fluid step, 3e-4 s for every k, is a whole number of DEM steps).
+for them, and time.max_overlap 0.3 instead of 0.2 for the harder landing), the DEM step
+k x 1.5e-5 s (the contact time grows as k), or the next shorter step that divides the fluid
+step, 3e-4 s for every k (k = 3: 3e-4/7 s).
 
 Per k: the mean pressure drop over [--from, end] against the bed's buoyant weight
 N V_p (rho_p - rho_f) g / A (the plateau above U_mf), its standard deviation (bubbles), three
@@ -23,8 +24,10 @@ mean eps (the bed's other cells);
 and the cost: grainFoam's CPU seconds (ExecutionTime) per simulated second and its wall time.
 
 usage: fluidised_bed.py [--ks 1,2,3] [--end 1.0] [--from 0.5] [--seed 1] [--depth 0.009]
-                        [--cells 0.003] [--bandwidth B] [--work DIR] [--build DIR]
-                        [--pp-restitution E] [--analyse-only] [--diagnose] [--plot PNG]
+                        [--cells 0.003] [--depth-cells N] [--periodic-depth] [--bandwidth B]
+                        [--sampling cell|cellPoint]
+                        [--work DIR] [--build DIR] [--pp-restitution E] [--analyse-only]
+                        [--diagnose] [--plot PNG]
 --ks takes any factors >= 1 (1.26 is about 2 beads per parcel; cases k<k>_seed<s>).
 --end sets both the scene's time.end and controlDict's endTime (grainFoam stops at the earlier).
 --seed sets the fill's random seed (another realisation of the same bed; cases k<k>_seed<s>).
@@ -32,13 +35,21 @@ usage: fluidised_bed.py [--ks 1,2,3] [--end 1.0] [--from 0.5] [--seed 1] [--dept
 real beads per area; cases k<k>_seed<s>_depth<D>mm).
 --cells C makes the cells C wide in x and z (dividing 60 and 240 mm), with a whole number of
 them across the depth, or one when the depth is under 1.5 C (cases ..._cells<C>mm).
+--depth-cells N puts N cells across the depth instead of cubic cells (1: the pseudo-2D mesh of
+many pseudo-2D studies, one cell spanning the depth; cases ..._ny<N>).
+--periodic-depth makes the column periodic across its depth: no front and back walls in the
+scene, cyclic front and back patches on the mesh (cases ..._periodic). The depth must be at
+least twice the interaction range (grainFoam refuses it otherwise: k = 3 needs --depth 0.018).
+--sampling cellPoint samples the fluid at the particles by interpolation instead of the
+tutorial's footprint-weighted cell values (docs/coupling.md; cases ..._cellPoint).
 --bandwidth B adds couplingProperties' diffusionBandwidth B [m] (docs/coupling.md; cases ..._b<B>mm).
 --pp-restitution E sets the restitution between the beads (parcels) to E, against the walls
 kept at 0.9 (cases k<k>_seed<s>_epp<E>): kinetic theory's collisional dissipation per volume
 falls as 1/k for parcels, restored by 1 - E^2 = k (1 - 0.9^2) (docs/accuracy-vs-cost-coupled.md).
 --analyse-only reads the cases already in DIR (the cost columns from their logs).
---diagnose also prints the heights per snapshot, the solid-fraction profiles and the real mass
-across the depth.
+--diagnose also prints the heights per snapshot, the solid-fraction profiles, the real mass
+across the depth, and where the gas goes: the emulsion's share of the gas flux through the bed
+and, per cell across the depth, the mean eps and the superficial velocity eps U_z.
 Prints one row per k and appends them to <work>/fluidised_bed.csv.
 --plot PNG runs nothing: it plots the bed height and the CPU per simulated second against k from
 that table (the 9 mm column, one series per mesh; docs/accuracy-vs-cost-coupled.md).
@@ -57,8 +68,8 @@ import time
 import h5py
 import numpy as np
 
-from bed_height import (centre_height, foam_scalar_field, pressure_height, real_height,
-                        sphere_fraction_below)
+from bed_height import (centre_height, foam_scalar_field, foam_vector_field, pressure_height,
+                        real_height, sphere_fraction_below)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
@@ -80,12 +91,15 @@ def sub(path, old, new):
 
 
 def dem_step(k):
-    steps = math.floor(FLUID_STEP / (k * 1.5e-5) + 1e-9)
+    """The DEM step: k x 1.5e-5 s, or the next shorter one that divides the fluid step."""
+    steps = math.ceil(FLUID_STEP / (k * 1.5e-5) - 1e-9)
     return FLUID_STEP / steps, steps
 
 
 PP_RESTITUTION = None  # --pp-restitution: the beads' (parcels') restitution against each other
 BANDWIDTH = None  # --bandwidth: couplingProperties' diffusionBandwidth [m]
+PERIODIC_DEPTH = False  # --periodic-depth: front and back cyclic instead of walls
+SAMPLING = None  # --sampling: couplingProperties' sampling (the tutorial's: cell)
 
 
 def parse_k(text):
@@ -104,7 +118,16 @@ def case_dir(work, k, seed):
         tail += f"_epp{PP_RESTITUTION:g}"
     if BANDWIDTH is not None:
         tail += f"_b{1e3 * BANDWIDTH:g}mm"
+    if PERIODIC_DEPTH:
+        tail += "_periodic"
+    if DEPTH_CELLS:
+        tail += f"_ny{DEPTH_CELLS}"
+    if SAMPLING:
+        tail += f"_{SAMPLING}"
     return os.path.join(work, f"k{k}_seed{seed}{tail}")
+
+
+DEPTH_CELLS = None  # --depth-cells: the cells across the depth (default: cubic cells)
 
 
 def set_mesh(depth, cell):
@@ -118,8 +141,8 @@ def set_mesh(depth, cell):
     NX, NZ = round(0.06 / cell), round(HEIGHT / cell)
     if abs(NX * cell - 0.06) > 1e-9 or abs(NZ * cell - HEIGHT) > 1e-9:
         sys.exit(f"fluidised_bed: --cells {cell} does not divide the 60 x 240 mm column")
-    NY = max(1, round(depth / cell))
-    if NY > 1 and abs(NY * cell - depth) > 1e-9:
+    NY = DEPTH_CELLS or max(1, round(depth / cell))
+    if not DEPTH_CELLS and NY > 1 and abs(NY * cell - depth) > 1e-9:
         sys.exit(f"fluidised_bed: --depth {depth} is not a whole number of {cell} m cells")
     DEPTH, AREA, CELL = depth, 0.06 * depth, cell
 
@@ -143,6 +166,9 @@ def prepare(work, k, end, seed):
         sub(scene, "max: [0.06, 0.009, 0.082]", "max: [0.06, 0.009, 0.16]")
         # The longer fall lands them harder: at k = 2 a pair reached 20.3 % overlap in the pour.
         sub(scene, "  max_overlap: 0.2\n", "  max_overlap: 0.3\n")
+    if SAMPLING:
+        sub(os.path.join(case, "constant", "couplingProperties"), "sampling          cell;",
+            f"sampling          {SAMPLING};")
     if BANDWIDTH is not None:
         with open(os.path.join(case, "constant", "couplingProperties"), "a") as f:
             f.write(f"diffusionBandwidth {BANDWIDTH:.6g};\n")
@@ -158,6 +184,20 @@ def prepare(work, k, end, seed):
         sub(mesh, "(60 9 240) (0 9 240)", f"(60 {mm} 240) (0 {mm} 240)")
     if (NX, NY, NZ) != (20, 3, 80):
         sub(mesh, "(20 3 80)", f"({NX} {NY} {NZ})")
+    if PERIODIC_DEPTH:  # no front and back walls: the column repeats across its depth
+        top = f"  max: [0.06, {DEPTH:g}, 0.24]\n"
+        sub(scene, top, top + "  periodic: [false, true, false]\n")
+        sub(scene, "  - {type: plane, name: back, point: [0, 0, 0], normal: [0, 1, 0], material: wall}\n", "")
+        sub(scene, f"  - {{type: plane, name: front, point: [0, {DEPTH:g}, 0], normal: [0, -1, 0], material: wall}}\n", "")
+        sub(mesh, "walls  { type wall;  faces ( (0 1 5 4) (2 3 7 6) (1 2 6 5) (3 0 4 7) ); }",
+            "walls  { type wall;  faces ( (1 2 6 5) (3 0 4 7) ); }\n"
+            "    front  { type cyclic; neighbourPatch back;  faces ( (0 1 5 4) ); }\n"
+            "    back   { type cyclic; neighbourPatch front; faces ( (3 7 6 2) ); }")
+        for name in ("U", "p"):
+            field = os.path.join(case, "0", name)
+            text = open(field).read()
+            at = text.rindex("}")
+            open(field, "w").write(text[:at] + '    "(front|back)" { type cyclic; }\n' + text[at:])
     return case
 
 
@@ -206,7 +246,8 @@ NX, NY, NZ, HEIGHT = 20, 3, 80, 0.24  # the uniform mesh (3 mm cells; set_mesh),
 
 
 def written_fields(case, t_from, name):
-    """(time, field as [z, y, x]) of each written field `name` from t_from on."""
+    """(time, field as [z, y, x]; a vector field as [z, y, x, 3]) of each written field `name`
+    from t_from on."""
     out = []
     for d in glob.glob(os.path.join(case, "[0-9]*")):
         try:
@@ -214,7 +255,9 @@ def written_fields(case, t_from, name):
         except ValueError:
             continue
         if tw >= t_from - 1e-9 and os.path.exists(os.path.join(d, name)):
-            out.append((tw, foam_scalar_field(os.path.join(d, name)).reshape(NZ, NY, NX)))
+            path = os.path.join(d, name)
+            out.append((tw, foam_vector_field(path).reshape(NZ, NY, NX, 3) if name == "U"
+                        else foam_scalar_field(path).reshape(NZ, NY, NX)))
     return sorted(out, key=lambda x: x[0])
 
 
@@ -245,6 +288,26 @@ def bubbles(case, t_from):
     return (float(np.mean(hold)), float(np.mean(emulsion))) if hold else (float("nan"),) * 2
 
 
+def gas_paths(case, t_from):
+    """Where the gas goes through the bed (the cell layers whose mean eps is below 0.9), over the
+    written fields from t_from on: the emulsion's share (cells with eps <= 0.8) of the upward
+    gas flux sum(eps U_z), and per cell across the depth (y) the mean eps and the superficial
+    velocity eps U_z. grainFoam's U is the interstitial velocity."""
+    share, eps, flux = [], [], []
+    velocity = dict(written_fields(case, t_from, "U"))
+    for tw, e in written_fields(case, t_from, "voidfraction"):
+        if tw not in velocity:
+            continue
+        layers = e.mean(axis=(1, 2)) < 0.9
+        bed, q = e[layers], (e * velocity[tw][..., 2])[layers]
+        share.append(float(q[bed <= 0.8].sum() / q.sum()))
+        eps.append(bed.mean(axis=(0, 2)))
+        flux.append(q.mean(axis=(0, 2)))
+    if not share:
+        return float("nan"), [], []
+    return float(np.mean(share)), list(np.mean(eps, axis=0)), list(np.mean(flux, axis=0))
+
+
 def diagnose(case, t_from):
     """Print the heights per snapshot, the settled and the time-mean fluidised solid fraction
     per 3 mm layer (real mass spread over each sphere) and the real mass across the depth in
@@ -272,20 +335,25 @@ def diagnose(case, t_from):
           + " ".join(f"{v:.2f}" for v in settled[1]))
     print("    solid fraction per 3 mm layer, fluidised (time mean): " + " ".join(f"{v:.2f}" for v in np.mean(fluid, 0)))
     print("    real mass across the depth, z 5-25 mm, 1 mm bins: " + " ".join(f"{v:.3f}" for v in np.mean(depth, 0)))
+    share, eps, flux = gas_paths(case, t_from)
+    print(f"    gas through the bed: emulsion's share of the flux {share:.3f}; per cell across the depth, "
+          "eps " + " ".join(f"{v:.3f}" for v in eps) + ", superficial u_z [m/s] " + " ".join(f"{v:.3f}" for v in flux))
 
 
 def plot(table, path):
     """--plot: from the rows of `table` (every run of this script in its work directory), the
     real-particle bed height and the CPU per simulated second against k, for the column 9 mm
-    deep without averaging or a changed restitution, one series per mesh; a fill is a dot, the
-    mean over the fills a line."""
+    deep with its walls and cubic cells, without averaging or a changed restitution, one series
+    per mesh; a fill is a dot, the mean over the fills a line."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     rows = {}
     with open(table) as f:
         for r in csv.DictReader(f):
-            if abs(float(r["depth"]) - 0.009) < 1e-9 and not r["bandwidth"] and not r["pp_restitution"]:
+            if (abs(float(r["depth"]) - 0.009) < 1e-9 and not r["bandwidth"] and not r["pp_restitution"]
+                    and not r.get("depth_cells") and r.get("periodic_depth", "0") == "0"
+                    and r.get("sampling", "cell") == "cell"):
                 rows[(float(r["k"]), int(r["seed"]), float(r["cells"]))] = r  # the last run of each
     if not rows:
         sys.exit(f"fluidised_bed: no runs of the 9 mm column in {table}")
@@ -337,17 +405,26 @@ def main():
     ap.add_argument("--cells", type=float, default=0.003)
     ap.add_argument("--pp-restitution", type=float, default=None)
     ap.add_argument("--bandwidth", type=float, default=None)
+    ap.add_argument("--periodic-depth", action="store_true")
+    ap.add_argument("--depth-cells", type=int, default=None)
+    ap.add_argument("--sampling", choices=("cell", "cellPoint"), default=None)
     ap.add_argument("--plot", default=None, metavar="PNG")
     ap.add_argument("--work", default=os.path.join(ROOT, "build", "benchmarks", "coarse_grain_fluidised"))
     ap.add_argument("--build", default=os.environ.get("GRAINFLOW_BUILD_DIR", os.path.join(ROOT, "build")))
     args = ap.parse_args()
     if args.plot:
         return plot(os.path.join(args.work, "fluidised_bed.csv"), args.plot)
+    global DEPTH_CELLS, SAMPLING
+    SAMPLING = args.sampling if args.sampling != "cell" else None
+    if args.depth_cells is not None and args.depth_cells < 1:
+        sys.exit(f"fluidised_bed: --depth-cells {args.depth_cells} must be a whole number >= 1")
+    DEPTH_CELLS = args.depth_cells
     set_mesh(args.depth, args.cells)
     global PP_RESTITUTION
     PP_RESTITUTION = args.pp_restitution
-    global BANDWIDTH
+    global BANDWIDTH, PERIODIC_DEPTH
     BANDWIDTH = args.bandwidth
+    PERIODIC_DEPTH = args.periodic_depth
     if BANDWIDTH is not None and not BANDWIDTH >= 0:
         sys.exit(f"fluidised_bed: --bandwidth {BANDWIDTH} must be a length >= 0 [m] (0: no averaging)")
     os.makedirs(args.work, exist_ok=True)
@@ -369,11 +446,13 @@ def main():
         cpu = float(re.findall(r"ExecutionTime = (\S+) s", text)[-1])
         simulated = float(re.findall(r"^Time = (\S+)$", text, re.MULTILINE)[-1])  # the run's own end
         imbalance = max(float(x) for x in re.findall(r"relative imbalance (\S+)", text))
-        row = dict(k=k, seed=args.seed, depth=DEPTH, cells=CELL,
+        row = dict(k=k, seed=args.seed, depth=DEPTH, cells=CELL, depth_cells=DEPTH_CELLS or "",
+                   periodic_depth=int(PERIODIC_DEPTH), sampling=SAMPLING or "cell",
                    bandwidth="" if BANDWIDTH is None else BANDWIDTH,
                    pp_restitution="" if PP_RESTITUTION is None else PP_RESTITUTION,
                    **analyse(case, args.t_from), cpu_s=cpu, wall_s=wall,
-                   simulated_s=simulated, cpu_per_simulated_s=cpu / simulated, worst_imbalance=imbalance)
+                   simulated_s=simulated, cpu_per_simulated_s=cpu / simulated, worst_imbalance=imbalance,
+                   emulsion_gas_share=gas_paths(case, args.t_from)[0])
         rows.append(row)
         if args.diagnose:
             diagnose(case, args.t_from)
@@ -385,7 +464,7 @@ def main():
               f"pressure {1e3 * row['height_pressure']:.2f} mm; settled before the inflow: real-particle "
               f"height {1e3 * row['settled_height']:.2f} mm, solid fraction "
               f"{row['settled_solid_fraction']:.3f}; bubble holdup {row['bubble_holdup']:.3f}, emulsion eps "
-              f"{row['emulsion_voidfraction']:.3f}; CPU {cpu:.0f} s ({cpu / simulated:.0f} s per "
+              f"{row['emulsion_voidfraction']:.3f}, its share of the gas flux {row['emulsion_gas_share']:.3f}; CPU {cpu:.0f} s ({cpu / simulated:.0f} s per "
               f"simulated s), wall {wall:.0f} s, exchange imbalance {imbalance:.1e}", flush=True)
     out = os.path.join(args.work, "fluidised_bed.csv")
     new = not os.path.exists(out)

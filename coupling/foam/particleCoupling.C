@@ -611,6 +611,8 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
     const double smallest = std::cbrt(gMin(mesh.V().field()));
     for (const std::string& w : dem_->parcel_cell_warnings(smallest, std::cbrt(sums[2] / cells)))
       Info << "grainFoam coupling: " << w.c_str() << endl;
+    for (const std::string& w : dem_->parcel_domain_warnings())
+      Info << "grainFoam coupling: " << w.c_str() << endl;
   }
 
   voidFraction_.oldTime();  // keep old times for ddt(voidfraction)

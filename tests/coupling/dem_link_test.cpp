@@ -346,7 +346,8 @@ TEST(DemLink, CellPointReturnsTheDragsRemainderExplicitly) {
 // grain check; Radl et al. 2011). k = 1: real beads, no warning. k = 2: parcels up to 2.52 mm,
 // cells of 1.19 parcel diameters, one warning (fewer than 3). k = 3: parcels up to 3.78 mm,
 // wider than the cells: both warnings, each naming the class glass[k=3], the largest parcel
-// diameter (from the particles, independently of the link) and the cell sizes.
+// diameter (from the particles, independently of the link) and the cell sizes. The domain's
+// warning (its 9 mm depth under 10 parcel diameters) for k = 2 and 3, not for the beads.
 std::string fluidised_bed_scene(double k) {
   std::ostringstream s;
   s << "domain: {min: [0, 0, 0], max: [0.06, 0.009, 0.06]}\n"
@@ -387,10 +388,21 @@ TEST(DemLink, WarnsOfParcelsLargeAgainstTheCells) {
     MPI_Allreduce(MPI_IN_PLACE, &widest, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
     ASSERT_GT(widest, k * 1.14e-3);
     ASSERT_LE(widest, k * 1.26e-3 * (1 + 1e-12));
+    // The domain's rule (grain check's): its 9 mm depth is less than 10 parcel diameters for
+    // k = 2 and 3 (3.6 and 2.4 parcels deep), not a concern for the beads.
+    const std::vector<std::string> domain = link.parcel_domain_warnings();
     if (k == 1) {
       EXPECT_TRUE(warnings.empty()) << warnings.front();
+      EXPECT_TRUE(domain.empty()) << domain.front();
       continue;
     }
+    ASSERT_EQ(domain.size(), 1u);
+    EXPECT_EQ(domain[0].rfind("warning: the domain's narrowest side (0.009 m) is less than 10 "
+                              "diameters of parcels 'glass[k=" +
+                                  std::to_string(k) + "]' (" + significant(widest) + " m)",
+                              0),
+              0u)
+        << domain[0];
     const std::string cls = "parcels 'glass[k=" + std::to_string(k) + "]' (diameter up to " +
                             significant(widest) + " m)";
     const std::string cells = "(smallest 0.003 m, typical 0.003 m)";

@@ -86,5 +86,17 @@ with tempfile.TemporaryDirectory() as tmp:
         got = bh.foam_scalar_field(path)
         check(f"{fmt} field", float(np.abs(got - values).max()) if len(got) == 4 else 1.0, 0.0, 0.0)
 
+vectors = np.array([[1.5, -2.25, 3e-7], [4.0, 0.0, -1e3]])
+vheader = header.replace("volScalarField", "volVectorField").replace("List<scalar> \n4", "List<vector> \n2")
+with tempfile.TemporaryDirectory() as tmp:
+    for fmt in ("ascii", "binary"):
+        body = ("\n".join("(" + " ".join(repr(v) for v in row) + ")" for row in vectors) + "\n").encode() \
+            if fmt == "ascii" else vectors.astype("<f8").tobytes()
+        path = os.path.join(tmp, f"U_{fmt}")
+        with open(path, "wb") as f:
+            f.write(vheader.format(fmt=fmt).encode() + body + b")\n;\n\nboundaryField\n{\n}\n")
+        got = bh.foam_vector_field(path)
+        check(f"{fmt} vector field", float(np.abs(got - vectors).max()) if got.shape == (2, 3) else 1.0, 0.0, 0.0)
+
 print("bed_height_test:", "FAILED " + ", ".join(failures) if failures else "all passed")
 sys.exit(1 if failures else 0)
