@@ -709,6 +709,16 @@ DemSummary DemLink::summary() const {
   return s;
 }
 
+std::vector<WallLoad> DemLink::take_wall_loads(double& interval) {
+  const Simulation::WallLoads w = impl_->simulation().take_wall_loads();
+  interval = w.interval;
+  std::vector<WallLoad> out;
+  const auto& walls = impl_->simulation().walls().walls();
+  for (std::size_t k = 0; k < w.force.size(); ++k)
+    out.push_back({walls[k].name, {w.force[k][0], w.force[k][1], w.force[k][2]}});
+  return out;
+}
+
 std::array<double, 3> DemLink::buoyant_weight() const {
   const Particles& p = impl_->simulation().particles();
   double excess = 0;  // sum m - rho_f V
@@ -795,7 +805,7 @@ std::vector<std::string> DemLink::parcel_domain_warnings() const {
   const std::vector<ParcelClass> classes =
       parcel_classes(impl_->scene, impl_->simulation().particles(), impl_->dem_comm);
   const Vec3 extent = impl_->scene.domain.hi - impl_->scene.domain.lo;
-  return grainflow::parcel_domain_warnings(classes, extent.minCoeff());
+  return grainflow::parcel_domain_warnings(classes, extent, impl_->scene.domain.periodic);
 }
 
 }  // namespace grainflow::coupling

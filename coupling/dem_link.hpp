@@ -134,6 +134,13 @@ struct DemSummary {
   double collective_wait_seconds = 0;
 };
 
+// One wall's load (output.wall_loads): the mean force the particles exerted on it by contact
+// over the interval since the last DemLink::take_wall_loads().
+struct WallLoad {
+  std::string name;             // the scene's wall name
+  std::array<double, 3> force;  // [N]
+};
+
 class DemLink {
  public:
   // Reads and checks the scene (errors name the scene file, line and key; thrown as
@@ -271,6 +278,10 @@ class DemLink {
   // Collective; throws std::runtime_error if the write fails.
   std::string write_checkpoint(const std::string& directory, int keep);
   std::vector<std::string> reports() const;  // the force terms' closing remarks
+  // With output.wall_loads in the scene: each wall's load since the last call (or the start,
+  // or the checkpoint restored), in the scene's wall order, and in `interval` that time span
+  // [s]; the sums restart. Empty when the scene does not ask for them. Collective.
+  std::vector<WallLoad> take_wall_loads(double& interval);
   // Each fluid force's stability time scale and limit at initialise() (before the first
   // fluid sample: fluid at rest), one line each, and an "error: ..." line for a step beyond
   // an explicit force's limit (docs/models/fluid-forces.md).

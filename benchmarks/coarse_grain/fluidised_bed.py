@@ -73,6 +73,8 @@ from bed_height import (centre_height, foam_scalar_field, foam_vector_field, pre
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, os.path.join(ROOT, "tutorials", "cfd-dem"))
+from foam_case import WALL_LOADS, mean_wall_share, series as foam_series  # noqa: E402
 FOAM = os.path.join(ROOT, "scripts", "foam_env.sh")
 TUTORIAL = os.path.join(ROOT, "tutorials", "cfd-dem", "fluidisedBed")
 RHO_F, G = 1.2, 9.81
@@ -308,6 +310,48 @@ def gas_paths(case, t_from):
     return float(np.mean(share)), list(np.mean(eps, axis=0)), list(np.mean(flux, axis=0))
 
 
+def momentum_budget(case, t_from):
+    """The bed's vertical momentum budget between the first snapshot from t_from on (t0) and
+    the last (t1), each term a share of the buoyant weight W: the gas (mean dp A over the
+    fluid steps in (t0, t1]), each wall (grainFoam's `wall loads` lines of the write intervals
+    inside [t0, t1]), the inflow's momentum rho U_s^2 (1/eps_b - 1) A (eps_b: the bottom cells'
+    void fraction, written fields), the bed's momentum gain between the two snapshots, and
+    the balance gas + walls + inflow - gain - 1 (0 when every force is accounted for)."""
+    snaps = []
+    for s in sorted(glob.glob(os.path.join(case, "particles", "particles_*.h5"))):
+        with h5py.File(s, "r") as f:
+            ts = float(f.attrs["time"])
+            if ts >= t_from - 1e-9:
+                m, d = f["mass"][:], f["diameter"][:]
+                snaps.append((ts, float(np.dot(m, f["velocity"][:, 2])),
+                              float(np.sum(m - RHO_F * math.pi / 6 * d**3)) * G))
+    (t0, p0, weight), (t1, p1, _) = snaps[0], snaps[-1]
+    t, p_in, _ = foam_series(case, "pInlet")
+    _, p_out, _ = foam_series(case, "pOutlet")
+    tq, q, area = foam_series(case, "inletFlow")
+    n = min(len(t), len(p_out), len(tq))
+    inside = (t[:n] > t0 + 1e-9) & (t[:n] <= t1 + 1e-9)
+    out = dict(gas=float(RHO_F * (p_in[:n] - p_out[:n])[inside].mean()) * AREA / weight)
+    walls, span, now = {}, 0.0, None
+    for line in open(os.path.join(case, "log.grainFoam")):
+        if line.startswith("Time = "):
+            now = float(line.split()[2])
+        elif (m := WALL_LOADS.match(line)) and now is not None:
+            dt = float(m.group(1))
+            if now - dt >= t0 - 1e-9 and now <= t1 + 1e-9:
+                span += dt
+                for name, values in re.findall(r"(\S+) \(([^)]*)\)", m.group(2)):
+                    walls[name] = walls.get(name, 0.0) - dt * float(values.split()[2])
+    out["walls"] = {name: f / span / weight for name, f in walls.items()} if span > 0 else {}
+    u_s = float(-q[:n][inside].mean() / area)
+    inverse = [np.mean(1 / e[0]) for _, e in written_fields(case, t0, "voidfraction") if _ <= t1 + 1e-9]
+    out["inflow"] = RHO_F * u_s**2 * (float(np.mean(inverse)) - 1) * AREA / weight
+    out["gain"] = (p1 - p0) / (t1 - t0) / weight
+    out["balance"] = out["gas"] + sum(out["walls"].values()) + out["inflow"] - out["gain"] - 1
+    out["window"] = (t0, t1)
+    return out
+
+
 def diagnose(case, t_from):
     """Print the heights per snapshot, the settled and the time-mean fluidised solid fraction
     per 3 mm layer (real mass spread over each sphere) and the real mass across the depth in
@@ -335,6 +379,11 @@ def diagnose(case, t_from):
           + " ".join(f"{v:.2f}" for v in settled[1]))
     print("    solid fraction per 3 mm layer, fluidised (time mean): " + " ".join(f"{v:.2f}" for v in np.mean(fluid, 0)))
     print("    real mass across the depth, z 5-25 mm, 1 mm bins: " + " ".join(f"{v:.3f}" for v in np.mean(depth, 0)))
+    b = momentum_budget(case, t_from)
+    print(f"    momentum budget {b['window'][0]:.2f}-{b['window'][1]:.2f} s, shares of the buoyant weight: "
+          f"gas {b['gas']:.4f}, " + ", ".join(f"{k} {v:+.4f}" for k, v in b["walls"].items())
+          + f", inflow's momentum {b['inflow']:+.4f}, the bed's momentum gain {b['gain']:+.4f}: "
+          f"balance {b['balance']:+.4f}")
     share, eps, flux = gas_paths(case, t_from)
     print(f"    gas through the bed: emulsion's share of the flux {share:.3f}; per cell across the depth, "
           "eps " + " ".join(f"{v:.3f}" for v in eps) + ", superficial u_z [m/s] " + " ".join(f"{v:.3f}" for v in flux))
@@ -452,13 +501,14 @@ def main():
                    pp_restitution="" if PP_RESTITUTION is None else PP_RESTITUTION,
                    **analyse(case, args.t_from), cpu_s=cpu, wall_s=wall,
                    simulated_s=simulated, cpu_per_simulated_s=cpu / simulated, worst_imbalance=imbalance,
-                   emulsion_gas_share=gas_paths(case, args.t_from)[0])
+                   emulsion_gas_share=gas_paths(case, args.t_from)[0],
+                   walls_share=mean_wall_share(os.path.join(case, "log.grainFoam"), args.t_from)[0])
         rows.append(row)
         if args.diagnose:
             diagnose(case, args.t_from)
         print(f"k = {k}: {row['parcels']} parcels ({row['real']} beads), mean dp "
               f"{row['dp_mean']:.1f} Pa = {row['dp_mean'] / row['weight']:.4f} x weight "
-              f"{row['weight']:.1f} Pa, std {row['dp_std']:.1f} Pa, bed height (real particles) "
+              f"{row['weight']:.1f} Pa (the walls carry {row['walls_share']:.4f}), std {row['dp_std']:.1f} Pa, bed height (real particles) "
               f"{1e3 * row['height']:.2f} mm (sd over {row['snapshots']} snapshots "
               f"{1e3 * row['height_sd']:.2f}), parcel centres {1e3 * row['height_centres']:.2f} mm, "
               f"pressure {1e3 * row['height_pressure']:.2f} mm; settled before the inflow: real-particle "

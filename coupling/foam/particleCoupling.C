@@ -1852,6 +1852,9 @@ void ParticleCoupling::write() {
   using namespace Foam;
   Stopwatch clock;
   const Time& time = mesh_.time();
+  // output.wall_loads: taken before the checkpoint, which then starts the next interval
+  // (a restart from it reports the same loads as the uninterrupted run).
+  const std::string wallLoads = wallLoadLine();
   std::string checkpoint;
   try {
     if (snapshotInterval_ <= 0) writeSnapshot();
@@ -1936,12 +1939,35 @@ void ParticleCoupling::write() {
              << "grainFoam CPU time split since the last write: " << split(interval + 4).c_str()
              << "\n"
              << "grainFoam CPU time split: " << split(times + 4).c_str() << perRank.c_str()
-             << Foam::endl;
+             << wallLoads.c_str() << Foam::endl;
   if (undisturbed_)
     for (const std::string& line : dem_->reports())
       if (line.rfind("undisturbed velocity", 0) == 0)
         Foam::Info << "grainFoam " << line.c_str()
                    << (Pstream::parRun() ? " (particles of rank 0)" : "") << Foam::endl;
+}
+
+std::string ParticleCoupling::wallLoadLine() {
+  double interval = 0;
+  const std::vector<coupling::WallLoad> loads = dem_->take_wall_loads(interval);
+  if (loads.empty()) return {};
+  const std::array<double, 3> w = dem_->buoyant_weight();
+  const double weight2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+  std::ostringstream text;
+  text.precision(8);
+  text << "\ngrainFoam wall loads over the last " << interval
+       << " s (mean force of the particles on each wall, N):";
+  std::array<double, 3> total{0, 0, 0};
+  for (const coupling::WallLoad& l : loads) {
+    text << " " << l.name << " (" << l.force[0] << " " << l.force[1] << " " << l.force[2] << ")";
+    for (int a = 0; a < 3; ++a) total[a] += l.force[a];
+  }
+  // The walls' share of the particles' buoyant weight: with the fluid's share (the pressure
+  // drop times the cross-section in a column) it closes the bed's momentum balance.
+  if (weight2 > 0)
+    text << "; all walls carry " << (total[0] * w[0] + total[1] * w[1] + total[2] * w[2]) / weight2
+         << " of the particles' buoyant weight";
+  return text.str();
 }
 
 std::string ParticleCoupling::cellPointLine() const {

@@ -464,6 +464,7 @@ void apply_wall_contacts(ContactSweep& s, int material, const WallHit* hits, int
         if constexpr (Law::keeps_tangential) history[h[l]->k].tangential = lane(ht, l);
         force[i] += lane(res.force, l);
         if constexpr (Law::needs_spin) torque[i] += lane(res.torque_i, l);
+        if (s.load) *s.load += lane(res.force, l);
         ++s.contacts;
         if (const double ratio = g.overlap[l] / radius[i]; ratio > s.max_overlap_ratio)
           s.worst.consider(ratio, s.max_overlap_ratio, p.id[i], -1,

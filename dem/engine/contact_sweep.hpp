@@ -111,6 +111,11 @@ struct ContactSweep {
   // completes there the exchange of the ghosts' positions and velocities, which travel while
   // the pairs of this rank's own particles are swept.
   std::function<void()> ghosts_ready = {};
+  // output.wall_loads: one sum per wall (WallSet order) of the contact forces the walls
+  // exert on this rank's particles in this sweep; null: not kept. `load` is the current
+  // wall's entry while the wall sweep runs.
+  std::vector<Vec3>* wall_forces = nullptr;
+  Vec3* load = nullptr;
 };
 
 using SweepFunction = void (*)(ContactSweep&);

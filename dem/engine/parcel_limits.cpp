@@ -62,7 +62,12 @@ std::vector<std::string> parcel_cell_warnings(const std::vector<ParcelClass>& cl
 }
 
 std::vector<std::string> parcel_domain_warnings(const std::vector<ParcelClass>& classes,
-                                                double narrowest_side) {
+                                                const Vec3& extent,
+                                                const std::array<bool, 3>& periodic) {
+  int axis = 0;
+  for (int a = 1; a < 3; ++a)
+    if (extent[a] < extent[axis] || (extent[a] == extent[axis] && periodic[axis])) axis = a;
+  const double narrowest_side = extent[axis];
   double widest = 0;
   const ParcelClass* by = nullptr;
   for (const ParcelClass& c : classes)
@@ -72,10 +77,13 @@ std::vector<std::string> parcel_domain_warnings(const std::vector<ParcelClass>& 
     }
   if (!by || !(narrowest_side < 10 * widest)) return {};
   std::ostringstream o;
-  o << "warning: the domain's narrowest side (" << significant(narrowest_side)
-    << " m) is less than 10 diameters of parcels '" << by->name << "' (" << significant(widest)
-    << " m): walls and the bed's own structures (bubbles, shear bands) are then resolved by "
-       "few parcels, where coarse graining is known to fail; lower coarse_grain";
+  o << "warning: the domain's narrowest side (" << significant(narrowest_side) << " m"
+    << (periodic[axis] ? std::string(", periodic along ") + "xyz"[axis] : std::string())
+    << ") is less than 10 diameters of parcels '" << by->name << "' (" << significant(widest)
+    << " m): "
+    << (periodic[axis] ? "the bed's own structures" : "walls and the bed's own structures")
+    << " (bubbles, shear bands) are then resolved by few parcels, where coarse graining is known "
+       "to fail; lower coarse_grain";
   return {o.str()};
 }
 

@@ -36,9 +36,12 @@ std::vector<std::string> parcel_cell_warnings(const std::vector<ParcelClass>& cl
                                               double smallest_cell, double typical_cell,
                                               const std::string& cell_what);
 
-// Parcels against the domain: a line when the domain's narrowest side is less than 10
-// diameters of the widest parcel (walls and the bed's structures resolved by few parcels).
+// Parcels against the domain: a line when the domain's narrowest side (`extent` per axis;
+// of equally narrow sides, a bounded one before a periodic one) is less than 10 diameters of
+// the widest parcel: walls (on a bounded side) and the bed's structures resolved by few
+// parcels.
 std::vector<std::string> parcel_domain_warnings(const std::vector<ParcelClass>& classes,
-                                                double narrowest_side);
+                                                const Vec3& extent,
+                                                const std::array<bool, 3>& periodic);
 
 }  // namespace grainflow

@@ -149,7 +149,7 @@ void print_coarse_grain_report(const Scene& scene, const Particles& p, MPI_Comm 
   o << "  all particles: " << parcels << " computed, " << real << " real, mass " << mass
     << " kg\n";
   const Vec3 extent = scene.domain.hi - scene.domain.lo;
-  for (const std::string& w : parcel_domain_warnings(classes, extent.minCoeff()))
+  for (const std::string& w : parcel_domain_warnings(classes, extent, scene.domain.periodic))
     o << "  " << w << "\n";
   if (scene.fluid && scene.fluid->computed_void_fraction) {
     const double h = scene.fluid->computed_void_fraction->cell_size;
@@ -229,15 +229,23 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   SnapshotWriter snapshots(comm, dir, "particles", scene.output.fields);
   snapshots.set_coarse_grain(scene.coarse_grain_table(), scene.real_material_table());
   const std::string log_path = (std::filesystem::path(dir) / "log.csv").string();
+  // output.wall_loads: each wall's mean load since the previous row, and that time span.
+  std::vector<std::string> wall_columns;
+  if (scene.output.wall_loads) {
+    for (const WallSet::Entry& w : sim.walls().walls())
+      for (const char* axis : {"x", "y", "z"})
+        wall_columns.push_back(w.name + "_load_" + axis + "_N");
+    wall_columns.emplace_back("wall_load_interval_s");
+  }
   std::optional<LogTable> log_table;
   if (options.restart) {
     const std::size_t kept = snapshots.continue_series(first_step);
-    log_table.emplace(comm, log_path, first_step);
+    log_table.emplace(comm, log_path, first_step, wall_columns);
     say << "restart: from " << *options.restart << " at step " << first_step
         << " (t = " << sim.time() << " s); continuing " << dir
         << "/log.csv and the snapshot series after " << kept << " earlier snapshot(s)\n";
   } else {
-    log_table.emplace(comm, log_path);
+    log_table.emplace(comm, log_path, wall_columns);
   }
   LogTable& log = *log_table;
   ProgressLine progress(comm, scene.time.end, options.progress && scene.output.progress, out);
@@ -276,10 +284,16 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   };
   auto write_log = [&] {
     const GlobalState g = sim.global_state();
+    std::vector<double> loads;
+    if (scene.output.wall_loads) {
+      const Simulation::WallLoads w = sim.take_wall_loads();
+      for (const Vec3& f : w.force) loads.insert(loads.end(), {f[0], f[1], f[2]});
+      loads.push_back(w.interval);
+    }
     try {
       log.write({sim.time(), sim.counters().steps, g.particles, g.kinetic_translational,
                  g.kinetic_rotational, g.max_overlap_ratio, g.contacts, sim.counters().rebuilds,
-                 g.removed, wall()});
+                 g.removed, wall(), std::move(loads)});
     } catch (const OutputError& e) {
       throw resumable(e);
     }

@@ -137,6 +137,10 @@ Simulation::Simulation(const Scene& scene, bool insert, MPI_Comm comm,
     throw SetupError(e.what());
   }
   streams_ = StreamInsertion(scene_);
+  if (scene_.output.wall_loads) {
+    wall_forces_.assign(walls_.walls().size(), Vec3::Zero());
+    wall_impulse_ = wall_forces_;
+  }
   if (scene_.heat) heat_ = std::make_unique<HeatTransfer>(scene_);
   if (insert) insert_particles(scene_, p_, next_id_, &walls_);
 }
@@ -685,6 +689,30 @@ void Simulation::restore(const CheckpointData& checkpoint) {
   next_id_ = checkpoint.next_id;
   restored_springs_ = checkpoint.springs;
   restored_grid_ = checkpoint.grid;
+  // The wall loads' sums since the last log row before the checkpoint (global, so rank 0
+  // takes them); a checkpoint without them starts the sums at the restart.
+  if (!wall_impulse_.empty() && !checkpoint.wall_impulse.empty()) {
+    const std::vector<double>& j = checkpoint.wall_impulse;
+    if (j.size() != 3 * wall_impulse_.size() + 1 ||
+        !std::all_of(j.begin(), j.end(), [](double x) { return std::isfinite(x); }) || j.back() < 0)
+      throw SetupError(scene_.file + ": error: " + where + ": attribute 'wall_impulse' holds " +
+                       std::to_string(j.size()) + " values" +
+                       (j.size() == 3 * wall_impulse_.size() + 1
+                            ? " with a non-finite value or a negative time span"
+                            : std::string(", but the scene's ") +
+                                  std::to_string(wall_impulse_.size()) + " walls need " +
+                                  std::to_string(3 * wall_impulse_.size() + 1)) +
+                       "; the file is damaged or from another scene: restart from another "
+                       "checkpoint, or with the scene it was written with");
+    int rank = 0;
+    MPI_Comm_rank(comm_, &rank);
+    for (std::size_t w = 0; w < wall_impulse_.size(); ++w)
+      wall_impulse_[w] =
+          rank == 0 ? Vec3(checkpoint.wall_impulse[3 * w], checkpoint.wall_impulse[3 * w + 1],
+                           checkpoint.wall_impulse[3 * w + 2])
+                    : Vec3::Zero();
+    wall_load_time_ = checkpoint.wall_impulse.back();
+  }
   restored_ = true;
   network_recorded_ = false;
 }
@@ -707,6 +735,14 @@ void Simulation::write_checkpoint(const std::string& path) {
     d.drag_fluid_velocity = drag_.fluid_velocity;
   }
   d.streams = streams_.save_state();
+  if (!wall_impulse_.empty()) {
+    d.wall_impulse.reserve(3 * wall_impulse_.size() + 1);
+    for (const Vec3& j : wall_impulse_)
+      d.wall_impulse.insert(d.wall_impulse.end(), {j[0], j[1], j[2]});
+    MPI_Allreduce(MPI_IN_PLACE, d.wall_impulse.data(), static_cast<int>(d.wall_impulse.size()),
+                  MPI_DOUBLE, MPI_SUM, comm_);
+    d.wall_impulse.push_back(wall_load_time_);
+  }
   CheckpointGrid& grid = d.grid.emplace();
   grid.ranks = decomp_->size();
   grid.dims = decomp_->dims();
@@ -838,6 +874,10 @@ ContactGuards Simulation::compute_forces(bool advance_springs) {
   // clang-format on
   s.canonical = &canonical_;
   if (forward_pending_) s.ghosts_ready = [this] { finish_forward(); };
+  if (!wall_forces_.empty()) {
+    std::fill(wall_forces_.begin(), wall_forces_.end(), Vec3::Zero());
+    s.wall_forces = &wall_forces_;
+  }
   // Before the sweep: it reads the springs as the sweep will, and leaves them unchanged.
   if (record_contacts_) {
     finish_forward();
@@ -849,6 +889,10 @@ ContactGuards Simulation::compute_forces(bool advance_springs) {
   }
   sweep_.run(s);
   finish_forward();  // when the sweep read no ghost
+  if (advance_springs && !wall_forces_.empty()) {  // a step's forces (not the initial state's)
+    for (std::size_t w = 0; w < wall_forces_.size(); ++w) wall_impulse_[w] += dt_ * wall_forces_[w];
+    wall_load_time_ += dt_;
+  }
   // The fastest local particle bounds both the steps-per-contact gate and the travel guard;
   // kick_and_drift() has found it (in the same order) unless a rebuild came since.
   double v2_local = 0;
@@ -1429,6 +1473,24 @@ void Simulation::step() {
   state_finite_ = half_kick<true>();
   finite_everywhere_ = check_contacts(guards, state_finite_);
   ++counters_.steps;
+}
+
+Simulation::WallLoads Simulation::take_wall_loads() {
+  WallLoads out;
+  if (wall_impulse_.empty()) return out;
+  const std::size_t n = wall_impulse_.size();
+  std::vector<double> sum(3 * n);
+  for (std::size_t w = 0; w < n; ++w)
+    for (int a = 0; a < 3; ++a) sum[3 * w + a] = wall_impulse_[w][a];
+  MPI_Allreduce(MPI_IN_PLACE, sum.data(), static_cast<int>(sum.size()), MPI_DOUBLE, MPI_SUM, comm_);
+  out.interval = wall_load_time_;
+  out.force.assign(n, Vec3::Zero());
+  if (wall_load_time_ > 0)  // the load: the reaction to the walls' forces on the particles
+    for (std::size_t w = 0; w < n; ++w)
+      out.force[w] = -Vec3(sum[3 * w], sum[3 * w + 1], sum[3 * w + 2]) / wall_load_time_;
+  std::fill(wall_impulse_.begin(), wall_impulse_.end(), Vec3::Zero());
+  wall_load_time_ = 0;
+  return out;
 }
 
 void Simulation::advance_to(double t_end) {

@@ -193,6 +193,17 @@ class Simulation {
   // Whether contact_network() holds the last force evaluation's network.
   bool contact_network_recorded() const { return network_recorded_; }
 
+  // output.wall_loads: each wall's load (WallSet order): the mean force the particles
+  // exerted on it by contact (minus the sum of the wall's contact forces on them) over
+  // `interval`, the simulated time since the last call, the start, or the checkpoint
+  // restored (one written with output.wall_loads carries the time before it). Resets the
+  // sums. Collective; `force` is empty when output.wall_loads is off.
+  struct WallLoads {
+    std::vector<Vec3> force;  // [N]
+    double interval = 0;      // [s]
+  };
+  WallLoads take_wall_loads();
+
   // Largest over mean particle count per rank (1 = perfectly balanced). Collective.
   double load_imbalance() const;
 
@@ -315,6 +326,11 @@ class Simulation {
   // force evaluation that recorded it.
   bool record_fluid_ = false;
   std::vector<Vec3> fluid_explicit_;
+  // output.wall_loads (else empty): the walls' contact forces on this rank's particles in
+  // the last sweep, and their time integral over wall_load_time_ since the last
+  // take_wall_loads() (on rank 0 also a restored checkpoint's global sums).
+  std::vector<Vec3> wall_forces_, wall_impulse_;
+  double wall_load_time_ = 0;
   bool record_contacts_ = false;   // record_contacts()
   bool network_recorded_ = false;  // network_ is the last force evaluation's
   ContactNetwork network_;

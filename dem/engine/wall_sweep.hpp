@@ -62,6 +62,7 @@ void apply_wall_contact(ContactSweep& s, std::size_t i, const WallTouch& t, int 
                                         h.tangential, h.rolling, s.dt, s.spring_dt);
   p.force[i] += r.force;
   if constexpr (Law::needs_spin) p.torque[i] += r.torque_i;
+  if (s.load) *s.load += r.force;
   ++s.contacts;
   if (const double ratio = g.overlap / p.radius[i]; ratio > s.max_overlap_ratio)
     s.worst.consider(ratio, s.max_overlap_ratio, p.id[i], -1, -g.v_pred.dot(g.n), g.r_star, g.m_star,
@@ -195,6 +196,7 @@ void wall_sweep(ContactSweep& s) {
   for (std::size_t w = 0; w < s.walls.walls().size(); ++w) {
     const WallSet::Entry& wall = s.walls.walls()[w];
     const WallNeighbours::List& list = s.wall_neighbours.lists[w];
+    if (s.wall_forces) s.load = &(*s.wall_forces)[w];
     switch (wall.kind) {
       case Wall::Kind::plane:
         wall_sweep_one<Law>(s, wall, list, s.wall_history[wall.column],
@@ -213,6 +215,7 @@ void wall_sweep(ContactSweep& s) {
         break;
     }
   }
+  s.load = nullptr;
 }
 
 }  // namespace grainflow

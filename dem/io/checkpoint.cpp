@@ -216,6 +216,13 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
     if (!written) fail.capture();
     fail.check(written, "writing the attributes material_coarse_grain, material_real");
   }
+  if (fail.ok() && !d.wall_impulse.empty()) {
+    const bool written =
+        write_array_attribute(f.id(), "wall_impulse", H5T_NATIVE_DOUBLE, H5T_NATIVE_DOUBLE,
+                              d.wall_impulse.size(), d.wall_impulse.data());
+    if (!written) fail.capture();
+    fail.check(written, "writing the attribute wall_impulse");
+  }
   std::vector<long long> ids(p.id.begin(), p.id.end());
   std::vector<int> mats(p.material.begin(), p.material.end());
   auto flat = [](const std::vector<Vec3>& v) {
@@ -353,6 +360,7 @@ void write_checkpoint(MPI_Comm comm, const std::string& path, const CheckpointDa
     d.grid = local.grid;
     d.material_coarse_grain = local.material_coarse_grain;
     d.material_real = local.material_real;
+    d.wall_impulse = local.wall_impulse;
     for (int r = 0; r < size; ++r) unpack(all.data() + displs[r], counts[r], d);
     const std::string part = path + ".part";
     // A foreseeable full disk is refused before HDF5 starts: a checksummed (chunked) file
@@ -411,6 +419,9 @@ CheckpointData read_checkpoint(const std::string& path) {
       error = "attribute 'material_real' cannot be read";
     if (error.empty() && d.material_coarse_grain.size() != d.material_real.size())
       error = "attributes 'material_coarse_grain' and 'material_real' differ in length";
+    if (error.empty() &&
+        !read_array_attribute(f, "wall_impulse", H5T_NATIVE_DOUBLE, d.wall_impulse))
+      error = "attribute 'wall_impulse' cannot be read";
     std::size_t n = static_cast<std::size_t>(-1), m = static_cast<std::size_t>(-1);
     if (error.empty() && H5Lexists(f, "particles", H5P_DEFAULT) <= 0)
       error = "group 'particles' is missing";

@@ -78,6 +78,10 @@ struct CheckpointData {
   // attributes; empty in a file written before they were, which is then not checked for them.
   std::vector<double> material_coarse_grain;
   std::vector<int> material_real;
+  // output.wall_loads: the time integral of each wall's contact forces on the particles
+  // since the last log row (x, y, z per wall, summed over ranks), then that time span;
+  // the root attribute `wall_impulse`, absent (empty) in a run without wall loads.
+  std::vector<double> wall_impulse;
   std::string file;  // set by read_checkpoint: where it came from, for messages
 };
 

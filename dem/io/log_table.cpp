@@ -11,7 +11,16 @@
 
 namespace grainflow {
 
-LogTable::LogTable(MPI_Comm comm, const std::string& path) : comm_(comm), path_(path) {
+namespace {
+std::string full_header(const std::vector<std::string>& extra) {
+  std::string h = LogTable::header;
+  for (const std::string& name : extra) h += "," + name;
+  return h;
+}
+}  // namespace
+
+LogTable::LogTable(MPI_Comm comm, const std::string& path, const std::vector<std::string>& extra)
+    : comm_(comm), path_(path), header_(full_header(extra)), extra_(extra.size()) {
   MPI_Comm_rank(comm_, &rank_);
   int err = 0;
   if (rank_ == 0) {
@@ -19,7 +28,7 @@ LogTable::LogTable(MPI_Comm comm, const std::string& path) : comm_(comm), path_(
     file_ = std::fopen(path_.c_str(), "w");
     if (!file_)
       err = errno ? errno : EIO;
-    else if (std::fprintf(file_, "%s\n", header) < 0 || std::fflush(file_) != 0)
+    else if (std::fprintf(file_, "%s\n", header_.c_str()) < 0 || std::fflush(file_) != 0)
       err = errno ? errno : EIO;
     if (err && file_) {
       std::fclose(file_);
@@ -29,15 +38,16 @@ LogTable::LogTable(MPI_Comm comm, const std::string& path) : comm_(comm), path_(
   agree(err, "cannot create the log table");
 }
 
-LogTable::LogTable(MPI_Comm comm, const std::string& path, long continue_after_step)
-    : comm_(comm), path_(path) {
+LogTable::LogTable(MPI_Comm comm, const std::string& path, long continue_after_step,
+                   const std::vector<std::string>& extra)
+    : comm_(comm), path_(path), header_(full_header(extra)), extra_(extra.size()) {
   MPI_Comm_rank(comm_, &rank_);
   int err = 0;
   if (rank_ == 0) {
     std::ifstream in(path_);
     std::string line;
     std::string kept;
-    if (in && std::getline(in, line) && line == header) {
+    if (in && std::getline(in, line) && line == header_) {
       kept = line + "\n";
       while (std::getline(in, line)) {
         // A row without its newline was cut short (by a kill, or a full disk's short write);
@@ -50,7 +60,7 @@ LogTable::LogTable(MPI_Comm comm, const std::string& path, long continue_after_s
         kept += line + "\n";
       }
     } else {
-      kept = std::string(header) + "\n";
+      kept = header_ + "\n";
     }
     in.close();
     try {
@@ -76,10 +86,13 @@ void LogTable::write(const LogRow& r) {
   if (rank_ == 0) {
     errno = 0;
     const int n =
-        std::fprintf(file_, "%.17g,%ld,%ld,%.17g,%.17g,%.17g,%ld,%ld,%ld,%.17g\n", r.time, r.step,
+        std::fprintf(file_, "%.17g,%ld,%ld,%.17g,%.17g,%.17g,%ld,%ld,%ld,%.17g", r.time, r.step,
                      r.particles, r.kinetic_translational, r.kinetic_rotational,
                      r.max_overlap_ratio, r.contacts, r.rebuilds, r.removed, r.wall_seconds);
-    if (n < 0 || std::fflush(file_) != 0) err = errno ? errno : EIO;
+    bool ok = n >= 0;
+    for (std::size_t k = 0; k < extra_ && ok; ++k)
+      ok = std::fprintf(file_, ",%.17g", k < r.extra.size() ? r.extra[k] : 0.0) >= 0;
+    if (!ok || std::fputc('\n', file_) == EOF || std::fflush(file_) != 0) err = errno ? errno : EIO;
   }
   agree(err, "cannot append to the log table");
 }

@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <string>
+#include <vector>
 
 namespace grainflow {
 
@@ -20,6 +21,7 @@ struct LogRow {
   long rebuilds;                 // neighbour-list rebuilds since the previous row
   long removed;                  // particles removed (left the domain) since the previous row
   double wall_seconds;           // wall-clock time since the start of the run [s]
+  std::vector<double> extra = {};  // one value per extra column (LogTable's constructors)
 };
 
 class LogTable {
@@ -28,14 +30,16 @@ class LogTable {
       "time_s,step,particles,ke_trans_J,ke_rot_J,max_overlap_ratio,contacts,rebuilds,removed,"
       "wall_s";
 
-  // Collective: rank 0 creates (truncates) `path` and writes the header; every rank throws
-  // OutputError naming the path if that fails.
-  LogTable(MPI_Comm comm, const std::string& path);
+  // Collective: rank 0 creates (truncates) `path` and writes the header, `header` followed
+  // by the `extra` column names (each row then carries as many LogRow::extra values); every
+  // rank throws OutputError naming the path if that fails.
+  LogTable(MPI_Comm comm, const std::string& path, const std::vector<std::string>& extra = {});
   // Collective: continues the table of a restarted run. Rank 0 keeps the header and the rows
   // with step <= `continue_after_step` (rows that a stopped run wrote after its checkpoint are
   // dropped, the restarted run writes them again), then appends. A missing file, or one with
   // another header, is replaced by a new table.
-  LogTable(MPI_Comm comm, const std::string& path, long continue_after_step);
+  LogTable(MPI_Comm comm, const std::string& path, long continue_after_step,
+           const std::vector<std::string>& extra = {});
   ~LogTable();
   LogTable(const LogTable&) = delete;
   LogTable& operator=(const LogTable&) = delete;
@@ -53,6 +57,8 @@ class LogTable {
   MPI_Comm comm_;
   int rank_ = 0;
   std::string path_;
+  std::string header_;  // header and the extra columns
+  std::size_t extra_ = 0;
   std::FILE* file_ = nullptr;  // open on rank 0 only
 };
 

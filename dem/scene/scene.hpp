@@ -230,6 +230,9 @@ struct OutputSettings {
   // Each snapshot also holds the contact network (touching pairs and wall contacts with
   // their forces; dem/io/contact_network.hpp), indexed as lines in the XDMF.
   bool contacts = false;
+  // Each wall's load: the mean force the particles exert on it since the previous log row,
+  // as columns of log.csv (grain) or a line at each write time (grainFoam).
+  bool wall_loads = false;
 };
 
 struct NeighbourSettings {

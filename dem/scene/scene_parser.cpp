@@ -819,7 +819,7 @@ std::vector<Insertion> parse_insertions(const Field& f, const Scene& scene) {
 OutputSettings parse_output(const Field& f, const TimeSettings& time, bool heat) {
   const Map m =
       f.map({"directory", "snapshot_interval", "log_interval", "progress", "checkpoint_interval",
-             "checkpoint_keep", "fields", "start", "stop", "contacts"});
+             "checkpoint_keep", "fields", "start", "stop", "contacts", "wall_loads"});
   OutputSettings o;
   for (const char* key : {"directory", "snapshot_interval", "log_interval", "progress",
                           "checkpoint_interval", "checkpoint_keep"})
@@ -830,6 +830,7 @@ OutputSettings parse_output(const Field& f, const TimeSettings& time, bool heat)
   o.log_interval = m.maybe_number("log_interval", kPositive);
   if (const auto p = m.find("progress")) o.progress = p->boolean();
   if (const auto c = m.find("contacts")) o.contacts = c->boolean();
+  if (const auto w = m.find("wall_loads")) o.wall_loads = w->boolean();
   o.checkpoint_interval = m.maybe_number("checkpoint_interval", kPositive);
   if (const auto k = m.find("checkpoint_keep"))
     o.checkpoint_keep = static_cast<int>(k->integer(Range{1, 1000, true, true}));

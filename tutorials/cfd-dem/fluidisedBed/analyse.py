@@ -8,6 +8,7 @@ Reads, from the case folder CASE (default: this script's folder):
                                     outlet patches every fluid step (controlDict functions);
   postProcessing/inletFlow          sum of phi over the inlet (the superficial inflow);
   particles/particles_*.h5          particle snapshots at the write times;
+  log.grainFoam                     the walls' share of the weight (output.wall_loads);
   constant/transportProperties      rho, nu;  the scene named in constant/couplingProperties.
 
 Reference values (DESIGN.md section 7):
@@ -37,7 +38,8 @@ import numpy as np
 import yaml
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from foam_case import foam_entry, series  # noqa: E402 (tutorials/cfd-dem/foam_case.py)
+# tutorials/cfd-dem/foam_case.py
+from foam_case import foam_entry, mean_wall_share, series  # noqa: E402
 
 ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 ap.add_argument("case", nargs="?", default=os.path.dirname(os.path.abspath(__file__)))
@@ -115,6 +117,13 @@ print(f"fluidisedBed: {len(d_p)} beads d32 {d32*1e3:.3f} mm, U_mf (Wen-Yu) {u_mf
       f"{dp_mean:.1f} Pa, bed weight {weight:.1f} Pa, ratio {ratio:.4f} "
       f"(tolerance {100*args.tolerance:g} %: {'ok' if ok else 'FAILED'}); bed height settled "
       f"{h_settled*1e3:.1f} mm, fluidised {h_fluid*1e3:.1f} mm")
+# The rest of the weight rests on the walls (particles.yaml output.wall_loads: grainFoam's
+# `wall loads` lines): the distributor where beads lie on it, the side walls by friction.
+walls, span = mean_wall_share(os.path.join(case, "log.grainFoam"), args.t_from)
+if span > 0:
+    print(f"fluidisedBed: the walls carry {walls:.4f} of the weight over the {span:.3g} s of "
+          f"write intervals after {args.t_from:g} s (grainFoam's wall loads); gas and walls "
+          f"together {ratio + walls:.4f}")
 
 # --- plots ---------------------------------------------------------------------------------
 fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
