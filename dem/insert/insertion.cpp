@@ -433,17 +433,45 @@ void check_snapshot_records(const Scene& scene, const Insertion& ins, const Part
       false);
 }
 
+// A snapshot's particle is inside the domain when its centre is: a run keeps a particle until
+// its centre leaves a bounded side (Simulation::mark_leaving), so a particle on its way out
+// through a side without a wall may cross it by up to its radius in a snapshot the run wrote.
+// A wall on that side is checked separately (inside_a_wall).
+bool snapshot_centre_inside(const Domain& d, const Vec3& x) {
+  for (int a = 0; a < 3; ++a)
+    if (d.periodic[a] ? (x[a] < d.lo[a] || x[a] >= d.hi[a]) : !(x[a] >= d.lo[a] && x[a] <= d.hi[a]))
+      return false;
+  return true;
+}
+
 // The snapshot's particle i is not inside the domain: a StateError naming the dataset.
 [[noreturn]] void snapshot_outside_domain(const Scene& scene, const Insertion& ins,
                                           const Particles& q, std::size_t i) {
-  throw StateError(
-      ins.snapshot_file + ": error: dataset '/position', index " + std::to_string(i) +
-      " (particle id " + std::to_string(q.id[i]) + "): the particle lies outside the domain: " +
-      outside_domain_reason(scene.domain, q.x[i], q.radius[i]) +
-      " (a bounded side may be crossed by up to time.max_overlap of the radius, a "
-      "periodic range left by up to the larger of the radius and half the skin); "
-      "the snapshot (insertion at " +
-      ins.source + ") belongs to another domain, or was changed or damaged after it was written");
+  const Domain& d = scene.domain;
+  std::string why = "it lies outside the domain";
+  for (int a = 0; a < 3; ++a) {
+    const double c = q.x[i][a];
+    const std::string axis(1, "xyz"[a]);
+    const std::string range = exact_number(d.lo[a]) + ", " + exact_number(d.hi[a]);
+    if (d.periodic[a] && (c < d.lo[a] || c >= d.hi[a])) {
+      why = "its centre " + axis + " = " + exact_number(c) + " is outside the periodic range [" +
+            range +
+            ") by more than the larger of the radius and half the skin (the most a run "
+            "lets a centre leave it between two wraps)";
+      break;
+    }
+    if (!d.periodic[a] && !(c >= d.lo[a] && c <= d.hi[a])) {
+      why = "its centre " + axis + " = " + exact_number(c) + " is outside the bounded range [" +
+            range + "] (a run removes a particle once its centre leaves a bounded side, so no " +
+            "snapshot it writes holds one)";
+      break;
+    }
+  }
+  throw StateError(ins.snapshot_file + ": error: dataset '/position', index " + std::to_string(i) +
+                   " (particle id " + std::to_string(q.id[i]) +
+                   "): the particle lies outside the domain: " + why +
+                   "; the snapshot (insertion at " + ins.source +
+                   ") belongs to another domain, or was changed or damaged after it was written");
 }
 
 // `grid_needed`: whether a later entry checks overlaps against this one's particles.
@@ -541,10 +569,9 @@ void read_snapshot_entry(const Scene& scene, const WallSet* walls, const Inserti
       throw InsertionError(ins.source + ": error: particle id " + std::to_string(q.id[i]) +
                            " of snapshot '" + ins.snapshot_file + "' " + what);
     };
-    // A snapshot of a settled bed has particles overlapping walls on the domain's sides by
-    // up to the overlap the run allowed.
-    if (!inside_domain(scene.domain, q.x[i], q.radius[i], scene.time.max_overlap * q.radius[i]))
-      snapshot_outside_domain(scene, ins, q, i);
+    // The run's own rule (snapshot_centre_inside); a settled bed's overlaps with walls on the
+    // domain's sides, up to the overlap the run allowed, are inside_a_wall's to check.
+    if (!snapshot_centre_inside(scene.domain, q.x[i])) snapshot_outside_domain(scene, ins, q, i);
     if (const std::string why = inside_a_wall(scene, walls, q.x[i], q.radius[i]); !why.empty())
       fail(why);
     // Touching neighbours of a settled bed overlap slightly: only particles of

@@ -121,8 +121,8 @@ elif case == "position_bounded":  # z is bounded
     edit(setitem(g + "position", (5, 2), 1e300))
     expect = (f_ + r": error: dataset '/%sposition', %s: the position \(.*, 1e\+300\) is outside "
               r"the domain along z \(bounded" % (g, particle(5))) if kind == "checkpoint" else \
-        (f_ + r": error: dataset '/position', %s: the particle lies outside the domain: it spans z"
-         % particle(5))
+        (f_ + r": error: dataset '/position', %s: the particle lies outside the domain: its "
+         r"centre z = 1e\+300 is outside the bounded range" % particle(5))
 elif case == "position_periodic":  # x is periodic
     edit(setitem(g + "position", (5, 0), 1e300))
     expect = (f_ + r": error: dataset '/%sposition', %s: the position \(1e\+300, .*\) is outside "
