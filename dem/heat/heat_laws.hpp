@@ -85,6 +85,18 @@ inline double convective_conductance(const FluidThermal& th, double eps, double 
   return nusselt_number(th.nusselt, eps, re, pr) * th.conductivity * std::numbers::pi * d;
 }
 
+// h A [W/K] of a coarse-grained parcel of diameter `parcel_d` standing for k^3 real particles
+// of diameter parcel_d / k (docs/models/coarse-graining.md, "Heat transfer"): each real
+// particle exchanges with the gas at the parcel's eps and slip as its Nusselt law gives for
+// the real diameter, so the parcel's conductance is k^3 times the real particle's and its time
+// constant m c / (h A) is the real particle's. At k = 1 this is convective_conductance, bit
+// for bit (the factors 1 and parcel_d / 1 are exact).
+inline double parcel_convective_conductance(const FluidThermal& th, double eps, double density,
+                                            double viscosity, double parcel_d, double k,
+                                            double slip) {
+  return k * k * k * convective_conductance(th, eps, density, viscosity, parcel_d / k, slip);
+}
+
 inline double convective_conductance(const FluidThermal& th, const PrescribedFluid& f, double d,
                                      double slip) {
   return convective_conductance(th, f.void_fraction, f.density, f.viscosity, d, slip);

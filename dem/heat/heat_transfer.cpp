@@ -37,6 +37,7 @@ HeatTransfer::HeatTransfer(const Scene& scene)
     cp_.push_back(m.heat_capacity);
     source_.push_back(m.heat_source);
     k_.push_back(m.conductivity);
+    coarse_grain_.push_back(m.coarse_grain);
   }
   radius_factor_ = contact_radius_factors(scene);
   k_star_.resize(static_cast<std::size_t>(materials_) * materials_);
@@ -175,9 +176,9 @@ void HeatTransfer::step(Particles& p, const Ghosts& g, const std::vector<double>
     }
     const Vec3 u = field_.sample(p.x[i], gravity_).velocity;
     const double eps = void_fraction_ ? void_fraction_->at(p.x[i]) : field_.void_fraction;
-    const double h = convective_conductance(*fluid_thermal_, eps, field_.density,
-                                            field_.viscosity, 2 * p.radius[i],
-                                            (u - p.v[i]).norm());
+    const double h = parcel_convective_conductance(
+        *fluid_thermal_, eps, field_.density, field_.viscosity, 2 * p.radius[i],
+        coarse_grain_[p.material[i]], (u - p.v[i]).norm());
     const double t_f = fluid_thermal_->temperature;
     Tw[i] = (Tw[i] + dt * (q_[i] + s + h * t_f) / c) / (1 + dt * h / c);
     fluid_heat_ += h * (t_f - Tw[i]);
@@ -194,9 +195,9 @@ void HeatTransfer::coupled_step(Particles& p, double dt) {
     const double s = p.mass[i] * source_[p.material[i]];
     source_heat_ += s;
     const CoupledSample& f = view.samples[i];
-    const double h = convective_conductance(*fluid_thermal_, f.void_fraction, field_.density,
-                                            field_.viscosity, 2 * p.radius[i],
-                                            (f.velocity - p.v[i]).norm());
+    const double h = parcel_convective_conductance(
+        *fluid_thermal_, f.void_fraction, field_.density, field_.viscosity, 2 * p.radius[i],
+        coarse_grain_[p.material[i]], (f.velocity - p.v[i]).norm());
     const double t_f = view.temperature[i];
     T[i] = (T[i] + dt * (q_[i] + s + h * t_f) / c) / (1 + dt * h / c);
     const double q = h * (t_f - T[i]);

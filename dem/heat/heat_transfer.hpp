@@ -78,6 +78,7 @@ class HeatTransfer {
   // 2 k* f sqrt(R* delta)); f itself for the flux walls' area pi (f a)^2.
   std::vector<double> k_star_, radius_factor_;
   std::vector<double> cp_, source_, k_;
+  std::vector<double> coarse_grain_;       // per material: its parcels' k (1: real particles)
   std::vector<WallThermal> wall_thermal_;  // per scene wall (= WallSet entry)
   std::optional<FluidThermal> fluid_thermal_;
   PrescribedFluid field_;

@@ -67,14 +67,16 @@ ThermalLimits check_thermal_limits(const Scene& scene, const Particles& p, TimeS
     const double slip = scene.fluid->field.sample(centre, scene.gravity).velocity.norm();
     for (int a = 0; a < nm; ++a) {
       if (r_min[a] == inf) continue;
-      double h =
-          convective_conductance(*scene.fluid->thermal, scene.fluid->field, 2 * r_min[a], slip);
+      // A parcel class: k^3 real particles of diameter 2 r / k (heat_laws.hpp).
+      const double k = scene.materials[a].coarse_grain;
+      const PrescribedFluid& f = scene.fluid->field;
+      double h = parcel_convective_conductance(*scene.fluid->thermal, f.void_fraction, f.density,
+                                               f.viscosity, 2 * r_min[a], k, slip);
       // eps computed from the particles: anywhere between its minimum and 1; the larger h.
       if (const auto& grid = scene.fluid->computed_void_fraction)
         for (const double eps : {grid->minimum, 1.0})
-          h = std::max(h, convective_conductance(*scene.fluid->thermal, eps,
-                                                 scene.fluid->field.density,
-                                                 scene.fluid->field.viscosity, 2 * r_min[a], slip));
+          h = std::max(h, parcel_convective_conductance(*scene.fluid->thermal, eps, f.density,
+                                                        f.viscosity, 2 * r_min[a], k, slip));
       if (capacity(a) / h < out.convection_time) {
         out.convection_time = capacity(a) / h;
         smallest = scene.materials[a].name;

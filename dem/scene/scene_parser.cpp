@@ -590,15 +590,11 @@ double region_volume(const Region& r) {
 
 // `coarse_grain: k` of a fill or stream insertion (docs/models/coarse-graining.md): k >= 1;
 // the size distribution, given for the real particles, becomes the parcels' (times k).
-void parse_coarse_grain(const Map& m, const Scene& scene, Insertion& ins) {
+void parse_coarse_grain(const Map& m, Insertion& ins) {
   const auto f = m.find("coarse_grain");
   if (!f) return;
   ins.coarse_grain = f->number(Range{1, 1e3, true, true});
   if (ins.coarse_grain == 1) return;
-  if (scene.heat)
-    f->fail_at_key("coarse-grained parcels (coarse_grain " + format_number(ins.coarse_grain) +
-                   ") are not available with heat transfer yet (" + scene.heat->source +
-                   "); use coarse_grain: 1 or switch heat off");
   SizeDistribution& r = ins.radius;
   const double k = ins.coarse_grain;
   r.value *= k;
@@ -632,7 +628,7 @@ void parse_fill(const Map& m, const Scene& scene, Insertion& ins) {
   ins.material = material_ref(m, "material", scene.materials);
   ins.radius = parse_size_distribution(
       m.get("radius", "add `radius: {distribution: constant, value: <m>}`"));
-  parse_coarse_grain(m, scene, ins);
+  parse_coarse_grain(m, ins);
   if (ins.count) {
     // Even the smallest spheres the distribution can draw must fit by volume alone;
     // this also bounds what insertion will try to allocate.
@@ -710,7 +706,7 @@ void parse_stream(const Map& m, const Scene& scene, Insertion& ins) {
   ins.material = material_ref(m, "material", scene.materials);
   ins.radius = parse_size_distribution(
       m.get("radius", "add `radius: {distribution: constant, value: <m>}`"));
-  parse_coarse_grain(m, scene, ins);
+  parse_coarse_grain(m, ins);
   ins.velocity = m.vec3_or("velocity", Vec3::Zero());
   if (const auto s = m.find("seed"))
     ins.seed = static_cast<unsigned>(s->integer(Range{0, double(UINT_MAX), true, true}));
@@ -754,11 +750,6 @@ void parse_snapshot_classes(const Field& file, const Scene& scene, Insertion& in
                 "); list the materials in the order of the scene that wrote it");
     ins.coarse_grain = std::max(ins.coarse_grain, c.k[m]);
   }
-  if (ins.coarse_grain != 1 && scene.heat)
-    file.fail("the snapshot '" + ins.snapshot_file + "' holds coarse-grained parcels (k up to " +
-              format_number(ins.coarse_grain) +
-              "), which are not available with heat transfer yet (" + scene.heat->source +
-              "); insert real particles or switch heat off");
   ins.snapshot_class_k = std::move(c.k);
   ins.snapshot_class_real = std::move(c.real);
 }

@@ -916,6 +916,68 @@ def heat_equilibrium(runner, checks):
                   f"({restarted[-1][2] if restarted else None} vs {lines[-1][2]})")
 
 
+def heat_parcels(runner, checks):
+    """cases/heated_box with its eight beads as one parcel of k = 2 (real d = 1 mm, parcel
+    d = 2 mm) at the box's centre, in one 4 mm cell: the parcel's heat capacity is the
+    eight beads' and its convective conductance eight times a bead's (Ranz-Marshall for the
+    real d at Re = 0: Nu = 2; docs/models/coarse-graining.md, "Heat transfer"), so the
+    closed form of coupling.heat_equilibrium holds unchanged: the mixture's energy conserved
+    to 1e-12, the exchange balanced to round-off, the mean temperatures on
+    T_eq + (T_0 - T_eq) exp(-t/tau) within 0.5 % of the initial difference. A bead of the
+    parcel's size (k = 1, d = 2 mm) would relax with tau 4 times longer."""
+    d, n, rho_p, c_p, k_f, rho_f, c_f = 1e-3, 8, 2500.0, 7.0, 0.026, 1.2, 1000.0
+    vp = math.pi / 6 * d ** 3
+    cap_p = n * rho_p * vp * c_p
+    cap_f = rho_f * c_f * (0.004 ** 3 - n * vp)
+    t_p0, t_f0 = 400.0, 300.0
+    t_eq = (cap_p * t_p0 + cap_f * t_f0) / (cap_p + cap_f)
+    tau = 1 / (n * 2 * k_f * math.pi * d * (1 / cap_p + 1 / cap_f))
+    # One cell: the closed form assumes well-mixed air, which the eight beads' symmetric
+    # cells give; a parcel centred on the cells' common corner would not (the `divided`
+    # footprint puts its sub-volumes on the faces into the upper cells).
+    case = runner.fresh_case("heated_box", "parcel", [
+        ("system/blockMeshDict", "(2 2 2)", "(1 1 1)"),
+        ("system/fvSolution", "solver GAMG; smoother DIC;", "solver PCG; preconditioner DIC;"),
+        ("particles.yaml", "  - {type: csv, file: beads.csv, material: glass, temperature: 400}",
+         "  - {type: fill, region: {box: {min: [0.001, 0.001, 0.001], max: [0.003, 0.003, 0.003]}},\n"
+         "     count: 1, material: glass, radius: {distribution: constant, value: 5e-4},\n"
+         "     coarse_grain: 2, temperature: 400}")])
+    log = runner.solve(case, 1)
+    lines = heat_lines(log)
+    check_heat_balance(checks, "parcel", lines, 11)
+    energies = [e for _, _, e in lines if e]
+    checks.expect(len(energies) == len(lines), "a thermal energy line after each heat report")
+    if not energies:
+        return
+    checks.expect(abs(energies[0][1] - cap_p) <= 1e-12 * cap_p and
+                  abs(energies[0][3] - cap_f) <= 1e-12 * cap_f,
+                  f"heat capacities: parcel {energies[0][1]:.10g} J/K (8 real m c = {cap_p:.10g}), "
+                  f"air {energies[0][3]:.10g} J/K (rho c_p (V - 8 V_p) = {cap_f:.10g})")
+    e0 = cap_p * t_p0 + cap_f * t_f0
+    drift = max(abs(e[4] - e0) / e0 for e in energies)
+    checks.expect(drift < ROUND_OFF, f"mixture energy conserved: largest relative change "
+                                     f"{drift:.3g} < 1e-12")
+    worst = 0.0
+    for (t, _, e) in lines:
+        exact_p = t_eq + (t_p0 - t_eq) * math.exp(-t / tau)
+        exact_f = t_eq + (t_f0 - t_eq) * math.exp(-t / tau)
+        err_p = abs(e[0] / e[1] - exact_p) / (t_p0 - t_eq)
+        err_f = abs(e[2] / e[3] - exact_f) / (t_eq - t_f0)
+        worst = max(worst, err_p, err_f)
+        print(f"    t = {t:.4f} s: parcel {e[0] / e[1]:.4f} K (closed form {exact_p:.4f} K), "
+              f"air {e[2] / e[3]:.4f} K ({exact_f:.4f} K)")
+    checks.expect(worst < 5e-3, f"mean temperatures against the eight beads' closed form, "
+                                f"T_eq = {t_eq:.4f} K, tau = {tau * 1e3:.3f} ms: largest error "
+                                f"{100 * worst:.3f} % of the initial difference < 0.5 %")
+    snaps = snapshots(case)
+    last = snaps[-1][1] if snaps else {}
+    checks.expect(len(last.get("real_count", [])) == 1 and last["real_count"][0] == 8 and
+                  last["coarse_grain"][0] == 2 and
+                  np.allclose(last["position"][0], 0.002, rtol=0, atol=1e-12),
+                  f"the last snapshot holds one parcel of k = 2 standing for 8 real beads, at "
+                  f"the box's centre ({last.get('position')})")
+
+
 def heated_bed(runner, name, ranks):
     """cases/periodic_box with heat on: the beads (glass, 350 K) rain at 10 g through water
     at 300 K flowing at (0.05 0.02 0) m/s; 100 fluid steps, written every 20."""
@@ -1265,7 +1327,7 @@ def diffusion_smoothing(runner, checks):
 TESTS = {f.__name__: f for f in (void_fraction_volume, exchange_balance, neutrally_buoyant,
                                   cellpoint_ranks,
                                  refuses_bad_setup, restart, restart_bed_surface, stop_signal, nan_guard,
-                                 scene_output, heat_equilibrium, heat_balance,
+                                 scene_output, heat_equilibrium, heat_parcels, heat_balance,
                                  heat_front, balanced_decomposition,
                                  diffusion_smoothing)}
 

@@ -43,6 +43,9 @@
 #       the exchange balanced to round-off at every write time; a restart at half time ends
 #       with the same T; missing kappa, Cp unlike the scene, heat without convection keys
 #       refused with their messages. About 10 s.
+#   coupling.heat_parcels          cases/heated_box with the eight beads as one parcel of
+#       k = 2 at the centre of one 4 mm cell: the same closed form (T_eq, tau) within 0.5 %, energy conserved
+#       to 1e-12, exchange balanced, the snapshot's real_count 8. About 5 s.
 #   coupling.heat_balance          cases/periodic_box with heat (Gunn), beads at 350 K raining
 #       through water at 300 K, on 1 and 2 ranks: heat taken by the particles = heat lost by
 #       the fluid to 1e-12 relative at every write time, mixture energy conserved to 1e-12,
@@ -166,6 +169,7 @@ grainflow_coupling_test(stop_signal 2)
 grainflow_coupling_test(nan_guard 2)
 grainflow_coupling_test(scene_output 1)
 grainflow_coupling_test(heat_equilibrium 1)
+grainflow_coupling_test(heat_parcels 1)
 grainflow_coupling_test(heat_balance 2)
 grainflow_coupling_test(heat_front 1)
 grainflow_coupling_test(balanced_decomposition 2)
