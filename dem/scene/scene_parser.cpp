@@ -973,16 +973,20 @@ void check_coarse_grain_models(Scene& s, const Map& top) {
                                       "' (the insertion at " + first->source + ")"
                                 : "coarse_grain " + format_number(first->coarse_grain) +
                                       " (the insertion at " + first->source + ")";
-  const Map contact = top.get("contact").map();
-  if (s.contact.cohesion != CohesionModel::none)
-    contact.get("cohesion").fail_at_key(
-        "cohesion is not available with coarse-grained parcels, " + where +
-        ": the literature's scaling of cohesion with the parcel size is not settled and not "
-        "validated here (docs/models/coarse-graining.md); use cohesion: none or coarse_grain: 1");
-  if (s.contact.rolling != RollingModel::none)
-    contact.get("rolling").fail_at_key(
-        "rolling resistance is not available with coarse-grained parcels, " + where +
-        " (docs/models/coarse-graining.md); use rolling: none or coarse_grain: 1");
+  // A stiffness in N/m is one contact's, not scaled with the parcel: the energy-conserving
+  // rule needs k_n, k_t in proportion to k, which the characteristic-velocity form gives.
+  if (s.contact.normal == NormalModel::hooke && s.contact.hooke_kn)
+    top.get("contact")
+        .map()
+        .get("hooke")
+        .map()
+        .get("stiffness")
+        .fail_at_key(
+            "a fixed Hooke stiffness is the same for every contact, so it does not grow with the "
+            "parcels as the energy-conserving scaling asks (k_n in proportion to k), " +
+            where +
+            "; use `hooke: {characteristic_velocity: <m/s>}`, whose stiffness follows each "
+            "contact's radius and mass (docs/models/coarse-graining.md), or coarse_grain: 1");
   if (!s.fluid) return;
   for (FluidForce f : s.fluid->forces)
     if (f == FluidForce::saffman_mei || f == FluidForce::magnus ||
