@@ -978,10 +978,13 @@ def heat_parcels(runner, checks):
                   f"the box's centre ({last.get('position')})")
 
 
-def heated_bed(runner, name, ranks):
+def heated_bed(runner, name, ranks, parcels=False):
     """cases/periodic_box with heat on: the beads (glass, 350 K) rain at 10 g through water
-    at 300 K flowing at (0.05 0.02 0) m/s; 100 fluid steps, written every 20."""
-    case = runner.fresh_case("periodic_box", name, [
+    at 300 K flowing at (0.05 0.02 0) m/s; 100 fluid steps, written every 20. `parcels`: the
+    fill's 300 beads become 38 parcels of k = 2 (304 real beads) among the csv's real ones."""
+    extra = [("particles.yaml", "    count: 300\n", "    count: 38\n    coarse_grain: 2\n")] \
+        if parcels else []
+    case = runner.fresh_case("periodic_box", name, extra + [
         ("0/U", "internalField   uniform (0 0 0);", "internalField   uniform (0.05 0.02 0);"),
         ("particles.yaml", "gravity: [0, 0, -9.81]", "gravity: [0, 0, -98.1]\nheat: {}"),
         ("particles.yaml", "density: 2500}",
@@ -1013,7 +1016,8 @@ def heat_balance(runner, checks):
     Gunn's law, beads crossing the processor plane and the periodic faces): at every write
     time the heat the particles took equals the heat the fluid lost, to round-off, and the
     mixture's thermal energy (walls adiabatic, box periodic) stays what it was; the two rank
-    counts agree on the exchanged heat within 1 %."""
+    counts agree on the exchanged heat within 1 %. Then the same on 2 ranks with the fill's
+    beads as parcels of k = 2 among the real ones."""
     finals = {}
     for ranks in (1, 2):
         case, log = heated_bed(runner, f"heat_balance_np{ranks}", ranks)
@@ -1029,6 +1033,21 @@ def heat_balance(runner, checks):
                       f"np {ranks}: the beads gave the water {-exchanged:.6g} J in 10 ms; the "
                       f"mixture's thermal energy changed by {drift:.3g} of itself (< 1e-12)")
         finals[ranks] = exchanged
+    # Coarse-grained parcels among real beads, on 2 ranks (heat with parcels,
+    # docs/models/coarse-graining.md): the same balance and conservation.
+    case, log = heated_bed(runner, "heat_balance_parcels_np2", 2, parcels=True)
+    lines = heat_lines(log)
+    check_heat_balance(checks, "parcels np 2", lines, 6)
+    energies = [e for _, _, e in lines if e]
+    if energies:
+        drift = max(abs(e[4] - energies[0][4]) / energies[0][4] for e in energies)
+        exchanged = lines[-1][1][3]
+        snaps = snapshots(case)
+        k = snaps[-1][1].get("coarse_grain", np.ones(1)) if snaps else np.ones(1)
+        checks.expect(drift < 1e-12 and exchanged < -0.01 and int((k == 2).sum()) == 38,
+                      f"parcels np 2: 38 parcels of k = 2 ({int((k == 2).sum())} in the last "
+                      f"snapshot) and the real beads gave the water {-exchanged:.6g} J in 10 ms; "
+                      f"the mixture's thermal energy changed by {drift:.3g} of itself (< 1e-12)")
     if len(finals) == 2:
         diff = abs(finals[1] - finals[2]) / abs(finals[1])
         # Not to round-off: the colliding bed amplifies the sums' order, and a bead that
