@@ -125,8 +125,12 @@ if not snaps:
     sys.exit(f"analyse.py: no particle snapshots in {case}/particles")
 with h5py.File(snaps[-1], "r") as f:
     n_beads, bead_mass = len(f["id"]), float(np.sum(f["mass"][:]))
+    # Coarse-grained parcels (an insertion's coarse_grain): each stands for real_count beads.
+    n_real = float(np.sum(f["real_count"][:])) if "real_count" in f else float(n_beads)
 scene = yaml.safe_load(open(os.path.join(case, "particles.yaml")))   # the domain only
-print(f"heatedBed: {n_beads} beads, m c = {c_p:.5g} J/K, inflow rho c_p Q = "
+counted = f"{n_beads} beads" if n_real == n_beads else \
+    f"{n_beads} parcels ({n_real:.0f} real beads)"
+print(f"heatedBed: {counted}, m c = {c_p:.5g} J/K, inflow rho c_p Q = "
       f"{rho_f * cp_f * q[-1]:.4g} W/K (time constant {c_p / (rho_f * cp_f * q[-1]):.3f} s), "
       f"T_in {t_in_final:.1f} K")
 print(f"  at t = {e[-1, 0]:.3f} s: mean bead temperature {beads[-1]:.2f} K, bounds "
@@ -156,7 +160,7 @@ ax.plot(e[:, 0], beads, "o", ms=4, color="tab:blue", label="mean bead temperatur
 ax.plot(e[:, 0], e[:, 3] / e[:, 4], "s", ms=3, color="tab:green", label="mean air temperature")
 ax.set_xlabel("time [s]")
 ax.set_ylabel("temperature [K]")
-ax.set_title(f"{n_beads} glass beads (c = {c_p / bead_mass:.0f} J/(kg K)) fluidised by hot air",
+ax.set_title(f"{counted} of glass (c = {c_p / bead_mass:.0f} J/(kg K)) fluidised by hot air",
              fontsize=10)
 ax.legend(fontsize=7, loc="lower right")
 fig.tight_layout()
