@@ -24,7 +24,7 @@ each k's angle within DEG degrees of the beads' (ANGLE_K1, measured by this scri
 with k = 1 in --ks, that run's), and parcels x k^3 = N_REAL.
 
 usage: drum.py [--ks 1,2,3] [--work DIR] [--grain PATH] [--check DEG] [--cohesion KC]
-               [--analyse-only]
+               [--length L] [--analyse-only] [--plot PNG]
 Prints one row per k (parcels, angle, its spread, against k = 1, steps, CPU seconds) and
 appends them to <work>/drum.csv.
 """
@@ -45,6 +45,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 
 N_REAL = 11232            # 2^3 x 3^3 x 52: whole parcels at k = 2 and 3
+DEPTH = 0.03              # drum depth [m]; --length L multiplies it and N_REAL by L
 R_DRUM = 0.05
 END = 3.0
 STEADY_FROM = 1.5
@@ -58,7 +59,7 @@ def scene(k, kc):
     return f"""# drum.py: k = {k:g}{f', k_c = {kc:g} J/m^3' if kc else ''}
 domain:
   min: [-0.052, -0.052, 0]
-  max: [0.052, 0.052, 0.03]
+  max: [0.052, 0.052, {DEPTH:g}]
 gravity: [0, -9.81, 0]
 time:
   rayleigh_fraction: 0.15
@@ -79,10 +80,10 @@ walls:
   - {{type: cylinder, name: drum, axis_point: [0, 0, 0], axis: [0, 0, 1], radius: 0.05,
      side: inside, angular_velocity: 2.0, material: steel}}
   - {{type: plane, name: back, point: [0, 0, 0], normal: [0, 0, 1], material: steel}}
-  - {{type: plane, name: front, point: [0, 0, 0.03], normal: [0, 0, -1], material: steel}}
+  - {{type: plane, name: front, point: [0, 0, {DEPTH:g}], normal: [0, 0, -1], material: steel}}
 insert:
   - type: fill
-    region: {{cylinder: {{base: [0, 0, 0], axis: [0, 0, 1], radius: 0.048, height: 0.03}}}}
+    region: {{cylinder: {{base: [0, 0, 0], axis: [0, 0, 1], radius: 0.048, height: {DEPTH:g}}}}}
     count: {round(N_REAL / k**3)}
     material: glass
     radius: {{distribution: uniform, min: 0.95e-3, max: 1.05e-3}}
@@ -151,10 +152,18 @@ def main():
                          "k, or K:DEG,K:DEG per k")
     ap.add_argument("--cohesion", type=float, default=0.0,
                     help="SJKR cohesion energy density k_c [J/m^3] between the beads (0: none)")
+    ap.add_argument("--length", type=int, default=1,
+                    help="the drum L times as deep (30 L mm) with L times the beads; the stored "
+                         "k = 1 angles are for L = 1")
     ap.add_argument("--analyse-only", action="store_true")
     ap.add_argument("--plot", default=None,
                     help="write the centre-of-mass angle against time of each k to this PNG")
     a = ap.parse_args()
+    global N_REAL, DEPTH
+    N_REAL *= a.length
+    DEPTH *= a.length
+    if a.length != 1:
+        ANGLE_K1.clear()
     ks = [float(s) for s in a.ks.split(",")]
     allowed = {}
     if a.check is not None:
@@ -168,7 +177,8 @@ def main():
     failures = []
     curves = []
     for k in ks:
-        case = os.path.join(a.work, f"k{k:g}" + (f"_kc{a.cohesion:g}" if a.cohesion else ""))
+        case = os.path.join(a.work, f"k{k:g}" + (f"_kc{a.cohesion:g}" if a.cohesion else "")
+                            + (f"_L{a.length}" if a.length != 1 else ""))
         cpu = wall = math.nan
         timing = os.path.join(case, "cpu_wall_s.txt")
         if not a.analyse_only:
