@@ -159,20 +159,29 @@ def main():
     ap.add_argument("--plot", default=None,
                     help="write the centre-of-mass angle against time of each k to this PNG")
     a = ap.parse_args()
+    if a.length < 1:
+        ap.error(f"--length must be a whole number >= 1, got {a.length}")
+    if a.cohesion < 0:
+        ap.error(f"--cohesion is an energy density >= 0 J/m^3, got {a.cohesion:g}")
     global N_REAL, DEPTH
     N_REAL *= a.length
     DEPTH *= a.length
     if a.length != 1:
         ANGLE_K1.clear()
-    ks = [float(s) for s in a.ks.split(",")]
-    allowed = {}
-    if a.check is not None:
-        for item in a.check.split(","):
+    try:
+        ks = [float(v) for v in a.ks.split(",")]
+        allowed = {}
+        for item in (a.check.split(",") if a.check is not None else []):
             if ":" in item:
                 kk, deg = item.split(":")
                 allowed[float(kk)] = float(deg)
             else:
                 allowed.update({k: float(item) for k in ks})
+    except ValueError:
+        ap.error(f"--ks takes numbers (1,2,3) and --check DEG or K:DEG,K:DEG; got --ks {a.ks} "
+                 f"--check {a.check}")
+    if any(k < 1 for k in ks):
+        ap.error(f"--ks: coarse-graining factors are >= 1, got {a.ks}")
     rows = []
     failures = []
     curves = []

@@ -31,31 +31,21 @@
 #include "dem/io/output_directory.hpp"
 #include "dem/io/snapshot_writer.hpp"
 #include "dem/scene/scene_parser.hpp"
+#include "tests/dem/support/terminal_velocity.hpp"
 
 namespace grainflow {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-// Schiller & Naumann's terminal velocity of a sphere (Re < 1000), by bisection on
-// (pi/8) C_D rho_f d^2 u^2 = (rho_p - rho_f) g pi d^3 / 6.
-double terminal_velocity(double d, double rho_p, double rho_f, double mu, double g) {
-  const double weight = (rho_p - rho_f) * g * kPi * d * d * d / 6;
-  double lo = 0, hi = 100;
-  for (int k = 0; k < 200; ++k) {
-    const double u = 0.5 * (lo + hi), re = rho_f * d * u / mu;
-    const double drag = kPi / 8 * 24 / re * (1 + 0.15 * std::pow(re, 0.687)) * rho_f * d * d * u * u;
-    (drag < weight ? lo : hi) = u;
-  }
-  return 0.5 * (lo + hi);
-}
+using test::schiller_naumann_terminal_velocity;
 
 // A glass bead (d = 1 mm) in air rising at its terminal velocity: the bead stays at rest at a
 // constant slip, so h is constant and the cooling exponential.
 TEST(HeatTransfer, LumpedCoolingMatchesRanzMarshall) {
   const double d = 1e-3, rho = 2500, c = 840, rho_f = 1.2, mu = 1.8e-5, cf = 1005, kf = 0.026;
   const double t0 = 600, tf = 300, g = 9.81;
-  const double ut = terminal_velocity(d, rho, rho_f, mu, g);
+  const double ut = schiller_naumann_terminal_velocity(d, rho, rho_f, mu, g);
   const std::string scene = R"(domain: {min: [-0.1, -0.1, -0.1], max: [0.1, 0.1, 0.1]}
 gravity: [0, 0, -9.81]
 time: {step: 5e-4, end: 3}

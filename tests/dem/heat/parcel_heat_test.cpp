@@ -26,6 +26,7 @@
 #include "dem/heat/heat_transfer.hpp"
 #include "dem/heat/thermal_limits.hpp"
 #include "dem/scene/scene_parser.hpp"
+#include "tests/dem/support/terminal_velocity.hpp"
 
 namespace grainflow {
 namespace {
@@ -39,18 +40,7 @@ std::string num(double x) {
   return o.str();
 }
 
-// Schiller & Naumann's terminal velocity of a sphere (Re < 1000), by bisection.
-double terminal_velocity(double d, double rho_p, double rho_f, double mu, double g) {
-  const double weight = (rho_p - rho_f) * g * kPi * d * d * d / 6;
-  double lo = 0, hi = 100;
-  for (int i = 0; i < 200; ++i) {
-    const double u = 0.5 * (lo + hi), re = rho_f * d * u / mu;
-    const double drag =
-        kPi / 8 * 24 / re * (1 + 0.15 * std::pow(re, 0.687)) * rho_f * d * d * u * u;
-    (drag < weight ? lo : hi) = u;
-  }
-  return 0.5 * (lo + hi);
-}
+using test::schiller_naumann_terminal_velocity;
 
 // The air rises at the real bead's terminal velocity: the parcel, whose drag is k^3 times the
 // real bead's at the same slip, stays at rest, so its h is constant and its cooling
@@ -58,7 +48,7 @@ double terminal_velocity(double d, double rho_p, double rho_f, double mu, double
 TEST(ParcelHeat, ParcelCoolsAtTheRealBeadsRate) {
   const double d = 1e-3, rho = 2500, c = 840, rho_f = 1.2, mu = 1.8e-5, cf = 1005, kf = 0.026;
   const double t0 = 600, tf = 300, g = 9.81;
-  const double ut = terminal_velocity(d, rho, rho_f, mu, g);
+  const double ut = schiller_naumann_terminal_velocity(d, rho, rho_f, mu, g);
   const double re = rho_f * d * ut / mu, pr = cf * mu / kf;
   const double h = (2 + 0.6 * std::sqrt(re) * std::cbrt(pr)) * kf / d;
   const double tau = rho * c * d / (6 * h);
