@@ -39,10 +39,15 @@ int world_size() {
   return s;
 }
 
-// A fresh, empty directory per test, the same path on every rank.
+// A fresh, empty directory per test, the same path on every rank. CTest runs this executable
+// twice, the second time with GRAINFLOW_SNAPSHOT_MPIIO=1 (snapshot_writer_mpiio_mpi_test,
+// tests/CMakeLists.txt), and may run the two at once: each route has a folder of its own.
 std::string test_directory() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "snapshot_writer_mpi_test" /
+  const char* mpiio = std::getenv("GRAINFLOW_SNAPSHOT_MPIIO");
+  const std::string route = mpiio && std::string(mpiio) == "1" ? "snapshot_writer_mpiio_mpi_test"
+                                                               : "snapshot_writer_mpi_test";
+  const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / route /
                        (std::string(info->test_suite_name()) + "." + info->name());
   if (world_rank() == 0) fs::remove_all(dir);
   MPI_Barrier(MPI_COMM_WORLD);

@@ -1,6 +1,8 @@
 #pragma once
 // Meshes for wall tests: written as ASCII STL into the build tree and wrapped as
 // scene walls.
+#include <unistd.h>
+
 #include <array>
 #include <filesystem>
 #include <string>
@@ -71,13 +73,20 @@ inline MeshData split_at(const MeshData& m, double x_seam, const Vec3& offset) {
   return out;
 }
 
+// Writes `m` as build/test_output/walls/<name> and returns the path. CTest runs each test in
+// a process of its own, several at once, and tests may write the same name: the file is
+// written under a name of this process's own and renamed onto `name` (atomic on POSIX), so a
+// reader sees either the whole old file or the whole new one, never a truncated one. Tests
+// whose meshes differ must still use names of their own.
 inline std::string write_mesh(const MeshData& m, const std::string& name) {
   const std::filesystem::path dir =
       std::filesystem::path(GRAINFLOW_BINARY_DIR) / "test_output" / "walls";
   std::filesystem::create_directories(dir);
-  const std::string path = (dir / name).string();
-  write_ascii_stl(path, m.v, m.t);
-  return path;
+  const std::filesystem::path path = dir / name;
+  const std::filesystem::path part = dir / (name + ".tmp." + std::to_string(::getpid()));
+  write_ascii_stl(part.string(), m.v, m.t);
+  std::filesystem::rename(part, path);
+  return path.string();
 }
 
 inline Wall mesh_wall(const std::string& file, const std::string& name = "mesh") {

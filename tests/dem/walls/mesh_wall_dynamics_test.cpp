@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <string>
 
 #include "dem/contact/restitution_mapping.hpp"
 #include "dem/engine/simulation.hpp"
@@ -29,7 +30,9 @@ void roll_across(const Vec3& direction, const char* label) {
   s.domain.lo = Vec3(-0.01, -0.01, -0.01);
   s.domain.hi = Vec3(0.06, 0.06, 0.01);
   s.gravity = Vec3(0, 0, -9.81);
-  s.walls.push_back(test::mesh_wall(test::write_mesh(test::flat_grid(24, 0.002, 0, 0, 0), "roll.stl")));
+  // One file per test (CTest runs the two at once).
+  s.walls.push_back(test::mesh_wall(test::write_mesh(test::flat_grid(24, 0.002, 0, 0, 0),
+                                                     std::string("roll_") + label + ".stl")));
   Simulation sim(s, false);
   const double k = 4.0 / 3.0 * kYStar * std::sqrt(kR);
   const double delta = std::pow(kMass * 9.81 / k, 2.0 / 3.0);
