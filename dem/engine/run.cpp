@@ -170,6 +170,24 @@ std::string continue_command(const std::string& scene_file, const RunOptions& op
   return cmd + " --restart " + shell_word(checkpoint);
 }
 
+namespace {
+
+// The advice of a refused step: the smallest step the refusing checks propose, which every
+// one of them allows (following the first error alone may meet the next one).
+std::string refusal_remedy(const TimeStepReport& rep) {
+  if (!std::isfinite(rep.refusal_step) || !(rep.refusal_step > 0))
+    return "lower time.step / time.rayleigh_fraction";
+  std::ostringstream o;
+  o.precision(4);
+  o << "use dt <= " << round_down_3(rep.refusal_step) << " s (time.step";
+  if (rep.rayleigh_time > 0 && std::isfinite(rep.rayleigh_time))
+    o << ", or time.rayleigh_fraction <= " << round_down_3(rep.refusal_step / rep.rayleigh_time);
+  o << "), the smallest step proposed above, which every limit above allows";
+  return o.str();
+}
+
+}  // namespace
+
 int check_scene(const Scene& scene, std::ostream& out) {
   check_grids(scene);
   Simulation sim(scene);
@@ -185,7 +203,10 @@ int check_scene(const Scene& scene, std::ostream& out) {
     speaker(MPI_COMM_WORLD, out) << "steps to reach t_end = " << scene.time.end << " s: "
                                  << static_cast<long>(std::ceil(scene.time.end / rep.dt - 0.5))
                                  << "\n";
-  return rep.verdict == TimeStepReport::Verdict::refuse ? 1 : 0;
+  if (rep.verdict != TimeStepReport::Verdict::refuse) return 0;
+  speaker(MPI_COMM_WORLD, out) << scene.file << ": error: `grain run` would refuse this time step; "
+                               << refusal_remedy(rep) << "\n";
+  return 1;
 }
 
 RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm comm,
@@ -221,9 +242,9 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   print_coarse_grain_report(scene, sim.particles(), comm, out);
   if (sim.time_step_report().verdict == TimeStepReport::Verdict::refuse &&
       !options.allow_large_time_step)
-    throw SetupError(scene.file + ": error: refusing to run with this time step (see above); "
-                                  "lower time.step / time.rayleigh_fraction, or pass "
-                                  "--allow-large-dt to run anyway");
+    throw SetupError(scene.file + ": error: refusing to run with this time step (see above); " +
+                     refusal_remedy(sim.time_step_report()) +
+                     ", or pass --allow-large-dt to run anyway");
   guard_finite(sim, has_non_finite(sim.particles()), dir, comm);
 
   SnapshotWriter snapshots(comm, dir, "particles", scene.output.fields);

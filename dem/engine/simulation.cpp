@@ -309,7 +309,7 @@ void Simulation::check_force_limits() {
         << "' from fluid.forces";
       report_.notes.push_back(o.str());
       force_limit_notes_.push_back(o.str());
-      report_.verdict = TimeStepReport::Verdict::refuse;
+      report_.refuse_above(0.9 * l.dt_max);
     }
   }
 }

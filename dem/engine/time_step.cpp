@@ -202,7 +202,7 @@ TimeStepReport check_time_step(const Scene& scene, const Particles& p, const Pai
     rep.recommended_step =
         std::min(kWarnRayleighFraction * rep.rayleigh_time, rep.contact_time / kWarnStepsPerContact);
     if (fr > kRefuseRayleighFraction || steps < kRefuseStepsPerContact) {
-      rep.verdict = TimeStepReport::Verdict::refuse;
+      rep.refuse_above(rep.recommended_step);
       o << "error: dt is too large to resolve contacts (limits: dt <= " << kRefuseRayleighFraction
         << " t_R and >= " << kRefuseStepsPerContact << " steps per impact); use dt <= " << rep.recommended_step
         << " s";

@@ -5,6 +5,8 @@
 // impact between the smallest particles (and particle-wall):
 //   Hertz: t_c = 2.868 (m*^2 / (R* Y*^2 v))^{1/5}   (elastic; damping lengthens it)
 //   Hooke: t_c = pi / sqrt(k_n/m* - (gamma_n / 2 m*)^2)
+#include <algorithm>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -28,6 +30,13 @@ struct TimeStepReport {
   // particle-wall pair) whose restitution suffers most at its steps per impact and e.
   std::optional<ImpactAccuracy> accuracy;
   enum class Verdict { ok, warn, refuse } verdict = Verdict::ok;
+  // The smallest step that the refusing checks propose (each its `use dt <=` figure), so
+  // that the final refusal names one step that every limit allows; infinity without one.
+  double refusal_step = std::numeric_limits<double>::infinity();
+  void refuse_above(double proposed_step) {
+    verdict = Verdict::refuse;
+    refusal_step = std::min(refusal_step, proposed_step);
+  }
   std::vector<std::string> notes;  // human-readable findings, one per line
 };
 

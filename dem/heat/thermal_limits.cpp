@@ -99,7 +99,7 @@ ThermalLimits check_thermal_limits(const Scene& scene, const Particles& p, TimeS
     rep.notes.push_back(o.str());
     o.str("");
     if (dt > limit) {
-      escalate(TimeStepReport::Verdict::refuse);
+      rep.refuse_above(kWarnConductionFraction * limit);
       o << "error: dt = " << dt << " s is beyond the stability limit of heat conduction (dt <= "
         << limit << " s); use dt <= " << kWarnConductionFraction * limit
         << " s, or switch conduction off with `heat: {conduction: none}`";

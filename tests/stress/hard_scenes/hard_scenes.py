@@ -12,7 +12,8 @@ contact-slot combinations (normal x tangential x rolling x cohesion; seeds 0..23
 planes, cylinders inside and outside, STL meshes written next to the scene, moving walls,
 periodic axes, 1 or 2 ranks, one-way fluid with every drag law and force term, streams, CSV
 particles placed at the limits (touching, on a cylinder's axis, on a wall). The family of a
-scene is seed % 8 (see FAMILIES).
+scene is seed % 8 (see FAMILIES); `--family thermal` draws heat transfer with coarse-grained
+parcels for every seed instead (Draw.thermal, its invariants in check_heat).
 
 A scene passes when either
   * `grain run` exits 0 and the run's output holds the invariants: finite state in every
@@ -59,6 +60,9 @@ except ImportError:  # this python3 lacks them: scripts/python.sh finds one that
     os.execv(_helper, [_helper, os.path.abspath(__file__), *sys.argv[1:]])
 
 FAMILIES = ["pour", "drum", "rod", "mesh", "periodic_gas", "closed_gas", "fluid", "limits"]
+# Families outside the seed % 8 cycle (so that a seed's scene above never changes): chosen
+# with --family, they draw a scene of their own for every seed.
+EXTRA_FAMILIES = ["thermal"]
 NORMAL = ["hertz", "hooke"]
 TANGENTIAL = ["none", "history"]
 ROLLING = ["none", "cdt", "epsd"]
@@ -94,15 +98,15 @@ def rayleigh_time(r, rho, y, nu):
 class Draw:
     """One scene: the YAML dict plus what the checks need to know about it."""
 
-    def __init__(self, seed):
+    def __init__(self, seed, family=None):
         self.seed = seed
         self.rng = random.Random(seed)
-        self.family = FAMILIES[seed % len(FAMILIES)]
+        self.family = family or FAMILIES[seed % len(FAMILIES)]
         self.ranks = 2 if seed % 3 == 2 else 1
         self.files = {}  # extra files: name -> text
         self.meta = {"moving_walls": False, "gravity": False, "fluid": False, "cohesion": False,
                      "streams": False, "expected_start": None, "plates": [], "rods": [],
-                     "isolated": False, "momentum": False}
+                     "isolated": False, "momentum": False, "heat": None}
 
     # -- pieces shared by the families ------------------------------------------------------
     def materials(self, n, y_max=1e11):
@@ -669,19 +673,203 @@ class Draw:
         self.parallel(scene, [0, 1, 2])
         return scene
 
+    def thermal(self):
+        """Heat transfer with coarse-grained parcels (`--family thermal`; not in the seed % 8
+        cycle): a box under gravity, beads and parcels of k in [1.2, 3] side by side, walls
+        adiabatic, at a fixed temperature or (rarely) under a fixed flux, a heat source now and
+        then, and sometimes a prescribed fluid that exchanges heat by convection."""
+        rng = self.rng
+        scene = self.base(y_max=1e9)
+        for m in scene["materials"]:
+            m["heat_capacity"] = float(f"{logu(rng, 100, 5000):.4g}")
+            m["conductivity"] = float(f"{logu(rng, 0.01, 400):.4g}")  # reset below if used
+        heat = {}
+        c = scene["contact"]
+        if c["normal"] == "hertz" and rng.random() < 0.3:
+            heat["contact_radius"] = rng.choice(["morris_static", "morris_collision"])
+            for m in scene["materials"]:
+                m["real_youngs_modulus"] = float(f"{m['youngs_modulus'] * logu(rng, 1, 1e4):.4g}")
+        if rng.random() < 0.1:
+            heat["conduction"] = "none"
+        scene["heat"] = heat
+        if rng.random() < 0.2:
+            m = rng.choice(scene["materials"])
+            m["heat_source"] = float(f"{rng.choice([-1, 1]) * logu(rng, 1e-2, 1e5):.4g}")
+        mats = [x["name"] for x in scene["materials"]]
+        r0 = logu(rng, 2e-4, 3e-3)
+        ratio = logu(rng, 1, 4) if rng.random() < 0.6 else 1
+        # One or two insertions (a fill, sometimes a stream), each beads or parcels.
+        ks = [1.0 if rng.random() < 0.3 else round(rng.uniform(1.2, 3), 3)
+              for _ in range(rng.choice([1, 2]))]
+        if any(k != 1 for k in ks) and "stiffness" in c.get("hooke", {}) and rng.random() < 0.9:
+            # A fixed Hooke stiffness is refused with parcels; keep a few to check the message.
+            c["hooke"] = {"characteristic_velocity": float(f"{logu(rng, 0.01, 20):.3g}")}
+        r_big = r0 * ratio * max(ks)
+        lx, ly = (r_big * rng.uniform(6, 14) for _ in range(2))
+        lz = r_big * rng.uniform(12, 30)
+        per = [rng.random() < 0.3, rng.random() < 0.3, False]
+        scene["domain"] = {"min": [0, 0, 0], "max": [lx, ly, lz], "periodic": per}
+        scene["gravity"] = [0, 0, -9.81]
+        self.meta["gravity"] = True
+        temps = [round(rng.uniform(250, 500), 3) for _ in ks]
+        bounds = list(temps)
+        flux = False
+        # A third of the scenes are closed and adiabatic (no wall temperature or flux, no
+        # fluid, no stream): the particles' m c T then changes only by their heat sources.
+        adiabatic = rng.random() < 0.35
+
+        def thermal(w):
+            nonlocal flux
+            u = 1 if adiabatic else rng.random()
+            if u < 0.35:
+                w["temperature"] = round(rng.uniform(250, 500), 3)
+                bounds.append(w["temperature"])
+            elif u < 0.45:
+                w["heat_flux"] = float(f"{rng.choice([-1, 1]) * logu(rng, 1, 1e5):.4g}")
+                flux = True
+            return w
+
+        walls = [thermal({"type": "plane", "name": "floor", "point": [0, 0, 0],
+                          "normal": [0, 0, 1], "material": rng.choice(mats)})]
+        for a, hi in enumerate([lx, ly]):
+            if per[a]:
+                continue
+            n = [0, 0, 0]
+            n[a] = 1
+            walls.append(thermal({"type": "plane", "name": f"side{a}lo", "point": [0, 0, 0],
+                                  "normal": list(n), "material": rng.choice(mats)}))
+            n[a] = -1
+            p = [0, 0, 0]
+            p[a] = hi
+            walls.append(thermal({"type": "plane", "name": f"side{a}hi", "point": p,
+                                  "normal": n, "material": rng.choice(mats)}))
+        # A lid keeps everything in (no removal), so that the energy balance is exact.
+        walls.append(thermal({"type": "plane", "name": "lid", "point": [0, 0, lz],
+                              "normal": [0, 0, -1], "material": rng.choice(mats)}))
+        scene["walls"] = walls
+        inserts = []
+        expected = 0
+        base = lz * 0.02
+        block = None
+        if rng.random() < 0.6:
+            # A block of beads on the floor in a simple cubic lattice, each touching its
+            # neighbours and the floor (written with 17 digits), each at its own temperature:
+            # under gravity the contacts close at once and heat flows from the first step.
+            rc = r0 * logu(rng, 1, ratio) if ratio > 1 else r0
+            nx, ny = max(1, int(lx / (2 * rc))), max(1, int(ly / (2 * rc)))
+            nz = max(1, min(rng.randint(1, 3), 150 // (nx * ny)))
+            rows = []
+            for i in range(nx):
+                for j in range(ny):
+                    for kz in range(nz):
+                        if len(rows) < 150:
+                            t = rng.uniform(250, 500)
+                            bounds.append(t)
+                            rows.append((rc + 2 * rc * i, rc + 2 * rc * j, rc + 2 * rc * kz, rc, t))
+            text = "x,y,z,radius,T\n" + "".join(",".join(f"{v:.17g}" for v in row) + "\n"
+                                                 for row in rows)
+            self.files["block.csv"] = text
+            block = {"type": "csv", "file": "block.csv", "material": rng.choice(mats)}
+            inserts.append(block)
+            expected += len(rows)
+            self.meta["csv_valid_lines"] = set(range(2, len(rows) + 2))
+            base = 2 * rc * nz + 0.02 * lz
+        top = lz * 0.7
+        for i, (k, t) in enumerate(zip(ks, temps)):
+            ins = {"type": "fill",
+                   "region": {"box": {"min": [0, 0, base + i * (top - base) / len(ks)],
+                                      "max": [lx, ly, base + (i + 1) * (top - base) / len(ks)]}},
+                   "material": rng.choice(mats), "radius": self.radii(r0, ratio),
+                   "temperature": t, "seed": rng.randrange(1 << 32)}
+            if k != 1 or rng.random() < 0.2:
+                ins["coarse_grain"] = k
+            vol = lx * ly * (top - base) / len(ks)
+            r_mean = k * r0 * ((1 + ratio) / 2 if ratio > 1 else 1)
+            n = min(150, self.count_fill(vol, r_mean, rng.uniform(0.1, 0.28)))
+            ins["count"] = n
+            if rng.random() < 0.4:
+                ins["velocity"] = self.velocity(logu(rng, 0.01, 0.5))
+            expected += n
+            inserts.append(ins)
+        scene["insert"] = inserts
+        self.meta["expected_start"] = expected
+        fluid = not adiabatic and rng.random() < 0.5
+        if fluid:
+            fl = {"density": float(f"{logu(rng, 1, 1000):.4g}"),
+                  "viscosity": float(f"{logu(rng, 1e-5, 1e-2):.3g}"),
+                  "velocity": [0, 0, round(rng.uniform(0, 1), 4)],
+                  "drag": rng.choice(DRAG_LAWS), "model": "B",
+                  "forces": ["drag", "pressure_gradient", "viscous"],
+                  "pressure": {"hydrostatic": True},
+                  "temperature": round(rng.uniform(250, 500), 3),
+                  "heat_capacity": float(f"{logu(rng, 500, 5000):.4g}"),
+                  "conductivity": float(f"{logu(rng, 0.02, 1):.3g}"),
+                  "convection": rng.choice(["ranz_marshall", "gunn"])}
+            if rng.random() < 0.5:
+                fl["void_fraction"] = {"cell_size": float(f"{r_big * logu(rng, 2, 6):.4g}"),
+                                       "minimum": round(rng.uniform(0.35, 0.5), 3)}
+            else:
+                fl["void_fraction"] = round(rng.uniform(0.4, 1), 3)
+            scene["fluid"] = fl
+            self.meta["fluid"] = True
+            bounds.append(fl["temperature"])
+        sources = any("heat_source" in m for m in scene["materials"])
+        self.meta["heat"] = {
+            "bounds": None if flux or sources else (min(bounds), max(bounds)),
+            # A closed box without a fixed wall temperature, flux or fluid exchanges no heat:
+            # the particles' m c T changes only by their sources.
+            "closed": adiabatic,
+            "ks": sorted({float(k) for k in ks})}
+        # Long enough for the particles to meet and settle, so that heat passes.
+        dt = self.time(scene, r0, rng.randint(2000, 20000))
+        # Each inserted material's conductivity puts its conduction time scale m c / (2 k a)
+        # (a at the default overlap limit 0.25 r: sqrt(r/2 0.25 r) = 0.354 r; the start-up's
+        # estimate) at 12 dt times 0.5 to 100: near the stability limit of dt <= tau / 12,
+        # and beyond it now and then, where the start-up refuses and its advice is rerun.
+        by_name = {m["name"]: m for m in scene["materials"]}
+        r_of = {}
+        fills = [ins for ins in inserts if ins["type"] == "fill"]
+        for ins, k in zip(fills, ks):
+            r_of[ins["material"]] = min(r_of.get(ins["material"], 1e9), k * r0)
+        if block:
+            r_of[block["material"]] = min(r_of.get(block["material"], 1e9), r0)
+        for name, r in r_of.items():
+            m = by_name[name]
+            tau = 12 * dt * logu(rng, 0.5, 100)
+            cond = m["density"] * 4 / 3 * math.pi * r ** 2 * m["heat_capacity"] / (0.707 * tau)
+            m["conductivity"] = float(f"{cond:.4g}")
+        # A stream of parcels or beads delivers a few more (then not closed).
+        if not adiabatic and rng.random() < 0.3:
+            k = rng.choice(ks)
+            st = {"type": "stream", "material": rng.choice(mats),
+                  "face": {"rectangle": {"centre": [lx / 2, ly / 2, lz * 0.9],
+                                         "normal": [0, 0, -1], "u": [1, 0, 0],
+                                         "size": [lx * 0.5, ly * 0.5]}},
+                  "count_rate": float(f"{rng.randint(3, 20) / scene['time']['end']:.4g}"),
+                  "radius": {"distribution": "constant", "value": r0},
+                  "velocity": [0, 0, -0.1], "temperature": temps[0],
+                  "seed": rng.randrange(1000)}
+            if k != 1:
+                st["coarse_grain"] = k
+            scene["insert"].append(st)
+            self.meta["streams"] = True
+            self.meta["heat"]["closed"] = False
+        self.parallel(scene, [0, 1])
+        return scene
+
     def scene(self):
         f = self.family
         s = {"pour": self.pour, "drum": self.drum, "rod": self.rod, "mesh": self.mesh,
              "periodic_gas": lambda: self.gas(True), "closed_gas": lambda: self.gas(False),
-             "fluid": self.fluid, "limits": self.limits}[f]()
+             "fluid": self.fluid, "limits": self.limits, "thermal": self.thermal}[f]()
         self.output(s)
         order = ["domain", "gravity", "time", "materials", "interactions", "interaction_defaults",
-                 "contact", "walls", "insert", "fluid", "parallel", "output"]
+                 "contact", "heat", "walls", "insert", "fluid", "parallel", "output"]
         return {k: s[k] for k in order if k in s}
 
 
-def draw(seed):
-    d = Draw(seed)
+def draw(seed, family=None):
+    d = Draw(seed, family)
     s = d.scene()
     return d, clean(s)
 
@@ -756,6 +944,11 @@ class Failure(Exception):
 
 
 def error_line(out):
+    # A step refused at start-up by several limits: the final line's advice is the one that
+    # must satisfy them all (each earlier error proposes its own limit's step).
+    for line in out.splitlines():
+        if "error: refusing to run with this time step" in line:
+            return line.strip()
     for line in out.splitlines():
         if re.search(r"\berror: ", line):
             return line.strip()
@@ -769,7 +962,11 @@ def read_snapshots(outdir):
         if name.startswith("particles_") and name.endswith(".h5"):
             with h5py.File(os.path.join(outdir, name), "r") as f:
                 d = {k: f[k][...] for k in ("id", "position", "velocity", "angular_velocity",
-                                            "radius", "mass", "material") if k in f}
+                                            "radius", "mass", "material", "temperature",
+                                            "coarse_grain", "real_count") if k in f}
+                for a in ("material_coarse_grain", "material_real"):
+                    if a in f.attrs:
+                        d[a] = np.asarray(f.attrs[a])
                 d["time"] = float(f.attrs["time"])
                 d["count"] = int(f.attrs["count"])
                 snaps.append(d)
@@ -998,6 +1195,8 @@ def check_output(d, scene, cwd, out):
                               f"the earlier lowest {lowest:.6g} J by {100 * (ek - lowest) / e0:.3g}"
                               f" % of E0 = {e0:.6g} J (isolated, dissipative)")
             lowest = min(lowest, ek)
+    if d.meta["heat"]:
+        check_heat(d, scene, snaps)
     if d.meta["momentum"] and removed == 0:
         p = [np.sum(s["mass"][:, None] * s["velocity"], axis=0) for s in snaps]
         scale = max(float(np.sum(snaps[0]["mass"] * np.linalg.norm(snaps[0]["velocity"],
@@ -1009,6 +1208,71 @@ def check_output(d, scene, cwd, out):
                               f"|P - P0| = {np.max(np.abs(pk - p[0])):.3g} kg m/s at t = "
                               f"{s['time']:.6g} s, sum m|v| = {scale:.3g} (fully periodic, no "
                               "walls, gravity or fluid)")
+
+
+def check_heat(d, scene, snaps):
+    """Invariants of heat transfer and parcels (the thermal family)."""
+    h = d.meta["heat"]
+    mats = scene["materials"]
+    for s in snaps:
+        if not s["count"]:
+            continue
+        t = s.get("temperature")
+        if t is None:
+            raise Failure("no temperature", f"heat is on, but the snapshot at t = {s['time']} "
+                          "holds no dataset 'temperature'")
+        if not np.all(np.isfinite(t)) or np.any(t <= 0):
+            i = int(np.argmin(np.where(np.isfinite(t), t, -np.inf)))
+            raise Failure("temperature not finite and positive",
+                          f"T = {t[i]} K (id {int(s['id'][i])}) at t = {s['time']:.6g} s")
+        if h["bounds"]:
+            lo, hi = h["bounds"]
+            tol = 1e-9 * hi
+            if t.min() < lo - tol or t.max() > hi + tol:
+                raise Failure("temperature outside its bounds",
+                              f"T in [{t.min():.12g}, {t.max():.12g}] K at t = {s['time']:.6g} "
+                              f"s, outside [{lo}, {hi}] K, the initial, wall and fluid "
+                              "temperatures (no source, no flux: a maximum principle)")
+        # Each particle's k is one that an insertion asked for, and its class's.
+        cg = s.get("coarse_grain")
+        if cg is not None:
+            allowed = set(h["ks"]) | {1.0}
+            if not set(np.unique(cg).tolist()) <= allowed:
+                raise Failure("coarse_grain", f"k values {sorted(set(cg.tolist()))} at t = "
+                              f"{s['time']:.6g} s, asked {sorted(allowed)}")
+            if "real_count" in s and np.max(np.abs(s["real_count"] - cg ** 3)) > 1e-9 * \
+                    np.max(cg ** 3):
+                raise Failure("real_count", f"real_count != k^3 at t = {s['time']:.6g} s")
+            mk = s.get("material_coarse_grain")
+            if mk is not None and np.any(mk[s["material"]] != cg):
+                raise Failure("coarse_grain", f"a particle's k is not its class's at t = "
+                              f"{s['time']:.6g} s")
+    if not h["closed"] or not snaps[0]["count"]:
+        return
+    # Closed and adiabatic: sum m c T moves only by the sources, sum m q t.
+    real = snaps[0].get("material_real")
+
+    def listed(idx):
+        return mats[int(real[idx]) if real is not None else int(idx)]
+
+    first = snaps[0]
+    mc = np.array([listed(i)["heat_capacity"] for i in first["material"]]) * first["mass"]
+    q = np.array([listed(i).get("heat_source", 0.0) for i in first["material"]]) * first["mass"]
+    e0 = float(np.sum(mc * first["temperature"]))
+    order0 = np.argsort(first["id"])
+    for s in snaps[1:]:
+        if s["count"] != first["count"]:
+            return  # a particle left (then the balance has a term this check does not see)
+        order = np.argsort(s["id"])
+        if not np.array_equal(s["id"][order], first["id"][order0]):
+            return
+        e = float(np.sum(mc[order0] * s["temperature"][order]))
+        expected = e0 + float(np.sum(q)) * (s["time"] - first["time"])
+        if abs(e - expected) > 1e-10 * abs(e0):
+            raise Failure("heat not conserved",
+                          f"sum m c T = {e:.15g} J at t = {s['time']:.6g} s, expected "
+                          f"{expected:.15g} J (closed, adiabatic; sources {np.sum(q):.6g} W): "
+                          f"off by {abs(e - expected) / e0:.3g} of it")
 
 
 def run_dt(scene):
@@ -1084,7 +1348,7 @@ def check_scene(args, seed, d, scene, workdir, depth=0):
     re_scene["time"]["end"] = float(f"{end:.6g}")
     re_scene["output"]["snapshot_interval"] = end / 8
     sub = os.path.join(workdir, f"rerun{depth + 1}")
-    d2 = Draw(seed)
+    d2 = Draw(seed, d.family)
     d2.files, d2.meta, d2.ranks, d2.family = d.files, d.meta, d.ranks, d.family
     d2.dt_estimate = step
     try:
@@ -1112,6 +1376,7 @@ STOP_CAUSES = [
     ("key time.max_step_travel", "travel guard"),
     ("key time.max_overlap", "overlap guard"),
     ("dt is too large", "start-up step refusal"),
+    ("refusing to run with this time step", "start-up step refusal"),
     ("non-finite", "NaN guard"),
     ("overlaps an earlier particle", "CSV overlap refused"),
     ("wall", "insertion against a wall"),
@@ -1167,7 +1432,9 @@ def main():
     ap.add_argument("--keep", action="store_true", help="keep the folders of passing scenes")
     ap.add_argument("--print-scene", action="store_true", help="print the seed's YAML, no run")
     ap.add_argument("--report", help="write a JSON line per scene to this file")
-    ap.add_argument("--family", choices=FAMILIES, help="run only the seeds of this family")
+    ap.add_argument("--family", choices=FAMILIES + EXTRA_FAMILIES,
+                    help="run only the seeds of this family; an extra family (thermal) draws "
+                         "its own scene for every seed")
     ap.add_argument("--verbose", action="store_true", help="print the message of each stop")
     args = ap.parse_args()
     if args.summarise:
@@ -1193,9 +1460,10 @@ def main():
         if args.budget and time.monotonic() - start > args.budget:
             print(f"time budget of {args.budget:g} s used after {done} scenes")
             break
-        if args.family and FAMILIES[seed % len(FAMILIES)] != args.family:
+        extra = args.family if args.family in EXTRA_FAMILIES else None
+        if args.family and not extra and FAMILIES[seed % len(FAMILIES)] != args.family:
             continue
-        d, scene = draw(seed)
+        d, scene = draw(seed, extra)
         if args.ranks != "mixed":
             d.ranks = int(args.ranks)
         if args.print_scene:

@@ -16,3 +16,15 @@ add_test(NAME hard_scenes.ci
                  --timeout 25 --work ${PROJECT_BINARY_DIR}/test_output/hard_scenes)
 set_tests_properties(hard_scenes.ci PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}"
                      LABELS stress PROCESSORS 2 TIMEOUT 240)
+
+# The thermal family (--family thermal, outside the seed % 8 cycle): heat transfer with
+# coarse-grained parcels, a block of touching beads at random temperatures, fixed-temperature
+# and flux walls, heat sources, convection with a prescribed fluid; checked for finite,
+# positive temperatures, the maximum principle, m c T conserved in closed adiabatic boxes,
+# and each parcel's k (docs/stability.md).
+add_test(NAME hard_scenes.thermal_ci
+         COMMAND ${GRAINFLOW_HARD_SCENES_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/hard_scenes.py
+                 --grain $<TARGET_FILE:grain> --mpiexec ${MPIEXEC_EXECUTABLE} --family thermal
+                 --seeds 0:16 --timeout 25 --work ${PROJECT_BINARY_DIR}/test_output/hard_scenes_thermal)
+set_tests_properties(hard_scenes.thermal_ci PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}"
+                     LABELS stress PROCESSORS 2 TIMEOUT 240)

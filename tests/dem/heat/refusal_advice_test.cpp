@@ -1,0 +1,118 @@
+// A step that several start-up limits refuse (docs/stability.md, "Start-up checks"): each
+// error line proposes the step its own limit allows, and the final refusal proposes the
+// smallest of them. Reference: the advice itself, rerun. Found by the thermal family of the
+// hard-scene generator: a step refused for the contacts and for heat conduction at once, whose
+// first error's proposal (the contacts') was refused again for conduction.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "dem/engine/run.hpp"
+#include "dem/scene/scene_parser.hpp"
+
+namespace grainflow {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Two touching beads (r = 1 mm, Y = 5 MPa: t_R = 1.22e-4 s) on a floor, and a conductivity
+// (1e6 W/(m K), no real solid's) that puts the conduction limit, tau / 12 = m c / (24 k a) =
+// 1.04e-6 s, far below the contacts' t_R.
+std::string scene(const std::string& step) {
+  return R"(domain: {min: [-0.005, -0.005, 0], max: [0.005, 0.005, 0.01]}
+gravity: [0, 0, -9.81]
+time: {step: )" +
+         step + R"(, end: 2e-6}
+materials:
+  - {name: glass, youngs_modulus: 5e6, poisson_ratio: 0.3, density: 2500, heat_capacity: 840,
+     conductivity: 1e6}
+interaction_defaults: {restitution: 0.5, friction: 0.3}
+contact: {normal: hertz}
+heat: {}
+walls:
+  - {type: plane, name: floor, point: [0, 0, 0], normal: [0, 0, 1], material: glass}
+insert:
+  - {type: csv, file: beads.csv, material: glass, temperature: 300}
+output: {progress: false}
+)";
+}
+
+struct Outcome {
+  std::string error, log;
+};
+
+Outcome run(const std::string& step, const std::string& name) {
+  const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "refusal_advice" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  {
+    std::ofstream csv(dir / "beads.csv");
+    csv << "x,y,z,radius\n0,0,0.001,0.001\n0.002,0,0.001,0.001\n";
+  }
+  const Scene s = parse_scene(scene(step), (dir / "scene.yaml").string());
+  RunOptions options;
+  options.output_directory = (dir / "out").string();
+  options.progress = false;
+  options.handle_stop_signals = false;
+  std::ostringstream log;
+  Outcome o;
+  try {
+    run_scene(s, options, MPI_COMM_WORLD, log);
+  } catch (const std::exception& e) {
+    o.error = e.what();
+  }
+  o.log = log.str();
+  return o;
+}
+
+std::vector<double> proposals(const std::string& text) {
+  std::vector<double> out;
+  const std::regex use("use dt <= ([0-9.eE+-]+) s");
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), use); it != std::sregex_iterator();
+       ++it)
+    out.push_back(std::stod((*it)[1].str()));
+  return out;
+}
+
+TEST(RefusalAdvice, TheFinalRefusalProposesAStepEveryLimitAllows) {
+  // 1e-4 s = 0.82 t_R, 2.7 steps per impact: refused for the contacts and, far more, for
+  // conduction.
+  const Outcome refused = run("1e-4", "refused");
+  ASSERT_NE(refused.error.find("refusing to run with this time step"), std::string::npos)
+      << refused.error;
+  ASSERT_NE(refused.log.find("error: dt is too large to resolve contacts"), std::string::npos);
+  ASSERT_NE(refused.log.find("beyond the stability limit of heat conduction"), std::string::npos);
+  const std::vector<double> each = proposals(refused.log);
+  ASSERT_EQ(each.size(), 2u) << refused.log;
+  const std::vector<double> final_advice = proposals(refused.error);
+  ASSERT_EQ(final_advice.size(), 1u) << refused.error;
+  const double smallest = std::min(each[0], each[1]);
+  std::printf("[ measured ] proposals %.4g s (contacts), %.4g s (conduction); final %.4g s\n",
+              each[0], each[1], final_advice[0]);
+  EXPECT_LE(final_advice[0], smallest);
+  EXPECT_GE(final_advice[0], 0.99 * smallest);  // rounded down to 3 digits, no further
+
+  // The first error's proposal alone is refused again (the case this test is about) ...
+  std::ostringstream first;
+  first.precision(17);
+  first << each[0];
+  const Outcome again = run(first.str(), "first_proposal");
+  EXPECT_NE(again.error.find("refusing to run"), std::string::npos);
+  // ... and the final one runs to the end.
+  std::ostringstream final_step;
+  final_step.precision(17);
+  final_step << final_advice[0];
+  const Outcome ran = run(final_step.str(), "final_proposal");
+  EXPECT_EQ(ran.error, "");
+  EXPECT_NE(ran.log.find("done: "), std::string::npos) << ran.log;
+}
+
+}  // namespace
+}  // namespace grainflow
