@@ -74,6 +74,9 @@ void print_report(const Simulation& sim, MPI_Comm comm, std::ostream& out,
       case Simulation::GridChoice::given: o << " (parallel.grid)"; break;
       case Simulation::GridChoice::imposed: o << " (imposed planes)"; break;
       case Simulation::GridChoice::checkpoint: o << " (default: the checkpoint's)"; break;
+      case Simulation::GridChoice::given_checkpoint:
+        o << " (parallel.grid, planes of the checkpoint)";
+        break;
       case Simulation::GridChoice::particles: o << " (default: for the particles)"; break;
       case Simulation::GridChoice::domain: o << " (default: for the domain)"; break;
     }

@@ -167,6 +167,12 @@ void Simulation::initialise() {
     }
   if (cuts_imposed_) {
     grid_choice_ = GridChoice::imposed;
+  } else if (!automatic_grid_ && restored_grid_ && restored_grid_->ranks == decomp_->size() &&
+             restored_grid_->dims == decomp_->dims()) {
+    // The scene's grid is the checkpoint's: its planes are where that run had them (uniform,
+    // or moved by parallel.balance), so the run continues bit for bit.
+    take_restored_grid(*restored_grid_);
+    grid_choice_ = GridChoice::given_checkpoint;
   } else if (automatic_grid_) {
     // On as many ranks as wrote the checkpoint, its boxes: the run continues bit for bit.
     if (restored_grid_ && restored_grid_->ranks == decomp_->size())
@@ -686,6 +692,7 @@ void Simulation::restore(const CheckpointData& checkpoint) {
   time_ = checkpoint.time;
   if (dt_ <= 0) dt_ = checkpoint.dt;
   counters_.steps = checkpoint.step;
+  counters_.rebuilds = checkpoint.rebuilds;  // paces parallel.balance as in the written run
   next_id_ = checkpoint.next_id;
   restored_springs_ = checkpoint.springs;
   restored_grid_ = checkpoint.grid;
@@ -722,6 +729,7 @@ void Simulation::write_checkpoint(const std::string& path) {
   d.time = time_;
   d.dt = dt_;
   d.step = counters_.steps;
+  d.rebuilds = counters_.rebuilds;
   d.next_id = next_id_;
   d.particles = p_;
   d.has_temperature = heat_ != nullptr;
@@ -1330,6 +1338,13 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
         o << " scale the Young's modulus by at least " << round_up(s) << " (material '" << m.name
           << "': " << round_up(s) * m.youngs_modulus << " Pa"
           << (material_b != a.material ? ", and the partner's alike" : "") << ");";
+      } else if (const auto& v = scene_.contact.hooke_characteristic_velocity) {
+        // k_n from the characteristic velocity grows as v^(2/5) for every pair alike
+        // (normal_hooke.hpp), and keeps growing with the parcels' size, which a fixed
+        // stiffness would not (refused with parcels).
+        o << " raise contact.hooke.characteristic_velocity to at least "
+          << round_up(*v * std::pow(round_up(s), 2.5)) << " m/s (k_n grows as its 2/5 power: "
+          << "at least " << round_up(s) << " times stiffer);";
       } else {
         o << " set contact.hooke.stiffness.normal to at least " << round_up(s) * c.kn << " N/m;";
       }

@@ -209,11 +209,13 @@ class Simulation {
 
   // Where initialise() took the processor grid from.
   enum class GridChoice {
-    given,       // processor_grid or the scene's `parallel.grid`, uniform planes
-    imposed,     // set_cut_planes()
-    checkpoint,  // the restored checkpoint's grid and planes (written on as many ranks)
-    particles,   // the default rule for the particles present at initialise()
-    domain,      // the default rule for the domain alone (no particles yet, or streams)
+    given,             // processor_grid or the scene's `parallel.grid`, uniform planes
+    imposed,           // set_cut_planes()
+    checkpoint,        // the restored checkpoint's grid and planes (written on as many ranks)
+    particles,         // the default rule for the particles present at initialise()
+    domain,            // the default rule for the domain alone (no particles yet, or streams)
+    given_checkpoint,  // the scene's `parallel.grid`, the planes where the checkpoint's run
+                       // had them (moved by parallel.balance): a restart on as many ranks
   };
   GridChoice grid_choice() const { return grid_choice_; }
 

@@ -8,6 +8,7 @@
 
 #include "dem/contact/normal_hooke.hpp"
 #include "dem/heat/thermal_limits.hpp"
+#include "dem/walls/wall_travel.hpp"
 
 namespace grainflow {
 
@@ -101,6 +102,14 @@ TimeStepReport check_time_step(const Scene& scene, const Particles& p, const Pai
   std::vector<double> r_min(nm, inf);
   for (std::size_t i = 0; i < p.size(); ++i)
     r_min[p.material[i]] = std::min(r_min[p.material[i]], p.radius[i]);
+  // The particles streams will insert count as present: the step must resolve their contacts
+  // too (a stream of smaller or softer particles than the fill's ran unresolved before).
+  std::vector<std::string> streamed(nm);  // the stream whose particles set r_min, if one does
+  for (const Insertion& ins : scene.insertions)
+    if (ins.kind == Insertion::Kind::stream && min_radius(ins.radius) < r_min[ins.material]) {
+      r_min[ins.material] = min_radius(ins.radius);
+      streamed[ins.material] = ins.source;
+    }
 
   rep.rayleigh_time = inf;
   std::string rayleigh_material;
@@ -111,7 +120,8 @@ TimeStepReport check_time_step(const Scene& scene, const Particles& p, const Pai
       const double t = rayleigh_time(scene.materials[m], r_min[m]);
       if (t < rep.rayleigh_time) {
         rep.rayleigh_time = t;
-        rayleigh_material = scene.materials[m].name;
+        rayleigh_material = "'" + scene.materials[m].name + "' particle" +
+                            (streamed[m].empty() ? "" : ", of the stream at " + streamed[m]);
       }
     }
 
@@ -154,8 +164,7 @@ TimeStepReport check_time_step(const Scene& scene, const Particles& p, const Pai
   std::ostringstream o;
   o.precision(4);
   if (rep.rayleigh_time < inf) {
-    o << "Rayleigh time t_R = " << rep.rayleigh_time << " s (smallest '" << rayleigh_material
-      << "' particle)";
+    o << "Rayleigh time t_R = " << rep.rayleigh_time << " s (smallest " << rayleigh_material << ")";
     rep.notes.push_back(o.str());
     o.str("");
   } else if (!scene.contacts_possible && p.size() > 0) {

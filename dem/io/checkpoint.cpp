@@ -199,12 +199,13 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
     H5Sclose(space);
   }
   H5Tclose(str);
-  const long long step = d.step, next = d.next_id;
+  const long long step = d.step, next = d.next_id, rebuilds = d.rebuilds;
   fail.check(fail.ok() && write_attribute(fail, f.id(), "time", H5T_NATIVE_DOUBLE, d.time) &&
                  write_attribute(fail, f.id(), "dt", H5T_NATIVE_DOUBLE, d.dt) &&
                  write_attribute(fail, f.id(), "step", H5T_NATIVE_LLONG, step) &&
-                 write_attribute(fail, f.id(), "next_id", H5T_NATIVE_LLONG, next),
-             "writing the attributes time, dt, step, next_id");
+                 write_attribute(fail, f.id(), "next_id", H5T_NATIVE_LLONG, next) &&
+                 write_attribute(fail, f.id(), "rebuilds", H5T_NATIVE_LLONG, rebuilds),
+             "writing the attributes time, dt, step, next_id, rebuilds");
   if (fail.ok() && !d.material_coarse_grain.empty()) {
     const std::vector<long long> real(d.material_real.begin(), d.material_real.end());
     const std::size_t materials = d.material_coarse_grain.size();
@@ -356,6 +357,7 @@ void write_checkpoint(MPI_Comm comm, const std::string& path, const CheckpointDa
     d.dt = local.dt;
     d.step = local.step;
     d.next_id = local.next_id;
+    d.rebuilds = local.rebuilds;
     d.streams = local.streams;
     d.grid = local.grid;
     d.material_coarse_grain = local.material_coarse_grain;
@@ -411,6 +413,14 @@ CheckpointData read_checkpoint(const std::string& path) {
     d.step = step;
     d.next_id = next;
     if (error.empty() && H5Aexists(f, "format") <= 0) error = "it is not a grainflow checkpoint";
+    // Optional (written since restarts continue parallel.balance's pacing).
+    if (error.empty() && H5Aexists(f, "rebuilds") > 0) {
+      long long rebuilds = 0;
+      attr("rebuilds", H5T_NATIVE_LLONG, &rebuilds);
+      if (error.empty() && rebuilds < 0)
+        error = "attribute 'rebuilds' is negative (" + std::to_string(rebuilds) + ")";
+      d.rebuilds = static_cast<long>(rebuilds);
+    }
     // Optional (written since the parcel classes are checked on restart).
     if (error.empty() && !read_array_attribute(f, "material_coarse_grain", H5T_NATIVE_DOUBLE,
                                                d.material_coarse_grain))

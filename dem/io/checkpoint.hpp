@@ -59,6 +59,10 @@ struct CheckpointData {
   double dt = 0;
   long step = 0;
   GlobalId next_id = 1;
+  // Neighbour-list rebuilds before this checkpoint: they pace `parallel.balance` (every 10th
+  // rebuild checks the load), so a restart continues the balancing bit for bit. Root
+  // attribute `rebuilds`, optional (0 when absent: files written before it).
+  long rebuilds = 0;
   Particles particles;
   // The implicit drag of the step's end, aligned with `particles`; empty when the run
   // has no fluid forces.

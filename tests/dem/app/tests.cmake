@@ -57,6 +57,17 @@ grain_cli_test(bad_model_name 2 "bad/model_name.yaml:[0-9]+:[0-9]+: error: .*'he
 grain_cli_test(refuses_huge_time_step 1 "error: dt is too large;refusing to run with this time step"
                CMD ${_grain} run ${_scenes}/bad/huge_time_step.yaml --no-progress
                WORKDIR ${_work}/huge_dt)
+# The particles a stream will insert set the time step as those present do: t_R of a 0.1 mm
+# glass bead, 0.1224 r = 1.224e-5 s (DESIGN.md §3), not the 2 mm fill's (found by the
+# restart check of the hard-scene generator: such a run ended "done" with the streamed
+# beads' contacts unresolved, and its restart from a checkpoint was refused).
+grain_cli_test(refuses_step_too_large_for_streamed_particles 1
+               "Rayleigh time t_R = 1.224e-05 s [(]smallest 'glass' particle, of the stream at [^)]*stream_unresolved.yaml:17[)];error: dt is too large to resolve contacts;would refuse this time step; use dt <= 2.69e-06 s"
+               CMD ${_grain} check ${_scenes}/bad/stream_unresolved.yaml)
+grain_cli_test(run_refuses_step_too_large_for_streamed_particles 1
+               "error: refusing to run with this time step [(]see above[)]; use dt <= 2.69e-06 s"
+               CMD ${_grain} run ${_scenes}/bad/stream_unresolved.yaml --no-progress
+               WORKDIR ${_work}/stream_unresolved)
 grain_cli_test(unwritable_output 1 "/etc/hostname/out"
                CMD ${_grain} run ${_scenes}/minimal.yaml --output /etc/hostname/out)
 grain_cli_test(run_periodic_bed 0 "done: [0-9]+ steps, 300 particles \\(0 removed\\);particles.xdmf"

@@ -189,7 +189,11 @@ class Draw:
 
     def output(self, scene):
         end = scene["time"]["end"]
-        scene["output"] = {"directory": "out", "snapshot_interval": end / 8, "progress": False}
+        scene["output"] = {"directory": "out", "snapshot_interval": end / 8, "progress": False,
+                           # One checkpoint between the third and the ninth snapshot: the
+                           # restart from it must end bit for bit as this run (check_restart).
+                           "checkpoint_interval": float(f"{end * self.rng.uniform(0.3, 0.9):.6g}"),
+                           "checkpoint_keep": 1}
 
     def parallel(self, scene, axis_choices):
         if self.ranks == 2 and self.rng.random() < 0.5:
@@ -902,8 +906,8 @@ def limit_memory():
     resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT, MEMORY_LIMIT))
 
 
-def run_grain(args, ranks, scene_path, cwd, timeout, extra=()):
-    cmd = [args.grain, "run", scene_path, "--output", "out", "--no-progress", *extra]
+def run_grain(args, ranks, scene_path, cwd, timeout, extra=(), output="out"):
+    cmd = [args.grain, "run", scene_path, "--output", output, "--no-progress", *extra]
     if ranks > 1:
         cmd = [args.mpiexec, "-np", str(ranks), "--oversubscribe", *cmd]
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
@@ -1275,6 +1279,136 @@ def check_heat(d, scene, snaps):
                           f"off by {abs(e - expected) / e0:.3g} of it")
 
 
+OVERLOAD_REMEDIES = [
+    (re.compile(r"scale the Young's modulus by at least ([0-9.eE+-]+)"), "youngs_modulus"),
+    (re.compile(r"set contact\.hooke\.stiffness\.normal to at least ([0-9.eE+-]+) N/m"),
+     "hooke_stiffness"),
+    (re.compile(r"raise contact\.hooke\.characteristic_velocity to at least ([0-9.eE+-]+) m/s"),
+     "hooke_velocity"),
+    (re.compile(r"lower cohesion_energy_density to at most ([0-9.eE+-]+) J/m\^3"), "cohesion"),
+    (re.compile(r"set time\.max_overlap to at least ([0-9.eE+-]+)"), "max_overlap"),
+]
+OVERLOADED_PAIR = re.compile(r"(particles? \d+ and (?:\d+|a wall)) overlap by")
+
+
+def apply_remedy(scene, kind, value):
+    """The scene with one remedy of the overlap guard's message applied, as a user would."""
+    s = json.loads(json.dumps(scene))
+    if kind == "youngs_modulus":  # "..., and the partner's alike": every material
+        for m in s["materials"]:
+            m["youngs_modulus"] = float(f"{m['youngs_modulus'] * value:.6g}")
+    elif kind == "hooke_stiffness":
+        h = s["contact"].setdefault("hooke", {})
+        h.pop("characteristic_velocity", None)
+        h.setdefault("stiffness", {})["normal"] = value
+    elif kind == "hooke_velocity":
+        s["contact"]["hooke"]["characteristic_velocity"] = value
+    elif kind == "cohesion":
+        s["interaction_defaults"]["cohesion_energy_density"] = value
+        for e in s.get("interactions", []):
+            if "cohesion_energy_density" in e:
+                e["cohesion_energy_density"] = value
+    else:
+        s["time"]["max_overlap"] = value
+    return s
+
+
+def check_overload_advice(args, seed, d, scene, workdir, msg, seconds):
+    """The overlap guard stopped the run and found no step that prevents it; it lists what
+    changes it. Each remedy it names, applied alone, must carry the run past that contact:
+    the rerun ends, or stops later, or stops elsewhere (another pair, another cause)."""
+    m = FAIL_TIME.search(msg)
+    t_fail = float(m.group(1)) if m else 0.0
+    pair = OVERLOADED_PAIR.search(msg)
+    pair = pair.group(1) if pair else None
+    dt = d.dt_run or d.dt_estimate
+    end = min(scene["time"]["end"], 1.5 * t_fail + 50 * dt)
+    tried = []
+    for pattern, kind in OVERLOAD_REMEDIES:
+        hit = pattern.search(msg)
+        if not hit:
+            continue
+        value = float(hit.group(1))
+        re_scene = apply_remedy(scene, kind, value)
+        re_scene["time"]["end"] = float(f"{end:.6g}")
+        re_scene["output"]["snapshot_interval"] = end / 8
+        re_scene["output"].pop("checkpoint_interval", None)
+        if kind == "youngs_modulus" and "step" not in re_scene["time"] and \
+                end / (dt / math.sqrt(value)) > 2e5:
+            continue  # too many steps to rerun here
+        sub = os.path.join(workdir, f"advice_{kind}")
+        d2 = Draw(seed, d.family)
+        d2.files, d2.meta, d2.ranks, d2.family = d.files, d.meta, d.ranks, d.family
+        d2.dt_estimate = dt
+        try:
+            how, s2 = check_scene(args, seed, d2, re_scene, sub, 1)
+        except Failure as f:
+            raise Failure(f"rerun with the advice ({kind} {value:g}): " + f.cls,
+                          f.detail + f" [after: {msg}]")
+        seconds += s2
+        tried.append(kind)
+        if how == "refused":
+            raise Failure("advice refused", f"{kind} {value:g}, as the message says, is refused: "
+                          f"{getattr(d2, 'message', '')} [after: {msg}]")
+        if how.startswith("stopped"):
+            msg2 = error_line(open(os.path.join(sub, "grain.out")).read())
+            m2 = FAIL_TIME.search(msg2)
+            t2 = float(m2.group(1)) if m2 else 0.0
+            p2 = OVERLOADED_PAIR.search(msg2)
+            same = p2 is not None and pair is not None and p2.group(1) == pair
+            if same and t2 <= t_fail * (1 + 1e-9):
+                raise Failure("advice does not get further",
+                              f"with {kind} {value:g} the same contact ({pair}) stops again at "
+                              f"t = {t2:.6g} s (first at {t_fail:.6g} s): {msg2} [after: {msg}]")
+    return ("stopped, advice ran: " + "+".join(tried)) if tried else "stopped", seconds
+
+
+RESTART_FIELDS = ("position", "velocity", "angular_velocity", "radius", "mass", "material",
+                  "temperature", "coarse_grain")
+
+
+def check_restart(args, d, workdir):
+    """A run that ended: restarted from its checkpoint on as many ranks, it must end with
+    the same particles bit for bit (docs/reliability.md, "Bit-identical on the same rank
+    count"). Returns the restart's seconds."""
+    outdir = os.path.join(workdir, "out")
+    cps = sorted(n for n in os.listdir(outdir) if n.startswith("checkpoint_") and n.endswith(".h5"))
+    if not cps:
+        return 0.0  # the run ended before its first checkpoint
+    rc, out, seconds = run_grain(args, d.ranks, "scene.yaml", workdir, args.timeout,
+                                 extra=("--restart", os.path.join("out", cps[-1])), output="out_restart")
+    with open(os.path.join(workdir, "restart.out"), "w") as f:
+        f.write(out)
+    for pat, cls in FATAL_PATTERNS:
+        if re.search(pat, out):
+            raise Failure("restart: " + cls, error_line(out))
+    if rc != 0:
+        raise Failure("restart failed", f"exit {rc} restarting from {cps[-1]}: {error_line(out)}")
+    a = read_snapshots(outdir)[-1]
+    snaps = read_snapshots(os.path.join(workdir, "out_restart"))
+    if not snaps:
+        raise Failure("restart failed", "the restart wrote no snapshot")
+    b = snaps[-1]
+    if a["time"] != b["time"] or a["count"] != b["count"]:
+        raise Failure("restart differs", f"last snapshot t = {b['time']!r} s, {b['count']} "
+                      f"particles; the run's t = {a['time']!r} s, {a['count']} particles")
+    ia, ib = np.argsort(a["id"]), np.argsort(b["id"])
+    if not np.array_equal(a["id"][ia], b["id"][ib]):
+        raise Failure("restart differs", f"other particle ids at t = {a['time']:.6g} s")
+    for k in RESTART_FIELDS:
+        if k not in a:
+            continue
+        x, y = a[k][ia], b[k][ib]
+        if not np.array_equal(x, y):
+            bad = np.nonzero(np.any((x != y).reshape(len(x), -1), axis=1))[0]
+            i = int(bad[0])
+            raise Failure("restart differs",
+                          f"'{k}' of {len(bad)} particle(s) at t = {a['time']:.6g} s after a restart "
+                          f"from {cps[-1]} on {d.ranks} rank(s), e.g. id {int(a['id'][ia][i])}: "
+                          f"{x[i]!r} != {y[i]!r}")
+    return seconds
+
+
 def run_dt(scene):
     """The step a scene runs with: given, or from its line in the start-up report."""
     return scene["time"].get("step")
@@ -1309,6 +1443,8 @@ def check_scene(args, seed, d, scene, workdir, depth=0):
         raise Failure("signal", f"killed by signal {-rc}")
     if rc == 0:
         check_output(d, scene, workdir, out)
+        if depth == 0 and not args.no_restarts:
+            seconds += check_restart(args, d, workdir)
         return "ran", seconds
     if rc not in (1, 2):
         raise Failure(f"exit {rc}", error_line(out))
@@ -1329,6 +1465,8 @@ def check_scene(args, seed, d, scene, workdir, depth=0):
                           f"enabled {', '.join(scene['fluid']['forces'])}, not named: "
                           f"{', '.join(silent)}: {msg}")
     proposals = [float(v) for v in STEP_PROPOSAL.findall(msg)]
+    if "No time step prevents this" in msg and depth == 0 and not args.no_advice:
+        return check_overload_advice(args, seed, d, scene, workdir, msg, seconds)
     if not proposals or depth >= 2:
         return ("refused" if rc == 2 else "stopped"), seconds
     dt_ran = d.dt_run
@@ -1436,6 +1574,10 @@ def main():
                     help="run only the seeds of this family; an extra family (thermal) draws "
                          "its own scene for every seed")
     ap.add_argument("--verbose", action="store_true", help="print the message of each stop")
+    ap.add_argument("--no-advice", action="store_true",
+                    help="do not rerun the overlap guard's remedies")
+    ap.add_argument("--no-restarts", action="store_true",
+                    help="do not restart the runs that ended from their checkpoint")
     args = ap.parse_args()
     if args.summarise:
         summarise(args.summarise)
