@@ -22,11 +22,15 @@ A scene passes when either
     no resting particle in the path of a moving rod left untouched; particles at the end +
     removed = particles at the start + streamed; in an isolated system (no gravity, fluid,
     cohesion or moving wall) the energy, kinetic + elastic, does not rise; in a fully
-    periodic box without walls, gravity or fluid the momentum is conserved;
+    periodic box without walls, gravity or fluid the momentum is conserved; restarted from
+    the checkpoint the run wrote (grain run --restart, as many ranks), it ends bit for bit
+    as the run (--no-restarts leaves this out);
   * or it exits 1 with a message of the form "error: <cause>" that names a key or a remedy;
     a step the message proposes ("a step of at most X s", "use dt <= X s") must be smaller
     than the step that ran, and the scene rerun with it must get further (finish, or stop
-    later in simulated time); a CSV row that is valid input (touching spheres written with
+    later in simulated time); when the overlap guard finds no step that prevents a stop,
+    each remedy it lists, applied alone, must be accepted and get past that contact
+    (--no-advice leaves this out); a CSV row that is valid input (touching spheres written with
     17 digits) must not be refused; the NaN guard of a scene with fluid forces must name
     each enabled force term (issue 17, item 4). Exit 2 (input refused) is judged as exit 1.
 A signal, std::bad_alloc, an abort, exit codes other than 0 and 1, or a run longer than
