@@ -1,5 +1,5 @@
-// A step that several start-up limits refuse (docs/stability.md, "Start-up checks"): each
-// error line proposes the step its own limit allows, and the final refusal proposes the
+// A step that several start-up limits refuse (docs/models/contact-models.md, "Time-step limits"):
+// each error line proposes the step its own limit allows, and the final refusal proposes the
 // smallest of them. Reference: the advice itself, rerun. Found by the thermal family of the
 // hard-scene generator: a step refused for the contacts and for heat conduction at once, whose
 // first error's proposal (the contacts') was refused again for conduction.
