@@ -17,6 +17,21 @@ double elastic_energy(const ContactLoad& c, double d) {
   return c.hertz ? 8.0 / 15.0 * c.y_star * std::sqrt(c.r_star) * d * d * std::sqrt(d)
                  : 0.5 * c.kn * d * d;
 }
+
+// The elastic energy the contact (and its series partner) hold now: the partner's from its
+// own overlap, with its stiffness from λ (Hooke k₂ = k/λ; Hertz K₂ = K λ^{-3/2}).
+double energy_now(const ContactLoad& c) {
+  const double d0 = std::max(c.overlap, 0.0);
+  double e = elastic_energy(c, d0);
+  if (c.series > 0)
+    e += elastic_energy(c, c.series_overlap) * (c.hertz ? std::pow(c.series, -1.5) : 1 / c.series);
+  return e;
+}
+
+// The driver's travel towards the far body now: both overlaps (one for a single contact).
+double travel_now(const ContactLoad& c) {
+  return std::max(c.overlap, 0.0) + (c.series > 0 ? std::max(c.series_overlap, 0.0) : 0.0);
+}
 }  // namespace
 
 double cohesion_force(const ContactLoad& c, double d) {
@@ -36,15 +51,22 @@ double stopping_overlap(const ContactLoad& c, double ks, double cs) {
   // the smaller radius; the first root above δ₀ is where the approach ends (δ₀ itself when
   // at rest there and pushed out: g > 0 at once).
   constexpr int n = 20000;
-  const double h = (top - d0) / n, e0 = elastic_energy(c, d0);
-  double work_c = 0, f_prev = cs * cohesion_force(c, d0), g_prev = -kinetic;
+  // A chain stores (1 + λ) E_el(δ) once its contacts carry one force, and the load works
+  // over the driver's travel (1 + λ) δ (overload.hpp); its energy now is what each contact
+  // holds at its own overlap.
+  const double chain = 1 + std::max(c.series, 0.0);
+  const double h = (top - d0) / n, e0 = energy_now(c), x0 = travel_now(c);
+  const auto balance = [&](double d, double work_c) {
+    return ks * (chain * elastic_energy(c, d) - e0) - kinetic - c.load * (chain * d - x0) - work_c;
+  };
+  double work_c = 0, f_prev = cs * cohesion_force(c, d0), g_prev = balance(d0, 0);
   for (int k = 1; k <= n; ++k) {
     const double d = d0 + k * h;
     const double f = cs * cohesion_force(c, d);
     work_c += 0.5 * h * (f + f_prev);
     f_prev = f;
-    const double g = ks * (elastic_energy(c, d) - e0) - kinetic - c.load * (d - d0) - work_c;
-    if (g >= 0) return d - h * g / (g - g_prev);  // linear between the two samples
+    const double g = balance(d, work_c);
+    if (g >= 0) return g_prev >= 0 ? d - h : d - h * g / (g - g_prev);  // linear between samples
     g_prev = g;
   }
   return kNoStop;
@@ -78,8 +100,9 @@ ContactLoad at_first_touch(const ContactLoad& c) {
   for (int k = 0; k < n; ++k)
     work_c += 0.5 * d0 / n * (cohesion_force(c, d0 * k / n) + cohesion_force(c, d0 * (k + 1) / n));
   const double v = std::max(c.speed, 0.0);
-  const double e0 = 0.5 * c.m_star * v * v + elastic_energy(c, d0) - c.load * d0 - work_c;
+  const double e0 = 0.5 * c.m_star * v * v + energy_now(c) - c.load * travel_now(c) - work_c;
   t.overlap = 0;
+  t.series_overlap = 0;
   t.speed = e0 > 0 ? std::sqrt(2 * e0 / c.m_star) : 0.0;
   return t;
 }

@@ -8,6 +8,10 @@
 // and the cohesion F_c(δ) stops approaching at the first δ > δ₀ where
 //   E_el(δ) − E_el(δ₀) = ½ m* v² + W (δ − δ₀) + ∫_δ₀^δ F_c,
 // with E_el = (8/15) Y* √R* δ^{5/2} (Hertz; F = (4/3) Y* √R* δ^{3/2}) or ½ k_n δ² (Hooke).
+// A chain (a heavy particle pressing this contact through a light one, ContactLoad::series)
+// stores (1 + λ) E_el(δ) in its two contacts, which carry one force, and the load works over
+// the driver's travel (1 + λ) δ, where λ is the second contact's overlap per overlap of this
+// one (both laws: E₂/E = δ₂/δ at equal force).
 // Damping only shortens the approach, so that overlap bounds the damped run's from above.
 // Error path only: nothing here runs in a step that passes the guards.
 #include <limits>
@@ -27,6 +31,14 @@ struct ContactLoad {
   double load = 0;          // constant compressive load [N] (weight pressing the contact)
   double speed = 0;         // normal approach speed [m/s] (> 0 approaching)
   double overlap = 0;       // δ₀ [m]
+  // A chain: a heavier particle (the driver) presses this contact through the particle
+  // between them, by a second contact in series. `m_star`, `speed` and `load` are then the
+  // driver's (with the middle particle's own load added); the middle particle is taken as
+  // massless, so the two contacts carry one force. `series` is the second contact's
+  // overlap per overlap of this one at equal force (k_n/k_n2 for Hooke, (K/K2)^{2/3} for
+  // Hertz, K = (4/3) Y* √R*), `series_overlap` its overlap now [m]. 0: a single contact.
+  double series = 0;
+  double series_overlap = 0;
 };
 
 double elastic_force(const ContactLoad& c, double overlap);

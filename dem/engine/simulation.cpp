@@ -1166,25 +1166,190 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
   // resists the approach, is left in, so the load is if anything underestimated). For a
   // partner on another rank, its weight.
   std::string load_by;
+  const Body* pressed = nullptr;  // the body whose load that is, and the direction it is
+  Vec3 into = Vec3::Zero();       // pressed in: towards its partner in the contact
+  // The implicit drag K (u_f - v) acts through the velocity update, not p_.force: add it.
+  const auto force_on = [&](long i) {
+    Vec3 f = p_.force[i];
+    if (static_cast<std::size_t>(i) < drag_.coefficient.size())
+      f += drag_.coefficient[i] * (drag_.fluid_velocity[i] - p_.v[i]);
+    return f;
+  };
   if (n.squaredNorm() > 0) {
     const double own = elastic_force(c, c.overlap) - cohesion_force(c, c.overlap);
-    // The implicit drag K (u_f - v) acts through the velocity update, not p_.force: add it.
-    const auto force_on = [&](long i) {
-      Vec3 f = p_.force[i];
-      if (static_cast<std::size_t>(i) < drag_.coefficient.size())
-        f += drag_.coefficient[i] * (drag_.fluid_velocity[i] - p_.v[i]);
-      return f;
-    };
     const auto pressing = [&](const Body& body, double sign, GlobalId id) {
       const double load =
           body.local >= 0 ? own - sign * force_on(body.local).dot(n) : -sign * body.m * g.dot(n);
       if (load > c.load) {
         c.load = load;
         load_by = "particle " + std::to_string(id);
+        pressed = &body;
+        into = -sign * n;
       }
     };
     pressing(a, 1, w.a);  // a is pushed along +n by the contact
     if (!c.wall && b.found) pressing(b, -1, w.b);
+  }
+  // A chain: a heavier particle D drives a lighter one P into a body X behind it (a wall or
+  // a particle), through the contacts D-P and P-X, which carry one force when P is light.
+  // The force D passes on grows with the stiffness, so a fixed load understates it: the two
+  // contacts are judged together (ContactLoad::series), with D's mass and approach speed
+  // towards X and every other force on D and P as the load. Either contact may be the one
+  // that passed the limit: D a heavier neighbour pushing the loaded body into this contact,
+  // or this contact's heavier partner with the loaded body's backing (a wall or particle
+  // within 60 degrees of the line) as X. Of the chains found, the one that stops deepest.
+  std::optional<ContactLoad> chain;
+  GlobalId driver_id = 0, middle_id = 0;
+  double driver_mass = 0, middle_mass = 0, chain_stop = 0, group_mass = 0;
+  std::size_t group_size = 0;
+  std::string backing;  // X: "wall 'floor'" or "particle 7"
+  int driver_material = 0;
+  {
+    struct Ball {
+      GlobalId id = 0;
+      Vec3 x = Vec3::Zero(), v = Vec3::Zero();
+      double r = 0, m = 0;
+      int material = 0;
+      long local = -1;
+    };
+    const auto ball = [](GlobalId id, const Body& body) {
+      return Ball{id, body.x, body.v, body.r, body.m, body.material, body.local};
+    };
+    // The contact of sphere p with a sphere (or, with q == nullptr, a wall of `wall_material`)
+    // at `overlap`: its coefficients and elastic force.
+    const auto contact_of = [&](const Ball& p, const Ball* q, int wall_material, double overlap) {
+      ContactLoad k = c;
+      k.wall = q == nullptr;
+      k.r_star = q ? p.r * q->r / (p.r + q->r) : p.r;
+      k.m_star = q ? p.m * q->m / (p.m + q->m) : p.m;
+      const PairCoefficients& pq = table_(p.material, q ? q->material : wall_material);
+      k.y_star = pq.y_star;
+      if (!c.hertz) k.kn = HookeNormal::coefficients(pq, constants_, k.r_star, k.m_star, 0).kn;
+      k.overlap = overlap;
+      return k;
+    };
+    const auto stiffness = [&](const ContactLoad& k) {
+      return c.hertz ? std::pow(k.y_star * std::sqrt(k.r_star), 2.0 / 3.0) : k.kn;
+    };
+    const auto others = [&](const Ball& body, const Vec3& u) {
+      return body.local >= 0 ? force_on(body.local).dot(u) : body.m * g.dot(u);
+    };
+    // Each sphere touching p (not `skip1`, `skip2`) whose push on p lies within 60 degrees
+    // of `dir`: f(ball, unit push direction, overlap).
+    const auto touching = [&](const Ball& p, GlobalId skip1, GlobalId skip2, const Vec3& dir,
+                              const auto& f) {
+      const auto one = [&](const Ball& q) {
+        if (q.id == p.id || q.id == skip1 || q.id == skip2) return;
+        const double dist = (p.x - q.x).norm(), overlap = p.r + q.r - dist;
+        if (!(overlap > 0) || !(dist > 0)) return;
+        const Vec3 e = (p.x - q.x) / dist;
+        if (e.dot(dir) >= 0.5) f(q, e, overlap);
+      };
+      for (std::size_t i = 0; i < p_.size(); ++i)
+        one(Ball{p_.id[i], p_.x[i], p_.v[i], p_.radius[i], p_.mass[i], p_.material[i],
+                 static_cast<long>(i)});
+      for (std::size_t q = 0; q < ghosts_.id.size(); ++q)
+        one(Ball{ghosts_.id[q], ghosts_.position(q), ghosts_.v[q], ghosts_.radius[q],
+                 ghosts_.mass[q], ghosts_.material[q], -1});
+    };
+    // D drives P towards X along u; `dp` and `px` are the two contacts, `dp_checked` whether
+    // D-P is the contact that passed the limit (else P-X is). For a wall, x == nullptr.
+    const auto offer = [&](const Ball& d, const Ball& p, const Ball* x, const std::string& x_name,
+                           const Vec3& u, const ContactLoad& dp, const ContactLoad& px,
+                           bool dp_checked) {
+      if (!(d.m > p.m)) return;
+      const ContactLoad& checked = dp_checked ? dp : px;
+      const ContactLoad& other = dp_checked ? px : dp;
+      // The driving group: D, and the spheres pressing D (and those pressing them, two layers)
+      // along u: a heavy stack drives as one. Its mass, its kinetic energy towards X (each
+      // member's own, an upper bound on what the stack can deliver), and the sum of the
+      // members' forces along u, in which their contacts with one another cancel.
+      std::vector<Ball> group{d};
+      for (std::size_t layer = 0, from = 0; layer < 2; ++layer) {
+        const std::size_t to = group.size();
+        for (std::size_t i = from; i < to; ++i)
+          touching(group[i], p.id, x != nullptr ? x->id : p.id, u,
+                   [&](const Ball& q, const Vec3&, double) {
+                     for (const Ball& m : group)
+                       if (m.id == q.id) return;
+                     group.push_back(q);
+                   });
+        from = to;
+      }
+      const Vec3 v_x = x != nullptr ? x->v : Vec3::Zero();
+      // The contacts' elastic forces (this one's less its cohesion, as for a single contact).
+      const double f_dp =
+          elastic_force(dp, dp.overlap) - (dp_checked ? cohesion_force(dp, dp.overlap) : 0);
+      const double f_px =
+          elastic_force(px, px.overlap) - (dp_checked ? 0 : cohesion_force(px, px.overlap));
+      // Every force on the group and on P along u but the two contacts' (for a sphere on
+      // another rank, its weight).
+      double mass = p.m, kinetic = 0;
+      double load = p.local >= 0 ? others(p, u) - f_dp + f_px : others(p, u);
+      for (const Ball& m : group) {
+        mass += m.m;
+        load += others(m, u) + (m.id == d.id && m.local >= 0 ? f_dp : 0.0);
+      }
+      const auto approach = [&](const Ball& m) { return std::max(0.0, (m.v - v_x).dot(u)); };
+      kinetic += 0.5 * p.m * approach(p) * approach(p);
+      for (const Ball& m : group) kinetic += 0.5 * m.m * approach(m) * approach(m);
+      ContactLoad k = c;
+      // At equal force the other contact's overlap per overlap of this one: k/k₂ (Hooke) or
+      // (K/K₂)^{2/3} (Hertz, K = (4/3) Y* √R*), which `stiffness` gives to the power 1.
+      k.series = stiffness(checked) / stiffness(other);
+      k.series_overlap = other.overlap;
+      k.m_star = x != nullptr ? mass * x->m / (mass + x->m) : mass;
+      k.speed = std::sqrt(2 * kinetic / k.m_star);
+      k.load = std::max(0.0, load);
+      const double st = stopping_overlap(k);
+      if (chain && !(st > chain_stop)) return;
+      chain = k;
+      chain_stop = st;
+      driver_id = d.id;
+      driver_mass = d.m;
+      driver_material = d.material;
+      group_size = group.size();
+      group_mass = mass - p.m;
+      middle_mass = p.m;
+      middle_id = p.id;
+      backing = x != nullptr ? "particle " + std::to_string(x->id) : x_name;
+    };
+    // This contact between P and X, driven by a heavier neighbour D of the loaded body P.
+    if (pressed != nullptr) {
+      const Ball p = ball(pressed == &a ? w.a : w.b, *pressed);
+      const Body* far = c.wall ? nullptr : (pressed == &a ? &b : &a);
+      const std::optional<Ball> x = far != nullptr
+                                        ? std::optional<Ball>(ball(pressed == &a ? w.b : w.a, *far))
+                                        : std::nullopt;
+      const ContactLoad px = contact_of(p, x ? &*x : nullptr, material_b, c.overlap);
+      touching(p, w.a, w.b, into, [&](const Ball& d, const Vec3& e, double overlap) {
+        offer(d, p, x ? &*x : nullptr, wall_name.empty() ? "a wall" : "wall '" + wall_name + "'",
+              into, contact_of(p, &d, 0, overlap), px, false);
+        (void)e;
+      });
+    }
+    // This contact between a heavier D and P, P backed by a wall or a particle X.
+    if (!c.wall && a.found && b.found) {
+      const bool a_heavier = a.m > b.m;
+      const Ball d = a_heavier ? ball(w.a, a) : ball(w.b, b);
+      const Ball p = a_heavier ? ball(w.b, b) : ball(w.a, a);
+      const Vec3 u = (p.x - d.x).normalized();  // D's drive, through P, towards X
+      const ContactLoad dp = contact_of(p, &d, 0, c.overlap);
+      for (const WallSet::Entry& e : walls_.walls()) {
+        WallTouch t;
+        const bool touches = e.kind == Wall::Kind::plane ? touch_plane(e.plane, p.x, p.r, t)
+                             : e.kind == Wall::Kind::cylinder
+                                 ? touch_cylinder(e.cylinder, p.x, p.r, t)
+                                 : false;
+        if (touches && t.n.dot(-u) >= 0.5)
+          offer(d, p, nullptr, "wall '" + e.name + "'", u, dp,
+                contact_of(p, nullptr, e.material, t.overlap), true);
+      }
+      touching(p, d.id, d.id, -u, [&](const Ball& x, const Vec3& e, double overlap) {
+        offer(d, p, &x, "", u, dp, contact_of(p, &x, 0, overlap), true);
+        (void)e;
+      });
+    }
   }
   const double limit = scene_.time.max_overlap, at_limit = limit * c.r_small;
   const double tc = pair_contact_time(scene_.contact, pc, constants_, c.r_star, c.m_star,
@@ -1313,10 +1478,29 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
   for (const WallSet::Entry* e : moving)
     o << "; wall '" << e->name << "' moves by its prescribed motion whatever resists it, so "
       << "particles it presses against others are squeezed by its travel";
-  o << ". By its energy and load now, " << stop_text() << ". What changes it:";
+  o << ". By its energy and load now, " << stop_text();
+  // Driven by a heavier neighbour: the chain's stop when it is deeper, and the advice for
+  // both (the larger stiffness, the smaller cohesion).
+  const bool driven = chain && chain_stop > stop;
+  if (driven) {
+    o << "; but particle " << middle_id << " is pressed against " << backing << " by particle "
+      << driver_id << " (" << driver_mass << " kg, " << significant(driver_mass / middle_mass, 3)
+      << " times its mass";
+    if (group_size > 1)
+      o << "; with the " << group_size - 1 << " pressing on it, " << group_mass << " kg";
+    o << "; approaching at " << chain->speed << " m/s, with a load of " << chain->load
+      << " N), whose push grows with the stiffness: the two contacts in series, with particle "
+      << middle_id << " between them, ";
+    if (chain_stop < kNoStop)
+      o << "stop it at " << significant(100 * chain_stop / c.r_small, 4) << " %";
+    else
+      o << "do not stop it before the overlap reaches the whole smaller radius";
+  }
+  o << ". What changes it:";
   const double target = 0.9 * at_limit;
-  if (stop < kNoStop) {
-    const double need = round_up(1.1 * stop / c.r_small);
+  const double deepest = driven ? chain_stop : stop;
+  if (deepest < kNoStop) {
+    const double need = round_up(1.1 * deepest / c.r_small);
     if (need <= 1)
       o << " set time.max_overlap to at least " << need << " (knowingly: the overlap then "
         << "stands for that much deformation"
@@ -1331,13 +1515,20 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
   }
   if (moving.empty()) {
     const ContactLoad touch = at_first_touch(c);
-    const double s = stiffness_factor_for(touch, target);
+    const std::optional<ContactLoad> chain_touch =
+        driven ? std::optional<ContactLoad>(at_first_touch(*chain)) : std::nullopt;
+    const double s = std::max(stiffness_factor_for(touch, target),
+                              chain_touch ? stiffness_factor_for(*chain_touch, target) : 0.0);
     if (s < kNoStop && s > 1) {
       if (c.hertz) {
         const Material& m = scene_.materials[a.material];
         o << " scale the Young's modulus by at least " << round_up(s) << " (material '" << m.name
           << "': " << round_up(s) * m.youngs_modulus << " Pa"
-          << (material_b != a.material ? ", and the partner's alike" : "") << ");";
+          << (material_b != a.material ? ", and the partner's alike" : "")
+          << (driven && driver_material != a.material && driver_material != material_b
+                  ? ", and particle " + std::to_string(driver_id) + "'s alike"
+                  : "")
+          << ");";
       } else if (const auto& v = scene_.contact.hooke_characteristic_velocity) {
         // k_n from the characteristic velocity grows as v^(2/5) for every pair alike
         // (normal_hooke.hpp), and keeps growing with the parcels' size, which a fixed
@@ -1350,7 +1541,11 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
       }
     }
     if (c.cohesion > 0) {
-      const double f = cohesion_factor_for(touch, target);
+      double f = cohesion_factor_for(touch, target);
+      if (chain_touch && f >= 0) {
+        const double f_chain = cohesion_factor_for(*chain_touch, target);
+        f = f_chain < 0 ? f_chain : std::min(f, f_chain);
+      }
       if (f >= 0 && f < 1)
         o << " lower cohesion_energy_density to at most " << f * c.cohesion << " J/m^3;";
       else if (f < 0)
@@ -1361,6 +1556,7 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
     if (c.load > 0.1 * spring) o << " a smaller load on the contact;";
     if (0.5 * c.m_star * w.speed * w.speed > 0.1 * 0.4 * spring * at_limit)
       o << " a slower impact;";
+    if (driven) o << " a lighter or slower particle " << driver_id << ";";
   }
   for (const WallSet::Entry* e : moving)
     o << " stop or slow wall '" << e->name << "' before it squeezes the particles this far;";

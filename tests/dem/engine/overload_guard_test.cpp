@@ -238,6 +238,63 @@ TEST(OverloadGuard, RadiusRatioTwenty) {
   }
 }
 
+// A heavy sphere driving a light bead into the floor (thermal hard scenes 608 and 695: dense
+// parcels landing on soft beads). The bead (1 mm, glass density) rests on the floor; a sphere
+// of the same size, 100 times denser, comes down on it at 1 m/s, Y = 1e7 Pa. The contacts
+// carry one force, so the light bead's contact sees the heavy sphere's push, which grows
+// with the stiffness: a factor from the bead's load at the moment falls short. Judged as a
+// chain, the two Hertz contacts (K = (4/3) Y* sqrt(R*); R* = 0.5 and 1 mm) at 0.9 of the
+// limit hold 8.9e-5 J, under the 5.3e-4 J the sphere brings.
+TEST(OverloadGuard, HeavySphereDrivesABeadIntoTheFloor) {
+  const double r = 1e-3, dt = 1e-6, end = 4e-3, dense = 100 * kRho;
+  Scene s = base_scene(1e7, 0.9);
+  const auto place = [&](Particles& p) {
+    p.add(1, Vec3(0, 0, r * (1 - 1e-9)), Vec3::Zero(), Vec3::Zero(), r, 0, kRho);
+    p.add(2, Vec3(0, 0, 3 * r + 1e-6), Vec3(0, 0, -1), Vec3::Zero(), r, 0, dense);
+  };
+  const Outcome first = run(s, place, dt, end);
+  expect_overload(first);
+  EXPECT_NE(first.stop.find("particle 1 is pressed against wall 'floor' by particle 2 ("),
+            std::string::npos)
+      << first.stop;
+  EXPECT_NE(first.stop.find("a lighter or slower particle 2;"), std::string::npos) << first.stop;
+  // The chain stops deeper than the contact alone.
+  const double alone = number_after(first.stop, "undamped, it stops at ");
+  const double chained = number_after(first.stop, "between them, stop it at ");
+  EXPECT_TRUE(std::isnan(chained) || chained > alone) << first.stop;
+  EXPECT_TRUE(!std::isnan(chained) ||
+              first.stop.find("between them, do not stop it") != std::string::npos)
+      << first.stop;
+  // Undamped, the chain's energy from first touch: ½ M v² (M: both spheres, the bead taken as
+  // massless between the contacts) plus the weights' work, into (1 + λ) (8/15) K' δ^{5/2} with
+  // λ = (K/K2)^{2/3} = 2^{-1/3} (R* of 0.5 mm against 1 mm) and K' = Y* sqrt(R*) of the
+  // sphere-sphere contact (the one that passes the limit first: the more compliant). The
+  // factor on Y that brings δ to 0.9 of the limit is then the energy ratio there, within the
+  // weights' work (< 1 %) and the rounding of the message (2 digits, up).
+  const double y_star = 1e7 / (2 * (1 - kNu * kNu)), m = kRho * sphere_volume(r);
+  const double lambda = 1 / std::cbrt(2.0), d = 0.9 * 0.25 * r;
+  const double held = (1 + lambda) * 8.0 / 15 * y_star * std::sqrt(0.5 * r) * std::pow(d, 2.5);
+  const double brought = 0.5 * (m + 100 * m) * 1.0;
+  const double factor = number_after(first.stop, "scale the Young's modulus by at least ");
+  ASSERT_GT(factor, 1) << first.stop;
+  EXPECT_NEAR(factor / (brought / held), 1.0, 0.03) << first.stop;
+  Scene a = s;
+  a.materials[0].youngs_modulus *= factor;
+  const Outcome stiff = run(a, place, dt, end);
+  EXPECT_TRUE(stiff.stop.empty()) << stiff.stop;
+  expect_further(first, stiff, "heavy sphere on a bead, proposed Young's modulus");
+  if (const double mo = number_after(first.stop, "set time.max_overlap to at least "); mo > 0) {
+    Scene c = s;
+    c.time.max_overlap = mo;
+    const Outcome deep = run(c, place, dt, end);
+    EXPECT_TRUE(deep.stop.empty()) << deep.stop;
+    expect_further(first, deep, "heavy sphere on a bead, proposed max_overlap");
+  } else {
+    EXPECT_NE(first.stop.find("no time.max_overlap (at most 1) carries it"), std::string::npos)
+        << first.stop;
+  }
+}
+
 // A piston (a plane moving down at 0.1 m/s) crushing a bed of 3 x 3 x 2 spheres in a box
 // that fits it exactly: the bed cannot give way, so its overlaps grow with the piston's
 // travel whatever the step or the stiffness.
@@ -307,6 +364,34 @@ TEST(OverloadGuard, StoppingOverlapClosedForms) {
   // The stiffness that stops it at x: k x^2 = m v^2.
   const double target = 0.2e-3;
   EXPECT_NEAR(stiffness_factor_for(h, target) * 100 / (1e-5 / (target * target)), 1.0, 1e-4);
+
+  // Two Hooke springs in series, k and k2 = k / λ, driven by M at v from first touch: the
+  // pair stops when ½ k_eff X² = ½ M v² (k_eff = k k2 / (k + k2)), this spring's share of X
+  // being k2 / (k + k2): δ = v sqrt(M / (k (1 + λ))).
+  ContactLoad chain = h;
+  chain.series = 3;
+  EXPECT_NEAR(stopping_overlap(chain) / std::sqrt(1e-5 / (100 * 4)), 1.0, 1e-4);
+  // Under a constant load W from rest: W (1 + λ) δ = ½ k (1 + λ) δ², δ = 2 W / k (the
+  // undamped swing to twice the static k δ = W, whatever λ).
+  ContactLoad loaded = chain;
+  loaded.speed = 0;
+  loaded.load = 0.01;
+  EXPECT_NEAR(stopping_overlap(loaded) / (2 * 0.01 / 100), 1.0, 1e-4);
+  // Half way, with the series spring at its share (λ δ) and the speed the balance gives
+  // there: back at first touch, the same speed.
+  ContactLoad half = chain;
+  half.overlap = 0.5 * std::sqrt(1e-5 / (100 * 4));
+  half.series_overlap = 3 * half.overlap;
+  half.speed = std::sqrt(1 - 100 * 4 * half.overlap * half.overlap / 1e-5);
+  EXPECT_NEAR(at_first_touch(half).speed, 1.0, 1e-9);
+  EXPECT_NEAR(stopping_overlap(half) / std::sqrt(1e-5 / (100 * 4)), 1.0, 1e-4);
+  // Hertz, λ = 1 (two equal contacts): 2 (8/15) Y* sqrt(R*) δ^{5/2} = ½ m v².
+  ContactLoad hz = z;
+  hz.load = 0;
+  hz.speed = 1;
+  hz.series = 1;
+  EXPECT_NEAR(stopping_overlap(hz) / std::pow(15 * 1e-5 / (32 * 5e6 * std::sqrt(1e-3)), 0.4), 1.0,
+              1e-4);
 }
 
 }  // namespace
