@@ -3,6 +3,7 @@
 
     hard_scenes.py --grain build/bin/grain [--mpiexec mpiexec] --seeds 0:40
     hard_scenes.py --grain build/bin/grain --seed 17          # one scene, reproducibly
+    hard_scenes.py --grain build/bin/grain --seeds 0:16,608   # ranges and single seeds
     hard_scenes.py --grain build/bin/grain --first 1000 --count 400 --budget 1200
 
 Each seed draws one valid scene (numbers from Python's seeded `random.Random(seed)`, so a
@@ -1599,7 +1600,7 @@ def main():
     ap.add_argument("--summarise", metavar="REPORT", help="summarise a --report file and exit")
     ap.add_argument("--mpiexec", default="mpiexec")
     ap.add_argument("--seed", type=int, help="one scene")
-    ap.add_argument("--seeds", help="a range A:B (B excluded)")
+    ap.add_argument("--seeds", help="ranges A:B (B excluded) and seeds, comma-separated: 0:16,608")
     ap.add_argument("--first", type=int, default=0)
     ap.add_argument("--count", type=int, default=40)
     ap.add_argument("--budget", type=float, default=0, help="stop after this many seconds")
@@ -1629,8 +1630,13 @@ def main():
     if args.seed is not None:
         seeds = [args.seed]
     elif args.seeds:
-        a, b = (int(v) for v in args.seeds.split(":"))
-        seeds = list(range(a, b))
+        seeds = []
+        for part in args.seeds.split(","):
+            if ":" in part:
+                a, b = (int(v) for v in part.split(":"))
+                seeds += range(a, b)
+            else:
+                seeds.append(int(part))
     else:
         seeds = list(range(args.first, args.first + args.count))
     os.makedirs(args.work, exist_ok=True)
