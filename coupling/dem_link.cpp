@@ -178,6 +178,7 @@ double DemLink::fluid_conductivity() const {
 }
 std::string DemLink::fluid_source() const { return impl_->scene.fluid->source; }
 double DemLink::end_time() const { return impl_->scene.time.end; }
+double DemLink::expected_max_speed() const { return impl_->scene.time.expected_max_speed; }
 std::string DemLink::end_time_source() const { return impl_->scene.time.end_source; }
 
 namespace {

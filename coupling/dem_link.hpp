@@ -166,6 +166,7 @@ class DemLink {
   double fluid_conductivity() const;
   std::string fluid_source() const;
   double end_time() const;           // the scene's time.end [s]
+  double expected_max_speed() const;    // the scene's time.expected_max_speed [m/s] (default 1)
   std::string end_time_source() const;  // "file:line" of time.end
   // The scene's output block as a coupled run honours it: the folder for particle snapshots
   // and checkpoints (empty: not given) and the simulated time between snapshots (0: not

@@ -10,7 +10,9 @@ namespace {
 
 const char* const kMethods =
     "decompose the mesh with method `simple` or `hierarchical` in system/decomposeParDict (they "
-    "cut a box-shaped mesh into a grid of boxes); scotch, metis and other graph methods do not";
+    "cut a box-shaped mesh into a grid of boxes when the cells along each direction divide "
+    "evenly among the processors along it: they split by cell count, so 7 layers over 2 "
+    "processors share one layer between them); scotch, metis and other graph methods do not";
 
 std::string box_text(const Box& b) {
   std::ostringstream s;

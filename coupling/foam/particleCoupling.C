@@ -141,6 +141,7 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
   coupling::VoidFractionMethod vf = coupling::VoidFractionMethod::divided;
   try {
     vf = coupling::parse_void_fraction_method(method);
+    voidFractionMethod_ = method;
   } catch (const std::invalid_argument& e) {
     FatalIOErrorInFunction(dict) << "voidFraction: " << e.what() << exit(FatalIOError);
   }
@@ -1793,6 +1794,70 @@ void ParticleCoupling::reportMixtureMomentum() {
        << particles[0] << " " << particles[1] << " " << particles[2] << ") kg m/s" << endl;
 }
 
+std::string ParticleCoupling::fluidState(bool collective, bool* jumpy) const {
+  using namespace Foam;
+  const scalarField& now = voidFraction_.primitiveField();
+  const scalarField& before = voidFraction_.oldTime().primitiveField();
+  const vectorField& u = U_.oldTime().primitiveField();
+  const scalar dt = mesh_.time().deltaTValue();
+  const label me = collective ? Pstream::myProcNo() : 0, none = Pstream::nProcs();
+  scalar jump = -1, speed = 0, courant = 0;
+  label at = -1;
+  forAll(now, i) {
+    if (mag(now[i] - before[i]) > jump) {
+      jump = mag(now[i] - before[i]);
+      at = i;
+    }
+    if (!std::isfinite(u[i].x()) || !std::isfinite(u[i].y()) || !std::isfinite(u[i].z())) continue;
+    speed = max(speed, mag(u[i]));
+    courant = max(courant, mag(u[i]) * dt / std::cbrt(mesh_.V()[i]));
+  }
+  scalar maxJump = jump, from = at >= 0 ? before[at] : 0, to = at >= 0 ? now[at] : 0;
+  vector where = at >= 0 ? mesh_.C()[at] : vector::zero;
+  if (collective) {
+    maxJump = returnReduce(jump, maxOp<scalar>());
+    const label owner = returnReduce(jump == maxJump ? me : none, minOp<label>());
+    const bool mine = me == owner && at >= 0;
+    from = returnReduce(mine ? from : 0.0, sumOp<scalar>());
+    to = returnReduce(mine ? to : 0.0, sumOp<scalar>());
+    where = returnReduce(mine ? where : vector::zero, sumOp<vector>());
+    speed = returnReduce(speed, maxOp<scalar>());
+    courant = returnReduce(courant, maxOp<scalar>());
+  }
+  if (jumpy) *jumpy = maxJump > 0.25 || courant > 0.5;
+  std::ostringstream m;
+  m.precision(4);
+  if (!collective) {
+    // Between the fluid steps eps and its old time are one field: no jump to report.
+    m << "The fluid the particles moved in (this rank's cells) ran at up to " << speed
+      << " m/s, a Courant number of " << courant << " (voidFraction " << voidFractionMethod_
+      << ", ddtVoidFraction " << (ddtVoidFraction_ ? "on" : "off") << ", minVoidFraction "
+      << minVoidFraction_ << ").";
+    return m.str();
+  }
+  m << "In this fluid step the void fraction changed by up to " << max(maxJump, 0.0)
+    << " in one cell (from " << from << " to " << to << " at (" << where.x() << " " << where.y()
+    << " " << where.z() << ") m; minVoidFraction " << minVoidFraction_ << ", voidFraction "
+    << voidFractionMethod_ << ", ddtVoidFraction " << (ddtVoidFraction_ ? "on" : "off")
+    << "); before it the fluid "
+    << "moved at up to " << speed << " m/s, a Courant number of " << courant << ".";
+  return m.str();
+}
+
+std::string ParticleCoupling::jumpRemedies() const {
+  std::string m;
+  if (voidFractionMethod_ == "centre")
+    m += "voidFraction divided in constant/couplingProperties (each particle's volume spread "
+         "over the cells it overlaps, so eps changes as it crosses); ";
+  if (ddtVoidFraction_)
+    m += "ddtVoidFraction off in constant/couplingProperties (knowingly: continuity then "
+         "leaves out d(eps)/dt); ";
+  m += (m.empty() ? "" : "or ");
+  m += "cells several particle diameters wide (docs/coupling.md, \"Known limits\"); a "
+       "smaller deltaT only helps when the Courant number above is near 1 or more";
+  return m;
+}
+
 void ParticleCoupling::evolve() {
   Stopwatch clock;
   sample();  // straight into the DEM (DemLink::fluid_samples or add_fluid)
@@ -1808,7 +1873,32 @@ void ParticleCoupling::evolve() {
   try {
     dem_->advance(subSteps_, snapshotDir_);
   } catch (const std::exception& e) {
-    FatalErrorInFunction << "\n" << e.what() << Foam::exit(Foam::FatalError);
+    // The fluid the particles moved in, from this rank's cells (no collective here: the
+    // other ranks need not be in this branch). When its void fraction jumped or it ran fast,
+    // the particles' speeds in the message may be the fluid's doing.
+    bool jumpy = false;
+    std::string fluid = fluidState(false, &jumpy);
+    // Faster than the scene says particles move (time.expected_max_speed): a fluid that
+    // fast throws them about.
+    const double expected = dem_->expected_max_speed();
+    scalar fastest = 0;
+    for (const vector& u : U_.primitiveField())
+      if (std::isfinite(mag(u))) fastest = max(fastest, mag(u));
+    if (fastest > expected) {
+      std::ostringstream t;
+      t.precision(4);
+      t << " That is faster than the scene's time.expected_max_speed, " << expected << " m/s.";
+      fluid += t.str();
+      jumpy = true;
+    }
+    if (jumpy)
+      fluid +=
+          " The fluid may be what drove the particles: if their speeds above are "
+          "unphysical, smooth the void fraction: " +
+          jumpRemedies();
+    FatalErrorInFunction << "\n"
+                         << e.what() << "\ngrainFoam: " << fluid.c_str()
+                         << Foam::exit(Foam::FatalError);
   }
   add(kDem, clock);
   clock.restart();

@@ -300,8 +300,12 @@ void Simulation::check_force_limits() {
     if (l.time_scale == "none")
       o << l.rule;
     else {
-      o << "time scale " << l.time_scale << " = " << l.tau << " s";
-      if (std::isfinite(l.tau)) o << " (particle " << l.particle << "), dt/tau = " << dt_ / l.tau;
+      if (std::isfinite(l.tau))
+        o << "time scale " << l.time_scale << " = " << l.tau << " s (particle " << l.particle
+          << "), dt/tau = " << dt_ / l.tau;
+      else  // no particle feels the force yet (none placed, or a law that vanishes at eps = 1)
+        o << "time scale " << l.time_scale << ": none finite at start-up (no particle feels "
+          << "this force yet)";
       o << "; " << l.rule;
       if (std::isfinite(l.dt_max)) o << "; dt <= " << l.dt_max << " s";
     }

@@ -28,11 +28,13 @@
 // in the corrected U = HbyA - rAU c grad p is ParticleCoupling::seriesGradient (face pressures
 // of half cells crossed in series with their drag resistances); otherwise Gauss linear and
 // U = HbyA - reconstruct(rAU_f c_f snGrad p).
+#include <fenv.h>
 #include <mpi.h>
 
+#include <cmath>
 #include <memory>
-#include <string>
 #include <sstream>
+#include <string>
 
 #include "coupling/foam/particleCoupling.H"
 #include "dem/engine/stop_signals.hpp"
@@ -41,6 +43,63 @@
 #include "pimpleControl.H"
 
 namespace {
+
+// OpenFOAM traps floating-point exceptions (FOAM_SIGFPE): a linear solve that diverges dies in
+// its smoother with a stack trace and no word on why. The fluid's solves run with the traps
+// off instead, and their results are checked (stopIfDiverged): a non-finite U or p stops the
+// run with what the coupling did to the fluid in that step and what changes it.
+class TrapsOff {
+ public:
+  TrapsOff() : traps_(fegetexcept()) {
+    if (traps_ != 0) fedisableexcept(traps_);
+  }
+  ~TrapsOff() {
+    if (traps_ == 0) return;
+    feclearexcept(FE_ALL_EXCEPT);
+    feenableexcept(traps_);
+  }
+  TrapsOff(const TrapsOff&) = delete;
+  TrapsOff& operator=(const TrapsOff&) = delete;
+
+ private:
+  int traps_;
+};
+
+// Collective: stops the run (FatalError on every rank) when U or p holds a non-finite value
+// after `stage`, with the fluid's state in the step (ParticleCoupling::fluidState: the largest
+// change of the void fraction in one cell, the speed and Courant number before the step) and
+// the coupling settings that smooth such jumps (jumpRemedies).
+void stopIfDiverged(const char* stage, const Foam::volVectorField& U, const Foam::volScalarField& p,
+                    const grainflow::foam::ParticleCoupling& particles) {
+  using namespace Foam;
+  const fvMesh& mesh = U.mesh();
+  const auto finite = [](const vector& v) {
+    return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
+  };
+  label badCell = -1;
+  forAll(U, i) {
+    if (!finite(U[i]) || !std::isfinite(p[i])) {
+      badCell = i;
+      break;
+    }
+  }
+  const label me = Pstream::myProcNo(), none = Pstream::nProcs();
+  const label badRank = returnReduce(badCell >= 0 ? me : none, minOp<label>());
+  if (badRank == none) return;
+  const vector badAt =
+      returnReduce(me == badRank ? mesh.C()[badCell] : vector::zero, sumOp<vector>());
+  std::ostringstream m;
+  m.precision(4);
+  m << "grainFoam: error: the fluid diverged in " << stage << " at t = " << mesh.time().value()
+    << " s (time index " << mesh.time().timeIndex() << "): U or p is not finite, first in the "
+    << "cell at (" << badAt.x() << " " << badAt.y() << " " << badAt.z() << ") m. "
+    << particles.fluidState(true).c_str()
+    << " Particles as large as the cells move their whole volume from one cell to the next "
+       "as they cross a face, and continuity turns that change of eps into div(eps U): a jump "
+       "drives the velocity beyond what the step carries. What changes it: "
+    << particles.jumpRemedies().c_str();
+  FatalErrorInFunction << m.str().c_str() << exit(FatalError);
+}
 
 // The solver proper; everything it creates (the DEM included) is gone when it returns,
 // before MPI is finalised.
@@ -168,8 +227,11 @@ void solve(const Foam::argList& args) {
       // facePressure dragSeries: the cell gradient with the face pressures of half cells in
       // series (ParticleCoupling::seriesGradient), in the predictor and the corrected U.
       const bool series = particles.dragSeriesPressure();
-      if (pimple.momentumPredictor())
+      if (pimple.momentumPredictor()) {
+        const TrapsOff trapsOff;
         solve(UEqn == -c * (series ? particles.seriesGradient(p) : fvc::grad(p)));
+        stopIfDiverged("the momentum predictor", U, p, particles);
+      }
 
       while (pimple.correct()) {
         const volScalarField rAU(1.0 / UEqn.A());
@@ -205,7 +267,11 @@ void solve(const Foam::argList& args) {
         while (pimple.correctNonOrthogonal()) {
           fvScalarMatrix pEqn(fvm::laplacian(Dp, p) == fvc::div(phiHbyA) + ddtEps);
           pEqn.setReference(pRefCell, pRefValue);
-          pEqn.solve(mesh.solver(p.select(pimple.finalInnerIter())));
+          {
+            const TrapsOff trapsOff;
+            pEqn.solve(mesh.solver(p.select(pimple.finalInnerIter())));
+            stopIfDiverged("the pressure equation", U, p, particles);
+          }
           if (pimple.finalNonOrthogonalIter()) {
             phi = phiHbyA - pEqn.flux();
             p.relax();
