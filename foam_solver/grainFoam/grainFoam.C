@@ -106,6 +106,19 @@ void stopIfDiverged(const char* stage, const Foam::volVectorField& U, const Foam
 void solve(const Foam::argList& args) {
   using namespace Foam;
   Time runTime(Time::controlDictName, args);
+  // A restart takes its time value from the folder's name (timePrecision digits), not from
+  // the exact value the stopped run stored in <time>/uniform/time: the continued times then
+  // differ from the uninterrupted run's in their last bits, and so does everything that
+  // depends on the time (a time table at an inlet). Continue from the stored value when it
+  // names this folder.
+  {
+    IOdictionary timeDict(IOobject("time", runTime.timeName(), "uniform", runTime,
+                                   IOobject::READ_IF_PRESENT, IOobject::NO_WRITE, false));
+    scalar stored = 0;
+    if (runTime.timeIndex() > 0 && timeDict.readIfPresent("value", stored) &&
+        runTime.timeName(stored) == runTime.timeName() && stored != runTime.value())
+      runTime.setTime(stored, runTime.timeIndex());
+  }
   fvMesh mesh(IOobject(fvMesh::defaultRegion, runTime.timeName(), runTime, IOobject::MUST_READ));
   pimpleControl pimple(mesh);
 

@@ -25,6 +25,9 @@ A case passes when grainFoam exits 0 and
   * every snapshot is finite, holds all the particles, and every particle centre lies
     inside the domain and at least r (1 - time.max_overlap) from each wall plane;
   * every written void fraction lies within [minVoidFraction, 1];
+  * stopped at a middle write and continued from it (startFrom latestTime, as many ranks),
+    it ends with every particle's position and velocity equal to the run's to the last bit
+    (--no-restarts leaves this out);
 or when it exits non-zero with a message naming what to change (`error:` from the DEM
 scene, with its file and key, or an OpenFOAM FatalError naming a dictionary key).
 Anything else (a signal, a hang past --timeout, a crash without a message, a broken
@@ -115,6 +118,10 @@ def draw(seed):
     for axis in range(2):
         if c["periodic"][axis] and c["size"][axis] < 3 * c["k"] * c["d"]:
             c["periodic"][axis] = False
+    # Each rank's half must be thicker than the interaction range (the scene refuses it
+    # otherwise, "use fewer MPI ranks"): one rank when it is not comfortably so.
+    if c["ranks"] == 2 and c["size"][c["split"]] / 2 < 1.5 * c["k"] * c["d"]:
+        c["ranks"], c["split"] = 1, None
     c["phi"] = rnd.uniform(0.02, 0.25)
     volume = c["size"][0] * c["size"][1] * c["size"][2]
     parcel = math.pi / 6 * (c["k"] * c["d"]) ** 3
@@ -299,8 +306,14 @@ def make_case(c, template, case):
         control = f.read()
     control = re.sub(r"endTime\s+[^;]+;", f"endTime         {c['end']!r};", control)
     control = re.sub(r"deltaT\s+[^;]+;", f"deltaT          {c['dt_f']!r};", control)
-    write_interval = c["dt_f"] * max(1, round(c["end"] / c["dt_f"] / c["writes"]))
+    # Writes every m fluid steps; binary, so that a restart is bit-identical (docs/coupling.md).
+    c["steps"] = int(round(c["end"] / c["dt_f"]))
+    m = max(1, c["steps"] // c["writes"])
+    c["write_steps"] = m
+    write_interval = c["dt_f"] * m
     control = re.sub(r"writeInterval\s+[^;]+;", f"writeInterval   {write_interval!r};", control)
+    control = re.sub(r"writeFormat\s+[^;]+;", "writeFormat     binary;", control)
+    control = re.sub(r"timePrecision\s+[^;]+;", "timePrecision   12;", control)
     control = re.sub(r"writeControl\s+[^;]+;", "writeControl    runTime;", control)
     write("system/controlDict", control)
     write("system/blockMeshDict", blockmesh(c))
@@ -345,6 +358,23 @@ class Runner:
         return code, out
 
 
+def read_void_fraction(path):
+    """internalField of a binary (or ASCII) volScalarField: uniform or nonuniform."""
+    with open(path, "rb") as f:
+        data = f.read()
+    head = data.index(b"internalField")
+    m = re.compile(rb"internalField\s+uniform\s+(\S+);").match(data, head)
+    if m:
+        return np.array([float(m.group(1))])
+    m = re.compile(rb"internalField\s+nonuniform\s+List<scalar>\s*(\d+)\s*\(").match(data, head)
+    if not m:
+        raise RuntimeError(f"{path}: no internalField")
+    n = int(m.group(1))
+    if b"format      binary" in data[:head] or b"format binary" in data[:head]:
+        return np.frombuffer(data, dtype="<f8", count=n, offset=m.end())
+    return read_scalar_field(path)
+
+
 def check(c, case, log):
     """The invariants of a run that ended; a list of failures."""
     bad = []
@@ -386,7 +416,7 @@ def check(c, case, log):
                 bad.append(f"t = {t}: particle {int(s['id'][i])} at {x[i]} is {gap[i]:.3g} r "
                            f"from a wall across axis {axis} (< 0.75 r)")
     for folder in time_folders(case):
-        eps = read_scalar_field(os.path.join(case, folder, "voidfraction"))
+        eps = read_void_fraction(os.path.join(case, folder, "voidfraction"))
         if not (np.all(np.isfinite(eps)) and eps.min() >= c["min_eps"] and eps.max() <= 1.0):
             bad.append(f"t = {folder}: eps in [{eps.min()}, {eps.max()}], not within "
                        f"[{c['min_eps']}, 1]")
@@ -479,7 +509,56 @@ def run_seed(runner, args, seed):
     bad = check(c, case, log)
     if bad:
         return c, "FAIL", "; ".join(bad[:6]), elapsed
+    if not args.no_restarts:
+        failure, ran = restart_check(runner, args, c, case)
+        elapsed = time.monotonic() - t0
+        if failure:
+            return c, "FAIL", failure, elapsed
+        if ran:
+            return c, "ok", f"{c['placed']} particles, restart identical", elapsed
     return c, "ok", f"{c['placed']} particles", elapsed
+
+
+def restart_check(runner, args, c, case):
+    """The case stopped at a middle write and continued from it (startFrom latestTime) must
+    end with every particle's position and velocity equal to the uninterrupted run's to the
+    last bit. Returns (failure or None, whether it ran)."""
+    writes = c["steps"] // c["write_steps"]
+    if writes < 2:
+        return None, False
+    middle = (writes // 2) * c["write_steps"]
+    part = case + "_restart"
+    make_case(c, os.path.join(args.cases, "dense_bed"), part)
+    control = os.path.join(part, "system", "controlDict")
+    with open(control) as f:
+        text = f.read()
+    t_mid = middle * c["dt_f"]
+    with open(control, "w") as f:
+        f.write(re.sub(r"endTime\s+[^;]+;", f"endTime         {t_mid!r};", text))
+    runner.run(part, "blockMesh", "blockMesh")
+    if c["ranks"] == 2:
+        runner.run(part, "decomposePar", "decomposePar")
+    code, log = runner.run(part, "grainFoam", args.solver, ranks=c["ranks"])
+    if code != 0:
+        return f"restart: the run to the middle write (t = {t_mid:.6g} s) exited {code}", True
+    with open(control, "w") as f:
+        f.write(text.replace("startFrom       startTime;", "startFrom       latestTime;"))
+    code, log = runner.run(part, "grainFoam.restart", args.solver, ranks=c["ranks"])
+    if code != 0 or "restart at time" not in log:
+        return (f"restart from t = {t_mid:.6g} s: exit {code}, restart line "
+                f"{'restart at time' in log}"), True
+    a, b = snapshots(case)[-1], snapshots(part)[-1]
+    if a[0] != b[0]:
+        return f"restart: last snapshots at t = {a[0]} and {b[0]} s", True
+    for key in ("id", "position", "velocity"):
+        if a[1][key].shape != b[1][key].shape or not np.array_equal(a[1][key], b[1][key]):
+            diff = (float(np.max(np.abs(a[1][key] - b[1][key])))
+                    if a[1][key].shape == b[1][key].shape else float("nan"))
+            return (f"restart from t = {t_mid:.6g} s: {key} differs from the uninterrupted run "
+                    f"by {diff:.3g}"), True
+    if not args.keep:
+        shutil.rmtree(part, ignore_errors=True)
+    return None, True
 
 
 def summary(c):
@@ -501,6 +580,8 @@ def main():
     ap.add_argument("--seeds", default="0:8", help="ranges A:B and seeds, comma-separated")
     ap.add_argument("--timeout", type=float, default=120, help="per grainFoam run [s]")
     ap.add_argument("--keep", action="store_true", help="keep the folders of passing seeds")
+    ap.add_argument("--no-restarts", action="store_true",
+                    help="leave out the restart from a middle write (bit for bit)")
     args = ap.parse_args()
     for key in ("foam_env", "solver", "cases", "work"):
         setattr(args, key, os.path.abspath(getattr(args, key)))
