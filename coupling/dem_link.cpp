@@ -1,7 +1,5 @@
 #include "coupling/dem_link.hpp"
 
-#include <fenv.h>
-
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -10,6 +8,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "coupling/floating_point_traps.hpp"
 #include "dem/engine/checkpoint_series.hpp"
 #include "dem/engine/finite_guard.hpp"
 #include "dem/engine/parcel_limits.hpp"
@@ -205,34 +204,13 @@ std::string DemLink::snapshot_interval_source() const {
 
 void DemLink::use_processor_grid(const ProcessorGrid& grid) { impl_->grid = grid; }
 
-namespace {
-
-// OpenFOAM traps floating-point exceptions (FOAM_SIGFPE): a NaN born in the DEM would kill
-// the run with a stack trace before the DEM's own guard could name the particle. Everything
-// that runs DEM code (initialise: the first forces; restore; advance; write_checkpoint: a
-// list rebuild) runs with the traps off, and the guard checks every step instead. The DEM's
-// pair kernel also relies on it: it evaluates four contacts at a time and computes both
-// sides of a branch in every lane (e.g. 0/0 for a fresh spring's rotation), keeping the
+// The DEM runs with OpenFOAM's floating-point traps off (FloatingPointTrapsOff): a NaN born
+// in the DEM would otherwise kill the run with a stack trace before the DEM's own guard could
+// name the particle. Everything that runs DEM code (initialise: the first forces; restore;
+// advance; write_checkpoint: a list rebuild) does so, and the guard checks every step instead.
+// The DEM's pair kernel also relies on it: it evaluates four contacts at a time and computes
+// both sides of a branch in every lane (e.g. 0/0 for a fresh spring's rotation), keeping the
 // side that applies.
-class FloatingPointTrapsOff {
- public:
-  FloatingPointTrapsOff() : traps_(fegetexcept()) {
-    if (traps_ != 0) fedisableexcept(traps_);
-  }
-  ~FloatingPointTrapsOff() {
-    if (traps_ == 0) return;
-    feclearexcept(FE_ALL_EXCEPT);  // flags raised (and checked) in the DEM
-    feenableexcept(traps_);
-  }
-  FloatingPointTrapsOff(const FloatingPointTrapsOff&) = delete;
-  FloatingPointTrapsOff& operator=(const FloatingPointTrapsOff&) = delete;
-
- private:
-  int traps_;
-};
-
-}  // namespace
-
 void DemLink::initialise() {
   Impl& m = *impl_;
   const FloatingPointTrapsOff traps_off;

@@ -1,23 +1,23 @@
-#include "coupling/foam/particleCoupling.H"
-
-#include <algorithm>
-#include <climits>
-#include <limits>
-#include <chrono>
-#include <cmath>
 #include <mpi.h>
 #include <time.h>
 
+#include <algorithm>
+#include <chrono>
+#include <climits>
+#include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "coupling/accuracy_table.hpp"
+#include "coupling/floating_point_traps.hpp"
+#include "coupling/foam/gaussLinearGrad.H"
+#include "coupling/foam/particleCoupling.H"
 #include "coupling/shared_decomposition.hpp"
 #include "dem/io/output_directory.hpp"
-#include "zeroGradientFvPatchFields.H"
 #include "extrapolatedCalculatedFvPatchField.H"
-#include "coupling/foam/gaussLinearGrad.H"
 #include "volPointInterpolation.H"
 #include "wallFvPatch.H"
+#include "zeroGradientFvPatchFields.H"
 
 namespace grainflow::foam {
 
@@ -1794,8 +1794,10 @@ void ParticleCoupling::reportMixtureMomentum() {
        << particles[0] << " " << particles[1] << " " << particles[2] << ") kg m/s" << endl;
 }
 
-std::string ParticleCoupling::fluidState(bool collective, bool* jumpy) const {
+ParticleCoupling::FluidState ParticleCoupling::fluidState(bool collective) const {
   using namespace Foam;
+  // Called when something diverged: the speeds may overflow when squared.
+  const FloatingPointTrapsOff trapsOff;
   const scalarField& now = voidFraction_.primitiveField();
   const scalarField& before = voidFraction_.oldTime().primitiveField();
   const vectorField& u = U_.oldTime().primitiveField();
@@ -1808,9 +1810,10 @@ std::string ParticleCoupling::fluidState(bool collective, bool* jumpy) const {
       jump = mag(now[i] - before[i]);
       at = i;
     }
-    if (!std::isfinite(u[i].x()) || !std::isfinite(u[i].y()) || !std::isfinite(u[i].z())) continue;
-    speed = max(speed, mag(u[i]));
-    courant = max(courant, mag(u[i]) * dt / std::cbrt(mesh_.V()[i]));
+    const scalar s = std::hypot(u[i].x(), u[i].y(), u[i].z());
+    if (!std::isfinite(s)) continue;
+    speed = max(speed, s);
+    courant = max(courant, s * dt / std::cbrt(mesh_.V()[i]));
   }
   scalar maxJump = jump, from = at >= 0 ? before[at] : 0, to = at >= 0 ? now[at] : 0;
   vector where = at >= 0 ? mesh_.C()[at] : vector::zero;
@@ -1824,7 +1827,10 @@ std::string ParticleCoupling::fluidState(bool collective, bool* jumpy) const {
     speed = returnReduce(speed, maxOp<scalar>());
     courant = returnReduce(courant, maxOp<scalar>());
   }
-  if (jumpy) *jumpy = maxJump > 0.25 || courant > 0.5;
+  FluidState state;
+  state.jump = collective ? max(maxJump, 0.0) : 0.0;
+  state.speed = speed;
+  state.courant = courant;
   std::ostringstream m;
   m.precision(4);
   if (!collective) {
@@ -1833,15 +1839,88 @@ std::string ParticleCoupling::fluidState(bool collective, bool* jumpy) const {
       << " m/s, a Courant number of " << courant << " (voidFraction " << voidFractionMethod_
       << ", ddtVoidFraction " << (ddtVoidFraction_ ? "on" : "off") << ", minVoidFraction "
       << minVoidFraction_ << ").";
+  } else {
+    m << "In this fluid step the void fraction changed by up to " << state.jump
+      << " in one cell (from " << from << " to " << to << " at (" << where.x() << " " << where.y()
+      << " " << where.z() << ") m; minVoidFraction " << minVoidFraction_ << ", voidFraction "
+      << voidFractionMethod_ << ", ddtVoidFraction " << (ddtVoidFraction_ ? "on" : "off")
+      << "); before it the fluid "
+      << "moved at up to " << speed << " m/s, a Courant number of " << courant << ".";
+  }
+  state.text = m.str();
+  return state;
+}
+
+void ParticleCoupling::checkStartingFlow() {
+  using namespace Foam;
+  const FloatingPointTrapsOff trapsOff;  // a typo's 1e200 m/s must not overflow here
+  const scalar dt = mesh_.time().deltaTValue();
+  const scalarField& V = mesh_.V();
+  scalar courant = 0, speed = 0;
+  vector where = Zero;
+  label part = -1;  // the patch, or -1: the internal field
+  const auto consider = [&](const vector& u, label cell, const vector& at, label in) {
+    const scalar s = std::hypot(u.x(), u.y(), u.z());
+    const scalar co = s * dt / std::cbrt(V[cell]);
+    if (!(co <= courant)) {  // also takes a non-finite value
+      courant = co;
+      speed = s;
+      where = at;
+      part = in;
+    }
+  };
+  forAll(U_, i) consider(U_[i], i, mesh_.C()[i], -1);
+  forAll(U_.boundaryField(), patch) {
+    const fvPatch& fp = mesh_.boundary()[patch];
+    if (fp.coupled()) continue;  // cyclic and processor faces repeat cells' values
+    const labelUList& cells = fp.faceCells();
+    forAll(cells, f) consider(U_.boundaryField()[patch][f], cells[f], fp.Cf()[f], patch);
+  }
+  const scalar worst = returnReduce(courant, maxOp<scalar>());
+  startCourant_ = worst;
+  if (!(worst > 1)) return;
+  const label me = Pstream::myProcNo(), none = Pstream::nProcs();
+  const bool mine = me == returnReduce(courant == worst ? me : none, minOp<label>());
+  speed = returnReduce(mine ? speed : 0.0, sumOp<scalar>());
+  where = returnReduce(mine ? where : vector::zero, sumOp<vector>());
+  part = returnReduce(mine ? part : labelMin, maxOp<label>());  // the physical patches'
+  const word in = part >= 0 ? "patch " + mesh_.boundary()[part].name() : "internalField";
+  std::ostringstream m;
+  m.precision(4);
+  m << U_.time().timeName() << "/U starts the fluid at up to " << speed << " m/s (its " << in
+    << ", at (" << where.x() << " " << where.y() << " " << where.z() << ") m), a Courant number "
+    << "of " << worst << " at deltaT " << dt << " s";
+  startFlow_ = m.str();
+  Info << "grainFoam coupling: warning: " << startFlow_.c_str()
+       << "; a fluid step carries a Courant number up to about 1, so the run may diverge: "
+          "check that field for a speed the case does not mean, or lower deltaT "
+          "(system/controlDict)"
+       << endl;
+}
+
+std::string ParticleCoupling::remedies(const FluidState& state) const {
+  const Foam::Time& time = mesh_.time();
+  std::ostringstream m;
+  m.precision(4);
+  if (state.courant > 1) {
+    // One fluid step moves the fastest fluid further than a cell: more than the PISO/PIMPLE
+    // step carries.
+    if (startCourant_ > 1) {
+      m << "the run started above 1 (" << startFlow_.c_str()
+        << "): check that field for a speed the case does not mean; a fluid step carries a "
+           "Courant number up to about 1";
+    } else {
+      m << "a smaller deltaT in system/controlDict (now " << time.deltaTValue() << " s, "
+        << subSteps_ << " DEM step" << (subSteps_ == 1 ? "" : "s")
+        << "; the Courant number above should stay below 1";
+      if (subSteps_ == 1)
+        m << "; deltaT is a whole number of DEM steps, so lower the scene's time.dt with it";
+      m << ")";
+    }
+    if (state.jump > 0.25) m << "; or, for the void fraction's jump, " << jumpRemedies();
     return m.str();
   }
-  m << "In this fluid step the void fraction changed by up to " << max(maxJump, 0.0)
-    << " in one cell (from " << from << " to " << to << " at (" << where.x() << " " << where.y()
-    << " " << where.z() << ") m; minVoidFraction " << minVoidFraction_ << ", voidFraction "
-    << voidFractionMethod_ << ", ddtVoidFraction " << (ddtVoidFraction_ ? "on" : "off")
-    << "); before it the fluid "
-    << "moved at up to " << speed << " m/s, a Courant number of " << courant << ".";
-  return m.str();
+  return jumpRemedies();
 }
 
 std::string ParticleCoupling::jumpRemedies() const {
@@ -1876,14 +1955,17 @@ void ParticleCoupling::evolve() {
     // The fluid the particles moved in, from this rank's cells (no collective here: the
     // other ranks need not be in this branch). When its void fraction jumped or it ran fast,
     // the particles' speeds in the message may be the fluid's doing.
-    bool jumpy = false;
-    std::string fluid = fluidState(false, &jumpy);
+    const FluidState state = fluidState(false);
+    std::string fluid = state.text;
+    bool jumpy = state.jumpy();
     // Faster than the scene says particles move (time.expected_max_speed): a fluid that
     // fast throws them about.
     const double expected = dem_->expected_max_speed();
     scalar fastest = 0;
-    for (const vector& u : U_.primitiveField())
-      if (std::isfinite(mag(u))) fastest = max(fastest, mag(u));
+    for (const vector& u : U_.primitiveField()) {
+      const scalar s = std::hypot(u.x(), u.y(), u.z());  // no overflow for |u| < 1e308
+      if (std::isfinite(s)) fastest = max(fastest, s);
+    }
     if (fastest > expected) {
       std::ostringstream t;
       t.precision(4);
@@ -1894,8 +1976,8 @@ void ParticleCoupling::evolve() {
     if (jumpy)
       fluid +=
           " The fluid may be what drove the particles: if their speeds above are "
-          "unphysical, smooth the void fraction: " +
-          jumpRemedies();
+          "unphysical, what changes it: " +
+          remedies(state);
     FatalErrorInFunction << "\n"
                          << e.what() << "\ngrainFoam: " << fluid.c_str()
                          << Foam::exit(Foam::FatalError);

@@ -28,14 +28,15 @@
 // in the corrected U = HbyA - rAU c grad p is ParticleCoupling::seriesGradient (face pressures
 // of half cells crossed in series with their drag resistances); otherwise Gauss linear and
 // U = HbyA - reconstruct(rAU_f c_f snGrad p).
-#include <fenv.h>
 #include <mpi.h>
 
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 
+#include "coupling/floating_point_traps.hpp"
 #include "coupling/foam/particleCoupling.H"
 #include "dem/engine/stop_signals.hpp"
 #include "fixedFluxPressureFvPatchScalarField.H"
@@ -45,25 +46,40 @@
 namespace {
 
 // OpenFOAM traps floating-point exceptions (FOAM_SIGFPE): a linear solve that diverges dies in
-// its smoother with a stack trace and no word on why. The fluid's solves run with the traps
-// off instead, and their results are checked (stopIfDiverged): a non-finite U or p stops the
-// run with what the coupling did to the fluid in that step and what changes it.
-class TrapsOff {
- public:
-  TrapsOff() : traps_(fegetexcept()) {
-    if (traps_ != 0) fedisableexcept(traps_);
-  }
-  ~TrapsOff() {
-    if (traps_ == 0) return;
-    feclearexcept(FE_ALL_EXCEPT);
-    feenableexcept(traps_);
-  }
-  TrapsOff(const TrapsOff&) = delete;
-  TrapsOff& operator=(const TrapsOff&) = delete;
+// its smoother with a stack trace and no word on why. The fluid's solves and updates run with
+// the traps off instead (grainflow::FloatingPointTrapsOff), and their results are checked
+// (stopIfDiverged): a non-finite U, p or T stops the run with what the coupling did to the
+// fluid in that step and what changes it.
+using TrapsOff = grainflow::FloatingPointTrapsOff;
 
- private:
-  int traps_;
-};
+// Collective: whether any rank has a cell where `bad(cell)` holds; `at` is then the centre of
+// the first such cell on the lowest such rank.
+template <class Bad>
+bool anyCell(const Foam::fvMesh& mesh, const Bad& bad, Foam::vector& at) {
+  using namespace Foam;
+  label badCell = -1;
+  forAll(mesh.C(), i) {
+    if (bad(i)) {
+      badCell = i;
+      break;
+    }
+  }
+  const label me = Pstream::myProcNo(), none = Pstream::nProcs();
+  const label badRank = returnReduce(badCell >= 0 ? me : none, minOp<label>());
+  if (badRank == none) return false;
+  at = returnReduce(me == badRank ? mesh.C()[badCell] : vector::zero, sumOp<vector>());
+  return true;
+}
+
+// " at t = 0.003608 s (time index 35): <what> is not finite, first in the cell at (x y z) m"
+std::string notFinite(const Foam::fvMesh& mesh, const char* what, const Foam::vector& at) {
+  std::ostringstream m;
+  m.precision(4);
+  m << " at t = " << mesh.time().value() << " s (time index " << mesh.time().timeIndex()
+    << "): " << what << " is not finite, first in the cell at (" << at.x() << " " << at.y() << " "
+    << at.z() << ") m";
+  return m.str();
+}
 
 // Collective: stops the run (FatalError on every rank) when U or p holds a non-finite value
 // after `stage`, with the fluid's state in the step (ParticleCoupling::fluidState: the largest
@@ -72,32 +88,43 @@ class TrapsOff {
 void stopIfDiverged(const char* stage, const Foam::volVectorField& U, const Foam::volScalarField& p,
                     const grainflow::foam::ParticleCoupling& particles) {
   using namespace Foam;
-  const fvMesh& mesh = U.mesh();
   const auto finite = [](const vector& v) {
     return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
   };
-  label badCell = -1;
-  forAll(U, i) {
-    if (!finite(U[i]) || !std::isfinite(p[i])) {
-      badCell = i;
-      break;
-    }
-  }
-  const label me = Pstream::myProcNo(), none = Pstream::nProcs();
-  const label badRank = returnReduce(badCell >= 0 ? me : none, minOp<label>());
-  if (badRank == none) return;
-  const vector badAt =
-      returnReduce(me == badRank ? mesh.C()[badCell] : vector::zero, sumOp<vector>());
+  vector at;
+  if (!anyCell(
+          U.mesh(), [&](label i) { return !finite(U[i]) || !std::isfinite(p[i]); }, at))
+    return;
+  const grainflow::foam::ParticleCoupling::FluidState state = particles.fluidState(true);
   std::ostringstream m;
-  m.precision(4);
-  m << "grainFoam: error: the fluid diverged in " << stage << " at t = " << mesh.time().value()
-    << " s (time index " << mesh.time().timeIndex() << "): U or p is not finite, first in the "
-    << "cell at (" << badAt.x() << " " << badAt.y() << " " << badAt.z() << ") m. "
-    << particles.fluidState(true).c_str()
-    << " Particles as large as the cells move their whole volume from one cell to the next "
-       "as they cross a face, and continuity turns that change of eps into div(eps U): a jump "
-       "drives the velocity beyond what the step carries. What changes it: "
-    << particles.jumpRemedies().c_str();
+  m << "grainFoam: error: the fluid diverged in " << stage << notFinite(U.mesh(), "U or p", at)
+    << ". " << state.text.c_str();
+  if (state.courant <= 1 || state.jump > 0.25)
+    m << " Particles as large as the cells move their whole volume from one cell to the next "
+         "as they cross a face, and continuity turns that change of eps into div(eps U): a "
+         "jump drives the velocity beyond what the step carries.";
+  m << " What changes it: " << particles.remedies(state).c_str();
+  FatalErrorInFunction << m.str().c_str() << exit(FatalError);
+}
+
+// Collective: stops the run when the fluid temperature holds a non-finite value after its
+// equation. U and p are finite by then (checked above), so the equation's coefficients come
+// from a finite flux and the particles' exchange: the check turns what would be NaN handed to
+// every particle's temperature into a stop that says where.
+void stopIfTemperatureDiverged(const Foam::volScalarField& T,
+                               const grainflow::foam::ParticleCoupling& particles) {
+  using namespace Foam;
+  vector at;
+  if (!anyCell(
+          T.mesh(), [&](label i) { return !std::isfinite(T[i]); }, at))
+    return;
+  std::ostringstream m;
+  m << "grainFoam: error: the fluid temperature diverged in the energy equation"
+    << notFinite(T.mesh(), "T", at) << ", while U and p are finite. "
+    << particles.fluidState(true).text.c_str()
+    << " The equation's sources are the flux and the particles' heat exchange in each cell "
+       "(heat response and heat source, constant/transportProperties: Cp, kappa); check "
+       "the fluid's initial T (0/T) and the particles' temperatures in the scene.";
   FatalErrorInFunction << m.str().c_str() << exit(FatalError);
 }
 
@@ -105,6 +132,10 @@ void stopIfDiverged(const char* stage, const Foam::volVectorField& U, const Foam
 // before MPI is finalised.
 void solve(const Foam::argList& args) {
   using namespace Foam;
+  // Reading the case runs with the traps off: OpenFOAM's number reader overflows on a value
+  // beyond the double range (1e400 in 0/U) and the trap would end the run with a stack trace
+  // where the reader's own error names the file and line. They are back on for the time loop.
+  std::optional<grainflow::FloatingPointTrapsOff> readingTraps(std::in_place);
   Time runTime(Time::controlDictName, args);
   // A restart takes its time value from the folder's name (timePrecision digits), not from
   // the exact value the stopped run stored in <time>/uniform/time: the continued times then
@@ -203,7 +234,9 @@ void solve(const Foam::argList& args) {
            << endl;
     }
   }
+  particles.checkStartingFlow();
   particles.writeSnapshotIfDue();
+  readingTraps.reset();
 
   Info << "\nStarting time loop\n" << endl;
   while (runTime.run()) {
@@ -286,6 +319,7 @@ void solve(const Foam::argList& args) {
             stopIfDiverged("the pressure equation", U, p, particles);
           }
           if (pimple.finalNonOrthogonalIter()) {
+            const TrapsOff trapsOff;
             phi = phiHbyA - pEqn.flux();
             p.relax();
             if (series)
@@ -295,6 +329,7 @@ void solve(const Foam::argList& args) {
             U.correctBoundaryConditions();
           }
         }
+        stopIfDiverged("the velocity correction", U, p, particles);
         // Continuity error of the volume-averaged equation.
         const volScalarField contErr(fvc::div(phi) + ddtEps);
         Info << "continuity error: sum local = "
@@ -317,7 +352,11 @@ void solve(const Foam::argList& args) {
                                  (particles.heatResponse() * *T0 - particles.heatSource()) /
                                      rhoCp);
       TEqn.relax();
-      TEqn.solve(mesh.solver("T"));
+      {
+        const TrapsOff trapsOff;
+        TEqn.solve(mesh.solver("T"));
+      }
+      stopIfTemperatureDiverged(T, particles);
     }
     particles.addFluidTime(fluidClock);
     if (temperature) particles.exchangeHeat(*temperature, *T0);

@@ -434,6 +434,78 @@ def refuses_bad_setup(runner, checks):
                   "constant/couplingProperties with its line")
 
 
+def hostile_fields(runner, checks):
+    """Starting fields a user may mistype (docs/reliability.md, "Starting fields"): a value
+    beyond the double range, a speed whose square overflows, a speed a fluid step cannot carry,
+    in the internal field and at an inlet. Each must stop grainFoam with a message that names
+    the file (never OpenFOAM's floating-point trap and its stack trace); a speed above a Courant
+    number of 1 is named in a start-up warning whose figure is the closed form |U| dt / h; and
+    the corrected field runs."""
+    def stack_trace(log):
+        return "printStack" in log or "sigFpe" in log
+
+    def with_u(name, value):
+        case = runner.fresh_case("periodic_box", name, [
+            ("0/U", "internalField   uniform (0 0 0);", f"internalField   uniform {value};")])
+        runner.run(case, "blockMesh", "blockMesh")
+        return case
+
+    # 1. Beyond the double range: OpenFOAM's own reader error, naming 0/U and its line.
+    case = with_u("u_1e400", "(1e400 0 0)")
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    checks.expect(re.search(r"FOAM FATAL IO ERROR.*\n.*'internalField' on line 11.*\n\nfile: "
+                            r"\S*/u_1e400/0/U at line 11", log) is not None and not stack_trace(log),
+                  "0/U (1e400 0 0): the reader's error names internalField, 0/U and line 11; no "
+                  "stack trace")
+
+    # 2. A speed whose square overflows, and one far above what a step carries: the start-up
+    # warning names the field, the stop repeats it as the remedy.
+    for value, speed in (("(1e160 0 0)", "1e+160"), ("(1e6 0 0)", "1e+06")):
+        case = with_u("u_" + value.split()[0][1:], value)
+        log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+        warned = f"warning: 0/U starts the fluid at up to {speed} m/s (its internalField" in log
+        remedy = re.search(r"FOAM FATAL ERROR.*(\n.*)*what changes it: the run started above 1 "
+                           rf"\(0/U starts the fluid at up to {re.escape(speed)} m/s", log,
+                           re.IGNORECASE)
+        checks.expect(warned and remedy is not None and not stack_trace(log),
+                      f"0/U {value}: warned at start-up, the stop names 0/U as what to change; "
+                      f"no stack trace")
+
+    # 3. The warning's Courant number: |U| dt / h with |(24 0 18)| = 30 m/s, dt = 1e-4 s and
+    # h = 2.5 mm cells: 1.2.
+    case = with_u("u_30", "(24 0 18)")
+    code = subprocess.run([runner.foam_env, runner.solver, "-case", case], cwd=case,
+                          env=runner.env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                          text=True, timeout=300)
+    m = re.search(r"warning: 0/U starts the fluid at up to (\S+) m/s \(its internalField, at "
+                  r"\(.*\) m\), a Courant number of (\S+) at deltaT 0.0001 s", code.stdout)
+    figures = (float(m.group(1)), float(m.group(2))) if m else None
+    checks.expect(figures is not None and abs(figures[0] - 30) < 1e-9
+                  and abs(figures[1] - 1.2) < 1e-3 and not stack_trace(code.stdout),
+                  f"0/U (24 0 18) in 2.5 mm cells at dt 1e-4 s: warned with speed, Courant "
+                  f"{figures} (30, 1.2)")
+
+    # 4. At an inlet: parcel_bed's superficial inlet at 1000 m/s is named as the patch.
+    case = runner.fresh_case("parcel_bed", "inlet_1e3", [
+        ("0/U", "superficialVelocity constant (0 0 0.2);",
+         "superficialVelocity constant (0 0 1000);"),
+        ("system/controlDict", "endTime         0.2;", "endTime         0.002;")])
+    runner.run(case, "blockMesh", "blockMesh")
+    code = subprocess.run([runner.foam_env, runner.solver, "-case", case], cwd=case,
+                          env=runner.env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                          text=True, timeout=300)
+    checks.expect("warning: 0/U starts the fluid at up to 1000 m/s (its patch inlet" in code.stdout
+                  and not stack_trace(code.stdout),
+                  f"inlet at 1000 m/s: warned naming patch inlet (exit {code.returncode}); no "
+                  f"stack trace")
+
+    # 5. The advice rerun: 0/U at rest runs to the end, without the warning.
+    case = with_u("u_rest", "(0 0 0)")
+    log = runner.run(case, "grainFoam", runner.solver)
+    checks.expect("starts the fluid" not in log,
+                  "0/U (0 0 0): runs to the end, no start-up warning")
+
+
 # --- coupling.restart -------------------------------------------------------------------
 
 
@@ -1323,7 +1395,7 @@ def diffusion_smoothing(runner, checks):
 
 TESTS = {f.__name__: f for f in (void_fraction_volume, exchange_balance, neutrally_buoyant,
                                   cellpoint_ranks,
-                                 refuses_bad_setup, restart, restart_bed_surface, stop_signal, nan_guard,
+                                 refuses_bad_setup, hostile_fields, restart, restart_bed_surface, stop_signal, nan_guard,
                                  scene_output, heat_equilibrium, heat_parcels, heat_balance,
                                  heat_front, balanced_decomposition,
                                  diffusion_smoothing)}

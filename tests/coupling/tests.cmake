@@ -162,6 +162,7 @@ grainflow_coupling_test(exchange_balance 2)
 grainflow_coupling_test(neutrally_buoyant 1)
 grainflow_coupling_test(cellpoint_ranks 2)
 grainflow_coupling_test(refuses_bad_setup 2)
+grainflow_coupling_test(hostile_fields 1)
 grainflow_coupling_test(restart 2)
 set_tests_properties(coupling.restart PROPERTIES TIMEOUT 600)  # ~45 s on a quiet machine
 grainflow_coupling_test(restart_bed_surface 2)

@@ -440,10 +440,17 @@ def refusal(log):
 
 # The settings grainFoam's divergence message may name, and the edit of couplingProperties
 # that applies each.
+# Each: (file, its text before, after) for a case c, or None when c cannot take it.
 REMEDIES = {
-    "voidFraction divided": ("voidFraction    centre;",
-                             "voidFraction    divided;\ndividedResolution 3;"),
-    "ddtVoidFraction off": ("ddtVoidFraction on;", "ddtVoidFraction off;"),
+    "voidFraction divided": lambda c: ("constant/couplingProperties", "voidFraction    centre;",
+                                       "voidFraction    divided;\ndividedResolution 3;"),
+    "ddtVoidFraction off": lambda c: ("constant/couplingProperties", "ddtVoidFraction on;",
+                                      "ddtVoidFraction off;"),
+    # Half as many DEM steps per fluid step (with one, the scene's time.dt would have to go
+    # down too: the message says so, and this rerun is skipped).
+    "a smaller deltaT in system/controlDict": lambda c: (
+        "system/controlDict", f"deltaT          {c['dt_f']!r};",
+        f"deltaT          {(c['n_sub'] // 2) * c['dt_dem']!r};") if c["n_sub"] >= 2 else None,
 }
 
 
@@ -475,20 +482,24 @@ def run_seed(runner, args, seed):
         if why is None:
             tail = " | ".join(log.strip().split("\n")[-6:])
             return c, "FAIL", f"exit {code} without a message naming what to change: {tail[-600:]}", elapsed
-        if "the fluid diverged" in log or "smooth the void fraction" in log:
+        if "the fluid diverged" in log or "The fluid may be what drove the particles" in log:
             # Each setting the message names, applied alone, must carry the run further.
             first = diverged_at(log)
             tried = []
-            for remedy, (old, new) in REMEDIES.items():
-                if remedy not in log:
+            for remedy, edit in REMEDIES.items():
+                if remedy not in log or edit(c) is None:
                     continue
-                again = case + "_" + remedy.split()[0]
+                path, old, new = edit(c)
+                again = case + "_" + next(w for w in remedy.split()
+                                          if w in ("voidFraction", "ddtVoidFraction", "deltaT"))
                 shutil.rmtree(again, ignore_errors=True)
                 shutil.copytree(case, again, ignore=shutil.ignore_patterns(
                     "[0-9].[0-9]*", "[1-9]*", "particles", "log.*"))
-                path = os.path.join(again, "constant", "couplingProperties")
+                path = os.path.join(again, path)
                 with open(path) as f:
                     text = f.read()
+                if old not in text:
+                    return c, "FAIL", f"generator: no '{old}' in {path}", elapsed
                 with open(path, "w") as f:
                     f.write(text.replace(old, new))
                 code2, log2 = runner.run(again, "grainFoam", args.solver, ranks=c["ranks"])
