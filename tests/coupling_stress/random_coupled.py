@@ -48,6 +48,7 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from seeds import parse_seeds  # noqa: E402
 from grainfoam_driver import (ROUND_OFF, NAN_WORD, balance_lines, particle_lines,  # noqa: E402
                               read_scalar_field, snapshots, time_folders, void_lines)
 
@@ -588,7 +589,8 @@ def main():
     ap.add_argument("--cases", required=True, help="tests/coupling_stress/cases (its dense_bed)")
     ap.add_argument("--work", required=True)
     ap.add_argument("--seed", type=int)
-    ap.add_argument("--seeds", default="0:8", help="ranges A:B and seeds, comma-separated")
+    ap.add_argument("--seeds", type=parse_seeds, default="0:8",
+                    help="ranges A:B (B excluded) and seeds, comma-separated: 0:8,17")
     ap.add_argument("--timeout", type=float, default=120, help="per grainFoam run [s]")
     ap.add_argument("--keep", action="store_true", help="keep the folders of passing seeds")
     ap.add_argument("--no-restarts", action="store_true",
@@ -599,16 +601,7 @@ def main():
     if args.lib_dir:
         args.lib_dir = os.path.abspath(args.lib_dir)
     os.makedirs(args.work, exist_ok=True)
-    if args.seed is not None:
-        seeds = [args.seed]
-    else:
-        seeds = []
-        for part in args.seeds.split(","):
-            if ":" in part:
-                a, b = (int(v) for v in part.split(":"))
-                seeds += range(a, b)
-            else:
-                seeds.append(int(part))
+    seeds = [args.seed] if args.seed is not None else args.seeds
     runner = Runner(args)
     failed, t0 = [], time.monotonic()
     tally = {}

@@ -64,6 +64,10 @@ except ImportError:  # this python3 lacks them: scripts/python.sh finds one that
                            "scripts", "python.sh")
     os.execv(_helper, [_helper, os.path.abspath(__file__), *sys.argv[1:]])
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.realpath(__file__)), "..", "..",
+                                "support"))
+from seeds import parse_seeds  # noqa: E402  (tests/support/seeds.py)
+
 FAMILIES = ["pour", "drum", "rod", "mesh", "periodic_gas", "closed_gas", "fluid", "limits"]
 # Families outside the seed % 8 cycle (so that a seed's scene above never changes): chosen
 # with --family, they draw a scene of their own for every seed.
@@ -1600,7 +1604,7 @@ def main():
     ap.add_argument("--summarise", metavar="REPORT", help="summarise a --report file and exit")
     ap.add_argument("--mpiexec", default="mpiexec")
     ap.add_argument("--seed", type=int, help="one scene")
-    ap.add_argument("--seeds", help="ranges A:B (B excluded) and seeds, comma-separated: 0:16,608")
+    ap.add_argument("--seeds", type=parse_seeds, help="ranges A:B (B excluded) and seeds, comma-separated: 0:16,608")
     ap.add_argument("--first", type=int, default=0)
     ap.add_argument("--count", type=int, default=40)
     ap.add_argument("--budget", type=float, default=0, help="stop after this many seconds")
@@ -1630,13 +1634,7 @@ def main():
     if args.seed is not None:
         seeds = [args.seed]
     elif args.seeds:
-        seeds = []
-        for part in args.seeds.split(","):
-            if ":" in part:
-                a, b = (int(v) for v in part.split(":"))
-                seeds += range(a, b)
-            else:
-                seeds.append(int(part))
+        seeds = args.seeds
     else:
         seeds = list(range(args.first, args.first + args.count))
     os.makedirs(args.work, exist_ok=True)
