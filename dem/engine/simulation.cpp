@@ -1096,6 +1096,22 @@ double round_up(double x) {
 }
 }  // namespace
 
+namespace {
+// Whether a sphere (x, r) touches a plane or a cylinder, with the touch in t; false for a mesh
+// (no single normal: the messages below do without it).
+bool touches_analytic_wall(const WallSet::Entry& e, const Vec3& x, double r, WallTouch& t) {
+  switch (e.kind) {
+    case Wall::Kind::plane:
+      return touch_plane(e.plane, x, r, t);
+    case Wall::Kind::cylinder:
+      return touch_cylinder(e.cylinder, x, r, t);
+    case Wall::Kind::mesh:
+      return false;
+  }
+  return false;
+}
+}  // namespace
+
 void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double ratio) const {
   // The two bodies: particles by id (local first, then ghosts), or the wall the particle
   // overlaps most (planes and cylinders; a mesh gives no normal here, and no load).
@@ -1140,11 +1156,7 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
     double best = std::numeric_limits<double>::infinity();
     for (const WallSet::Entry& e : walls_.walls()) {
       WallTouch t;
-      const bool touches = e.kind == Wall::Kind::plane ? touch_plane(e.plane, a.x, a.r, t)
-                           : e.kind == Wall::Kind::cylinder
-                               ? touch_cylinder(e.cylinder, a.x, a.r, t)
-                               : false;
-      if (touches && std::abs(t.overlap - c.overlap) < best) {
+      if (touches_analytic_wall(e, a.x, a.r, t) && std::abs(t.overlap - c.overlap) < best) {
         best = std::abs(t.overlap - c.overlap);
         wall = &e;
         n = t.n;
@@ -1341,11 +1353,7 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
       const ContactLoad dp = contact_of(p, &d, 0, c.overlap);
       for (const WallSet::Entry& e : walls_.walls()) {
         WallTouch t;
-        const bool touches = e.kind == Wall::Kind::plane ? touch_plane(e.plane, p.x, p.r, t)
-                             : e.kind == Wall::Kind::cylinder
-                                 ? touch_cylinder(e.cylinder, p.x, p.r, t)
-                                 : false;
-        if (touches && t.n.dot(-u) >= 0.5)
+        if (touches_analytic_wall(e, p.x, p.r, t) && t.n.dot(-u) >= 0.5)
           offer(d, p, nullptr, "wall '" + e.name + "'", u, dp,
                 contact_of(p, nullptr, e.material, t.overlap), true);
       }
