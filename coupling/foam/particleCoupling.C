@@ -420,14 +420,29 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
         << exit(FatalIOError);
   const double dtFluid = time.deltaTValue(), dtDem = dem_->time_step();
   const double ratio = dtFluid / dtDem;
-  subSteps_ = static_cast<int>(std::lround(ratio));
-  if (subSteps_ < 1 || std::abs(ratio - subSteps_) > 1e-6 * ratio)
+  // As one types them back (12 digits: 3 x 1e-05 is 3e-05, not 3.0000000000000004e-05).
+  const auto typed = [](double x) {
+    std::ostringstream s;
+    s.precision(12);
+    s << x;
+    return s.str();
+  };
+  if (!(dtFluid > 0))
     FatalIOErrorInFunction(time.controlDict())
-        << "deltaT " << dtFluid << " s is " << ratio << " DEM steps of " << dtDem
-        << " s (the scene's time step); dt_CFD / dt_DEM must be an integer: use deltaT "
-        << std::max(1L, std::lround(std::floor(ratio))) * dtDem << " or "
-        << std::max(1L, std::lround(std::ceil(ratio))) * dtDem
+        << "deltaT " << typed(dtFluid).c_str() << " s must be positive: a whole number of DEM "
+        << "steps of " << typed(dtDem).c_str() << " s (the scene's time step), e.g. deltaT "
+        << typed(dtDem).c_str() << exit(FatalIOError);
+  subSteps_ = static_cast<int>(std::min(std::lround(ratio), long(INT_MAX)));
+  if (subSteps_ < 1 || std::abs(ratio - subSteps_) > 1e-6 * ratio) {
+    const long below = std::lround(std::floor(ratio)), above = std::lround(std::ceil(ratio));
+    std::string use = "deltaT " + typed(above * dtDem);
+    if (below >= 1) use = "deltaT " + typed(below * dtDem) + " or " + use;
+    FatalIOErrorInFunction(time.controlDict())
+        << "deltaT " << typed(dtFluid).c_str() << " s is " << typed(ratio).c_str()
+        << " DEM steps of " << typed(dtDem).c_str()
+        << " s (the scene's time step); dt_CFD / dt_DEM must be an integer: use " << use.c_str()
         << ", or change the scene's time.step" << exit(FatalIOError);
+  }
   if (restartIndex_ > 0 && (dem_->steps() != restartIndex_ * subSteps_ ||
                             std::abs(dem_->time() - time.value()) > 1e-6 * dtFluid))
     FatalErrorInFunction << "the DEM checkpoint is at step " << dem_->steps() << " (t = "

@@ -233,6 +233,24 @@ void solve(const Foam::argList& args) {
            << particles.sceneEndTimeSource().c_str() << ", is " << text(sceneEnd).c_str() << " s)"
            << endl;
     }
+    // An end before the start is a typo (or a scene from another case): nothing would run
+    // and the run would still end as if done.
+    const scalar end = min(sceneEnd, foamEnd), start = runTime.value();
+    const scalar half = 0.5 * runTime.deltaTValue();
+    const std::string which = sceneEnd < foamEnd
+                                  ? "the scene's time.end (" + particles.sceneEndTimeSource() + ")"
+                                  : std::string("system/controlDict's endTime");
+    if (end < start - half)
+      FatalErrorInFunction << "grainFoam: error: the run would end at t = " << text(end).c_str()
+                           << " s, " << which.c_str()
+                           << ", before it starts at t = " << text(start).c_str()
+                           << " s (time folder " << runTime.timeName()
+                           << ", system/controlDict's startFrom): nothing to run; raise "
+                           << which.c_str() << exit(FatalError);
+    if (end < start + half)
+      Info << "grainFoam: nothing to run: the run starts at t = " << text(start).c_str()
+           << " s, where it ends (" << which.c_str() << "); to run longer, raise both "
+           << "system/controlDict's endTime and the scene's time.end" << endl;
   }
   particles.checkStartingFlow();
   particles.writeSnapshotIfDue();

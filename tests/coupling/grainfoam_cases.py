@@ -381,6 +381,32 @@ def refuses_bad_setup(runner, checks):
     log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
     checks.expect("must be an integer" in log and "1.5e-05" in log,
                   "deltaT 1.5e-5 s with a 1e-5 s DEM step: refused, 'must be an integer'")
+    # The message's own advice, rerun: each deltaT it names runs.
+    use = re.search(r"use deltaT (\S+) or deltaT (\S+),", log)
+    checks.expect(use is not None and use.groups() == ("1e-05", "2e-05"),
+                  f"deltaT 1.5e-5: the message advises deltaT 1e-05 or 2e-05, as typed "
+                  f"({use.groups() if use else None})")
+    for advised in (use.groups() if use else ()):
+        again = runner.fresh_case("periodic_box", f"deltaT_{advised}", [
+            ("system/controlDict", "deltaT          1e-4;", f"deltaT          {advised};")])
+        runner.run(again, "blockMesh", "blockMesh")
+        runner.run(again, "grainFoam", runner.solver)  # raises unless it runs to the end
+
+    # 2b. deltaT 0 and an endTime before the start: refused, saying why.
+    case = runner.fresh_case("periodic_box", "deltaT_zero", [
+        ("system/controlDict", "deltaT          1e-4;", "deltaT          0;")])
+    runner.run(case, "blockMesh", "blockMesh")
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    checks.expect("deltaT 0 s must be positive" in log and "e.g. deltaT 1e-05" in log
+                  and "controlDict" in log,
+                  "deltaT 0: refused, 'must be positive', advising 1e-05, naming controlDict")
+    case = runner.fresh_case("periodic_box", "end_before_start", [
+        ("system/controlDict", "endTime         2e-4;", "endTime         -1;")])
+    runner.run(case, "blockMesh", "blockMesh")
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    checks.expect("the run would end at t = -1 s, system/controlDict's endTime, before it "
+                  "starts at t = 0 s" in log,
+                  "endTime -1: refused (before, the run ran no step and ended 'End', exit 0)")
 
     # 3. The scene's fluid density differs from transportProperties' rho.
     case = runner.fresh_case("periodic_box", "density", [
