@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <limits>
 #include <sstream>
 #include <unordered_map>
@@ -723,6 +724,22 @@ void Simulation::restore(const CheckpointData& checkpoint) {
                            checkpoint.wall_impulse[3 * w + 2])
                     : Vec3::Zero();
     wall_load_time_ = checkpoint.wall_impulse.back();
+  }
+  // Last, after every rule (which names a value it refuses): the root attributes against
+  // their checksum, which no rule sees for a value that is merely wrong (a dt, a time, a
+  // step with one flipped bit).
+  if (checkpoint.attributes_checksum_stored &&
+      checkpoint.attributes_checksum_stored != checkpoint.attributes_checksum_read) {
+    char sums[64];
+    std::snprintf(sums, sizeof sums, "stored 0x%08x, computed 0x%08x",
+                  *checkpoint.attributes_checksum_stored, *checkpoint.attributes_checksum_read);
+    throw StateError(checkpoint.file +
+                     ": error: the root group's attributes (time, dt, step, next_id, rebuilds, "
+                     "material_coarse_grain, material_real, wall_impulse) do not match their "
+                     "checksum, attribute 'attributes_checksum' (" +
+                     sums +
+                     "): the checkpoint was changed or damaged after it was written; restart "
+                     "from an earlier checkpoint of this run (no file was changed or deleted)");
   }
   restored_ = true;
   network_recorded_ = false;

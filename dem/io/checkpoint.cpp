@@ -224,6 +224,11 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
     if (!written) fail.capture();
     fail.check(written, "writing the attribute wall_impulse");
   }
+  if (fail.ok()) {
+    const std::uint32_t sum = attributes_checksum(d);
+    fail.check(write_attribute(fail, f.id(), "attributes_checksum", H5T_NATIVE_UINT32, sum),
+               "writing the attribute attributes_checksum");
+  }
   std::vector<long long> ids(p.id.begin(), p.id.end());
   std::vector<int> mats(p.material.begin(), p.material.end());
   auto flat = [](const std::vector<Vec3>& v) {
@@ -302,7 +307,7 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
 // `name` is the dataset's full path (/particles/velocity), for messages.
 template <class T>
 std::vector<T> read_array(hid_t file, const char* name, hid_t type, std::size_t cols,
-                          std::size_t& rows, std::string& error) {
+                          std::size_t& rows, std::string& error, bool sealed) {
   std::vector<T> out;
   if (!error.empty()) return out;
   const hid_t set = H5Dopen2(file, name, H5P_DEFAULT);
@@ -321,8 +326,14 @@ std::vector<T> read_array(hid_t file, const char* name, hid_t type, std::size_t 
   } else {
     rows = dims[0];
     out.resize(rows * cols);
-    if (rows > 0 && H5Dread(set, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()) < 0)
+    if (rows > 0 && H5Dread(set, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()) < 0) {
       error = std::string("dataset '") + name + "' cannot be read: " + read_failure_reason();
+    } else if (rows > 0) {
+      const std::string unverified = verify_stored(set, type, out.data(), sealed);
+      if (!unverified.empty())
+        error = std::string("dataset '") + name + "' cannot be read: " + unverified +
+                ": the file was changed or damaged after it was written";
+    }
   }
   H5Sclose(space);
   H5Dclose(set);
@@ -388,6 +399,25 @@ void write_checkpoint(MPI_Comm comm, const std::string& path, const CheckpointDa
                       "; its partial file was deleted and no earlier checkpoint was touched");
 }
 
+std::uint32_t attributes_checksum(const CheckpointData& d) {
+  std::vector<unsigned char> bytes;
+  const auto put = [&bytes](auto value) {  // a double or a 64-bit integer, little-endian
+    const auto raw = std::bit_cast<std::uint64_t>(value);
+    for (int b = 0; b < 8; ++b) bytes.push_back(static_cast<unsigned char>(raw >> (8 * b)));
+  };
+  put(d.time);
+  put(d.dt);
+  put(static_cast<std::int64_t>(d.step));
+  put(static_cast<std::int64_t>(d.next_id));
+  put(static_cast<std::int64_t>(d.rebuilds));
+  put(static_cast<std::int64_t>(d.material_coarse_grain.size()));
+  for (double k : d.material_coarse_grain) put(k);
+  for (int real : d.material_real) put(static_cast<std::int64_t>(real));
+  put(static_cast<std::int64_t>(d.wall_impulse.size()));
+  for (double j : d.wall_impulse) put(j);
+  return fletcher32(bytes.data(), bytes.size());
+}
+
 CheckpointData read_checkpoint(const std::string& path) {
   H5E_auto2_t old_func;
   void* old_data;
@@ -432,21 +462,39 @@ CheckpointData read_checkpoint(const std::string& path) {
     if (error.empty() &&
         !read_array_attribute(f, "wall_impulse", H5T_NATIVE_DOUBLE, d.wall_impulse))
       error = "attribute 'wall_impulse' cannot be read";
+    // Optional (written since the attributes carry a checksum); compared by Simulation::restore
+    // after every rule, so that a value a rule refuses is named by that rule.
+    if (error.empty() && H5Aexists(f, "attributes_checksum") > 0) {
+      std::uint32_t stored = 0;
+      attr("attributes_checksum", H5T_NATIVE_UINT32, &stored);
+      d.attributes_checksum_stored = stored;
+      d.attributes_checksum_read = attributes_checksum(d);
+    }
+    // A file written with the attributes' checksum has a Fletcher32 checksum on every
+    // dataset: one without it was damaged.
+    const bool sealed = d.attributes_checksum_stored.has_value();
     std::size_t n = static_cast<std::size_t>(-1), m = static_cast<std::size_t>(-1);
     if (error.empty() && H5Lexists(f, "particles", H5P_DEFAULT) <= 0)
       error = "group 'particles' is missing";
-    const auto ids = read_array<long long>(f, "/particles/id", H5T_NATIVE_LLONG, 1, n, error);
-    const auto x = read_array<double>(f, "/particles/position", H5T_NATIVE_DOUBLE, 3, n, error);
-    const auto v = read_array<double>(f, "/particles/velocity", H5T_NATIVE_DOUBLE, 3, n, error);
-    const auto w =
-        read_array<double>(f, "/particles/angular_velocity", H5T_NATIVE_DOUBLE, 3, n, error);
-    const auto force = read_array<double>(f, "/particles/force", H5T_NATIVE_DOUBLE, 3, n, error);
-    const auto torque = read_array<double>(f, "/particles/torque", H5T_NATIVE_DOUBLE, 3, n, error);
-    const auto r = read_array<double>(f, "/particles/radius", H5T_NATIVE_DOUBLE, 1, n, error);
-    const auto mass = read_array<double>(f, "/particles/mass", H5T_NATIVE_DOUBLE, 1, n, error);
+    const auto ids =
+        read_array<long long>(f, "/particles/id", H5T_NATIVE_LLONG, 1, n, error, sealed);
+    const auto x =
+        read_array<double>(f, "/particles/position", H5T_NATIVE_DOUBLE, 3, n, error, sealed);
+    const auto v =
+        read_array<double>(f, "/particles/velocity", H5T_NATIVE_DOUBLE, 3, n, error, sealed);
+    const auto w = read_array<double>(f, "/particles/angular_velocity", H5T_NATIVE_DOUBLE, 3, n,
+                                      error, sealed);
+    const auto force =
+        read_array<double>(f, "/particles/force", H5T_NATIVE_DOUBLE, 3, n, error, sealed);
+    const auto torque =
+        read_array<double>(f, "/particles/torque", H5T_NATIVE_DOUBLE, 3, n, error, sealed);
+    const auto r =
+        read_array<double>(f, "/particles/radius", H5T_NATIVE_DOUBLE, 1, n, error, sealed);
+    const auto mass =
+        read_array<double>(f, "/particles/mass", H5T_NATIVE_DOUBLE, 1, n, error, sealed);
     const auto inertia =
-        read_array<double>(f, "/particles/inertia", H5T_NATIVE_DOUBLE, 1, n, error);
-    const auto mat = read_array<int>(f, "/particles/material", H5T_NATIVE_INT, 1, n, error);
+        read_array<double>(f, "/particles/inertia", H5T_NATIVE_DOUBLE, 1, n, error, sealed);
+    const auto mat = read_array<int>(f, "/particles/material", H5T_NATIVE_INT, 1, n, error, sealed);
     // Optional: present when the run had fluid forces.
     const bool has_drag =
         error.empty() && H5Lexists(f, "/particles/drag_coefficient", H5P_DEFAULT) > 0;
@@ -456,35 +504,43 @@ CheckpointData read_checkpoint(const std::string& path) {
     std::vector<double> temperature;
     if (d.has_temperature)
       temperature =
-          read_array<double>(f, "/particles/temperature", H5T_NATIVE_DOUBLE, 1, n, error);
+          read_array<double>(f, "/particles/temperature", H5T_NATIVE_DOUBLE, 1, n, error, sealed);
     std::vector<double> drag_k, drag_u;
     if (has_drag) {
-      drag_k = read_array<double>(f, "/particles/drag_coefficient", H5T_NATIVE_DOUBLE, 1, n, error);
-      drag_u =
-          read_array<double>(f, "/particles/drag_fluid_velocity", H5T_NATIVE_DOUBLE, 3, n, error);
+      drag_k = read_array<double>(f, "/particles/drag_coefficient", H5T_NATIVE_DOUBLE, 1, n, error,
+                                  sealed);
+      drag_u = read_array<double>(f, "/particles/drag_fluid_velocity", H5T_NATIVE_DOUBLE, 3, n,
+                                  error, sealed);
     }
     if (error.empty() && H5Lexists(f, "springs", H5P_DEFAULT) <= 0)
       error = "group 'springs' is missing";
-    const auto a = read_array<long long>(f, "/springs/particle", H5T_NATIVE_LLONG, 1, m, error);
-    const auto b = read_array<long long>(f, "/springs/partner", H5T_NATIVE_LLONG, 1, m, error);
-    const auto t = read_array<double>(f, "/springs/tangential", H5T_NATIVE_DOUBLE, 3, m, error);
-    const auto ro = read_array<double>(f, "/springs/rolling", H5T_NATIVE_DOUBLE, 3, m, error);
+    const auto a =
+        read_array<long long>(f, "/springs/particle", H5T_NATIVE_LLONG, 1, m, error, sealed);
+    const auto b =
+        read_array<long long>(f, "/springs/partner", H5T_NATIVE_LLONG, 1, m, error, sealed);
+    const auto t =
+        read_array<double>(f, "/springs/tangential", H5T_NATIVE_DOUBLE, 3, m, error, sealed);
+    const auto ro =
+        read_array<double>(f, "/springs/rolling", H5T_NATIVE_DOUBLE, 3, m, error, sealed);
     if (error.empty() && H5Lexists(f, "streams", H5P_DEFAULT) > 0) {
       std::size_t length = static_cast<std::size_t>(-1);
-      const auto text =
-          read_array<unsigned char>(f, "/streams/state", H5T_NATIVE_UCHAR, 1, length, error);
+      const auto text = read_array<unsigned char>(f, "/streams/state", H5T_NATIVE_UCHAR, 1, length,
+                                                  error, sealed);
       if (error.empty()) d.streams = std::string(text.begin(), text.end());
     }
     // Optional (format 3): the shapes here, the values in check_checkpoint.
     if (error.empty() && H5Lexists(f, "decomposition", H5P_DEFAULT) > 0) {
       CheckpointGrid grid;
       std::size_t one = 1, three = 3;
-      const auto ranks = read_array<int>(f, "/decomposition/ranks", H5T_NATIVE_INT, 1, one, error);
-      const auto dims = read_array<int>(f, "/decomposition/dims", H5T_NATIVE_INT, 1, three, error);
+      const auto ranks =
+          read_array<int>(f, "/decomposition/ranks", H5T_NATIVE_INT, 1, one, error, sealed);
+      const auto dims =
+          read_array<int>(f, "/decomposition/dims", H5T_NATIVE_INT, 1, three, error, sealed);
       for (int axis = 0; axis < 3; ++axis) {
         std::size_t planes = static_cast<std::size_t>(-1);
         const std::string name = std::string("/decomposition/") + kCutNames[axis];
-        grid.cuts[axis] = read_array<double>(f, name.c_str(), H5T_NATIVE_DOUBLE, 1, planes, error);
+        grid.cuts[axis] =
+            read_array<double>(f, name.c_str(), H5T_NATIVE_DOUBLE, 1, planes, error, sealed);
       }
       if (error.empty()) {
         grid.ranks = ranks[0];

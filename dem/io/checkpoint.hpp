@@ -11,7 +11,8 @@
 // verifies on reading: read_checkpoint names the dataset whose checksum fails. What the
 // values must satisfy is checked by check_checkpoint (dem/engine/restored_state.hpp).
 //
-// Layout: attributes format ("grainflow-checkpoint-3"), time, dt, step, next_id;
+// Layout: attributes format ("grainflow-checkpoint-3"), time, dt, step, next_id, rebuilds,
+// attributes_checksum (attributes_checksum() below);
 // /particles/{id, position, velocity, angular_velocity, force, torque, radius, mass,
 // inertia, material} — force and torque are those of the step's end, which the next
 // velocity-Verlet half kick uses (recomputing them would advance the springs twice);
@@ -31,6 +32,7 @@
 #include <mpi.h>
 
 #include <array>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -86,8 +88,21 @@ struct CheckpointData {
   // since the last log row (x, y, z per wall, summed over ranks), then that time span;
   // the root attribute `wall_impulse`, absent (empty) in a run without wall loads.
   std::vector<double> wall_impulse;
+  // The root attributes have no HDF5 checksum of their own (only datasets are filtered): a
+  // flipped bit of time, dt, step, next_id, rebuilds or the arrays above would pass every rule
+  // that can be checked. The writer stores attributes_checksum(*this) as the root attribute
+  // `attributes_checksum`; read_checkpoint sets `attributes_checksum_stored` to it and
+  // `attributes_checksum_read` to the checksum of the values it read. Both are empty for a file
+  // written before the attribute was (not checked then).
+  std::optional<std::uint32_t> attributes_checksum_stored, attributes_checksum_read;
   std::string file;  // set by read_checkpoint: where it came from, for messages
 };
+
+// The Fletcher32 checksum (hdf5_checksum.hpp) of the root attributes' values, in a fixed
+// order and width: time, dt, step, next_id, rebuilds, then the material count and each
+// material's coarse_grain and listed material, then the wall_impulse count and values (as
+// doubles and 64-bit integers, little-endian).
+std::uint32_t attributes_checksum(const CheckpointData& d);
 
 // Collective. `local` holds this rank's particles and springs; time, dt, step and
 // next_id are taken from rank 0. Throws OutputError (on every rank) on failure.

@@ -155,6 +155,83 @@ hid_t checksummed_layout(int rank, const hsize_t* dims, std::size_t element_byte
   return dcpl;
 }
 
+std::string verify_stored(hid_t dataset, hid_t mem_type, const void* values,
+                          bool require_checksum) {
+  const hid_t dcpl = H5Dget_create_plist(dataset);
+  if (dcpl < 0) return "its storage settings cannot be read";
+  const bool chunked = H5Pget_layout(dcpl) == H5D_CHUNKED;
+  int index = -1;  // the Fletcher32 filter's place in the pipeline
+  const int filters = H5Pget_nfilters(dcpl);
+  for (int i = 0; i < filters; ++i) {
+    unsigned flags = 0;
+    std::size_t n = 0;
+    if (H5Pget_filter2(dcpl, static_cast<unsigned>(i), &flags, &n, nullptr, 0, nullptr, nullptr) ==
+        H5Z_FILTER_FLETCHER32)
+      index = i;
+  }
+  hsize_t chunk[2] = {0, 0};
+  const int chunk_rank = chunked ? H5Pget_chunk(dcpl, 2, chunk) : 0;
+  H5Pclose(dcpl);
+  if (index < 0 || !chunked)
+    return require_checksum ? "it has no Fletcher32 checksum, which every dataset of this file "
+                              "was written with (the file's record of its filters is damaged)"
+                            : "";
+  if (filters != 1) return "";  // not a layout grainflow writes: HDF5's own checks stand
+  const hid_t space = H5Dget_space(dataset);
+  hsize_t dims[2] = {0, 1};
+  const int rank = H5Sget_simple_extent_dims(space, dims, nullptr);
+  hsize_t stored = 0;
+  const bool counted = H5Dget_num_chunks(dataset, space, &stored) >= 0;
+  H5Sclose(space);
+  if (rank < 1 || rank > 2 || chunk_rank != rank || chunk[0] == 0 ||
+      (rank == 2 && chunk[1] != dims[1]))
+    return "";  // chunks not of whole rows: not grainflow's layout
+  const hsize_t rows = dims[0], cols = rank == 2 ? dims[1] : 1;
+  const hsize_t expected = (rows + chunk[0] - 1) / chunk[0];
+  if (!counted || stored != expected)
+    return "it has " + std::to_string(counted ? stored : 0) + " stored chunk(s) where its " +
+           std::to_string(rows) + " rows need " + std::to_string(expected) +
+           " (the file's record of its chunks is damaged)";
+  const hid_t file_type = H5Dget_type(dataset);
+  const std::size_t element = H5Tget_size(file_type);
+  const bool same_type = H5Tequal(file_type, mem_type) > 0;
+  H5Tclose(file_type);
+  const std::size_t row_bytes = cols * element;
+  std::vector<unsigned char> raw;
+  for (hsize_t c = 0; c < expected; ++c) {
+    const hsize_t offset[2] = {c * chunk[0], 0};
+    const std::string which =
+        "chunk " + std::to_string(c) + " (rows " + std::to_string(offset[0]) + " on)";
+    hsize_t size = 0;
+    if (H5Dget_chunk_storage_size(dataset, offset, &size) < 0 || size < 4)
+      return which + " is not where the file's record says (the record is damaged)";
+    raw.resize(size);
+    std::uint32_t mask = 0;
+    if (H5Dread_chunk(dataset, H5P_DEFAULT, offset, &mask, raw.data()) < 0)
+      return which + " cannot be read raw (the file's record of it is damaged)";
+    if (mask & (1u << index))
+      return which +
+             " is marked as stored without its Fletcher32 checksum, which every chunk "
+             "was written with (the file's record of it is damaged)";
+    const std::uint32_t tail = std::uint32_t(raw[size - 4]) | std::uint32_t(raw[size - 3]) << 8 |
+                               std::uint32_t(raw[size - 2]) << 16 |
+                               std::uint32_t(raw[size - 1]) << 24;
+    if (fletcher32(raw.data(), size - 4) != tail)
+      return which + ": its Fletcher32 checksum does not match the data";
+    const hsize_t chunk_rows = std::min(chunk[0], rows - offset[0]);
+    if (size - 4 < chunk_rows * row_bytes)
+      return which + " holds " + std::to_string(size - 4) + " bytes, fewer than its " +
+             std::to_string(chunk_rows) + " rows";
+    if (same_type &&
+        std::memcmp(raw.data(), static_cast<const unsigned char*>(values) + offset[0] * row_bytes,
+                    chunk_rows * row_bytes) != 0)
+      return which +
+             ": the values HDF5 read are not the ones stored (the file's record of "
+             "where the chunk lies is damaged; HDF5 read its fill value, zeros, instead)";
+  }
+  return "";
+}
+
 std::string read_failure_reason() {
   std::string reason = hdf5_reason();
   std::string lower = reason;

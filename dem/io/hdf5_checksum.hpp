@@ -40,6 +40,18 @@ std::uint32_t fletcher32(const void* data, std::size_t bytes);
 bool write_checksummed(hid_t dataset, int rank, const hsize_t* dims, std::size_t element_bytes,
                        const void* data);
 
+// After a successful H5Dread of a whole non-empty dataset into `values` (memory type
+// `mem_type`): why those values cannot be trusted to be the ones stored, or "" when they can.
+// HDF5 verifies the Fletcher32 checksum of each chunk it finds, but a damaged chunk index (a
+// chunk recorded at a wrong offset, a filter mask saying the checksum was skipped) makes it
+// read the fill value, zeros, with no error. So each chunk of a checksummed dataset (the rows
+// it covers, as written: whole rows per chunk) is read again raw (H5Dread_chunk): it must
+// exist, carry its checksum, match it, and hold the bytes H5Dread returned (when the memory
+// type is the file's). With `require_checksum` (files written with checksums on every
+// dataset) a dataset without the Fletcher32 filter is refused too: its filter record was
+// damaged.
+std::string verify_stored(hid_t dataset, hid_t mem_type, const void* values, bool require_checksum);
+
 // After a failed H5Dread: the reason in one line (hdf5_reason()), and when HDF5's Fletcher32
 // check failed, a sentence saying that the data differ from what was written.
 std::string read_failure_reason();

@@ -63,7 +63,17 @@ std::size_t read(hid_t file, const std::string& path, const char* name, int comp
   out.resize(dims[0] * static_cast<std::size_t>(comps / per_element));
   const herr_t status =
       out.empty() ? 0 : H5Dread(d, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data());
-  const std::string reason = status < 0 ? read_failure_reason() : std::string();
+  std::string reason = status < 0 ? read_failure_reason() : std::string();
+  // A damaged chunk record reads as zeros without an error (verify_stored).
+  if (status >= 0 && !out.empty()) {
+    const std::string unverified = verify_stored(d, type, out.data(), false);
+    if (!unverified.empty()) {
+      H5Dclose(d);
+      throw SnapshotDamagedError(path + ": error: cannot read dataset '" + name +
+                                 "': " + unverified +
+                                 ": the file was changed or damaged after it was written");
+    }
+  }
   H5Dclose(d);
   if (status < 0)
     throw SnapshotDamagedError(path + ": error: cannot read dataset '" + name + "': " + reason);

@@ -83,6 +83,40 @@ def flip_low_bit(dataset, row, col):
     return before
 
 
+def flip_bytes_bit(offset, bit):
+    """Flips one bit of the file's raw bytes."""
+    with open(target, "r+b") as raw:
+        raw.seek(offset)
+        byte = raw.read(1)[0]
+        raw.seek(offset)
+        raw.write(bytes([byte ^ (1 << bit)]))
+
+
+def attribute_offset(name):
+    """Where the root attribute's value lies in the file's bytes (its value must occur once)."""
+    with h5py.File(target, "r") as f:
+        value = np.asarray(f.attrs[name]).tobytes()
+    data = open(target, "rb").read()
+    assert data.count(value) == 1, f"attribute {name}'s bytes occur {data.count(value)} times"
+    return data.index(value)
+
+
+def chunk_key_offset(dataset):
+    """Where the v1 B-tree key of the dataset's single chunk lies: chunk size (4 bytes), filter
+    mask (4), the chunk's offset per dimension and one for the element (8 each), then the
+    chunk's address (8): found by that pattern."""
+    import struct
+    with h5py.File(target, "r") as f:
+        d = f[dataset]
+        info = d.id.get_chunk_info(0)
+        rank = len(d.shape)
+    key = struct.pack("<II", info.size, info.filter_mask) + b"\0" * (8 * (rank + 1)) + \
+        struct.pack("<Q", info.byte_offset)
+    data = open(target, "rb").read()
+    assert data.count(key) == 1, f"{dataset}: the chunk key occurs {data.count(key)} times"
+    return data.index(key)
+
+
 def set_spring(f, particle, partner):
     """Replaces the springs with one (particle, partner) spring, as grain writes them."""
     for k in ("particle", "partner", "tangential", "rolling"):
@@ -152,6 +186,23 @@ elif case == "velocity_bit":  # only the checksum sees it
               r"Fletcher32 checksum does not match the data" % f_) if kind == "checkpoint" else \
         (f_ + r": error: cannot read dataset '/velocity': its Fletcher32 checksum does not "
          r"match the data")
+elif case in ("dt_bit", "time_bit"):  # attributes have no HDF5 checksum: only grainflow's
+    name = case.split("_")[0]
+    flip_bytes_bit(attribute_offset(name), 0)  # the lowest mantissa bit: one ulp
+    expect = f_ + r": error: the root group's attributes \(time, dt, step, next_id, rebuilds, " \
+        r"material_coarse_grain, material_real, wall_impulse\) do not match their checksum, " \
+        r"attribute 'attributes_checksum' \(stored 0x[0-9a-f]{8}, computed 0x[0-9a-f]{8}\): the " \
+        r"checkpoint was changed or damaged after it was written"
+elif case == "chunk_record":  # HDF5 then reads zeros for every position, with no error
+    with h5py.File(target, "r") as f:
+        rank = len(f[g + "position"].shape)
+    # The high byte of the element dimension's offset: the chunk is looked for elsewhere.
+    flip_bytes_bit(chunk_key_offset(g + "position") + 8 + 8 * rank + 7, 6)
+    expect = (r"cannot read checkpoint '%s': dataset '/particles/position' cannot be read: "
+              r"chunk 0 \(rows 0 on\) is not where the file's record says" % f_) \
+        if kind == "checkpoint" else \
+        (f_ + r": error: cannot read dataset '/position': chunk 0 \(rows 0 on\) is not where the "
+         r"file's record says")
 elif case == "spring_partner":
     edit(lambda f: set_spring(f, ids[0], 10**9))
     expect = f_ + r": error: dataset '/springs/partner', index 0 \(particle id %d\): the spring's " \

@@ -184,11 +184,11 @@ if(GRAINFLOW_PYTHON3)
                    ${_scenes}/checkpointed_bed.yaml ${_state_work} setup)
   set_tests_properties(grain.state_file_checks.setup PROPERTIES FIXTURES_SETUP grain_state_files)
   set(_state_cases material_max material_past position_bounded position_periodic negative_radius
-                   equal_ids zero_mass mass_not_rho_v velocity_bit)
+                   equal_ids zero_mass mass_not_rho_v velocity_bit chunk_record)
   foreach(_kind checkpoint snapshot)
     set(_cases ${_state_cases})
     if(_kind STREQUAL "checkpoint")
-      list(APPEND _cases spring_partner spring_wall next_id grid_ranks grid_planes)
+      list(APPEND _cases spring_partner spring_wall next_id grid_ranks grid_planes dt_bit time_bit)
     endif()
     foreach(_case ${_cases})
       add_test(NAME grain.state_file_checks.${_kind}.${_case}
