@@ -249,6 +249,19 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
                      refusal_remedy(sim.time_step_report()) +
                      ", or pass --allow-large-dt to run anyway");
   guard_finite(sim, has_non_finite(sim.particles()), dir, comm);
+  // A restart whose scene ends before the checkpoint would run no step, and would first cut
+  // the snapshot series and log back to the checkpoint: refused before anything is touched.
+  const long end_step =
+      std::max(1L, static_cast<long>(std::ceil(scene.time.end / sim.dt() - 0.5 - 1e-9)));
+  if (options.restart && end_step < first_step) {
+    std::ostringstream m;
+    m << scene.time.end_source << ": error: time.end = " << scene.time.end
+      << " s is before the checkpoint's time, t = " << sim.time() << " s (step " << first_step
+      << ", '" << *options.restart
+      << "'): the restart would run no step; raise time.end, or restart from an earlier "
+         "checkpoint (nothing was changed or deleted)";
+    throw SetupError(m.str());
+  }
 
   SnapshotWriter snapshots(comm, dir, "particles", scene.output.fields);
   snapshots.set_coarse_grain(scene.coarse_grain_table(), scene.real_material_table());
@@ -390,8 +403,10 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   }
   long global_particles = sum.particles_start;
   // The run ends at the step nearest to t_end (within half a step).
-  const long total_steps =
-      std::max(1L, static_cast<long>(std::ceil(scene.time.end / dt - 0.5 - 1e-9)));
+  const long total_steps = end_step;
+  if (options.restart && total_steps == first_step)
+    say << "restart: the checkpoint is at the scene's time.end already (step " << first_step
+        << "): nothing to run; to run longer, raise time.end (" << scene.time.end_source << ")\n";
   double particle_steps = 0;  // this rank's
   std::ostringstream stop_message;
   const auto snapshot_due = [&](double t, long k) {

@@ -203,6 +203,16 @@ elif case == "chunk_record":  # HDF5 then reads zeros for every position, with n
         if kind == "checkpoint" else \
         (f_ + r": error: cannot read dataset '/position': chunk 0 \(rows 0 on\) is not where the "
          r"file's record says")
+elif case == "end_before":  # an intact checkpoint, a scene that ends before it
+    text = open(scene).read()
+    assert "end: 0.01}" in text
+    scene = os.path.join(here, "ends_early.yaml")
+    with open(scene, "w") as out:
+        out.write(text.replace("end: 0.01}", "end: 0.003}"))
+    line = 1 + text[:text.index("end: 0.01}")].count("\n")
+    expect = r"ends_early\.yaml:%d: error: time\.end = 0\.003 s is before the checkpoint's " \
+        r"time, t = 0\.00499\d* s \(step 680, '%s'\): the restart would run no step; raise " \
+        r"time\.end" % (line, f_)
 elif case == "spring_partner":
     edit(lambda f: set_spring(f, ids[0], 10**9))
     expect = f_ + r": error: dataset '/springs/partner', index 0 \(particle id %d\): the spring's " \

@@ -194,7 +194,8 @@ if(GRAINFLOW_PYTHON3)
   foreach(_kind checkpoint snapshot)
     set(_cases ${_state_cases})
     if(_kind STREQUAL "checkpoint")
-      list(APPEND _cases spring_partner spring_wall next_id grid_ranks grid_planes dt_bit time_bit)
+      list(APPEND _cases spring_partner spring_wall next_id grid_ranks grid_planes dt_bit time_bit
+                         end_before)
     endif()
     foreach(_case ${_cases})
       add_test(NAME grain.state_file_checks.${_kind}.${_case}
