@@ -179,10 +179,10 @@ if(GRAINFLOW_PYTHON3)
   # file with one value changed (or one bit flipped) is refused with exit code 1, naming the
   # file, the dataset, the index and the rule, and nothing in the output directory changes.
   # Random single-bit flips of a real checkpoint and snapshot: each start is refused naming the
-  # file, or runs bit for bit like the intact file (tests/dem/app/bit_flips.py; about 10 s).
+  # file, or runs bit for bit like the intact file (tests/dem/app/bit_flips.py; about 5 s).
   add_test(NAME grain.bit_flips
            COMMAND ${GRAINFLOW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/bit_flips.py ${_grain}
-                   ${_scenes}/checkpointed_bed.yaml ${_work}/bit_flips --seeds 0:12)
+                   ${_scenes}/checkpointed_bed.yaml ${_work}/bit_flips --seeds 0:6)
   set_tests_properties(grain.bit_flips PROPERTIES TIMEOUT 300 ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}")
   set(_state_work ${_work}/state_file_checks)
   add_test(NAME grain.state_file_checks.setup
