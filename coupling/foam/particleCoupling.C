@@ -1929,7 +1929,8 @@ std::string ParticleCoupling::remedies(const FluidState& state) const {
         << subSteps_ << " DEM step" << (subSteps_ == 1 ? "" : "s")
         << "; the Courant number above should stay below 1";
       if (subSteps_ == 1)
-        m << "; deltaT is a whole number of DEM steps, so lower the scene's time.dt with it";
+        m << "; deltaT is a whole number of DEM steps, so lower the scene's time step with it "
+             "(time.step, or time.rayleigh_fraction)";
       m << ")";
     }
     if (state.jump > 0.25) m << "; or, for the void fraction's jump, " << jumpRemedies();

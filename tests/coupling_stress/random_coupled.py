@@ -447,7 +447,7 @@ REMEDIES = {
                                        "voidFraction    divided;\ndividedResolution 3;"),
     "ddtVoidFraction off": lambda c: ("constant/couplingProperties", "ddtVoidFraction on;",
                                       "ddtVoidFraction off;"),
-    # Half as many DEM steps per fluid step (with one, the scene's time.dt would have to go
+    # Half as many DEM steps per fluid step (with one, the scene's time.step would have to go
     # down too: the message says so, and this rerun is skipped).
     "a smaller deltaT in system/controlDict": lambda c: (
         "system/controlDict", f"deltaT          {c['dt_f']!r};",
