@@ -38,7 +38,9 @@
 
 #include "coupling/floating_point_traps.hpp"
 #include "coupling/foam/particleCoupling.H"
+#include "coupling/written_files.hpp"
 #include "dem/engine/stop_signals.hpp"
+#include "fileOperation.H"
 #include "fixedFluxPressureFvPatchScalarField.H"
 #include "fvCFD.H"
 #include "pimpleControl.H"
@@ -128,6 +130,65 @@ void stopIfTemperatureDiverged(const Foam::volScalarField& T,
   FatalErrorInFunction << m.str().c_str() << exit(FatalError);
 }
 
+// The files of each write time, with their checksums (coupling/written_files.hpp), checked
+// when a run restarts from that time: OpenFOAM's field files carry none. Only with the
+// uncollated file handler, where each rank's folder holds its own files (a collated one
+// writes them into processors<N>/ from a thread).
+bool writtenFilesRecorded() { return Foam::fileHandler().type() == "uncollated"; }
+
+// After everything of a write time is written (the fields, uniform/, the DEM checkpoint's
+// name): each rank records its own folder.
+void recordWrittenFiles(const Foam::Time& runTime) {
+  using namespace Foam;
+  if (!writtenFilesRecorded()) return;
+  std::ostringstream who;
+  if (Pstream::parRun())
+    who << "processor" << Pstream::myProcNo() << " of " << Pstream::nProcs() << " ranks";
+  else
+    who << "1 rank";
+  who << ", time " << runTime.timeName().c_str();
+  try {
+    grainflow::coupling::record_written_files(runTime.timePath(), who.str());
+  } catch (const std::exception& e) {
+    FatalErrorInFunction << "grainFoam: error: recording the files written at time "
+                         << runTime.timeName() << ": " << e.what() << exit(FatalError);
+  }
+}
+
+// Collective: before the start time's fields are read, every rank compares its folder with
+// the record written with it; any difference stops the run on every rank with the message
+// of the lowest rank that found one.
+void checkWrittenFiles(const Foam::Time& runTime) {
+  using namespace Foam;
+  if (!writtenFilesRecorded()) return;
+  grainflow::coupling::WrittenFilesCheck check =
+      grainflow::coupling::check_written_files(runTime.timePath());
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  int first = check.problem.empty() ? size : rank;
+  MPI_Allreduce(MPI_IN_PLACE, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  if (first < size) {
+    long length = static_cast<long>(check.problem.size());
+    MPI_Bcast(&length, 1, MPI_LONG, first, MPI_COMM_WORLD);
+    check.problem.resize(static_cast<std::size_t>(length));
+    MPI_Bcast(check.problem.data(), static_cast<int>(length), MPI_CHAR, first, MPI_COMM_WORLD);
+    FatalErrorInFunction << check.problem.c_str() << exit(FatalError);
+  }
+  const label unrecorded = returnReduce(label(check.recorded ? 0 : 1), sumOp<label>());
+  const label checked = returnReduce(label(check.checked), sumOp<label>());
+  if (unrecorded == 0)
+    Info << "grainFoam: time folder " << runTime.timeName() << ": its " << checked
+         << " files match the checksums grainFoam recorded when it wrote them ("
+         << grainflow::coupling::kWrittenFilesRecord << ")" << endl;
+  else if (runTime.timeIndex() > 0)
+    Info << "grainFoam: time folder " << runTime.timeName() << " has no record of its files ("
+         << grainflow::coupling::kWrittenFilesRecord
+         << "; decomposePar and reconstructPar write none) on " << unrecorded << " of "
+         << Pstream::nProcs() << (Pstream::nProcs() == 1 ? " rank" : " ranks")
+         << ": its fields are read unchecked" << endl;
+}
+
 // The solver proper; everything it creates (the DEM included) is gone when it returns,
 // before MPI is finalised.
 void solve(const Foam::argList& args) {
@@ -137,6 +198,7 @@ void solve(const Foam::argList& args) {
   // where the reader's own error names the file and line. They are back on for the time loop.
   std::optional<grainflow::FloatingPointTrapsOff> readingTraps(std::in_place);
   Time runTime(Time::controlDictName, args);
+  checkWrittenFiles(runTime);
   // A restart takes its time value from the folder's name (timePrecision digits), not from
   // the exact value the stopped run stored in <time>/uniform/time: the continued times then
   // differ from the uninterrupted run's in their last bits, and so does everything that
@@ -380,7 +442,10 @@ void solve(const Foam::argList& args) {
     if (temperature) particles.exchangeHeat(*temperature, *T0);
 
     runTime.write();
-    if (runTime.writeTime()) particles.write();
+    if (runTime.writeTime()) {
+      particles.write();
+      recordWrittenFiles(runTime);
+    }
     particles.writeSnapshotIfDue();
     runTime.printExecutionTime(Info);
 
@@ -390,6 +455,7 @@ void solve(const Foam::argList& args) {
         particles.completeWrittenFields();
         runTime.writeNow();
         particles.write();
+        recordWrittenFiles(runTime);
       }
       Info << "grainFoam: received " << grainflow::StopSignals::name(signal)
            << "; stopped after time " << runTime.timeName() << " (time index "

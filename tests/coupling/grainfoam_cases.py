@@ -592,6 +592,9 @@ def restart(runner, checks, coupling_keys="", other_rank_count=True):
                 runner.run(case, "reconstructPar.all", "reconstructPar", "-latestTime")
         checks.expect(f"restart at time {half_time} (time index 200)" in log,
                       f"np {ranks}: the solver says it restarts at {half_time}, time index 200")
+        checks.expect(f"time folder {half_time}: its" in log and
+                      "files match the checksums grainFoam recorded" in log,
+                      f"np {ranks}: the files of {half_time} match their record")
         contacts = [int(m) for m in re.findall(r"particles, (\d+) contacts", log)]
         checks.expect(contacts and max(contacts) > 100,
                       f"np {ranks}: contacts after the restart {contacts} (> 100 at some write)")
@@ -626,6 +629,9 @@ def restart(runner, checks, coupling_keys="", other_rank_count=True):
             "startFrom       startTime;", "startFrom       latestTime;"))
     runner.run(case, "decomposePar", "decomposePar", "-latestTime")
     log = runner.run(case, "grainFoam.restart", runner.solver, ranks=2)
+    checks.expect(f"time folder {half_time} has no record of its files" in log and
+                  "on 2 of 2 ranks: its fields are read unchecked" in log,
+                  "1 -> 2 ranks: decomposePar's folders have no record, and the log says so")
     lines = balance_lines(log)
     checks.expect(len(lines) >= 1 and all(imb < ROUND_OFF for _, _, imb in lines),
                   f"1 -> 2 ranks: exchange balance to round-off ({len(lines)} lines)")
@@ -648,6 +654,130 @@ def restart(runner, checks, coupling_keys="", other_rank_count=True):
     log = runner.run(case, "grainFoam.missing", runner.solver, expect_failure=True)
     checks.expect("restart from time 0.02" in log and checkpoint in log,
                   "a missing DEM checkpoint: refused; the message names the time and the file")
+
+
+def restart_files(runner, checks):
+    """The files of a restart time (docs/reliability.md, "Fluid fields of a restart"): grainFoam
+    records each file it wrote at a write time with its FNV-1a checksum (grainflowChecksums), and
+    a restart compares them. cases/periodic_box in a flow, binary fields written at 1 ms, then
+    restarted to 2 ms from copies of the stopped case: intact (every file named, matched, and
+    the run continues); one mantissa bit of one U value flipped (refused, naming the file; the
+    message's advice, deleting U's line, then runs, and ends with another U than the intact
+    restart: the flip alone would have been a silent wrong answer); phi deleted (without the
+    record OpenFOAM would rebuild it from U); a recorded checksum damaged; and on 2 ranks a
+    flipped bit in processor1's p."""
+    edits = [("0/U", "internalField   uniform (0 0 0);", "internalField   uniform (0.05 0.02 0);"),
+             ("system/controlDict", "endTime         2e-4;", "endTime         1e-3;"),
+             ("system/controlDict", "writeInterval   1;", "writeInterval   10;"),
+             ("system/controlDict", "writeFormat     ascii;", "writeFormat     binary;")]
+    record = "grainflowChecksums"
+
+    def restart_case(stopped, name, ranks=1):
+        case = os.path.join(runner.work, name)
+        shutil.rmtree(case, ignore_errors=True)
+        shutil.copytree(stopped, case)
+        path = os.path.join(case, "system", "controlDict")
+        with open(path) as f:
+            text = f.read()
+        with open(path, "w") as f:
+            f.write(text.replace("endTime         1e-3;", "endTime         2e-3;").replace(
+                "startFrom       startTime;", "startFrom       latestTime;"))
+        return case
+
+    def flip(path, offset, bit):
+        with open(path, "r+b") as f:
+            f.seek(offset)
+            byte = f.read(1)[0]
+            f.seek(offset)
+            f.write(bytes([byte ^ (1 << bit)]))
+
+    def first_value(path):
+        """Offset of the first double of a binary field's internalField list."""
+        with open(path, "rb") as f:
+            data = f.read()
+        start = data.index(b"internalField")
+        return data.index(b"(", start) + 1
+
+    def stack_trace(log):
+        return "printStack" in log or "sigFpe" in log
+
+    stopped = runner.fresh_case("periodic_box", "files_stopped", edits)
+    runner.solve(stopped, 1)
+    with open(os.path.join(stopped, "0.001", record)) as f:
+        listed = re.findall(r'^"([^"]+)"  "fnv1a64 [0-9a-f]{16}";$', f.read(), re.MULTILINE)
+    wanted = {"U", "p", "phi", "voidfraction", "Ksl", "uniform/time", "uniform/grainflowCheckpoint"}
+    checks.expect(wanted <= set(listed),
+                  f"the record of 0.001 lists {sorted(listed)} (at least {sorted(wanted)})")
+
+    # Intact: every listed file matches, and the run goes on to the end.
+    case = restart_case(stopped, "files_intact")
+    log = runner.run(case, "grainFoam.restart", runner.solver)
+    checks.expect(f"time folder 0.001: its {len(listed)} files match the checksums" in log,
+                  f"intact: all {len(listed)} files matched")
+    with open(os.path.join(case, "0.002", "U"), "rb") as f:
+        intact_u = f.read()
+
+    # One mantissa bit (2^-12 of the value) of the first U value: refused, naming the file.
+    case = restart_case(stopped, "files_u_bit")
+    u = os.path.join(case, "0.001", "U")
+    flip(u, first_value(u) + 5, 0)
+    log = runner.run(case, "grainFoam.restart", runner.solver, expect_failure=True)
+    checks.expect(re.search(r"1 file of time folder 0.001 differs from what grainFoam wrote there .*\n  "
+                            + re.escape(u) + r": FNV-1a checksum [0-9a-f]{16}, recorded", log)
+                  is not None and "delete its line from" in log and not stack_trace(log),
+                  "U with one flipped bit: refused, naming 0.001/U and both checksums")
+    # The advice: delete U's line (as after an edit made on purpose) and start again.
+    path = os.path.join(case, "0.001", record)
+    with open(path) as f:
+        lines = f.read().splitlines(keepends=True)
+    with open(path, "w") as f:
+        f.writelines(line for line in lines if not line.startswith('"U"'))
+    log = runner.run(case, "grainFoam.restart_advised", runner.solver)
+    with open(os.path.join(case, "0.002", "U"), "rb") as f:
+        flipped_u = f.read()
+    checks.expect(f"its {len(listed) - 1} files match" in log and flipped_u != intact_u,
+                  "advice rerun (U's line deleted): runs to the end, and its U at 0.002 differs "
+                  "from the intact restart's (the flip unchecked is a silent wrong answer)")
+
+    # phi deleted: OpenFOAM would rebuild it from U (READ_IF_PRESENT), not the written flux.
+    case = restart_case(stopped, "files_no_phi")
+    phi = os.path.join(case, "0.001", "phi")
+    os.remove(phi)
+    log = runner.run(case, "grainFoam.restart", runner.solver, expect_failure=True)
+    checks.expect(f"  {phi} is missing (line" in log and not stack_trace(log),
+                  "phi deleted: refused, naming 0.001/phi as missing")
+
+    # A recorded checksum damaged (the record itself on a failing disk): refused too.
+    case = restart_case(stopped, "files_record_bit")
+    path = os.path.join(case, "0.001", record)
+    with open(path) as f:
+        text = f.read()
+    at = text.index('"p"  "fnv1a64 ') + len('"p"  "fnv1a64 ')
+    digit = "0" if text[at] != "0" else "1"
+    with open(path, "w") as f:
+        f.write(text[:at] + digit + text[at + 1:])
+    log = runner.run(case, "grainFoam.restart", runner.solver, expect_failure=True)
+    checks.expect(re.search(re.escape(os.path.join(case, "0.001", "p")) + r": FNV-1a checksum", log)
+                  is not None and not stack_trace(log),
+                  "a damaged checksum in the record: refused, naming p")
+    case = restart_case(stopped, "files_record_line")
+    path = os.path.join(case, "0.001", record)
+    with open(path, "a") as f:
+        f.write('"U"  "fnv1a64 12345";\n')
+    log = runner.run(case, "grainFoam.restart", runner.solver, expect_failure=True)
+    checks.expect(re.search(r"line \d+ of " + re.escape(path) + r" is not an entry", log)
+                  is not None and not stack_trace(log),
+                  "a garbled line in the record: refused, naming the record and its line")
+
+    # 2 ranks: each processor folder has its own record; a bit of processor1's p is named.
+    stopped2 = runner.fresh_case("periodic_box", "files_stopped_np2", edits)
+    runner.solve(stopped2, 2)
+    case = restart_case(stopped2, "files_p_bit_np2")
+    p = os.path.join(case, "processor1", "0.001", "p")
+    flip(p, first_value(p) + 5, 0)
+    log = runner.run(case, "grainFoam.restart", runner.solver, ranks=2, expect_failure=True)
+    checks.expect((p + ": FNV-1a checksum") in log and not stack_trace(log),
+                  "2 ranks, processor1's p with one flipped bit: refused, naming that file")
 
 
 def restart_bed_surface(runner, checks):
@@ -1421,7 +1551,7 @@ def diffusion_smoothing(runner, checks):
 
 TESTS = {f.__name__: f for f in (void_fraction_volume, exchange_balance, neutrally_buoyant,
                                   cellpoint_ranks,
-                                 refuses_bad_setup, hostile_fields, restart, restart_bed_surface, stop_signal, nan_guard,
+                                 refuses_bad_setup, hostile_fields, restart, restart_files, restart_bed_surface, stop_signal, nan_guard,
                                  scene_output, heat_equilibrium, heat_parcels, heat_balance,
                                  heat_front, balanced_decomposition,
                                  diffusion_smoothing)}

@@ -25,6 +25,12 @@
 #       U, p, phi, voidfraction bit-identical; a 1-rank checkpoint restarted on 2 ranks
 #       continues the same flow (centre of mass within 2 % of its fall); a missing DEM
 #       checkpoint is refused naming the file. About 45 s.
+#   coupling.restart_files         the files of a restart time against the checksums grainFoam
+#       recorded when it wrote them (grainflowChecksums): intact (matched, runs on); a flipped
+#       mantissa bit of U refused naming the file, then the advice (delete U's line) runs and
+#       ends with another U than the intact restart; phi deleted, a damaged checksum and a
+#       garbled line of the record refused; on 2 ranks, processor1's p with a flipped bit.
+#       About 20 s.
 #   coupling.restart_bed_surface   the same restarts with dragVoidFraction sharpInterface and
 #       facePressure dragSeries (the beads pile on the floor): bit-identical on 1 and 2 ranks
 #       (Ksl taken as written at the restart, as the void fraction is). About 25 s.
@@ -164,6 +170,7 @@ grainflow_coupling_test(cellpoint_ranks 2)
 grainflow_coupling_test(refuses_bad_setup 2)
 grainflow_coupling_test(hostile_fields 1)
 grainflow_coupling_test(restart 2)
+grainflow_coupling_test(restart_files 2)
 set_tests_properties(coupling.restart PROPERTIES TIMEOUT 600)  # ~45 s on a quiet machine
 grainflow_coupling_test(restart_bed_surface 2)
 set_tests_properties(coupling.restart_bed_surface PROPERTIES TIMEOUT 600)
