@@ -15,10 +15,15 @@ bool finite(const Vec3& a) {
   return std::isfinite(a.x()) && std::isfinite(a.y()) && std::isfinite(a.z());
 }
 
-// Index of the first particle with a non-finite state, or p.size().
-std::size_t first_bad(const Particles& p) {
+bool positive(double temperature) { return temperature > 0 && std::isfinite(temperature); }
+
+// Index of the first particle with a non-finite state (or, with `temperatures`, a
+// temperature not above 0 K), or p.size().
+std::size_t first_bad(const Particles& p, bool temperatures) {
   for (std::size_t i = 0; i < p.size(); ++i)
-    if (!finite(p.x[i]) || !finite(p.v[i]) || !finite(p.omega[i])) return i;
+    if (!finite(p.x[i]) || !finite(p.v[i]) || !finite(p.omega[i]) ||
+        (temperatures && !positive(p.temperature[i])))
+      return i;
   return p.size();
 }
 
@@ -31,7 +36,15 @@ std::string text(const Vec3& a) {
 
 }  // namespace
 
-bool has_non_finite(const Particles& p) { return first_bad(p) < p.size(); }
+bool has_non_finite(const Particles& p, bool temperatures) {
+  return first_bad(p, temperatures) < p.size();
+}
+
+bool temperatures_positive(const Particles& p) {
+  bool all = true;
+  for (const double t : p.temperature) all &= positive(t);
+  return all;
+}
 
 bool non_finite_anywhere(bool local_bad, MPI_Comm comm) {
   int bad = local_bad ? 1 : 0;
@@ -44,9 +57,22 @@ bool non_finite_anywhere(const Particles& p, MPI_Comm comm) {
 }
 
 std::string describe_first_non_finite(const Particles& p, long step, double time, int rank,
-                                      const std::string& force_terms) {
-  const std::size_t i = first_bad(p);
+                                      const std::string& force_terms, bool temperatures) {
+  const std::size_t i = first_bad(p, temperatures);
   if (i == p.size()) return {};
+  if (finite(p.x[i]) && finite(p.v[i]) && finite(p.omega[i])) {  // its temperature
+    std::ostringstream s;
+    s.precision(9);
+    s << "error: step " << step << " (t = " << time << " s): particle " << p.id[i] << " (rank "
+      << rank << ") has a temperature of " << p.temperature[i] << " K, not above 0 K; position "
+      << text(p.x[i]) << " m, velocity " << text(p.v[i])
+      << " m/s. The run stops here. A fixed heat flow out of a particle takes heat at its rate "
+         "whatever the particle's temperature: a wall's negative `heat_flux` (W/m^2 over the "
+         "contact area) or a material's negative `heat_source` (W/kg). Lower it, or give the "
+         "wall a `temperature` instead, which cools a particle no further than to the wall's "
+         "(docs/models/heat-transfer.md)";
+    return s.str();
+  }
   const char* what = !finite(p.x[i])   ? "position"
                      : !finite(p.v[i]) ? "velocity"
                                        : "angular velocity";
@@ -79,8 +105,9 @@ void guard_finite(const Simulation& sim, bool local_bad, const std::string& dire
   }
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
-  const std::string mine = describe_first_non_finite(sim.particles(), sim.counters().steps,
-                                                     sim.time(), rank, sim.force_limits_summary());
+  const std::string mine =
+      describe_first_non_finite(sim.particles(), sim.counters().steps, sim.time(), rank,
+                                sim.force_limits_summary(), sim.heat() != nullptr);
   agree_on_error(comm, mine.empty() ? mine : mine + where);
 }
 

@@ -10,20 +10,28 @@
 
 namespace grainflow {
 
+// With heat on (`temperatures`), a temperature that is not finite or not above 0 K counts as
+// well: a fixed heat flow out of a particle (a wall's negative heat_flux, a negative
+// heat_source) is not bounded by its temperature, and ran on below 0 K.
+
 // Collective: true on every rank when any rank holds a particle whose position, velocity or
 // angular velocity is not finite. One MPI_Allreduce of an int.
 bool non_finite_anywhere(const Particles& p, MPI_Comm comm);
 // The same from each rank's own answer (`local_bad`: this rank holds a non-finite state).
 bool non_finite_anywhere(bool local_bad, MPI_Comm comm);
-// Whether p holds a non-finite position, velocity or angular velocity (no communication).
-bool has_non_finite(const Particles& p);
+// Whether p holds a non-finite position, velocity or angular velocity, or with
+// `temperatures` a temperature not finite or not above 0 K (no communication).
+bool has_non_finite(const Particles& p, bool temperatures = false);
+// Whether every temperature is finite and above 0 K (no communication).
+bool temperatures_positive(const Particles& p);
 
 // This rank's first such particle described for the user (id, rank, step, time, position,
 // velocity, angular velocity, force and torque), or "" when this rank has none. Local.
 // `force_terms`: the force terms enabled with their dt / time-scale ratios
 // (Simulation::force_limits_summary), or "" when the run has none.
 std::string describe_first_non_finite(const Particles& p, long step, double time, int rank,
-                                      const std::string& force_terms = "");
+                                      const std::string& force_terms = "",
+                                      bool temperatures = false);
 
 class Simulation;
 

@@ -248,7 +248,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     throw SetupError(scene.file + ": error: refusing to run with this time step (see above); " +
                      refusal_remedy(sim.time_step_report()) +
                      ", or pass --allow-large-dt to run anyway");
-  guard_finite(sim, has_non_finite(sim.particles()), dir, comm);
+  guard_finite(sim, has_non_finite(sim.particles(), sim.heat() != nullptr), dir, comm);
   // A restart whose scene ends before the checkpoint would run no step, and would first cut
   // the snapshot series and log back to the checkpoint: refused before anything is touched.
   const long end_step =

@@ -10,6 +10,7 @@
 
 #include "dem/contact/normal_hooke.hpp"
 #include "dem/core/number_format.hpp"
+#include "dem/engine/finite_guard.hpp"
 #include "dem/engine/restored_state.hpp"
 #include "dem/insert/insertion.hpp"
 #include "dem/walls/stl_reader.hpp"
@@ -1709,8 +1710,12 @@ void Simulation::step() {
   time_ += dt_;
   walls_.move_to(time_);
   const ContactGuards guards = compute_forces();
-  if (heat_) advance_temperatures();
-  state_finite_ = half_kick<true>();
+  bool temperatures_ok = true;
+  if (heat_) {
+    advance_temperatures();
+    temperatures_ok = temperatures_positive(p_);  // the guard's, with the step's one reduction
+  }
+  state_finite_ = half_kick<true>() && temperatures_ok;
   finite_everywhere_ = check_contacts(guards, state_finite_);
   ++counters_.steps;
 }

@@ -74,11 +74,12 @@ bool anyCell(const Foam::fvMesh& mesh, const Bad& bad, Foam::vector& at) {
 }
 
 // " at t = 0.003608 s (time index 35): <what> is not finite, first in the cell at (x y z) m"
-std::string notFinite(const Foam::fvMesh& mesh, const char* what, const Foam::vector& at) {
+std::string notFinite(const Foam::fvMesh& mesh, const char* what, const Foam::vector& at,
+                      const char* is = "is not finite") {
   std::ostringstream m;
   m.precision(4);
   m << " at t = " << mesh.time().value() << " s (time index " << mesh.time().timeIndex()
-    << "): " << what << " is not finite, first in the cell at (" << at.x() << " " << at.y() << " "
+    << "): " << what << " " << is << ", first in the cell at (" << at.x() << " " << at.y() << " "
     << at.z() << ") m";
   return m.str();
 }
@@ -114,19 +115,69 @@ void stopIfDiverged(const char* stage, const Foam::volVectorField& U, const Foam
 // from a finite flux and the particles' exchange: the check turns what would be NaN handed to
 // every particle's temperature into a stop that says where.
 void stopIfTemperatureDiverged(const Foam::volScalarField& T,
-                               const grainflow::foam::ParticleCoupling& particles) {
+                               const grainflow::foam::ParticleCoupling& particles,
+                               const Foam::word& startTime) {
   using namespace Foam;
   vector at;
   if (!anyCell(
-          T.mesh(), [&](label i) { return !std::isfinite(T[i]); }, at))
+          T.mesh(), [&](label i) { return !std::isfinite(T[i]) || !(T[i] > 0); }, at))
     return;
   std::ostringstream m;
   m << "grainFoam: error: the fluid temperature diverged in the energy equation"
-    << notFinite(T.mesh(), "T", at) << ", while U and p are finite. "
-    << particles.fluidState(true).text.c_str()
+    << notFinite(T.mesh(), "T", at, "is not finite or not above 0 K")
+    << ", while U and p are finite. " << particles.fluidState(true).text.c_str()
     << " The equation's sources are the flux and the particles' heat exchange in each cell "
        "(heat response and heat source, constant/transportProperties: Cp, kappa); check "
-       "the fluid's initial T (0/T) and the particles' temperatures in the scene.";
+       "the fluid's starting T ("
+    << startTime.c_str() << "/T) and the particles' temperatures in the scene.";
+  FatalErrorInFunction << m.str().c_str() << exit(FatalError);
+}
+
+// Collective: a starting fluid temperature that is not a positive, finite number of kelvin
+// (the scene's temperatures must be > 0 K too) stops the run before the first step, naming
+// the file, the internal field or patch, and where. A T <= 0 ran to the end: the energy
+// equation is linear in T, and nothing in it is bounded below.
+void checkStartingTemperature(const Foam::volScalarField& T, const Foam::word& startTime) {
+  using namespace Foam;
+  const auto bad = [](scalar t) { return !(t > 0) || !std::isfinite(t); };
+  scalar value = 1;
+  vector where = Zero;
+  label part = -2;  // -2: none, -1: the internal field, else the patch
+  forAll(T, i) {
+    if (bad(T[i])) {
+      value = T[i];
+      where = T.mesh().C()[i];
+      part = -1;
+      break;
+    }
+  }
+  forAll(T.boundaryField(), patch) {
+    if (part != -2) break;
+    const fvPatch& fp = T.mesh().boundary()[patch];
+    if (fp.coupled()) continue;  // cyclic and processor faces repeat cells' values
+    forAll(fp, f) {
+      if (bad(T.boundaryField()[patch][f])) {
+        value = T.boundaryField()[patch][f];
+        where = fp.Cf()[f];
+        part = patch;
+        break;
+      }
+    }
+  }
+  const label me = Pstream::myProcNo(), none = Pstream::nProcs();
+  const label first = returnReduce(part != -2 ? me : none, minOp<label>());
+  if (first == none) return;
+  const bool mine = me == first;
+  value = returnReduce(mine ? value : 0.0, sumOp<scalar>());
+  where = returnReduce(mine ? where : vector::zero, sumOp<vector>());
+  part = returnReduce(mine ? part : labelMin, maxOp<label>());
+  const word in = part >= 0 ? "patch " + T.mesh().boundary()[part].name() : "internalField";
+  std::ostringstream m;
+  m.precision(6);
+  m << "grainFoam: error: " << startTime.c_str() << "/T holds " << value << " K (its " << in
+    << ", at (" << where.x() << " " << where.y() << " " << where.z()
+    << ") m): the fluid temperature is absolute, in kelvin, and must be above 0 K, as the "
+       "scene's temperatures are (e.g. 293.15 for 20 degrees Celsius)";
   FatalErrorInFunction << m.str().c_str() << exit(FatalError);
 }
 
@@ -212,6 +263,7 @@ void solve(const Foam::argList& args) {
         runTime.timeName(stored) == runTime.timeName() && stored != runTime.value())
       runTime.setTime(stored, runTime.timeIndex());
   }
+  const word startTime = runTime.timeName();  // the folder the fields start from
   fvMesh mesh(IOobject(fvMesh::defaultRegion, runTime.timeName(), runTime, IOobject::MUST_READ));
   pimpleControl pimple(mesh);
 
@@ -254,6 +306,7 @@ void solve(const Foam::argList& args) {
     temperature.reset(new volScalarField(IOobject("T", runTime.timeName(), mesh,
                                                   IOobject::MUST_READ, IOobject::AUTO_WRITE),
                                          mesh));
+    checkStartingTemperature(*temperature, startTime);
     particles.setTemperature(*temperature, rhoCp.value(), kappa.value(), transport.objectPath());
   }
   const bool modelA = particles.model() == 'A';
@@ -436,7 +489,7 @@ void solve(const Foam::argList& args) {
         const TrapsOff trapsOff;
         TEqn.solve(mesh.solver("T"));
       }
-      stopIfTemperatureDiverged(T, particles);
+      stopIfTemperatureDiverged(T, particles, startTime);
     }
     particles.addFluidTime(fluidClock);
     if (temperature) particles.exchangeHeat(*temperature, *T0);

@@ -465,8 +465,9 @@ def hostile_fields(runner, checks):
     beyond the double range, a speed whose square overflows, a speed a fluid step cannot carry,
     in the internal field and at an inlet. Each must stop grainFoam with a message that names
     the file (never OpenFOAM's floating-point trap and its stack trace); a speed above a Courant
-    number of 1 is named in a start-up warning whose figure is the closed form |U| dt / h; and
-    the corrected field runs."""
+    number of 1 is named in a start-up warning whose figure is the closed form |U| dt / h; a
+    fluid temperature at or below 0 K (internal field, inlet) is refused; and the corrected
+    fields run."""
     def stack_trace(log):
         return "printStack" in log or "sigFpe" in log
 
@@ -530,6 +531,30 @@ def hostile_fields(runner, checks):
     log = runner.run(case, "grainFoam", runner.solver)
     checks.expect("starts the fluid" not in log,
                   "0/U (0 0 0): runs to the end, no start-up warning")
+
+    # 6. A fluid temperature at or below 0 K (a value in degrees Celsius, say) ran to the end
+    # with a negative thermal energy: refused before the first step, naming the internal
+    # field or the patch. The message's example, 293.15 K, then runs.
+    for name, edit, where in (
+            ("t_minus10", ("heated_box", "0/T", "internalField   uniform 300;",
+                           "internalField   uniform -10;"), "-10 K (its internalField"),
+            ("t_zero", ("heated_box", "0/T", "internalField   uniform 300;",
+                        "internalField   uniform 0;"), "0 K (its internalField"),
+            ("t_inlet", ("heated_bed", "0/T", "value uniform 400;", "value uniform -5;"),
+             "-5 K (its patch inlet")):
+        source, *change = edit
+        case = runner.fresh_case(source, name, [tuple(change)])
+        runner.run(case, "blockMesh", "blockMesh")
+        log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+        checks.expect(f"error: 0/T holds {where}" in log and "must be above 0 K" in log
+                      and not stack_trace(log),
+                      f"0/T {where.split(' (')[0]} in the {where.split('its ')[1]}: refused")
+    case = runner.fresh_case("heated_box", "t_advised", [
+        ("0/T", "internalField   uniform 300;", "internalField   uniform 293.15;"),
+        ("system/controlDict", "endTime         0.1;", "endTime         0.002;")])
+    runner.run(case, "blockMesh", "blockMesh")
+    log = runner.run(case, "grainFoam", runner.solver)
+    checks.expect("End" in log, "0/T 293.15 (the message's example): runs to the end")
 
 
 # --- coupling.restart -------------------------------------------------------------------

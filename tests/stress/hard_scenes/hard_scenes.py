@@ -1561,6 +1561,7 @@ STOP_CAUSES = [
     ("dt is too large", "start-up step refusal"),
     ("refusing to run with this time step", "start-up step refusal"),
     ("non-finite", "NaN guard"),
+    ("not above 0 K", "temperature guard"),
     ("overlaps an earlier particle", "CSV overlap refused"),
     ("wall", "insertion against a wall"),
 ]
