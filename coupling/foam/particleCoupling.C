@@ -13,6 +13,7 @@
 #include "coupling/foam/gaussLinearGrad.H"
 #include "coupling/foam/particleCoupling.H"
 #include "coupling/shared_decomposition.hpp"
+#include "coupling/written_files.hpp"
 #include "dem/io/output_directory.hpp"
 #include "extrapolatedCalculatedFvPatchField.H"
 #include "volPointInterpolation.H"
@@ -84,6 +85,28 @@ Foam::IOobject derivedField(const Foam::fvMesh& mesh, const Foam::word& name, bo
 }
 
 std::array<double, 3> toArray(const Foam::vector& v) { return {v.x(), v.y(), v.z()}; }
+
+}  // namespace
+
+namespace {
+
+// Collective: the FNV-1a checksum of a file that rank 0 reads (the DEM checkpoint, which rank
+// 0 writes), as 16 hex digits, or the error on every rank.
+std::string checkpointChecksum(const std::string& path) {
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  char text[64] = {};
+  if (rank == 0) {
+    try {
+      std::snprintf(text, sizeof text, "%016llx",
+                    static_cast<unsigned long long>(coupling::file_checksum(path)));
+    } catch (const std::exception& e) {
+      std::snprintf(text, sizeof text, "unreadable");
+    }
+  }
+  MPI_Bcast(text, sizeof text, MPI_CHAR, 0, MPI_COMM_WORLD);
+  return text;
+}
 
 }  // namespace
 
@@ -383,6 +406,25 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
              "names it there). Start from time 0, or from a time written by grainFoam"
           << exit(FatalError);
     const fileName checkpoint = snapshotDir_ / info.get<word>("checkpoint");
+    // The checkpoint must be the one written with this time: another run sharing the output
+    // directory, or a particles/ folder copied from elsewhere, holds a valid checkpoint of the
+    // same step with other particles.
+    if (info.found("checkpointChecksum") && isFile(checkpoint)) {
+      const word recorded = info.get<word>("checkpointChecksum");
+      const std::string now = "fnv1a64_" + checkpointChecksum(checkpoint);
+      if (now != recorded)
+        FatalErrorInFunction
+            << "restart from time " << mesh.time().timeName() << ": " << checkpoint.c_str()
+            << " is not the DEM checkpoint grainFoam wrote with this time: its checksum is "
+            << now.c_str() << ", " << info.objectPath().c_str() << " records " << recorded
+            << ". Another run may have written over it (an output.directory shared by two "
+               "cases), or it was copied from elsewhere. Put back the checkpoint of this run, "
+               "or restart from another time. If you changed it on purpose, delete the line "
+               "checkpointChecksum from that file"
+            << (Pstream::parRun() ? " in every processor folder" : "")
+            << ", and that file's line from " << mesh.time().timeName() << "/"
+            << coupling::kWrittenFilesRecord << exit(FatalError);
+    }
     try {
       dem_->restore(checkpoint);
     } catch (const std::exception& e) {
@@ -2055,6 +2097,8 @@ void ParticleCoupling::write() {
   IOdictionary info(IOobject("grainflowCheckpoint", time.timeName(), "uniform", time,
                              IOobject::NO_READ, IOobject::NO_WRITE, false));
   info.add("checkpoint", word(checkpoint));
+  info.add("checkpointChecksum",
+           word("fnv1a64_" + checkpointChecksum(std::string(snapshotDir_ / checkpoint))));
   info.add("demStep", label(dem_->steps()));
   info.add("demTime", dem_->time());
   info.regIOobject::write();

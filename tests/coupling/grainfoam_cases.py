@@ -689,8 +689,9 @@ def restart_files(runner, checks):
     the run continues); one mantissa bit of one U value flipped (refused, naming the file; the
     message's advice, deleting U's line, then runs, and ends with another U than the intact
     restart: the flip alone would have been a silent wrong answer); phi deleted (without the
-    record OpenFOAM would rebuild it from U); a recorded checksum damaged; and on 2 ranks a
-    flipped bit in processor1's p."""
+    record OpenFOAM would rebuild it from U); a recorded checksum damaged; another run's
+    checkpoint of the same step in particles/ (refused; this run's put back restarts as the
+    intact copy did); and on 2 ranks a flipped bit in processor1's p."""
     edits = [("0/U", "internalField   uniform (0 0 0);", "internalField   uniform (0.05 0.02 0);"),
              ("system/controlDict", "endTime         2e-4;", "endTime         1e-3;"),
              ("system/controlDict", "writeInterval   1;", "writeInterval   10;"),
@@ -793,6 +794,29 @@ def restart_files(runner, checks):
     checks.expect(re.search(r"line \d+ of " + re.escape(path) + r" is not an entry", log)
                   is not None and not stack_trace(log),
                   "a garbled line in the record: refused, naming the record and its line")
+
+    # Another run's checkpoint of the same step in particles/ (an output.directory shared by
+    # two cases): a valid file with other particles. Refused, naming it; the advice (put back
+    # this run's checkpoint) then restarts exactly as the intact copy did.
+    other = runner.fresh_case("periodic_box", "files_other_run", [
+        (f, a, b.replace("(0.05 0.02 0)", "(0 0.05 0.02)")) for f, a, b in edits])
+    runner.solve(other, 1)
+    case = restart_case(stopped, "files_other_checkpoint")
+    name = [n for n in os.listdir(os.path.join(case, "particles")) if n.startswith("checkpoint_")]
+    checks.expect(len(name) == 1, f"one checkpoint in particles/ ({name})")
+    ours = os.path.join(case, "particles", name[0])
+    shutil.copy(ours, ours + ".ours")
+    shutil.copy(os.path.join(other, "particles", name[0]), ours)
+    log = runner.run(case, "grainFoam.restart", runner.solver, expect_failure=True)
+    checks.expect(f"{ours} is not the DEM checkpoint grainFoam wrote with this time" in log
+                  and "Put back the checkpoint of this run" in log and not stack_trace(log),
+                  "another run's checkpoint of the same step: refused, naming it")
+    os.replace(ours + ".ours", ours)
+    log = runner.run(case, "grainFoam.restart_advised", runner.solver)
+    with open(os.path.join(case, "0.002", "U"), "rb") as f:
+        checks.expect(f.read() == intact_u,
+                      "advice rerun (this run's checkpoint put back): U at 0.002 byte for byte "
+                      "the intact restart's")
 
     # 2 ranks: each processor folder has its own record; a bit of processor1's p is named.
     stopped2 = runner.fresh_case("periodic_box", "files_stopped_np2", edits)
@@ -925,7 +949,8 @@ def stop_signal(runner, checks):
 def nan_guard(runner, checks):
     """The NaN / Inf guard in a coupled run: cases/periodic_box runs 10 fluid steps and
     writes its checkpoint; the velocity of one bead that touches nothing is set to NaN
-    (h5py) and the run is restarted from it. The first DEM step must stop grainFoam with an
+    (h5py) and the run is restarted from it (refused as not the checkpoint written with that
+    time, then accepted as the message says). The first DEM step must stop grainFoam with an
     error naming that particle, its non-finite state and its forces (not OpenFOAM's
     floating-point trap, which the DEM steps run without), and write every particle of
     that step to particles/diagnostic_000000.h5 — on 1 rank and on 2."""
@@ -955,6 +980,21 @@ def nan_guard(runner, checks):
             text = f.read().replace("endTime         1e-3;", "endTime         2e-3;")
         with open(path, "w") as f:
             f.write(text.replace("startFrom       startTime;", "startFrom       latestTime;"))
+        # The edited checkpoint is not the one written with that time: refused, and accepted
+        # as the message says (an edit made on purpose).
+        log = runner.run(case, "grainFoam.edited", runner.solver, ranks=ranks,
+                         expect_failure=True)
+        checks.expect("is not the DEM checkpoint grainFoam wrote with this time" in log,
+                      f"np {ranks}: the edited checkpoint is refused at first")
+        for folder in ([case] if ranks == 1 else
+                       [os.path.join(case, f"processor{i}") for i in range(ranks)]):
+            for name, drop in (("uniform/grainflowCheckpoint", "checkpointChecksum"),
+                               ("grainflowChecksums", '"uniform/grainflowCheckpoint"')):
+                path = os.path.join(folder, "0.001", name)
+                with open(path) as f:
+                    lines = f.read().splitlines(keepends=True)
+                with open(path, "w") as f:
+                    f.writelines(line for line in lines if not line.startswith(drop))
         log = runner.run(case, "grainFoam.nan", runner.solver, ranks=ranks, expect_failure=True)
         # The first step's drift carries the NaN from the velocity into the position.
         named = re.search(rf"step 101 \(t = 0.00101 s\): particle {victim} \(rank \d+\) has a "
