@@ -263,7 +263,7 @@ void Simulation::check_walls_travel() {
       check_wall_travel(scene_, walls_, dt_, std::isfinite(smallest.radius) ? smallest.radius : 0.0,
                         smallest.material, table_,
                         report_.verdict == TimeStepReport::Verdict::refuse
-                            ? report_.recommended_step
+                            ? report_.refusal_step  // every refusing limit's, conduction's too
                             : std::numeric_limits<double>::infinity());
   for (const std::string& note : walls.notes) report_.notes.push_back(note);
   if (!walls.error.empty()) throw SetupError(walls.error);
@@ -1034,13 +1034,15 @@ bool Simulation::check_contacts(const ContactGuards& s, bool finite_here) const 
     // Within the limit, and (when the start-up time-step check refuses dt as well, which it
     // reports only after this first step) within what that check accepts.
     const double within = round_down_3(travel_limit * r / speed);
-    const bool startup = report_.verdict == TimeStepReport::Verdict::refuse &&
-                         report_.recommended_step < within;
+    // The start-up limits' smallest proposal (refusal_step): the contacts' and, with heat,
+    // conduction's; proposing the contacts' alone was refused again for conduction (found by
+    // the hard-scene generator, thermal seed 717).
+    const bool startup =
+        report_.verdict == TimeStepReport::Verdict::refuse && report_.refusal_step < within;
     if (startup)
-      o << round_down_3(report_.recommended_step) << " s keeps it within the limit (" << within
-        << " s) and passes the start-up check of dt against the Rayleigh and contact times, "
-           "which refuses dt = "
-        << dt_ << " s too";
+      o << round_down_3(report_.refusal_step) << " s keeps it within the limit (" << within
+        << " s) and passes every start-up check of dt (the Rayleigh and contact times"
+        << (scene_.heat ? ", heat conduction" : "") << "), which refuse dt = " << dt_ << " s too";
     else
       o << within << " s keeps it within the limit";
     // A one-way flow faster than the particle drags it on towards its own speed: a step

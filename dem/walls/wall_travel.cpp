@@ -128,9 +128,9 @@ WallTravelReport check_wall_travel(const Scene& scene, const WallSet& walls, dou
     << step << " s fits: the wall alone needs at most " << wall_fit
     << " s, and a particle it strikes leaves at up to twice the wall's speed";
   if (startup_smaller)
-    o << " (" << travel_step << " s); the start-up check of dt against the Rayleigh and contact "
-         "times needs at most "
-      << round_down_3(startup_step) << " s";
+    o << " (" << travel_step << " s); the start-up checks of dt (the Rayleigh and contact times"
+      << (scene.heat ? ", heat conduction" : "") << ") need at most " << round_down_3(startup_step)
+      << " s";
   if (scene.contact.normal == NormalModel::hertz && material >= 0) {
     const int wall_material = scene.walls[w.index].material;
     const double mass = scene.materials[material].density * sphere_volume(r_min);

@@ -4,7 +4,7 @@
 # that fit (1e-3 / (2 x 150) = 3.33e-6 s, rounded down, lowered to the 1.81e-7 s that the
 # start-up contact-time check of the same dt accepts) and that resolve the impact.
 set(_fast_rod_refusal
-    "fast_rod.yaml: error: wall 'rod' moves 3.75 x the smallest particle radius per step \\(sweep speed 150 m/s x dt = 2.5e-05 s = 0.00375 m; smallest radius 0.001 m\\); the limit is 1 \\(key time.max_step_travel;A step of at most 1.81e-07 s fits;twice the wall's speed \\(3.33e-06 s\\); the start-up check of dt against the Rayleigh and contact times needs at most 1.81e-07 s;on the wall at 150 m/s needs at most 8.28e-08 s")
+    "fast_rod.yaml: error: wall 'rod' moves 3.75 x the smallest particle radius per step \\(sweep speed 150 m/s x dt = 2.5e-05 s = 0.00375 m; smallest radius 0.001 m\\); the limit is 1 \\(key time.max_step_travel;A step of at most 1.81e-07 s fits;twice the wall's speed \\(3.33e-06 s\\); the start-up checks of dt \\(the Rayleigh and contact times\\) need at most 1.81e-07 s;on the wall at 150 m/s needs at most 8.28e-08 s")
 grain_cli_test(walls_fast_rod_check_refused 1 "${_fast_rod_refusal}"
                CMD ${_grain} check ${_scenes}/walls/fast_rod.yaml)
 grain_cli_test(walls_fast_rod_run_refused 1 "${_fast_rod_refusal}"

@@ -148,7 +148,7 @@ TEST_P(WallTravel, RefusedWithSpeedLimitAndStepsThatWork) {
   EXPECT_THAT(m, HasSubstr("the limit is 1 (key time.max_step_travel"));
   const double fit = number_after(m, "A step of at most ");
   const double travel = number_after(m, "twice the wall's speed (");
-  const double startup = number_after(m, "Rayleigh and contact times needs at most ");
+  const double startup = number_after(m, "Rayleigh and contact times) need at most ");
   const double impact = number_after(m, " m/s needs at most ");
   // The travel rule: limit r / (2 U), rounded down to three digits.
   EXPECT_LE(travel, kR / (2 * c.speed));
