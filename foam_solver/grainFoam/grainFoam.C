@@ -484,6 +484,14 @@ void solve(const Foam::argList& args) {
                           == -fvm::Sp(particles.heatResponse() / rhoCp, T) +
                                  (particles.heatResponse() * *T0 - particles.heatSource()) /
                                      rhoCp);
+      // ddtVoidFraction off: continuity holds div(phi) = 0 without d(eps)/dt, so the
+      // conservative d(eps T)/dt would turn each change of eps into a change of T (particles
+      // arriving in a cell would heat its gas by eps_old / eps_new, particles leaving cool it:
+      // the fluid went 73 K below every starting and inlet temperature in random coupled seed
+      // 113). Consistent with
+      // that continuity, the storage term is eps dT/dt: T moves only by the flux, diffusion and
+      // the exchange.
+      if (!particles.ddtVoidFraction()) TEqn -= fvm::Sp(fvc::ddt(eps), T);
       TEqn.relax();
       {
         const TrapsOff trapsOff;

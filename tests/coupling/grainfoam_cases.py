@@ -1249,20 +1249,22 @@ def heat_parcels(runner, checks):
                   f"the box's centre ({last.get('position')})")
 
 
-def heated_bed(runner, name, ranks, parcels=False):
+def heated_bed(runner, name, ranks, parcels=False, bead_temperature=350, extra=()):
     """cases/periodic_box with heat on: the beads (glass, 350 K) rain at 10 g through water
     at 300 K flowing at (0.05 0.02 0) m/s; 100 fluid steps, written every 20. `parcels`: the
-    fill's 300 beads become 38 parcels of k = 2 (304 real beads) among the csv's real ones."""
-    extra = [("particles.yaml", "    count: 300\n", "    count: 38\n    coarse_grain: 2\n")] \
-        if parcels else []
+    fill's 300 beads become 38 parcels of k = 2 (304 real beads) among the csv's real ones;
+    `extra`: more edits of the case."""
+    extra = list(extra) + ([("particles.yaml", "    count: 300\n",
+                             "    count: 38\n    coarse_grain: 2\n")] if parcels else [])
     case = runner.fresh_case("periodic_box", name, extra + [
         ("0/U", "internalField   uniform (0 0 0);", "internalField   uniform (0.05 0.02 0);"),
         ("particles.yaml", "gravity: [0, 0, -9.81]", "gravity: [0, 0, -98.1]\nheat: {}"),
         ("particles.yaml", "density: 2500}",
          "density: 2500, heat_capacity: 840, conductivity: 1}"),
         ("particles.yaml", "file: straddling.csv, material: glass}",
-         "file: straddling.csv, material: glass, temperature: 350}"),
-        ("particles.yaml", "    material: glass\n", "    material: glass\n    temperature: 350\n"),
+         f"file: straddling.csv, material: glass, temperature: {bead_temperature}}}"),
+        ("particles.yaml", "    material: glass\n",
+         f"    material: glass\n    temperature: {bead_temperature}\n"),
         ("particles.yaml", "  forces: [drag, pressure_gradient, viscous, buoyancy]",
          "  forces: [drag, pressure_gradient, viscous, buoyancy]\n  temperature: 300\n"
          "  heat_capacity: 4180\n  conductivity: 0.6\n  convection: gunn"),
@@ -1288,7 +1290,8 @@ def heat_balance(runner, checks):
     time the heat the particles took equals the heat the fluid lost, to round-off, and the
     mixture's thermal energy (walls adiabatic, box periodic) stays what it was; the two rank
     counts agree on the exchanged heat within 1 %. Then the same on 2 ranks with the fill's
-    beads as parcels of k = 2 among the real ones."""
+    beads as parcels of k = 2 among the real ones; and with ddtVoidFraction off, beads and
+    water at 300 K: every temperature stays at 300 K."""
     finals = {}
     for ranks in (1, 2):
         case, log = heated_bed(runner, f"heat_balance_np{ranks}", ranks)
@@ -1319,6 +1322,23 @@ def heat_balance(runner, checks):
                       f"parcels np 2: 38 parcels of k = 2 ({int((k == 2).sum())} in the last "
                       f"snapshot) and the real beads gave the water {-exchanged:.6g} J in 10 ms; "
                       f"the mixture's thermal energy changed by {drift:.3g} of itself (< 1e-12)")
+    # ddtVoidFraction off, beads and water both at 300 K: nothing may change a temperature.
+    # The conservative storage term d(eps T)/dt, under a continuity without d(eps)/dt, turned
+    # each change of eps into one of T (the random coupled scenes found the fluid 73 K outside
+    # its starting and inlet temperatures); eps dT/dt keeps T where the flux, diffusion and
+    # exchange put it. Tolerance: the pressure solve leaves div(phi) at its tolerance, which
+    # the flux term turns into T div(phi) (1e-6 of T).
+    case, log = heated_bed(runner, "heat_isothermal_ddt_off", 1, bead_temperature=300, extra=[
+        ("constant/couplingProperties", "ddtVoidFraction on;", "ddtVoidFraction off;")])
+    worst = 0.0
+    for folder in time_folders(case):
+        t = read_scalar_field(os.path.join(case, folder, "T"))
+        worst = max(worst, float(np.max(np.abs(t - 300))))
+    hottest = max((float(np.max(np.abs(s["temperature"] - 300))) for _, s in snapshots(case)),
+                  default=float("nan"))
+    checks.expect(len(time_folders(case)) == 5 and worst < 3e-4 and hottest < 3e-4,
+                  f"ddtVoidFraction off, all at 300 K: fluid T within {worst:.3g} K and the "
+                  f"beads within {hottest:.3g} K of 300 K at every write (< 3e-4 K)")
     if len(finals) == 2:
         diff = abs(finals[1] - finals[2]) / abs(finals[1])
         # Not to round-off: the colliding bed amplifies the sums' order, and a bead that

@@ -15,7 +15,9 @@ particles' terminal velocity in the fluid) and a lid at the top; gas or liquid; 
 densities 1.05-3000 times the fluid's, one in three fills as coarse-grained parcels (k
 1.2-2); any of the nine drag laws, model A or B, void fraction centre or divided, sampling
 cell or cellPoint, minVoidFraction 0.2-0.45, diffusionBandwidth on or off, 1-12 DEM steps per
-fluid step, 1 or 2 ranks.
+fluid step, 1 or 2 ranks. One case in three carries heat (its own random stream, so the
+other draws stay as they were): particles, fluid and inlet at 280-500 K each, contact
+conduction on or off, Ranz-Marshall or Gunn convection, no sources and adiabatic walls.
 
 A case passes when grainFoam exits 0 and
   * the log holds no nan or inf; every printed void-fraction volume difference and
@@ -25,8 +27,13 @@ A case passes when grainFoam exits 0 and
   * every snapshot is finite, holds all the particles, and every particle centre lies
     inside the domain and at least r (1 - time.max_overlap) from each wall plane;
   * every written void fraction lies within [minVoidFraction, 1];
+  * with heat: every printed heat exchange imbalance is below 1e-12, and every particle
+    temperature (snapshots) and fluid temperature (written T) lies within the starting
+    and inlet temperatures (a maximum principle: no source, no flux), to 1e-3 of their range
+    for the fluid's bounded but not monotone convection scheme;
   * stopped at a middle write and continued from it (startFrom latestTime, as many ranks),
-    it ends with every particle's position and velocity equal to the run's to the last bit
+    it ends with every particle's position and velocity (and temperature) equal to the
+    run's to the last bit
     (--no-restarts leaves this out);
 or when it exits non-zero with a message naming what to change (`error:` from the DEM
 scene, with its file and key, or an OpenFOAM FatalError naming a dictionary key).
@@ -156,7 +163,27 @@ def draw(seed):
     c["end"] = float(f"{steps * c['dt_f']:.6g}")
     c["writes"] = rnd.randint(2, 4)
     c["max_speed"] = float(f"{max(1.0, 3 * u_max):.3g}")
+    c["heat"] = draw_heat(c)
+    if c["heat"]:
+        c["bandwidth"] = 0.0  # diffusion averaging is not combined with heat (refused)
     return c
+
+
+def draw_heat(c):
+    """Heat for one case in three, from its own stream (the other draws stay as they were):
+    starting particle, fluid and inlet temperatures, the particles' c and k, conduction on or
+    off, the Nusselt law. None without heat."""
+    rnd = random.Random(1000003 * c["seed"] + 17)
+    if rnd.random() >= 1 / 3:
+        return None
+    gas = c["rho_f"] < 10
+    return {"T_p": round(rnd.uniform(280, 500), 3), "T_f": round(rnd.uniform(280, 500), 3),
+            "T_in": round(rnd.uniform(280, 500), 3),
+            "c_p": float(f"{10 ** rnd.uniform(2, 3.3):.4g}"),
+            "k_p": float(f"{10 ** rnd.uniform(-1, 1.5):.4g}"),
+            "conduction": rnd.random() < 0.6,
+            "c_f": 1005.0 if gas else 4180.0, "k_f": 0.026 if gas else 0.6,
+            "convection": rnd.choice(["ranz_marshall", "gunn"])}
 
 
 def blockmesh(c):
@@ -230,6 +257,25 @@ boundaryField
     return u, p
 
 
+def temperature_field(c):
+    """0/T: the fluid at T_f, the inlet gas at T_in, outflow and walls insulated."""
+    th = c["heat"]
+    sides = []
+    for axis, (lo, hi) in enumerate([("left", "right"), ("front", "back")]):
+        kind = "cyclic" if c["periodic"][axis] else "zeroGradient"
+        sides.append(f"    \"({lo}|{hi})\" {{ type {kind}; }}")
+    return HEADER.format(cls="volScalarField", obj="T") + f"""
+dimensions      [0 0 0 1 0 0 0];
+internalField   uniform {th['T_f']!r};
+boundaryField
+{{
+    inlet  {{ type fixedValue; value uniform {th['T_in']!r}; }}
+    outlet {{ type inletOutlet; inletValue uniform {th['T_f']!r}; value uniform {th['T_f']!r}; }}
+{chr(10).join(sides)}
+}}
+"""
+
+
 def scene(c):
     lx, ly, lz = c["size"]
     walls = ["  - {type: plane, name: distributor, point: [0, 0, 0], normal: [0, 0, 1], "
@@ -250,6 +296,15 @@ def scene(c):
             walls.append(f"  - {{type: plane, name: {name}hi, point: {hi}, normal: {n_hi}, "
                          "material: m}")
     parcel = f"\n    coarse_grain: {c['k']:.4f}" if c["k"] > 1 else ""
+    th = c["heat"]
+    material_heat = heat = temperature = fluid_heat = ""
+    if th:
+        material_heat = f", heat_capacity: {th['c_p']!r}, conductivity: {th['k_p']!r}"
+        heat = "\nheat: {}" if th["conduction"] else "\nheat: {conduction: none}"
+        temperature = f"\n    temperature: {th['T_p']!r}"
+        # grain's prescribed fluid temperature; grainFoam's is 0/T.
+        fluid_heat = (f"\n  temperature: {th['T_f']!r}\n  heat_capacity: {th['c_f']!r}\n"
+                      f"  conductivity: {th['k_f']!r}\n  convection: {th['convection']}")
     r = 0.5 * c["d"]
     return f"""# random_coupled.py seed {c['seed']}
 domain:
@@ -262,9 +317,9 @@ time:
   end: {c['end']!r}
   expected_max_speed: {c['max_speed']!r}
 materials:
-  - {{name: m, youngs_modulus: {c['youngs']:.4g}, poisson_ratio: {c['poisson']:.3f}, density: {c['rho_p']:.6g}}}
+  - {{name: m, youngs_modulus: {c['youngs']:.4g}, poisson_ratio: {c['poisson']:.3f}, density: {c['rho_p']:.6g}{material_heat}}}
 interaction_defaults: {{restitution: {c['restitution']:.3f}, friction: {c['friction']:.3f}}}
-contact: {{normal: hertz, tangential: history}}
+contact: {{normal: hertz, tangential: history}}{heat}
 walls:
 {chr(10).join(walls)}
 insert:
@@ -273,14 +328,14 @@ insert:
     material: m
     radius: {{distribution: constant, value: {r!r}}}
     count: {c['count']}
-    seed: {c['seed'] + 1}{parcel}
+    seed: {c['seed'] + 1}{parcel}{temperature}
 fluid:
   density: {c['rho_f']!r}
   viscosity: {c['rho_f'] * c['nu_f']!r}
   drag: {c['drag']}
   model: {c['model']}
   pressure: {{hydrostatic: false}}
-  forces: [drag, pressure_gradient, viscous, buoyancy]
+  forces: [drag, pressure_gradient, viscous, buoyancy]{fluid_heat}
 """
 
 
@@ -321,8 +376,25 @@ def make_case(c, template, case):
     u, p = fields(c)
     write("0/U", u)
     write("0/p", p)
+    transport = f"rho     {c['rho_f']!r};\nnu      {c['nu_f']!r};\n"
+    th = c["heat"]
+    if th:
+        transport += f"Cp      {th['c_f']!r};\nkappa   {th['k_f']!r};\n"
+        write("0/T", temperature_field(c))
+        for path, after, add in (
+                ("system/fvSchemes", "div(phi,U)      Gauss limitedLinearV 1;",
+                 "\n    div(phi,T)      Gauss limitedLinear 1;"),
+                ("system/fvSolution", '"(U|UFinal)" { solver smoothSolver; smoother '
+                 'symGaussSeidel; tolerance 1e-9; relTol 0; }',
+                 "\n    T      { solver PBiCGStab; preconditioner DILU; tolerance 1e-12; "
+                 "relTol 0; }")):
+            with open(os.path.join(case, path)) as f:
+                text = f.read()
+            if after not in text:
+                raise RuntimeError(f"generator: no '{after}' in {path}")
+            write(path, text.replace(after, after + add))
     write("constant/transportProperties", HEADER.format(cls="dictionary", obj="transportProperties")
-          + f"rho     {c['rho_f']!r};\nnu      {c['nu_f']!r};\n")
+          + transport)
     write("constant/couplingProperties", coupling(c))
     write("particles.yaml", scene(c))
     if c["ranks"] == 2:
@@ -421,6 +493,41 @@ def check(c, case, log):
         if not (np.all(np.isfinite(eps)) and eps.min() >= c["min_eps"] and eps.max() <= 1.0):
             bad.append(f"t = {folder}: eps in [{eps.min()}, {eps.max()}], not within "
                        f"[{c['min_eps']}, 1]")
+    if c["heat"]:
+        bad += check_heat(c, case, log, snaps)
+    return bad
+
+
+HEAT_IMBALANCE = re.compile(r"grainFoam heat exchange: .*relative imbalance (\S+);")
+
+
+def check_heat(c, case, log, snaps):
+    """Heat: the exchange balanced to round-off, and the maximum principle (no source, no
+    flux, adiabatic walls): every temperature within the starting and inlet ones."""
+    bad = []
+    th = c["heat"]
+    imbalances = [float(v) for v in HEAT_IMBALANCE.findall(log)]
+    if not imbalances or not max(imbalances) < ROUND_OFF:
+        bad.append(f"heat exchange imbalance {max(imbalances, default=float('nan')):.3g} "
+                   f"(of {len(imbalances)} lines)")
+    lo = min(th["T_p"], th["T_f"], th["T_in"])
+    hi = max(th["T_p"], th["T_f"], th["T_in"])
+    # The fluid's limitedLinear convection is bounded but not monotone to round-off, and its
+    # solver stops at a tolerance: 1e-3 of the range (and round-off of the values).
+    tol = 1e-3 * (hi - lo) + 1e-12 * hi
+    for t, snap in snaps:
+        temp = snap.get("temperature")
+        if temp is None:
+            bad.append(f"t = {t}: the snapshot holds no temperature")
+            break
+        if not (np.all(np.isfinite(temp)) and temp.min() >= lo - tol and temp.max() <= hi + tol):
+            bad.append(f"t = {t}: particle temperatures in [{temp.min():.12g}, "
+                       f"{temp.max():.12g}] K, not within [{lo}, {hi}] K")
+    for folder in time_folders(case):
+        temp = read_void_fraction(os.path.join(case, folder, "T"))
+        if not (np.all(np.isfinite(temp)) and temp.min() >= lo - tol and temp.max() <= hi + tol):
+            bad.append(f"t = {folder}: fluid T in [{temp.min():.12g}, {temp.max():.12g}] K, "
+                       f"not within [{lo}, {hi}] K")
     return bad
 
 
@@ -515,7 +622,8 @@ def run_seed(runner, args, seed):
             return c, "refused", f"stopped at t = {first}; advice ran: {', '.join(tried)}", elapsed
         return c, "refused", why, elapsed
     if c["ranks"] == 2:
-        runner.run(case, "reconstructPar", "reconstructPar", "-fields", "(voidfraction)")
+        runner.run(case, "reconstructPar", "reconstructPar", "-fields",
+                   "(voidfraction T)" if c["heat"] else "(voidfraction)")
     m = re.search(r"grainFoam particles: (\d+) particles", log)
     c["placed"] = int(m.group(1)) if m else -1
     bad = check(c, case, log)
@@ -562,7 +670,7 @@ def restart_check(runner, args, c, case):
     a, b = snapshots(case)[-1], snapshots(part)[-1]
     if a[0] != b[0]:
         return f"restart: last snapshots at t = {a[0]} and {b[0]} s", True
-    for key in ("id", "position", "velocity"):
+    for key in ("id", "position", "velocity") + (("temperature",) if c["heat"] else ()):
         if a[1][key].shape != b[1][key].shape or not np.array_equal(a[1][key], b[1][key]):
             diff = (float(np.max(np.abs(a[1][key] - b[1][key])))
                     if a[1][key].shape == b[1][key].shape else float("nan"))
@@ -577,7 +685,7 @@ def summary(c):
     walls = "".join("p" if p else "w" for p in c["periodic"])
     return (f"{c['ranks']}r {walls} {'gas' if c['rho_f'] < 10 else 'liq'} d/h {c['d'] / c['h']:.2f} "
             f"k {c['k']:.2f} {c['drag']}/{c['model']} {c['void']}/{c['sampling']} "
-            f"n {c['n_sub']}")
+            f"n {c['n_sub']}{' heat' if c['heat'] else ''}")
 
 
 def main():
