@@ -1089,11 +1089,21 @@ bool Simulation::check_contacts(const ContactGuards& s, bool finite_here) const 
       << " % of the smaller radius. At that speed a Hertz contact lasts " << tc << " s: only "
       << s.unresolved.fewest << " steps of dt = " << dt_ << " s (fewer than " << n_min
       << ", key time.min_steps_per_contact). So coarse a step cannot resolve the contact and "
-         "can give it back more energy than it took. A step of at most "
-      << tc / 20
-      << " s would (1/20 of the Hertz contact time at that speed); lower time.step or "
-         "time.rayleigh_fraction, or raise time.expected_max_speed so that grain check warns "
-         "about it";
+         "can give it back more energy than it took. A step of at most ";
+    // In the first step the start-up check may refuse dt as well (it reports after it): then
+    // the proposal is also within every limit that check has (conduction's, with heat).
+    const bool startup =
+        report_.verdict == TimeStepReport::Verdict::refuse && report_.refusal_step < tc / 20;
+    if (startup)
+      o << round_down_3(report_.refusal_step) << " s would (1/20 of the Hertz contact time at "
+        << "that speed is " << tc / 20
+        << " s, and every start-up check of dt (the Rayleigh and contact times"
+        << (scene_.heat ? ", heat conduction" : "") << "), which refuse dt = " << dt_
+        << " s too, needs at most " << round_down_3(report_.refusal_step) << " s)";
+    else
+      o << tc / 20 << " s would (1/20 of the Hertz contact time at that speed)";
+    o << "; lower time.step or time.rayleigh_fraction, or raise time.expected_max_speed so that "
+         "grain check warns about it";
   } else {
     o << " overlap by " << 100 * worst[0] << " % of the smaller radius (limit " << 100 * limit
       << " %, key time.max_overlap)";

@@ -114,5 +114,74 @@ TEST(RefusalAdvice, TheFinalRefusalProposesAStepEveryLimitAllows) {
   EXPECT_NE(ran.log.find("done: "), std::string::npos) << ran.log;
 }
 
+// The steps-per-contact guard in a run that passed the start-up refusal (--allow-large-dt):
+// two stiff beads (Y = 5e10 Pa) touching and closing at 2 x 10 m/s, a Hertz contact of
+// about 1.5e-6 s against dt = 1e-5 s. Its own proposal, t_c / 20, is far above what heat
+// conduction allows at k = 1e9 W/(m K) (about 1e-9 s): the proposal must be a step every
+// start-up limit allows, and that step must run without --allow-large-dt. Reference: the advice
+// rerun (found by the same reasoning as the travel guard's fault, hard-scene generator thermal seed
+// 717).
+TEST(RefusalAdvice, TheFirstStepsContactGuardProposesAStepEveryLimitAllows) {
+  const auto colliding = [](const std::string& step, const std::string& end,
+                            const std::string& name, bool allow_large_step) {
+    const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "refusal_advice" / name;
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    std::ofstream(dir / "beads.csv") << "x,y,z,radius,vx,vy,vz\n"
+                                        "-0.001,0,0.005,0.001,10,0,0\n"
+                                        "0.001,0,0.005,0.001,-10,0,0\n";
+    const std::string text = R"(domain: {min: [-0.005, -0.005, 0], max: [0.005, 0.005, 0.01]}
+gravity: [0, 0, 0]
+time: {step: )" + step + R"(, end: )" +
+                             end +
+                             R"(, expected_max_speed: 0.1}
+materials:
+  - {name: glass, youngs_modulus: 5e10, poisson_ratio: 0.3, density: 2500, heat_capacity: 840,
+     conductivity: 1e9}
+interaction_defaults: {restitution: 0.5, friction: 0.3}
+contact: {normal: hertz}
+heat: {}
+insert:
+  - {type: csv, file: beads.csv, material: glass, temperature: 300}
+output: {progress: false}
+)";
+    const Scene s = parse_scene(text, (dir / "scene.yaml").string());
+    RunOptions options;
+    options.output_directory = (dir / "out").string();
+    options.progress = false;
+    options.handle_stop_signals = false;
+    options.allow_large_time_step = allow_large_step;
+    std::ostringstream log;
+    Outcome o;
+    try {
+      run_scene(s, options, MPI_COMM_WORLD, log);
+    } catch (const std::exception& e) {
+      o.error = e.what();
+    }
+    o.log = log.str();
+    return o;
+  };
+  // --allow-large-dt: past the start-up refusal (which a plain run reports first), to the
+  // guard in the first step.
+  const Outcome stopped = colliding("1e-5", "1e-4", "contact_guard", true);
+  ASSERT_NE(stopped.error.find("key time.min_steps_per_contact"), std::string::npos)
+      << stopped.error;
+  const std::regex at_most("A step of at most ([0-9.eE+-]+) s would");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(stopped.error, m, at_most)) << stopped.error;
+  const double proposed = std::stod(m[1].str());
+  std::printf("[ measured ] the guard proposes %.4g s\n", proposed);
+  EXPECT_NE(stopped.error.find("heat conduction"), std::string::npos) << stopped.error;
+  // The proposal, rerun for ten steps: past the start-up checks and the first steps.
+  std::ostringstream step, end;
+  step.precision(17);
+  step << proposed;
+  end.precision(17);
+  end << 10 * proposed;
+  const Outcome ran = colliding(step.str(), end.str(), "contact_guard_advised", false);
+  EXPECT_EQ(ran.error, "");
+  EXPECT_NE(ran.log.find("done: "), std::string::npos) << ran.log;
+}
+
 }  // namespace
 }  // namespace grainflow
