@@ -867,6 +867,16 @@ class Draw:
             scene["insert"].append(st)
             self.meta["streams"] = True
             self.meta["heat"]["closed"] = False
+        # One scene in ten: a heat sink (negative heat_source) that would take the first
+        # fill's particles below 0 K in 1/30 to 1/3 of the run. The temperature guard must stop
+        # it naming the key, and its advice, a weaker sink, must get further. From its own
+        # stream, so that the other draws stay as they were.
+        sink = random.Random(1000003 * self.seed + 29)
+        if sink.random() < 0.1 and fills:
+            m = by_name[fills[0]["material"]]
+            rate = m["heat_capacity"] * max(temps) / scene["time"]["end"] * sink.uniform(3, 30)
+            m["heat_source"] = -float(f"{rate:.4g}")
+            self.meta["heat"]["bounds"] = None
         self.parallel(scene, [0, 1])
         return scene
 
@@ -1350,6 +1360,46 @@ def touch_energy(msg, scene, workdir):
             delta)
 
 
+def check_sink_advice(args, seed, d, scene, workdir, msg, seconds):
+    """The temperature guard stopped the run: a particle is no longer above 0 K. The message
+    names the keys that draw heat out at a fixed rate (a wall's negative heat_flux, a
+    material's negative heat_source) and says to lower them. Each such value a tenth as
+    strong must carry the run further: no stop by the temperature guard until after the
+    first one (the other heat flows only bring temperatures towards the positive bounds)."""
+    if "`heat_source`" not in msg or "`heat_flux`" not in msg:
+        raise Failure("temperature guard without its keys", msg)
+    m = FAIL_TIME.search(msg)
+    t_fail = float(m.group(1)) if m else 0.0
+    dt = d.dt_run or d.dt_estimate
+    end = min(scene["time"]["end"], 2 * t_fail + 50 * dt)
+    re_scene = json.loads(json.dumps(scene))
+    for item in re_scene["materials"]:
+        if item.get("heat_source", 0) < 0:
+            item["heat_source"] = float(f"{item['heat_source'] / 10:.4g}")
+    for wall in re_scene.get("walls", []):
+        if wall.get("heat_flux", 0) < 0:
+            wall["heat_flux"] = float(f"{wall['heat_flux'] / 10:.4g}")
+    re_scene["time"]["end"] = float(f"{end:.6g}")
+    re_scene["output"]["snapshot_interval"] = end / 8
+    re_scene["output"].pop("checkpoint_interval", None)
+    sub = os.path.join(workdir, "advice_sink")
+    d2 = Draw(seed, d.family)
+    d2.files, d2.meta, d2.ranks, d2.family = d.files, d.meta, d.ranks, d.family
+    d2.dt_estimate = dt
+    try:
+        how, s2 = check_scene(args, seed, d2, re_scene, sub, 1)
+    except Failure as f:
+        raise Failure("rerun with a tenth of the heat sinks: " + f.cls, f.detail + f" [after: {msg}]")
+    if how.startswith("stopped"):
+        msg2 = error_line(open(os.path.join(sub, "grain.out")).read())
+        m2 = FAIL_TIME.search(msg2)
+        t2 = float(m2.group(1)) if m2 else 0.0
+        if "not above 0 K" in msg2 and t2 <= t_fail:
+            raise Failure("weaker sink does not get further",
+                          f"stopped at t = {t2:.6g} s, the full sink at t = {t_fail:.6g} s: {msg}")
+    return f"stopped by the temperature guard, a tenth of the sink {how}", seconds + s2
+
+
 def check_overload_advice(args, seed, d, scene, workdir, msg, seconds):
     """The overlap guard stopped the run and found no step that prevents it; it lists what
     changes it. Each remedy it names, applied alone, must carry the run past that contact:
@@ -1509,6 +1559,8 @@ def check_scene(args, seed, d, scene, workdir, depth=0):
             raise Failure("NaN guard silent on the force terms",
                           f"enabled {', '.join(scene['fluid']['forces'])}, not named: "
                           f"{', '.join(silent)}: {msg}")
+    if "not above 0 K" in msg and depth == 0 and not args.no_advice:
+        return check_sink_advice(args, seed, d, scene, workdir, msg, seconds)
     proposals = [float(v) for v in STEP_PROPOSAL.findall(msg)]
     if "No time step prevents this" in msg and depth == 0 and not args.no_advice:
         return check_overload_advice(args, seed, d, scene, workdir, msg, seconds)
