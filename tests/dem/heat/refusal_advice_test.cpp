@@ -14,8 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "dem/engine/run.hpp"
-#include "dem/scene/scene_parser.hpp"
+#include "tests/dem/support/run_scene_text.hpp"
 
 namespace grainflow {
 namespace {
@@ -44,32 +43,11 @@ output: {progress: false}
 )";
 }
 
-struct Outcome {
-  std::string error, log;
-};
+using Outcome = test::SceneOutcome;
 
 Outcome run(const std::string& step, const std::string& name) {
-  const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "refusal_advice" / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  {
-    std::ofstream csv(dir / "beads.csv");
-    csv << "x,y,z,radius\n0,0,0.001,0.001\n0.002,0,0.001,0.001\n";
-  }
-  const Scene s = parse_scene(scene(step), (dir / "scene.yaml").string());
-  RunOptions options;
-  options.output_directory = (dir / "out").string();
-  options.progress = false;
-  options.handle_stop_signals = false;
-  std::ostringstream log;
-  Outcome o;
-  try {
-    run_scene(s, options, MPI_COMM_WORLD, log);
-  } catch (const std::exception& e) {
-    o.error = e.what();
-  }
-  o.log = log.str();
-  return o;
+  return test::run_scene_text(scene(step), "refusal_advice", name,
+                              "x,y,z,radius\n0,0,0.001,0.001\n0.002,0,0.001,0.001\n");
 }
 
 std::vector<double> proposals(const std::string& text) {
@@ -124,12 +102,6 @@ TEST(RefusalAdvice, TheFinalRefusalProposesAStepEveryLimitAllows) {
 TEST(RefusalAdvice, TheFirstStepsContactGuardProposesAStepEveryLimitAllows) {
   const auto colliding = [](const std::string& step, const std::string& end,
                             const std::string& name, bool allow_large_step) {
-    const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "refusal_advice" / name;
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    std::ofstream(dir / "beads.csv") << "x,y,z,radius,vx,vy,vz\n"
-                                        "-0.001,0,0.005,0.001,10,0,0\n"
-                                        "0.001,0,0.005,0.001,-10,0,0\n";
     const std::string text = R"(domain: {min: [-0.005, -0.005, 0], max: [0.005, 0.005, 0.01]}
 gravity: [0, 0, 0]
 time: {step: )" + step + R"(, end: )" +
@@ -145,21 +117,10 @@ insert:
   - {type: csv, file: beads.csv, material: glass, temperature: 300}
 output: {progress: false}
 )";
-    const Scene s = parse_scene(text, (dir / "scene.yaml").string());
-    RunOptions options;
-    options.output_directory = (dir / "out").string();
-    options.progress = false;
-    options.handle_stop_signals = false;
-    options.allow_large_time_step = allow_large_step;
-    std::ostringstream log;
-    Outcome o;
-    try {
-      run_scene(s, options, MPI_COMM_WORLD, log);
-    } catch (const std::exception& e) {
-      o.error = e.what();
-    }
-    o.log = log.str();
-    return o;
+    return test::run_scene_text(text, "refusal_advice", name,
+                                "x,y,z,radius,vx,vy,vz\n-0.001,0,0.005,0.001,10,0,0\n"
+                                "0.001,0,0.005,0.001,-10,0,0\n",
+                                allow_large_step);
   };
   // --allow-large-dt: past the start-up refusal (which a plain run reports first), to the
   // guard in the first step.

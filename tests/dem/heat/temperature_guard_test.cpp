@@ -11,8 +11,7 @@
 #include <sstream>
 #include <string>
 
-#include "dem/engine/run.hpp"
-#include "dem/scene/scene_parser.hpp"
+#include "tests/dem/support/run_scene_text.hpp"
 
 namespace grainflow {
 namespace {
@@ -60,31 +59,11 @@ output: {progress: false, snapshot_interval: 0.01}
 )";
 }
 
-struct Outcome {
-  std::string error, log;
-  fs::path out;
-};
+using Outcome = test::SceneOutcome;
 
 Outcome run(const std::string& text, const std::string& name) {
-  const fs::path dir = fs::path(GRAINFLOW_BINARY_DIR) / "test_output" / "temperature_guard" / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  std::ofstream(dir / "beads.csv") << "x,y,z,radius\n0.005,0.005,0.005,0.001\n";
-  const Scene s = parse_scene(text, (dir / "scene.yaml").string());
-  RunOptions options;
-  options.output_directory = (dir / "out").string();
-  options.progress = false;
-  options.handle_stop_signals = false;
-  std::ostringstream log;
-  Outcome o;
-  o.out = dir / "out";
-  try {
-    run_scene(s, options, MPI_COMM_WORLD, log);
-  } catch (const std::exception& e) {
-    o.error = e.what();
-  }
-  o.log = log.str();
-  return o;
+  return test::run_scene_text(text, "temperature_guard", name,
+                              "x,y,z,radius\n0.005,0.005,0.005,0.001\n");
 }
 
 // s = -8.4e7 W/kg, c = 840: -1e5 K/s, so 300 K is gone after 3 ms, at step 300 (301 when the

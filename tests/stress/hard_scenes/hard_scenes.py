@@ -1360,6 +1360,14 @@ def touch_energy(msg, scene, workdir):
             delta)
 
 
+def rerun_draw(d, dt_estimate):
+    """The draw of an advice's rerun: the same files, checks, ranks and family as `d`."""
+    d2 = Draw(d.seed, d.family)
+    d2.files, d2.meta, d2.ranks, d2.family = d.files, d.meta, d.ranks, d.family
+    d2.dt_estimate = dt_estimate
+    return d2
+
+
 def check_sink_advice(args, seed, d, scene, workdir, msg, seconds):
     """The temperature guard stopped the run: a particle is no longer above 0 K. The message
     names the keys that draw heat out at a fixed rate (a wall's negative heat_flux, a
@@ -1383,9 +1391,7 @@ def check_sink_advice(args, seed, d, scene, workdir, msg, seconds):
     re_scene["output"]["snapshot_interval"] = end / 8
     re_scene["output"].pop("checkpoint_interval", None)
     sub = os.path.join(workdir, "advice_sink")
-    d2 = Draw(seed, d.family)
-    d2.files, d2.meta, d2.ranks, d2.family = d.files, d.meta, d.ranks, d.family
-    d2.dt_estimate = dt
+    d2 = rerun_draw(d, dt)
     try:
         how, s2 = check_scene(args, seed, d2, re_scene, sub, 1)
     except Failure as f:
@@ -1424,9 +1430,7 @@ def check_overload_advice(args, seed, d, scene, workdir, msg, seconds):
                 end / (dt / math.sqrt(value)) > 2e5:
             continue  # too many steps to rerun here
         sub = os.path.join(workdir, f"advice_{kind}")
-        d2 = Draw(seed, d.family)
-        d2.files, d2.meta, d2.ranks, d2.family = d.files, d.meta, d.ranks, d.family
-        d2.dt_estimate = dt
+        d2 = rerun_draw(d, dt)
         try:
             how, s2 = check_scene(args, seed, d2, re_scene, sub, 1)
         except Failure as f:
@@ -1583,9 +1587,7 @@ def check_scene(args, seed, d, scene, workdir, depth=0):
     re_scene["time"]["end"] = float(f"{end:.6g}")
     re_scene["output"]["snapshot_interval"] = end / 8
     sub = os.path.join(workdir, f"rerun{depth + 1}")
-    d2 = Draw(seed, d.family)
-    d2.files, d2.meta, d2.ranks, d2.family = d.files, d.meta, d.ranks, d.family
-    d2.dt_estimate = step
+    d2 = rerun_draw(d, step)
     try:
         how, s2 = check_scene(args, seed, d2, re_scene, sub, depth + 1)
     except Failure as f:
