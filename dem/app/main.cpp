@@ -32,7 +32,7 @@ commands:
   --help              print this help
 
 exit codes: 0 success, 1 refused (time step) or run failure, 2 bad input or usage
-docs: docs/scene-reference.md (every scene key), docs/getting-started.md
+docs: README.md (quick start, running a scene), docs/scene-reference.md (every scene key)
 )";
 
 int usage_error(const std::string& what) {

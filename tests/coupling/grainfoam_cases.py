@@ -682,7 +682,7 @@ def restart(runner, checks, coupling_keys="", other_rank_count=True):
 
 
 def restart_files(runner, checks):
-    """The files of a restart time (docs/reliability.md, "Fluid fields of a restart"): grainFoam
+    """The files of a restart time (docs/reliability.md, "Restart of a coupled run"): grainFoam
     records each file it wrote at a write time with its FNV-1a checksum (grainflowChecksums), and
     a restart compares them. cases/periodic_box in a flow, binary fields written at 1 ms, then
     restarted to 2 ms from copies of the stopped case: intact (every file named, matched, and

@@ -74,12 +74,16 @@ grain_cli_test(run_periodic_bed 0 "done: [0-9]+ steps, 300 particles \\(0 remove
                CMD ${_grain} run ${_scenes}/periodic_bed.yaml --output out --no-progress
                WORKDIR ${_work}/run_periodic_bed
                FILES out/particles.xdmf out/log.csv out/particles_000000.h5 out/particles_000010.h5)
-# minimal.yaml has a floor but no side walls: beads that bounce out over the sides
+# open_sides.yaml has a floor but no side walls: beads that bounce out over the sides
 # must be removed, counted and reported, never silently dropped.
 grain_cli_test(reports_removed_particles 0
                "particle\\(s\\) left the domain through a bounded side and were removed;done: [0-9]+ steps, [0-9]+ particles \\([1-9][0-9]* removed\\)"
-               CMD ${_grain} run ${_scenes}/minimal.yaml --output out --no-progress
+               CMD ${_grain} run ${_scenes}/open_sides.yaml --output out --no-progress
                WORKDIR ${_work}/reports_removed)
+# The scene of docs/scene-reference.md's example does what its comment says: no bead lost.
+grain_cli_test(runs_minimal_example 0 "done: [0-9]+ steps, 500 particles \\(0 removed\\)"
+               CMD ${_grain} run ${_scenes}/minimal.yaml --output out --no-progress
+               WORKDIR ${_work}/runs_minimal FORBID "warning")
 grain_cli_test(runs_on_two_ranks 0 "MPI ranks: 2 as a;done: [0-9]+ steps, 300 particles \\(0 removed\\)"
                CMD ${MPIEXEC_EXECUTABLE} -np 2 --oversubscribe ${_grain} run ${_scenes}/periodic_bed.yaml
                    --output out --no-progress
