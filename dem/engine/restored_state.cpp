@@ -162,9 +162,22 @@ void check_checkpoint(const CheckpointData& d, const Scene& scene, std::size_t w
   const Particles& p = d.particles;
   check_particle_records(p, scene, src, true);
 
-  // The skin Simulation::initialise will choose, from the same radii.
+  // The range the run chose at its start: at least as large as every radius it holds.
   double r_max = stream_max_radius;
   for (double r : p.radius) r_max = std::max(r_max, r);
+  if (d.largest_radius) {
+    if (!std::isfinite(*d.largest_radius) || !(*d.largest_radius >= r_max) ||
+        *d.largest_radius > std::max(r_max, 0.5 * (scene.domain.hi - scene.domain.lo).maxCoeff()))
+      attribute("largest_radius",
+                "the interaction range's radius " + number(*d.largest_radius) +
+                    " m is not a finite number between the largest particle radius (" +
+                    number(r_max) + " m) and half the domain's longest side");
+    r_max = *d.largest_radius;
+  }
+  if (d.removed < 0)
+    attribute("removed",
+              "the count of removed particles " + std::to_string(d.removed) + " is negative");
+  // The skin Simulation::initialise will choose, from the same radii.
   const double drift = 0.5 * scene.neighbour.skin.value_or(0.4 * r_max);
   const Domain& dom = scene.domain;
   for (std::size_t i = 0; i < p.size(); ++i) {

@@ -154,9 +154,12 @@ void Simulation::initialise() {
   double r_max = 0;
   for (double r : p_.radius) r_max = std::max(r_max, r);
   r_max = std::max(r_max, streams_.max_radius());  // particles still to come
+  // A restart keeps the range of the run it continues, whose largest particle may have left.
+  if (restored_largest_radius_) r_max = std::max(r_max, *restored_largest_radius_);
   MPI_Allreduce(MPI_IN_PLACE, &r_max, 1, MPI_DOUBLE, MPI_MAX, comm_);
   const Vec3 length = decomp_->length();
   if (r_max == 0) r_max = length.minCoeff() / 100;  // empty scene: any grid works
+  largest_radius_ = r_max;
   skin_ = scene_.neighbour.skin.value_or(0.4 * r_max);
   cutoff_ = 2 * r_max + skin_;
   for (int a = 0; a < 3; ++a)
@@ -699,6 +702,12 @@ void Simulation::restore(const CheckpointData& checkpoint) {
   if (dt_ <= 0) dt_ = checkpoint.dt;
   counters_.steps = checkpoint.step;
   counters_.rebuilds = checkpoint.rebuilds;  // paces parallel.balance as in the written run
+  restored_largest_radius_ = checkpoint.largest_radius;
+  {
+    int rank = 0;  // the removed total is a sum over ranks: rank 0 carries the earlier part
+    MPI_Comm_rank(comm_, &rank);
+    counters_.removed = rank == 0 ? checkpoint.removed : 0;
+  }
   next_id_ = checkpoint.next_id;
   restored_springs_ = checkpoint.springs;
   restored_grid_ = checkpoint.grid;
@@ -736,7 +745,8 @@ void Simulation::restore(const CheckpointData& checkpoint) {
                   *checkpoint.attributes_checksum_stored, *checkpoint.attributes_checksum_read);
     throw StateError(checkpoint.file +
                      ": error: the root group's attributes (time, dt, step, next_id, rebuilds, "
-                     "material_coarse_grain, material_real, wall_impulse) do not match their "
+                     "material_coarse_grain, material_real, wall_impulse, largest_radius, "
+                     "removed) do not match their "
                      "checksum, attribute 'attributes_checksum' (" +
                      sums +
                      "): the checkpoint was changed or damaged after it was written; restart "
@@ -752,6 +762,9 @@ void Simulation::write_checkpoint(const std::string& path) {
   d.dt = dt_;
   d.step = counters_.steps;
   d.rebuilds = counters_.rebuilds;
+  if (initialised_) d.largest_radius = largest_radius_;
+  d.removed = counters_.removed;
+  MPI_Allreduce(MPI_IN_PLACE, &d.removed, 1, MPI_LONG, MPI_SUM, comm_);
   d.next_id = next_id_;
   d.particles = p_;
   d.has_temperature = heat_ != nullptr;

@@ -352,6 +352,8 @@ class Simulation {
   bool automatic_grid_ = false;  // neither the caller nor the scene gave the grid
   bool cuts_imposed_ = false;    // set_cut_planes() was called
   bool initialised_ = false;
+  double largest_radius_ = 0;  // initialise(): the radius that sets skin_ and cutoff_
+  std::optional<double> restored_largest_radius_;  // from restore(): the earlier run's
 };
 
 }  // namespace grainflow

@@ -224,6 +224,13 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
     if (!written) fail.capture();
     fail.check(written, "writing the attribute wall_impulse");
   }
+  if (fail.ok() && d.largest_radius) {
+    const long long removed = d.removed;
+    fail.check(
+        write_attribute(fail, f.id(), "largest_radius", H5T_NATIVE_DOUBLE, *d.largest_radius) &&
+            write_attribute(fail, f.id(), "removed", H5T_NATIVE_LLONG, removed),
+        "writing the attributes largest_radius, removed");
+  }
   if (fail.ok()) {
     const std::uint32_t sum = attributes_checksum(d);
     fail.check(write_attribute(fail, f.id(), "attributes_checksum", H5T_NATIVE_UINT32, sum),
@@ -369,6 +376,8 @@ void write_checkpoint(MPI_Comm comm, const std::string& path, const CheckpointDa
     d.step = local.step;
     d.next_id = local.next_id;
     d.rebuilds = local.rebuilds;
+    d.largest_radius = local.largest_radius;
+    d.removed = local.removed;
     d.streams = local.streams;
     d.grid = local.grid;
     d.material_coarse_grain = local.material_coarse_grain;
@@ -415,6 +424,10 @@ std::uint32_t attributes_checksum(const CheckpointData& d) {
   for (int real : d.material_real) put(static_cast<std::int64_t>(real));
   put(static_cast<std::int64_t>(d.wall_impulse.size()));
   for (double j : d.wall_impulse) put(j);
+  if (d.largest_radius) {
+    put(*d.largest_radius);
+    put(static_cast<std::int64_t>(d.removed));
+  }
   return fletcher32(bytes.data(), bytes.size());
 }
 
@@ -450,6 +463,16 @@ CheckpointData read_checkpoint(const std::string& path) {
       if (error.empty() && rebuilds < 0)
         error = "attribute 'rebuilds' is negative (" + std::to_string(rebuilds) + ")";
       d.rebuilds = static_cast<long>(rebuilds);
+    }
+    // Optional (written since restarts keep the interaction range and the removed count);
+    // the values are checked by check_checkpoint.
+    if (error.empty() && H5Aexists(f, "largest_radius") > 0) {
+      double r = 0;
+      long long removed = 0;
+      attr("largest_radius", H5T_NATIVE_DOUBLE, &r);
+      attr("removed", H5T_NATIVE_LLONG, &removed);
+      d.largest_radius = r;
+      d.removed = static_cast<long>(removed);
     }
     // Optional (written since the parcel classes are checked on restart).
     if (error.empty() && !read_array_attribute(f, "material_coarse_grain", H5T_NATIVE_DOUBLE,

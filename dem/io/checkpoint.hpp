@@ -12,7 +12,7 @@
 // values must satisfy is checked by check_checkpoint (dem/engine/restored_state.hpp).
 //
 // Layout: attributes format ("grainflow-checkpoint-3"), time, dt, step, next_id, rebuilds,
-// attributes_checksum (attributes_checksum() below);
+// largest_radius, removed, attributes_checksum (attributes_checksum() below);
 // /particles/{id, position, velocity, angular_velocity, force, torque, radius, mass,
 // inertia, material} — force and torque are those of the step's end, which the next
 // velocity-Verlet half kick uses (recomputing them would advance the springs twice);
@@ -65,6 +65,15 @@ struct CheckpointData {
   // rebuild checks the load), so a restart continues the balancing bit for bit. Root
   // attribute `rebuilds`, optional (0 when absent: files written before it).
   long rebuilds = 0;
+  // The interaction range's radius the run chose at its start (Simulation::initialise: the
+  // largest radius present or to come from a stream), which sets the default skin, the bins and
+  // the ghost width. A restart takes it (or a larger one), so that a run whose largest particle
+  // left the domain continues with the lists of the uninterrupted run. Root attribute
+  // `largest_radius`, optional (absent: files written before it, or before the first step).
+  std::optional<double> largest_radius;
+  // Particles that left through a bounded side before this checkpoint, over all ranks: the
+  // restart's log and summary count on from it. Root attribute `removed`, optional (0).
+  long removed = 0;
   Particles particles;
   // The implicit drag of the step's end, aligned with `particles`; empty when the run
   // has no fluid forces.
@@ -100,8 +109,9 @@ struct CheckpointData {
 
 // The Fletcher32 checksum (hdf5_checksum.hpp) of the root attributes' values, in a fixed
 // order and width: time, dt, step, next_id, rebuilds, then the material count and each
-// material's coarse_grain and listed material, then the wall_impulse count and values (as
-// doubles and 64-bit integers, little-endian).
+// material's coarse_grain and listed material, then the wall_impulse count and values, then
+// (when the file has them) largest_radius and removed (as doubles and 64-bit integers,
+// little-endian).
 std::uint32_t attributes_checksum(const CheckpointData& d);
 
 // Collective. `local` holds this rank's particles and springs; time, dt, step and

@@ -190,7 +190,8 @@ elif case in ("dt_bit", "time_bit"):  # attributes have no HDF5 checksum: only g
     name = case.split("_")[0]
     flip_bytes_bit(attribute_offset(name), 0)  # the lowest mantissa bit: one ulp
     expect = f_ + r": error: the root group's attributes \(time, dt, step, next_id, rebuilds, " \
-        r"material_coarse_grain, material_real, wall_impulse\) do not match their checksum, " \
+        r"material_coarse_grain, material_real, wall_impulse, largest_radius, removed\) do not " \
+        r"match their checksum, " \
         r"attribute 'attributes_checksum' \(stored 0x[0-9a-f]{8}, computed 0x[0-9a-f]{8}\): the " \
         r"checkpoint was changed or damaged after it was written"
 elif case == "chunk_record":  # HDF5 then reads zeros for every position, with no error
@@ -225,6 +226,15 @@ elif case == "next_id":
     edit(lambda f: f.attrs.__setitem__("next_id", np.int64(ids.max())))
     expect = f_ + r": error: attribute 'next_id' of the root group: next_id = %d is not above " \
         r"the largest particle id %d" % (ids.max(), ids.max())
+elif case == "largest_radius":  # below the beads' own radii: the bins would miss contacts
+    edit(lambda f: f.attrs.__setitem__("largest_radius", np.float64(1e-4)))
+    expect = f_ + r": error: attribute 'largest_radius' of the root group: the interaction " \
+        r"range's radius 1e-0?4 m is not a finite number between the largest particle radius " \
+        r"\([0-9.e-]+ m\) and half the domain's longest side"
+elif case == "removed":
+    edit(lambda f: f.attrs.__setitem__("removed", np.int64(-3)))
+    expect = f_ + r": error: attribute 'removed' of the root group: the count of removed " \
+        r"particles -3 is negative"
 elif case == "grid_ranks":  # written on 1 rank: a 1 x 1 x 1 grid said to be of 2 ranks
     edit(setitem("decomposition/ranks", 0, 2))
     expect = f_ + r": error: dataset '/decomposition/dims', index 0: the grid 1 x 1 x 1 has 1 " \

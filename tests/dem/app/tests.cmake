@@ -198,7 +198,8 @@ if(GRAINFLOW_PYTHON3)
   foreach(_kind checkpoint snapshot)
     set(_cases ${_state_cases})
     if(_kind STREQUAL "checkpoint")
-      list(APPEND _cases spring_partner spring_wall next_id grid_ranks grid_planes dt_bit time_bit
+      list(APPEND _cases spring_partner spring_wall next_id largest_radius removed grid_ranks
+                         grid_planes dt_bit time_bit
                          end_before)
     endif()
     foreach(_case ${_cases})

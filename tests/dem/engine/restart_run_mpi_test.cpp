@@ -14,6 +14,13 @@
 // the streams' progress is in the checkpoint (group 'streams'), so the restart inserts the
 // same beads at the same steps. References: the uninterrupted run (==) and the stream's
 // closed form, delivered mass = rate x (stop - start) within half a bead.
+//
+// The third has its largest particle leave the domain before the checkpoint: the run chose its
+// neighbour skin and bins from that radius at the start, so the restart must keep them (the
+// checkpoint's largest_radius) and count the removed particles on (its `removed`). Before it
+// did, the restart took the range from the beads left, rebuilt its lists 194 times instead of
+// 75, and ended 2.2e-10 m and 3.4e-4 rad/s away from the uninterrupted run, one removed
+// particle short in its log and summary.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <hdf5.h>
@@ -110,6 +117,8 @@ TwoRuns run_and_restart(const Scene& scene, const fs::path& work) {
   r.restarted_run = run_scene(scene, options, MPI_COMM_WORLD, out);
   EXPECT_EQ(r.restarted_run.steps, r.whole_run.steps);
   EXPECT_EQ(r.restarted_run.particles_end, r.whole_run.particles_end);
+  EXPECT_EQ(r.restarted_run.removed, r.whole_run.removed);
+  EXPECT_EQ(r.restarted_run.rebuilds, r.whole_run.rebuilds);
   return r;
 }
 
@@ -119,11 +128,11 @@ long expect_same_end(const TwoRuns& r) {
   // Same numbering: the last snapshot has the same name in both directories.
   const std::string last_a = last_snapshot(r.whole), last_b = last_snapshot(r.restarted);
   EXPECT_EQ(fs::path(last_a).filename(), fs::path(last_b).filename());
-  // Same log rows: time, step, particles, energies, overlap and contacts. (Columns rebuilds
-  // and removed count from the restart, wall_s is wall-clock time.)
+  // Same log rows: time, step, particles, energies, overlap, contacts, rebuilds and removed
+  // (all but wall_s, the wall-clock time).
   auto first_columns = [](const std::string& row) {
     std::size_t at = 0;
-    for (int c = 0; c < 7 && at != std::string::npos; ++c) at = row.find(',', at + 1);
+    for (int c = 0; c < 9 && at != std::string::npos; ++c) at = row.find(',', at + 1);
     return row.substr(0, at);
   };
   const auto log_a = lines_of(r.whole / "log.csv"), log_b = lines_of(r.restarted / "log.csv");
@@ -131,9 +140,12 @@ long expect_same_end(const TwoRuns& r) {
   for (std::size_t i = 0; i < std::min(log_a.size(), log_b.size()); ++i)
     EXPECT_EQ(first_columns(log_a[i]), first_columns(log_b[i])) << "log row " << i;
   long contacts = 0;
-  for (std::size_t i = log_a.size() / 2; i < log_a.size(); ++i)
-    contacts =
-        std::max(contacts, std::stol(log_a[i].substr(first_columns(log_a[i]).rfind(',') + 1)));
+  for (std::size_t i = log_a.size() / 2; i < log_a.size(); ++i) {
+    std::stringstream row(log_a[i]);
+    std::string cell;
+    for (int c = 0; c <= 6; ++c) std::getline(row, cell, ',');  // column 6: contacts
+    contacts = std::max(contacts, std::stol(cell));
+  }
 
   const Snapshot sa = read_snapshot(last_a), sb = read_snapshot(last_b);
   EXPECT_EQ(sa.particles.size(), sb.particles.size());
@@ -180,6 +192,31 @@ TEST(RestartRun, ContinuesLikeTheUninterruptedRun) {
   if (rank() != 0 || r.checkpoint.empty()) return;
   EXPECT_GT(expect_same_end(r), 100)
       << "too few contacts after the checkpoint: the test shows little";
+}
+
+TEST(RestartRun, LargestParticleLeftBeforeTheCheckpoint) {
+  const Scene scene =
+      load_scene(std::string(GRAINFLOW_TEST_DATA_DIR) + "/scenes/largest_leaves.yaml");
+  const TwoRuns r = run_and_restart(scene, kWork / "largest_leaves");
+  ASSERT_FALSE(r.checkpoint.empty());
+  const CheckpointData c = read_checkpoint(r.checkpoint);
+  double r_left = 0;
+  for (double radius : c.particles.radius) r_left = std::max(r_left, radius);
+  ASSERT_TRUE(c.largest_radius.has_value());
+  if (rank() == 0)
+    std::printf(
+        "checkpoint: largest radius %.4g m (the beads left: %.4g m), %ld removed; "
+        "%ld / %ld removed and %ld / %ld rebuilds in all (uninterrupted / restarted)\n",
+        *c.largest_radius, r_left, c.removed, r.whole_run.removed, r.restarted_run.removed,
+        r.whole_run.rebuilds, r.restarted_run.rebuilds);
+  EXPECT_EQ(*c.largest_radius, 1.5e-3);  // the thrown bead's, not the beads' <= 0.6 mm
+  EXPECT_LE(r_left, 6e-4);
+  EXPECT_GE(c.removed, 1);
+  EXPECT_GT(r.whole_run.removed, c.removed);  // beads keep leaving after the checkpoint
+  if (rank() == 0) {
+    EXPECT_GT(expect_same_end(r), 30) << "too few contacts after the checkpoint";
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
 }
 
 // stream_bed.yaml: 0.025 kg/s of beads (radius 0.4-0.6 mm) from t = 0.002 s to 0.03 s onto a
