@@ -188,6 +188,17 @@ if(GRAINFLOW_PYTHON3)
            COMMAND ${GRAINFLOW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/bit_flips.py ${_grain}
                    ${_scenes}/checkpointed_bed.yaml ${_work}/bit_flips --seeds 0:6)
   set_tests_properties(grain.bit_flips PROPERTIES TIMEOUT 300 ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}")
+  # Every default docs/scene-reference.md states is what grain does: each key left out, written
+  # with its documented value, and written with another value, in a small scene; the first two
+  # must agree bit for bit (report, log, every HDF5 dataset), the third must differ. A table row
+  # with a stated default that no check covers fails the test (documented_defaults.py; about
+  # 160 runs, 20 s).
+  add_test(NAME grain.documented_defaults
+           COMMAND ${GRAINFLOW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/documented_defaults.py ${_grain}
+                   ${PROJECT_SOURCE_DIR}/docs/scene-reference.md ${_work}/documented_defaults
+                   --mpiexec ${MPIEXEC_EXECUTABLE})
+  set_tests_properties(grain.documented_defaults PROPERTIES TIMEOUT 600 PROCESSORS 2
+                       ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}")
   set(_state_work ${_work}/state_file_checks)
   add_test(NAME grain.state_file_checks.setup
            COMMAND ${GRAINFLOW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/state_file_checks.py ${_grain}
