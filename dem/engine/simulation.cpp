@@ -1,6 +1,7 @@
 #include "dem/engine/simulation.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -199,7 +200,9 @@ void Simulation::initialise() {
     }
 
   // Every rank holds the same full set here: the report is the same everywhere.
-  report_ = check_time_step(scene_, p_, table_, constants_);
+  // A restart keeps the checkpoint's step (restore): the report judges that one.
+  report_ = check_time_step(scene_, p_, table_, constants_,
+                            restored_ ? std::optional<double>(dt_) : std::nullopt);
   if (dt_ <= 0) dt_ = report_.dt;
   if (dt_ <= 0)
     throw SetupError(scene_.file +
@@ -699,6 +702,24 @@ void Simulation::restore(const CheckpointData& checkpoint) {
     restored_drag_[checkpoint.particles.id[i]] = {checkpoint.drag_coefficient[i],
                                                   checkpoint.drag_fluid_velocity[i]};
   time_ = checkpoint.time;
+  // The run continues with the step it was written with: the step counts of the snapshot and
+  // log series, of time.end and of the checkpoints are the run's. A time.step changed since
+  // would be silently ignored; it is refused instead.
+  if (scene_.time.step && *scene_.time.step != checkpoint.dt) {
+    const auto shortest = [](double v) {  // the shortest text that reads back as v
+      char buf[32];
+      return std::string(buf, std::to_chars(buf, buf + sizeof buf, v).ptr);
+    };
+    throw SetupError(
+        scene_.time.step_source + ": error: time.step = " + shortest(*scene_.time.step) +
+        " s, but " + where + " was written with a step of " + shortest(checkpoint.dt) +
+        " s, which a restart keeps (the snapshot, log and checkpoint series count its steps): "
+        "set time.step to " +
+        shortest(checkpoint.dt) +
+        " to restart; for another step from this state on, start a new run from its last "
+        "snapshot (insert `type: snapshot`, docs/scene-reference.md; contact springs start "
+        "afresh)");
+  }
   if (dt_ <= 0) dt_ = checkpoint.dt;
   counters_.steps = checkpoint.step;
   counters_.rebuilds = checkpoint.rebuilds;  // paces parallel.balance as in the written run

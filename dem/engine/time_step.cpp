@@ -95,7 +95,8 @@ void accuracy_note(const Scene& scene, TimeStepReport& rep,
 }  // namespace
 
 TimeStepReport check_time_step(const Scene& scene, const Particles& p, const PairTable& table,
-                               const ContactConstants& constants) {
+                               const ContactConstants& constants,
+                               std::optional<double> restart_step) {
   TimeStepReport rep;
   const int nm = static_cast<int>(scene.materials.size());
   const double inf = std::numeric_limits<double>::infinity();
@@ -160,6 +161,8 @@ TimeStepReport check_time_step(const Scene& scene, const Particles& p, const Pai
     rep.dt = *scene.time.step;
   else if (rep.rayleigh_time < inf)
     rep.dt = *scene.time.rayleigh_fraction * rep.rayleigh_time;
+  const double scene_step = rep.dt;  // what the scene gives for the particles present
+  if (restart_step) rep.dt = *restart_step;
 
   std::ostringstream o;
   o.precision(4);
@@ -187,6 +190,12 @@ TimeStepReport check_time_step(const Scene& scene, const Particles& p, const Pai
     if (rep.contact_time < inf)
       o << " = t_c / " << rep.contact_time / rep.dt << " (" << rep.contact_time / rep.dt
         << " steps per impact)";
+    if (restart_step) {
+      o << ", the checkpoint's step, which the restart keeps";
+      if (scene_step > 0 && scene_step != rep.dt)
+        o << " (" << (scene.time.step ? "time.step" : "time.rayleigh_fraction") << " gives "
+          << scene_step << " s for the particles present)";
+    }
     rep.notes.push_back(o.str());
     o.str("");
     accuracy_note(scene, rep, impacts);

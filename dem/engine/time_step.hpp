@@ -55,7 +55,11 @@ double hertz_contact_time(double y_star, double r_star, double m_star, double sp
 double pair_contact_time(const ContactSettings& cs, const PairCoefficients& pc,
                          const ContactConstants& cc, double r_star, double m_star, double v);
 
+// `restart_step`: the step of the checkpoint a restart continues with (Simulation::restore),
+// which the report then judges and prints instead of the scene's, and says so: its smallest
+// particle may have left, so time.rayleigh_fraction would give another step now.
 TimeStepReport check_time_step(const Scene& scene, const Particles& p, const PairTable& table,
-                               const ContactConstants& constants);
+                               const ContactConstants& constants,
+                               std::optional<double> restart_step = std::nullopt);
 
 }  // namespace grainflow

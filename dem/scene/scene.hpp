@@ -82,6 +82,7 @@ struct TimeSettings {
   std::optional<double> rayleigh_fraction;        // dt = fraction * Rayleigh time, (0, 1]
   double end = 0;                                 // simulated end time [s] > 0
   std::string end_source;                         // "file:line" of time.end, for messages
+  std::string step_source;  // "file:line" of time.step or time.rayleigh_fraction, for messages
   double expected_max_speed = 1.0;                // for the Hertz contact-time check [m/s]
   double max_overlap = 0.25;  // overlap / smaller radius that stops the run, (0, 1]
   // Hertz contacts: t_c(v)/dt at a contact's own approach speed v below this stops the

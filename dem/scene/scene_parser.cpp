@@ -97,6 +97,9 @@ TimeSettings parse_time(const Field& f) {
   t.rayleigh_fraction = m.maybe_number("rayleigh_fraction", kUnitOpenBelow);
   t.end = m.number("end", kPositive);
   t.end_source = f.source().label + ":" + std::to_string(m.find("end")->key_mark().line + 1);
+  t.step_source =
+      f.source().label + ":" +
+      std::to_string(m.find(t.step ? "step" : "rayleigh_fraction")->key_mark().line + 1);
   t.expected_max_speed = m.number_or("expected_max_speed", 1.0, kPositive);
   t.max_overlap = m.number_or("max_overlap", 0.25, Range{0, 1, false, true});
   t.min_steps_per_contact = m.number_or("min_steps_per_contact", 5, kNonNegative);

@@ -214,6 +214,16 @@ elif case == "end_before":  # an intact checkpoint, a scene that ends before it
     expect = r"ends_early\.yaml:%d: error: time\.end = 0\.003 s is before the checkpoint's " \
         r"time, t = 0\.00499\d* s \(step 680, '%s'\): the restart would run no step; raise " \
         r"time\.end" % (line, f_)
+elif case == "step_changed":  # an intact checkpoint, a scene whose time.step is another
+    text = open(scene).read()
+    assert "rayleigh_fraction: 0.15," in text
+    scene = os.path.join(here, "step_changed.yaml")
+    with open(scene, "w") as out:
+        out.write(text.replace("rayleigh_fraction: 0.15,", "step: 1e-6,"))
+    line = 1 + text[:text.index("rayleigh_fraction: 0.15,")].count("\n")
+    expect = r"step_changed\.yaml:%d: error: time\.step = 1e-06 s, but checkpoint '%s' was " \
+        r"written with a step of ([0-9.e-]+) s, which a restart keeps .*: set time\.step to " \
+        r"([0-9.e-]+) to restart" % (line, f_)
 elif case == "spring_partner":
     edit(lambda f: set_spring(f, ids[0], 10**9))
     expect = f_ + r": error: dataset '/springs/partner', index 0 \(particle id %d\): the spring's " \
@@ -275,4 +285,14 @@ after = {p: hashlib.sha256(open(os.path.join(here, "out", p), "rb").read()).hexd
          for p in os.listdir(os.path.join(here, "out"))}
 if after != before:
     fail("the output directory changed: %s -> %s" % (sorted(before), sorted(after)))
+if case == "step_changed":  # the message's advice, taken as written, restarts
+    advised = re.search(expect, out).group(2)
+    text = open(scene).read().replace("step: 1e-6,", "step: %s," % advised)
+    with open(scene, "w") as out_file:
+        out_file.write(text)
+    r = subprocess.run(cmd, cwd=here, capture_output=True, text=True, timeout=60)
+    print(" ".join(cmd) + "   # with time.step: " + advised)
+    print(r.stdout + r.stderr)
+    if r.returncode != 0 or "the checkpoint's step, which the restart keeps" not in r.stdout:
+        fail("the advised time.step %s did not restart (exit %d)" % (advised, r.returncode))
 print("PASS")

@@ -209,8 +209,8 @@ if(GRAINFLOW_PYTHON3)
   foreach(_kind checkpoint snapshot)
     set(_cases ${_state_cases})
     if(_kind STREQUAL "checkpoint")
-      list(APPEND _cases spring_partner spring_wall next_id largest_radius removed grid_ranks
-                         grid_planes dt_bit time_bit
+      list(APPEND _cases spring_partner spring_wall next_id largest_radius removed step_changed
+                         grid_ranks grid_planes dt_bit time_bit
                          end_before)
     endif()
     foreach(_case ${_cases})
@@ -254,3 +254,4 @@ if(GRAINFLOW_PYTHON3)
   set_tests_properties(grain.reproducible_snapshots_heat
                        PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}" TIMEOUT 300 PROCESSORS 2)
 endif()
+

@@ -79,6 +79,7 @@ struct TwoRuns {
   fs::path whole, restarted;
   std::string checkpoint;  // in `restarted`
   long checkpoint_step = 0;
+  std::string restart_report;  // what the restart printed
 };
 
 TwoRuns run_and_restart(const Scene& scene, const fs::path& work) {
@@ -114,7 +115,9 @@ TwoRuns run_and_restart(const Scene& scene, const fs::path& work) {
 
   options.output_directory = r.restarted.string();
   options.restart = r.checkpoint;
-  r.restarted_run = run_scene(scene, options, MPI_COMM_WORLD, out);
+  std::ostringstream restart_out;
+  r.restarted_run = run_scene(scene, options, MPI_COMM_WORLD, restart_out);
+  r.restart_report = restart_out.str();
   EXPECT_EQ(r.restarted_run.steps, r.whole_run.steps);
   EXPECT_EQ(r.restarted_run.particles_end, r.whole_run.particles_end);
   EXPECT_EQ(r.restarted_run.removed, r.whole_run.removed);
@@ -217,6 +220,27 @@ TEST(RestartRun, LargestParticleLeftBeforeTheCheckpoint) {
     EXPECT_GT(expect_same_end(r), 30) << "too few contacts after the checkpoint";
   }
   MPI_Barrier(MPI_COMM_WORLD);
+}
+
+// The same scene with the thrown bead the smallest (0.2 mm): it set the time step, 0.1 of its
+// Rayleigh time. The restart keeps the checkpoint's step, and its report says so and judges
+// that step (before, it printed the step the beads left would give, twice the one it ran).
+TEST(RestartRun, SmallestParticleLeftBeforeTheCheckpoint) {
+  Scene scene = load_scene(std::string(GRAINFLOW_TEST_DATA_DIR) + "/scenes/largest_leaves.yaml");
+  ASSERT_EQ(scene.insertions.size(), 2u);
+  scene.insertions[1].radius.value = 2e-4;
+  const TwoRuns r = run_and_restart(scene, kWork / "smallest_leaves");
+  ASSERT_FALSE(r.checkpoint.empty());
+  if (rank() != 0) return;
+  const CheckpointData c = read_checkpoint(r.checkpoint);
+  std::printf("restart report: %s\n", r.restart_report.c_str());
+  // dt = 0.1 t_R(0.2 mm) = 2.448e-6 s; the beads left (>= 0.4 mm) would give 4.9e-6 s.
+  EXPECT_NEAR(c.dt, 2.448e-6, 1e-9);
+  EXPECT_THAT(r.restart_report,
+              testing::ContainsRegex("dt = 2.448e-06 s = 0.0499[0-9]* t_R .*, the checkpoint's "
+                                     "step, which the restart keeps \\(time.rayleigh_fraction "
+                                     "gives 4.9e-06 s for the particles present\\)"));
+  expect_same_end(r);
 }
 
 // stream_bed.yaml: 0.025 kg/s of beads (radius 0.4-0.6 mm) from t = 0.002 s to 0.03 s onto a
