@@ -208,3 +208,25 @@ if(TARGET grainflowFoamBCs)
     PROCESSORS 2
     TIMEOUT 300)
 endif()
+
+# coupling.documented_defaults (tests/coupling/documented_defaults.py): every default that the
+# couplingProperties table of docs/coupling.md ("A coupled case") states is what grainFoam does.
+# The table is read from the page; for each key with a stated default one tiny case (128 cells,
+# 68 beads about a cell wide, a bed whose surface lies inside a cell, a horizontal flow; 5 fluid
+# steps) runs with the key left out, written as the page's default, and written otherwise: the
+# first two bit-identical (exit status, log without clock/host/PID lines, every field, uniform/
+# and grainflowChecksums, every HDF5 dataset and attribute of the snapshot and checkpoint), the
+# third with other fields or particles. A row without a check, or checked as another value than
+# the page's, fails. 25 runs of ~1 s on 2 worker threads: 20-35 s on 2 cores.
+add_test(NAME coupling.documented_defaults
+         COMMAND ${GRAINFLOW_COUPLING_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/documented_defaults.py
+                 --foam-env ${PROJECT_SOURCE_DIR}/scripts/foam_env.sh
+                 --solver $<TARGET_FILE:grainFoam>
+                 ${_grainflow_coupling_lib_dir}
+                 --page ${PROJECT_SOURCE_DIR}/docs/coupling.md
+                 --work ${CMAKE_CURRENT_BINARY_DIR}/coupling/documented_defaults)
+set_tests_properties(coupling.documented_defaults PROPERTIES
+  ENVIRONMENT "GRAINFLOW_FOAM_BASHRC=${OpenFOAM_BASHRC};${GRAINFLOW_MPIEXEC_ENV}"
+  LABELS "foam;coupling"
+  PROCESSORS 2
+  TIMEOUT 300)
