@@ -12,6 +12,7 @@
 #include "dem/engine/checkpoint_series.hpp"
 #include "dem/engine/finite_guard.hpp"
 #include "dem/engine/parcel_limits.hpp"
+#include "dem/engine/restored_state.hpp"
 #include "dem/engine/simulation.hpp"
 #include "dem/fluid/coupled_fluid.hpp"
 #include "dem/fluid/fluid_forces.hpp"
@@ -227,6 +228,7 @@ void DemLink::initialise() {
   try {
     m.sim = std::make_unique<Simulation>(m.scene, !m.restart, m.dem_comm, dims);
     if (m.restart) {
+      check_restart_step(m.scene, *m.restart);
       m.sim->restore(*m.restart);
       m.restored_step = m.restart->step;
       m.restart.reset();

@@ -4,6 +4,8 @@
 // compared with a limit gets every digit it needs to differ from that limit.
 #include <charconv>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <sstream>
 #include <string>
 
@@ -24,13 +26,40 @@ inline std::string significant(double x, int digits = 4) {
   return o.str();
 }
 
-// x rounded down to three significant digits (a proposed step that, printed, is below the
-// limit it stays under: 1.0599e-4 -> 1.05e-4).
+// x rounded down to three significant digits, as the double nearest that decimal (a proposed
+// step that, printed, is below the limit it stays under: 1.0599e-4 -> 1.05e-4).
 inline double round_down_3(double x) {
   if (!(x > 0) || !std::isfinite(x)) return x;
-  const double scale = std::pow(10.0, std::floor(std::log10(x)) - 2);
-  double y = std::floor(x / scale) * scale;
-  while (y > x) y = std::nextafter(y, 0.0);
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2e", x);  // nearest: d.dd e+-XX
+  double y = std::strtod(buf, nullptr);
+  if (y > x) {  // one unit down in the third digit
+    int exponent = std::atoi(buf + 5);
+    int digits = (buf[0] - '0') * 100 + (buf[2] - '0') * 10 + (buf[3] - '0') - 1;
+    if (digits < 100) {  // 1.00e-2 above x: 9.99e-3
+      digits = 999;
+      --exponent;
+    }
+    std::snprintf(buf, sizeof buf, "%de%d", digits, exponent - 2);
+    y = std::strtod(buf, nullptr);
+  }
+  return y;
+}
+
+// x rounded up to three significant digits, as the double nearest that decimal (so that it
+// prints as three digits and reads back as itself): a proposed length that is above the bound
+// it must reach (2.4000000000000002e-3 -> 2.41e-3).
+inline double round_up_3(double x) {
+  if (!(x > 0) || !std::isfinite(x)) return x;
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2e", x);  // nearest: d.dd e+-XX
+  double y = std::strtod(buf, nullptr);
+  if (y < x) {  // one unit up in the third digit
+    const int exponent = std::atoi(buf + 5);
+    const int digits = (buf[0] - '0') * 100 + (buf[2] - '0') * 10 + (buf[3] - '0') + 1;
+    std::snprintf(buf, sizeof buf, "%de%d", digits, exponent - 2);
+    y = std::strtod(buf, nullptr);
+  }
   return y;
 }
 

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <utility>
 
+#include "dem/engine/simulation.hpp"  // SetupError
+
 namespace grainflow {
 namespace {
 
@@ -244,6 +246,19 @@ void check_checkpoint(const CheckpointData& d, const Scene& scene, std::size_t w
       fail(springs, "rolling", k, particle(s.particle),
            "the rolling spring " + vec(s.rolling) + " is not finite");
   }
+}
+
+void check_restart_step(const Scene& scene, const CheckpointData& d) {
+  if (!scene.time.step || *scene.time.step == d.dt) return;
+  throw SetupError(scene.time.step_source + ": error: time.step = " + number(*scene.time.step) +
+                   " s, but checkpoint '" + d.file + "' was written with a step of " +
+                   number(d.dt) +
+                   " s, which a restart keeps (the snapshot, log and checkpoint series count its "
+                   "steps): set time.step to " +
+                   number(d.dt) +
+                   " to restart; for another step from this state on, start a new run from its "
+                   "last snapshot (insert `type: snapshot`, docs/scene-reference.md; contact "
+                   "springs start afresh)");
 }
 
 }  // namespace grainflow

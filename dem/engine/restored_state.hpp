@@ -55,4 +55,10 @@ void check_particle_records(const Particles& p, const Scene& scene, const StateS
 void check_checkpoint(const CheckpointData& d, const Scene& scene, std::size_t wall_columns,
                       double stream_max_radius, const std::vector<long>& stream_counts);
 
+// A restart continues with the checkpoint's step: the step counts of its snapshot, log and
+// checkpoint series and of time.end are the run's (Simulation::restore takes it). A scene whose
+// time.step differs from it would be silently ignored: refused instead (SetupError, naming
+// time.step's line and the step to set). Called by `grain run --restart` and grainFoam.
+void check_restart_step(const Scene& scene, const CheckpointData& d);
+
 }  // namespace grainflow

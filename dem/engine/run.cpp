@@ -13,6 +13,7 @@
 #include "dem/engine/checkpoint_series.hpp"
 #include "dem/engine/finite_guard.hpp"
 #include "dem/engine/parcel_limits.hpp"
+#include "dem/engine/restored_state.hpp"
 #include "dem/engine/simulation.hpp"
 #include "dem/engine/stop_signals.hpp"
 #include "dem/fluid/fluid_forces.hpp"
@@ -230,7 +231,11 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
                       "was killed, possibly incomplete; restart from a complete "
                       "checkpoint_<step>.h5");
   Simulation sim(scene, !options.restart, comm);
-  if (options.restart) sim.restore(read_checkpoint(*options.restart));
+  if (options.restart) {
+    const CheckpointData checkpoint = read_checkpoint(*options.restart);
+    check_restart_step(scene, checkpoint);
+    sim.restore(checkpoint);
+  }
   // fluid_force needs the force terms' share kept, at the steps that write a snapshot.
   const bool wants_fluid_force = (scene.output.fields & snapshot_field_bit("fluid_force")) != 0;
   sim.record_fluid_force(wants_fluid_force);  // the first forces (snapshot of step 0)

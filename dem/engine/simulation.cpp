@@ -1,7 +1,6 @@
 #include "dem/engine/simulation.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -165,10 +164,23 @@ void Simulation::initialise() {
   cutoff_ = 2 * r_max + skin_;
   for (int a = 0; a < 3; ++a)
     if (scene_.domain.periodic[a] && length[a] < 2 * cutoff_) {
+      // The remedies as values that work when set as written: a length rounded up, a skin
+      // rounded down (none when the particles alone need more than the axis has).
       std::ostringstream msg;
-      msg << scene_.file << ": error: periodic axis " << "xyz"[a] << " is " << length[a]
+      msg << scene_.file << ": error: periodic axis "
+          << "xyz"[a] << " is " << length[a]
           << " m long, shorter than twice the interaction range (2 r_max + skin = " << cutoff_
-          << " m); enlarge the domain along it or reduce the skin";
+          << " m, r_max = " << r_max << " m, skin = " << skin_ << " m): make the domain at least "
+          << exact_number(round_up_3(2 * cutoff_)) << " m long along "
+          << "xyz"[a];
+      double skin = round_down_3(0.5 * length[a] - 2 * r_max);
+      while (skin > 0 && 2 * (2 * r_max + skin) > length[a]) skin = round_down_3(0.999 * skin);
+      if (skin > 0)
+        msg << ", or set neighbour.skin to at most " << exact_number(skin)
+            << " m (the lists are then rebuilt more often)";
+      else
+        msg << " (no skin fits: twice the largest diameter, " << 4 * r_max
+            << " m, is already longer)";
       throw SetupError(msg.str());
     }
   if (cuts_imposed_) {
@@ -194,8 +206,10 @@ void Simulation::initialise() {
       std::ostringstream msg;
       msg << scene_.file << ": error: with " << decomp_->dims()[0] << " x " << decomp_->dims()[1]
           << " x " << decomp_->dims()[2] << " ranks, a subdomain is " << decomp_->thinnest_box()
-          << " m thick, thinner than the interaction range (2 r_max + skin = " << cutoff_
-          << " m); use fewer MPI ranks";
+          << " m thick, thinner than the interaction range (2 r_max + skin = " << cutoff_ << " m); "
+          << (automatic_grid_ ? std::string("use fewer MPI ranks")
+                              : "give parallel.grid fewer ranks, and run on as many MPI "
+                                "ranks as it then has");
       throw SetupError(msg.str());
     }
 
@@ -702,24 +716,7 @@ void Simulation::restore(const CheckpointData& checkpoint) {
     restored_drag_[checkpoint.particles.id[i]] = {checkpoint.drag_coefficient[i],
                                                   checkpoint.drag_fluid_velocity[i]};
   time_ = checkpoint.time;
-  // The run continues with the step it was written with: the step counts of the snapshot and
-  // log series, of time.end and of the checkpoints are the run's. A time.step changed since
-  // would be silently ignored; it is refused instead.
-  if (scene_.time.step && *scene_.time.step != checkpoint.dt) {
-    const auto shortest = [](double v) {  // the shortest text that reads back as v
-      char buf[32];
-      return std::string(buf, std::to_chars(buf, buf + sizeof buf, v).ptr);
-    };
-    throw SetupError(
-        scene_.time.step_source + ": error: time.step = " + shortest(*scene_.time.step) +
-        " s, but " + where + " was written with a step of " + shortest(checkpoint.dt) +
-        " s, which a restart keeps (the snapshot, log and checkpoint series count its steps): "
-        "set time.step to " +
-        shortest(checkpoint.dt) +
-        " to restart; for another step from this state on, start a new run from its last "
-        "snapshot (insert `type: snapshot`, docs/scene-reference.md; contact springs start "
-        "afresh)");
-  }
+  // The run continues with the step it was written with (check_restart_step).
   if (dt_ <= 0) dt_ = checkpoint.dt;
   counters_.steps = checkpoint.step;
   counters_.rebuilds = checkpoint.rebuilds;  // paces parallel.balance as in the written run
@@ -1595,25 +1592,45 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
         driven ? std::optional<ContactLoad>(at_first_touch(*chain)) : std::nullopt;
     const double s = std::max(stiffness_factor_for(touch, target),
                               chain_touch ? stiffness_factor_for(*chain_touch, target) : 0.0);
+    // A stiffer contact is shorter (Hertz t_c ~ Y^(-2/5), Hooke ~ k^(-1/2)): the step that
+    // resolves it then, and that the start-up check accepts for the scene's expected impacts,
+    // so that the advice runs as given.
+    const auto shorter_step = [&](double duration_factor) {
+      const double step =
+          round_down_3(duration_factor *
+                       std::min(tc / kResolvingSteps, report_.contact_time / kWarnStepsPerContact));
+      if (dt_ > step)
+        o << " (a stiffer contact is shorter: with it, time.step at most " << step << " s)";
+    };
     if (s < kNoStop && s > 1) {
       if (c.hertz) {
-        const Material& m = scene_.materials[a.material];
-        o << " scale the Young's modulus by at least " << round_up(s) << " (material '" << m.name
-          << "': " << round_up(s) * m.youngs_modulus << " Pa"
-          << (material_b != a.material ? ", and the partner's alike" : "")
+        const auto scaled = [&](int material) {
+          const Material& m = scene_.materials[material];
+          return "material '" + m.name + "': " + significant(round_up(s) * m.youngs_modulus, 6) +
+                 " Pa";
+        };
+        o << " scale the Young's modulus by at least " << round_up(s) << " (" << scaled(a.material)
+          << (material_b != a.material ? ", " + scaled(material_b) : "")
           << (driven && driver_material != a.material && driver_material != material_b
-                  ? ", and particle " + std::to_string(driver_id) + "'s alike"
+                  ? ", and of particle " + std::to_string(driver_id) + ", " +
+                        scaled(driver_material)
                   : "")
-          << ");";
+          << ")";
+        shorter_step(std::pow(round_up(s), -0.4));
+        o << ";";
       } else if (const auto& v = scene_.contact.hooke_characteristic_velocity) {
         // k_n from the characteristic velocity grows as v^(2/5) for every pair alike
         // (normal_hooke.hpp), and keeps growing with the parcels' size, which a fixed
         // stiffness would not (refused with parcels).
         o << " raise contact.hooke.characteristic_velocity to at least "
           << round_up(*v * std::pow(round_up(s), 2.5)) << " m/s (k_n grows as its 2/5 power: "
-          << "at least " << round_up(s) << " times stiffer);";
+          << "at least " << round_up(s) << " times stiffer)";
+        shorter_step(std::pow(round_up(s), -0.5));
+        o << ";";
       } else {
-        o << " set contact.hooke.stiffness.normal to at least " << round_up(s) * c.kn << " N/m;";
+        o << " set contact.hooke.stiffness.normal to at least " << round_up(s) * c.kn << " N/m";
+        shorter_step(std::pow(round_up(s), -0.5));
+        o << ";";
       }
     }
     if (c.cohesion > 0) {

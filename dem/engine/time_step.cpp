@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "dem/contact/normal_hooke.hpp"
+#include "dem/core/number_format.hpp"
 #include "dem/heat/thermal_limits.hpp"
 #include "dem/walls/wall_travel.hpp"
 
@@ -217,8 +218,10 @@ TimeStepReport check_time_step(const Scene& scene, const Particles& p, const Pai
     }
     const double fr = rep.dt / rep.rayleigh_time;
     const double steps = rep.contact_time / rep.dt;
-    rep.recommended_step =
-        std::min(kWarnRayleighFraction * rep.rayleigh_time, rep.contact_time / kWarnStepsPerContact);
+    // Rounded down: the printed step, set as written, is within both limits (rounded to
+    // nearest it could be a hair above and draw the same warning again).
+    rep.recommended_step = round_down_3(std::min(kWarnRayleighFraction * rep.rayleigh_time,
+                                                 rep.contact_time / kWarnStepsPerContact));
     if (fr > kRefuseRayleighFraction || steps < kRefuseStepsPerContact) {
       rep.refuse_above(rep.recommended_step);
       o << "error: dt is too large to resolve contacts (limits: dt <= " << kRefuseRayleighFraction

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "dem/core/number_format.hpp"
 #include "dem/heat/heat_laws.hpp"
 #include "dem/heat/heat_transfer.hpp"
 
@@ -99,9 +100,10 @@ ThermalLimits check_thermal_limits(const Scene& scene, const Particles& p, TimeS
     rep.notes.push_back(o.str());
     o.str("");
     if (dt > limit) {
-      rep.refuse_above(kWarnConductionFraction * limit);
-      o << "error: dt = " << dt << " s is beyond the stability limit of heat conduction (dt <= "
-        << limit << " s); use dt <= " << kWarnConductionFraction * limit
+      rep.refuse_above(round_down_3(kWarnConductionFraction * limit));
+      o << "error: dt = " << dt
+        << " s is beyond the stability limit of heat conduction (dt <= " << limit
+        << " s); use dt <= " << round_down_3(kWarnConductionFraction * limit)
         << " s, or switch conduction off with `heat: {conduction: none}`";
       rep.notes.push_back(o.str());
       o.str("");
@@ -110,7 +112,7 @@ ThermalLimits check_thermal_limits(const Scene& scene, const Particles& p, TimeS
       o << "warning: dt is above " << kWarnConductionFraction
         << " of the stability limit of heat conduction; temperatures of densely packed "
            "particles will be inaccurate; dt <= "
-        << kWarnConductionFraction * limit << " s is recommended";
+        << round_down_3(kWarnConductionFraction * limit) << " s is recommended";
       rep.notes.push_back(o.str());
       o.str("");
     }
@@ -130,8 +132,9 @@ ThermalLimits check_thermal_limits(const Scene& scene, const Particles& p, TimeS
       escalate(TimeStepReport::Verdict::warn);
       o << "warning: dt is above " << kWarnConvectionFraction
         << " of the convection time scale: the implicit step lags the exponential by about "
-        << 50 * dt / out.convection_time << " %; dt <= "
-        << kWarnConvectionFraction * out.convection_time << " s is recommended";
+        << 50 * dt / out.convection_time
+        << " %; dt <= " << round_down_3(kWarnConvectionFraction * out.convection_time)
+        << " s is recommended";
       rep.notes.push_back(o.str());
     }
   }

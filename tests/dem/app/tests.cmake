@@ -255,3 +255,18 @@ if(GRAINFLOW_PYTHON3)
                        PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}" TIMEOUT 300 PROCESSORS 2)
 endif()
 
+
+# Every advice an error or warning of grain gives works when applied as written: 32 messages
+# (time-step refusals and warnings, heat and fluid-force limits, the run-time guards' proposed
+# steps, the overlap guard's max_overlap / stiffness / cohesion proposals, periodic axis, MPI
+# ranks, mesh welding, restart, scene-file suggestions), each triggered by a tiny scene, its
+# advised value read from the message, applied, and rerun with `grain check` or `grain run`:
+# the message must be gone (tests/dem/app/advice_reruns.py; about 70 runs, 17 s). Advice
+# that does not work is listed there in KNOWN_BROKEN and fails the test as "BUG".
+if(GRAINFLOW_PYTHON3)
+  add_test(NAME grain.advice_reruns
+           COMMAND ${GRAINFLOW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/advice_reruns.py ${_grain}
+                   ${_work}/advice_reruns --mpiexec ${MPIEXEC_EXECUTABLE})
+  set_tests_properties(grain.advice_reruns PROPERTIES TIMEOUT 300 PROCESSORS 2
+                       ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}")
+endif()
