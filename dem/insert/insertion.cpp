@@ -392,7 +392,12 @@ void read_csv(const Scene& scene, const WallSet* walls, const Insertion& ins, Pa
         fail(lineno, "unknown material '" + name + "'; known materials: " + known);
       }
     }
-    if (!inside_domain(scene.domain, x, r))
+    // A sphere that touches a bounded side, written with every digit, may cross it by the
+    // round-off of its coordinates, as two touching spheres may overlap (kTouchUlps).
+    const double touch = kTouchUlps * std::numeric_limits<double>::epsilon() *
+                         std::max({x.cwiseAbs().maxCoeff(), scene.domain.lo.cwiseAbs().maxCoeff(),
+                                   scene.domain.hi.cwiseAbs().maxCoeff(), r});
+    if (!inside_domain(scene.domain, x, r, touch))
       fail(lineno, "the particle at " + format_vec(x) + " with radius " + format_number(r) +
                        " is outside the domain: " + outside_domain_reason(scene.domain, x, r));
     if (const std::string why = inside_a_wall(scene, walls, x, r); !why.empty())

@@ -134,14 +134,23 @@ TEST_F(CsvAgainstWalls, TouchingSpheresWithSeventeenDigitsAreAccepted) {
             0u);
 }
 
-// x = 0.009000000000000001 with r = 0.001 reaches 1.7e-18 m past the domain's 0.01: the
-// message shows every digit that differs, and the excess.
+// x = 0.009000000000000001 with r = 0.001 reaches 1.7e-18 m (one unit in the last place of
+// 0.01) past the domain's 0.01: the round-off of a sphere that touches the side, accepted as
+// for touching spheres. So is a sphere touching the side of a domain far from the origin
+// (CAD coordinates): z = 2.00005 with r = 0.00055 on a floor at 1.9995, where z - r in double
+// is 1.9994999999999998 (checked in Python). A real excess, 1e-14 m, is refused: the message
+// shows every digit that differs, and the excess.
 TEST_F(CsvAgainstWalls, DomainExcessIsShownWithItsDigits) {
-  EXPECT_THAT(error_of("0.009000000000000001,0.005,0.005,0.001\n"),
-              HasSubstr(at(2) + "the particle at (0.009000000000000001, 0.005, 0.005) with radius "
-                                "0.001 is outside the domain: it spans x from 0.008 to "
-                                "0.010000000000000002, beyond the "
-                                "domain's 0 to 0.01 by 1.735e-18 m"));
+  EXPECT_EQ(error_of("0.009000000000000001,0.005,0.005,0.001\n"), "no error");
+  EXPECT_THAT(
+      error_of("0.00900000000001,0.005,0.005,0.001\n"),
+      HasSubstr(at(2) + "the particle at (0.00900000000001, 0.005, 0.005) with radius "
+                        "0.001 is outside the domain: it spans x from 0.008000000000009999 "
+                        "to 0.010000000000010001, beyond the domain's 0 to 0.01 by 1e-14 m"));
+  scene_.domain.lo = Vec3(0, 0, 1.9995);
+  scene_.domain.hi = Vec3(0.01, 0.01, 2.01);
+  EXPECT_EQ(error_of("0.005,0.005,2.00005,0.00055\n"), "no error");
+  EXPECT_THAT(error_of("0.005,0.005,2.0000499,0.00055\n"), HasSubstr("is outside the domain"));
 }
 
 // The same rule for a snapshot: a particle of a snapshot with its centre on a rod's axis is
