@@ -34,7 +34,7 @@ if(NOT TARGET grainFoam OR NOT TARGET grainflowFoamBCs)
 endif()
 
 # h5py reads the particle snapshots (scripts/python.sh picks the Python).
-grainflow_find_python(GRAINFLOW_STRESS_PYTHON "h5py,numpy" "the coupling_stress.* tests are")
+grainflow_find_python(GRAINFLOW_STRESS_PYTHON "h5py,numpy,yaml" "the coupling_stress.* tests are")
 if(NOT GRAINFLOW_STRESS_PYTHON)
   return()
 endif()
@@ -88,3 +88,24 @@ set_tests_properties(coupling_stress.random_cases PROPERTIES
   LABELS "foam;coupling;stress"
   PROCESSORS 2
   TIMEOUT 300)
+
+# coupling_stress.twin_cases (tests/coupling_stress/twin_cases.py): random coupled cases 0 (2
+# ranks, parcels, a periodic side) and 8 run as drawn, turned (gravity along -x: mesh,
+# inlet, decomposition and scene turned together) and moved 0.01-10 m from the origin, the
+# fluid solved to 1e-15: every particle of a twin ends within 1e-6 of a diameter of the
+# drawn case's.
+add_test(NAME coupling_stress.twin_cases
+         COMMAND ${GRAINFLOW_STRESS_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/twin_cases.py
+                 --foam-env ${PROJECT_SOURCE_DIR}/scripts/foam_env.sh
+                 --solver $<TARGET_FILE:grainFoam>
+                 --grain $<TARGET_FILE:grain>
+                 --mpiexec ${MPIEXEC_EXECUTABLE}
+                 --lib-dir $<TARGET_FILE_DIR:grainflowFoamBCs>
+                 --cases ${CMAKE_CURRENT_LIST_DIR}/cases
+                 --work ${CMAKE_CURRENT_BINARY_DIR}/coupling_stress/twin_cases
+                 --seeds 0,8 --twins turn1,shift --timeout 120)
+set_tests_properties(coupling_stress.twin_cases PROPERTIES
+  ENVIRONMENT "GRAINFLOW_FOAM_BASHRC=${OpenFOAM_BASHRC};${GRAINFLOW_MPIEXEC_ENV}"
+  LABELS "foam;coupling;stress"
+  PROCESSORS 2
+  TIMEOUT 240)

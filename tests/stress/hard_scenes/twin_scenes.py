@@ -1,0 +1,676 @@
+#!/usr/bin/env python3
+"""Twin scenes: a hard scene turned or moved must run as the scene itself (docs/stability.md).
+
+    twin_scenes.py --grain build/bin/grain --seeds 0:24
+    twin_scenes.py --grain build/bin/grain --family thermal --seeds 0:16 --twins turn1,shift
+    twin_scenes.py --grain build/bin/grain --scene tutorials/dem/hopper/fill.yaml --end 0.02
+
+The physics knows neither which way the axes point nor where the origin lies; the scenes of
+the other tests all have gravity along -z and the domain's corner at the origin. Each seed's
+scene (drawn by hard_scenes.py, every family) is run as drawn and as its twins:
+  * turn1, turn2: the axes cycled (x -> y -> z -> x once or twice), the proper rotations by
+    120 and 240 degrees about (1, 1, 1). Every point and vector of the scene turns with it:
+    gravity, the domain and its periodic axes, walls, mesh vertices, mesh rotations and
+    translations, wall motions, insertion regions and faces, velocities, the fluid's velocity,
+    shear and pressure gradient, the processor grid. A turned scene does the same arithmetic
+    on permuted components, so it must end where the drawn one does to round-off.
+  * shift: every point moved by 1 to 100 of the domain's largest side along each axis,
+    either sign (a part in an assembly's coordinates); each coordinate is then rounded
+    differently, so its particles must end where the drawn scene's do to 1e-6 of their
+    radius.
+  * boost (asked for by name): the scene seen from a frame moving along a periodic axis at a
+    twentieth of the smallest radius per step (particles, walls and the fluid all faster by
+    that velocity), where that is a symmetry (boost_axis()); positions to 1e-6 of the radius
+    after taking the frame's motion back.
+--scene FILE twins a scene file instead of drawn ones (tests/data/scenes/twins/resting_bed.yaml
+is written for the boost).
+A fill draws its random positions axis by axis, so a turned region holds other particles:
+the fills are therefore run to their t = 0 snapshot first (with --allow-large-dt, so that
+a refused step still inserts), and the drawn scene and each twin start from that snapshot
+(turned or moved). Other insertions (CSV files, streams through a face) are turned or moved
+as written; a CSV file's columns are renamed (turn) or its positions moved (shift).
+
+A twin passes when it exits as the drawn scene did and
+  * after a stop: the message is the same with its numbers and axis letters set aside;
+  * after a run: every snapshot holds the same particle ids, each particle's position mapped
+    back lies within the twin's tolerance times its radius of the drawn scene's (turned 1e-9,
+    shifted 1e-6), each temperature within 1e-9 relative (shifted: 1e-3, see T_TOLERANCE);
+    the summaries (steps, particles, removed) are equal. Beyond the tolerance, a chaotic
+    scene is judged against a nudge of one ulp (judge()).
+A failing seed keeps its folder under --work: drawn/, the twins' and nudge/ (when run).
+
+Needs numpy, h5py and yaml (scripts/python.sh finds a Python that has them).
+"""
+import argparse
+import json
+import os
+import random
+import re
+import shutil
+import sys
+import time
+
+try:
+    import h5py
+    import numpy as np
+    import yaml
+except ImportError:  # this python3 lacks them: scripts/python.sh finds one that has them
+    if os.environ.get("GRAINFLOW_PYTHON_CHOSEN"):
+        raise
+    _helper = os.path.join(os.path.dirname(os.path.realpath(__file__)), "..", "..", "..",
+                           "scripts", "python.sh")
+    os.execv(_helper, [_helper, os.path.abspath(__file__), *sys.argv[1:]])
+
+sys.path.insert(0, os.path.dirname(os.path.realpath(__file__)))
+import hard_scenes as hs  # noqa: E402
+
+# Scene keys whose 3-lists are points (moved by a shift) and vectors or per-axis lists (only
+# turned). A 3-list under any other key (none exists today) stops the generator.
+POINTS = {"min", "max", "point", "axis_point", "base", "centre", "origin", "translate"}
+VECTORS = {"gravity", "normal", "axis", "velocity", "surface_velocity", "u", "flow_direction",
+           "gradient_direction", "gradient", "periodic", "grid"}
+LISTS = {"values", "weights"}  # radius distributions: numbers, not coordinates
+TOLERANCE = {"turn1": 1e-9, "turn2": 1e-9, "shift": 1e-6, "boost": 1e-6}
+# Temperatures, relative. A shift rounds each overlap differently by an ulp of the moved
+# coordinates, and conduction goes as the contact radius sqrt(R* overlap), whose sensitivity
+# is unbounded at zero overlap: beads that touch (the thermal family's blocks, written with
+# 17 digits) conduct through overlaps of a few ulps or none, and with the generator's largest
+# conductivities (1e5 W/(m K)) that moved a cold bead's temperature by 0.17 K of 268 K in
+# 0.4 ms (thermal seed 90 moved by 0.01 m; its positions agreed to 6e-8 r).
+T_TOLERANCE = {"turn1": 1e-9, "turn2": 1e-9, "shift": 1e-2, "boost": 1e-6}
+# How far a twin may deviate beyond its tolerance, in units of the nudge's deviation at the
+# same snapshot (judge()). These bound round-off growth, which cannot be derived exactly: a
+# turn's round-off differs once per sum, CHAOS; a shift's or a boost's in every step, whose
+# differences also start contacts a step apart, CHAOS_EVERY_STEP per step. Thermal seed 107,
+# shifted, needed 106 (a bead 1.8e-5 r off after 0.0023 s, the nudge 1.8e-13 r).
+CHAOS = 100
+CHAOS_EVERY_STEP = 1000
+SATURATED = 1e-2
+NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+
+
+class Twin:
+    """A proper rotation that cycles the axes s times, or a shift by an offset."""
+
+    def __init__(self, name, seed, size=1.0):
+        """`size`: the domain's largest side; a shift moves the scene 1 to 100 of it along
+        each axis, either sign (a part placed in an assembly's coordinates)."""
+        self.name = name
+        self.s = {"turn1": 1, "turn2": 2}.get(name, 0)
+        rng = random.Random(7919 * seed + 3)
+        self.offset = np.zeros(3)
+        if name == "shift":
+            self.offset = np.array([rng.choice((-1, 1)) * size * 10 ** rng.uniform(0, 2)
+                                    for _ in range(3)])
+
+    def turn(self, v):
+        out = [None] * 3
+        for a in range(3):
+            out[(a + self.s) % 3] = v[a]
+        return out
+
+    def point(self, p):
+        q = self.turn(p)
+        return [float(q[a] + self.offset[a]) if self.offset[a] else q[a] for a in range(3)]
+
+    def back(self, x):
+        """Rows of twin coordinates mapped back to the drawn scene's frame."""
+        x = x - self.offset
+        return np.stack([x[:, (a + self.s) % 3] for a in range(3)], axis=1)
+
+    def difference(self, x, drawn, time):
+        """A twin's positions mapped back, minus the drawn scene's."""
+        return self.back(x) - drawn
+
+    def scene(self, x, key=None):
+        if isinstance(x, dict):
+            if x.get("type") == "mesh" and "translate" not in x:
+                x = dict(x, translate=[0, 0, 0])  # the shift moves a mesh by its translate
+            return {k: self.scene(v, k) for k, v in x.items()}
+        if isinstance(x, list) and len(x) == 3 and key not in LISTS and all(
+                isinstance(v, (int, float)) for v in x):
+            if key in POINTS:
+                return self.point(x)
+            if key in VECTORS:
+                return self.turn(x)
+            raise RuntimeError(f"twin_scenes: a 3-list under key '{key}' is neither a point nor "
+                               "a vector; add the key to POINTS or VECTORS")
+        if isinstance(x, list):
+            return [self.scene(v) for v in x]
+        return x
+
+    def stl(self, text):
+        out = []
+        for line in text.splitlines():
+            m = re.match(r"(\s*)(facet normal|vertex)\s+(\S+)\s+(\S+)\s+(\S+)\s*$", line)
+            if m:
+                v = [float(m.group(k)) for k in (3, 4, 5)]
+                # The mesh's own translate carries the shift: vertices only turn.
+                v = self.turn(v)
+                line = f"{m.group(1)}{m.group(2)} {v[0]!r} {v[1]!r} {v[2]!r}"
+            out.append(line)
+        return "\n".join(out) + "\n"
+
+    def csv(self, text):
+        lines = text.splitlines()
+        header = None
+        for i, line in enumerate(lines):
+            if not line.strip() or line.startswith("#"):
+                continue
+            if header is None:
+                header = [c.strip() for c in line.split(",")]
+                names = {}
+                for trip in (("x", "y", "z"), ("vx", "vy", "vz"), ("wx", "wy", "wz")):
+                    for a in range(3):  # the drawn axis a is the twin's (a + s) % 3
+                        names[trip[a]] = trip[(a + self.s) % 3]
+                lines[i] = ",".join(names.get(c, c) for c in header)
+                continue
+            if self.offset.any() or self.name == "nudge":
+                # Move each position (the renamed columns hold the turn), or nudge its x.
+                cells = line.split(",")
+                for a, name in enumerate("xyz"):
+                    if name in header and header.index(name) < len(cells):
+                        j = header.index(name)
+                        try:
+                            v = float(cells[j]) + self.offset[(a + self.s) % 3]
+                            if self.name == "nudge" and name == "x":
+                                v = float(np.nextafter(v, np.inf))
+                            cells[j] = repr(v)
+                        except ValueError:
+                            pass  # a hostile row stays hostile
+                lines[i] = ",".join(cells)
+        return "\n".join(lines) + "\n"
+
+    def dataset(self, name, data):
+        """A snapshot dataset as the twin holds it: vectors turned, positions moved."""
+        if data.ndim == 2 and data.shape[1] == 3:
+            data = np.stack(self.turn([data[:, 0], data[:, 1], data[:, 2]]), axis=1)
+            if name == "position":
+                data = data + self.offset
+                if self.name == "nudge":
+                    data[:, 0] = np.nextafter(data[:, 0], np.inf)
+        return data
+
+    def snapshot(self, src, dst):
+        """A copy of a snapshot with every dataset as the twin holds it (checksummed)."""
+        with h5py.File(src, "r") as f, h5py.File(dst, "w") as g:
+            for k, v in f.attrs.items():
+                g.attrs[k] = v
+            for name in f:
+                ds = f[name]
+                h = g.create_dataset(name, data=self.dataset(name, ds[...]), chunks=ds.chunks,
+                                     fletcher32=ds.fletcher32)
+                for k, v in ds.attrs.items():
+                    h.attrs[k] = v
+
+    def files(self, files):
+        return {n: self.stl(t) if n.endswith(".stl") else self.csv(t) if n.endswith(".csv")
+                else t for n, t in files.items()}
+
+
+def domain_size(scene):
+    return max(hi - lo for lo, hi in zip(scene["domain"]["min"], scene["domain"]["max"]))
+
+
+def boost_axis(scene):
+    """A periodic axis along which the scene is the same after any translation (its walls
+    reach along it, its fluid does not vary along it), so that a boost along it is a
+    symmetry; None when there is none (why, as a second value)."""
+    text = json.dumps(scene)
+    if '"stream"' in text or '"mesh"' in text:
+        return None, "streams or meshes"
+    fluid = scene.get("fluid", {})
+    if not isinstance(fluid.get("void_fraction", 1.0), (int, float)):
+        return None, "a computed void fraction (its grid does not move with the particles)"
+    for a in range(3):
+        if not scene["domain"].get("periodic", [False] * 3)[a]:
+            continue
+        along = [1 if k == a else 0 for k in range(3)]
+
+        def across(v):  # the part of direction v across the axis
+            return any(abs(v[k]) > 0 for k in range(3) if k != a)
+        ok = not ("shear" in fluid and fluid["shear"]["gradient_direction"][a] != 0)
+        for w in scene.get("walls", []):
+            m = w.get("motion", {})
+            if m.get("angular_velocity", 0) and across(m["axis"]):
+                ok = False
+            if w["type"] == "plane" and w["normal"][a] != 0:
+                ok = False
+            if w["type"] == "cylinder" and across(w["axis"]):
+                ok = False
+        if ok:
+            return a, along
+    return None, "no periodic axis along which the walls and the fluid are uniform"
+
+
+class Boost(Twin):
+    """The drawn scene seen from a frame moving at -V along a periodic axis: every particle,
+    wall and the fluid move V faster along it (Galilean invariance: contacts, dashpots,
+    friction, rolling, drag and heat see relative velocities only)."""
+
+    def __init__(self, seed, axis, speed, domain):
+        super().__init__("boost", seed)
+        self.axis = axis
+        self.v = np.zeros(3)
+        self.v[axis] = speed * random.Random(7919 * seed + 5).choice((-1, 1))
+        self.period = domain["max"][axis] - domain["min"][axis]
+
+    def scene(self, x, key=None):
+        x = json.loads(json.dumps(x))
+        if "fluid" in x:
+            u = x["fluid"].get("velocity", [0, 0, 0])
+            x["fluid"]["velocity"] = [float(u[k] + self.v[k]) for k in range(3)]
+        for w in x.get("walls", []):
+            m = w.setdefault("motion", {})
+            u = m.get("velocity", [0, 0, 0])
+            m["velocity"] = [float(u[k] + self.v[k]) for k in range(3)]
+        return x
+
+    def stl(self, text):
+        return text
+
+    def csv(self, text):
+        lines = text.splitlines()
+        header = None
+        for i, line in enumerate(lines):
+            if not line.strip() or line.startswith("#"):
+                continue
+            if header is None:
+                header = [c.strip() for c in line.split(",")]
+                if "vx" not in header:
+                    lines[i] = line + ",vx,vy,vz"
+                continue
+            cells = line.split(",")
+            if "vx" in header:
+                for k, name in enumerate(("vx", "vy", "vz")):
+                    j = header.index(name)
+                    if j < len(cells):
+                        try:
+                            cells[j] = repr(float(cells[j]) + self.v[k])
+                        except ValueError:
+                            pass  # a hostile row stays hostile
+            else:
+                cells += [repr(float(v)) for v in self.v]
+            lines[i] = ",".join(cells)
+        return "\n".join(lines) + "\n"
+
+    def dataset(self, name, data):
+        return data + self.v if name == "velocity" else data
+
+    def difference(self, x, drawn, time):
+        d = x - self.v * time - drawn
+        a = self.axis
+        d[:, a] -= self.period * np.round(d[:, a] / self.period)  # the periodic image
+        return d
+
+
+def write_case(folder, scene, files):
+    shutil.rmtree(folder, ignore_errors=True)
+    os.makedirs(folder)
+    with open(os.path.join(folder, "scene.yaml"), "w") as f:
+        yaml.safe_dump(scene, f, default_flow_style=None, sort_keys=False, width=100)
+    for name, text in files.items():
+        os.makedirs(os.path.dirname(os.path.join(folder, name)), exist_ok=True)
+        with open(os.path.join(folder, name), "w") as f:
+            f.write(text)
+
+
+def snapshot_files(folder):
+    out = os.path.join(folder, "out")
+    if not os.path.isdir(out):
+        return []
+    return [os.path.join(out, n) for n in sorted(os.listdir(out))
+            if n.startswith("particles_") and n.endswith(".h5")]
+
+
+def template(message):
+    """A message with its numbers and axis letters set aside."""
+    return re.sub(r"\b[xyz]\b", "?", NUMBER.sub("#", message))
+
+
+def same_stop(a, b):
+    """Two stop messages alike, numbers and axis letters aside (the shorter may be cut)."""
+    ta, tb = template(a), template(b)
+    n = min(len(ta), len(tb))
+    return n > 0 and ta[:n] == tb[:n]
+
+
+def summary(out):
+    m = re.search(r"done: (\d+) steps, (\d+) particles \((\d+) removed\)", out)
+    return m.groups() if m else None
+
+
+def start_from_snapshot(args, d, scene, work):
+    """The scene with its fills replaced by their t = 0 snapshot: (scene, snapshot path), or
+    (None, output) when the fills insert nothing."""
+    if not any(i["type"] == "fill" for i in scene.get("insert", [])):
+        return scene, None
+    fills = json.loads(json.dumps(scene))
+    fills["insert"] = [i for i in fills["insert"] if i["type"] == "fill"]
+    out = fills.setdefault("output", {})
+    out.pop("checkpoint_interval", None)
+    out.pop("checkpoint_keep", None)
+    out["snapshot_interval"] = fills["time"]["end"]
+    folder = os.path.join(work, "fills")
+    write_case(folder, fills, d.files)
+    code, text, _ = hs.run_grain(args, d.ranks, "scene.yaml", folder, args.timeout,
+                                 extra=("--allow-large-dt",))
+    snaps = snapshot_files(folder)
+    if not snaps:
+        return None, text
+    with h5py.File(snaps[0], "r") as f:
+        if float(f.attrs["time"]) != 0:
+            return None, f"the fills' first snapshot is at t = {f.attrs['time']}"
+    started = json.loads(json.dumps(scene))
+    started["insert"] = [{"type": "snapshot", "file": "filled.h5"}] + \
+        [i for i in started["insert"] if i["type"] != "fill"]
+    return started, snaps[0]
+
+
+def read_run(folder):
+    snaps = []
+    for path in snapshot_files(folder):
+        with h5py.File(path, "r") as f:
+            order = np.argsort(f["id"][...])
+            snaps.append({"time": float(f.attrs["time"]), "id": f["id"][...][order],
+                          "position": f["position"][...][order],
+                          "radius": f["radius"][...][order],
+                          "temperature": f["temperature"][...][order]
+                          if "temperature" in f else None})
+    return snaps
+
+
+def deviations(twin, drawn, other):
+    """Per snapshot, the twin's largest position deviation in radii and temperature deviation
+    (relative), mapped back; or a failure text when the runs hold other particles."""
+    if len(drawn) != len(other):
+        return None, f"{len(drawn)} snapshots, the twin {len(other)}"
+    out = []
+    for a, b in zip(drawn, other):
+        if abs(a["time"] - b["time"]) > 1e-9 * max(abs(a["time"]), 1e-30):
+            return None, f"snapshot at t = {a['time']}, the twin's at {b['time']}"
+        if not np.array_equal(a["id"], b["id"]):
+            return None, f"t = {a['time']}: the twin holds other particle ids"
+        dx = dt = 0.0
+        if len(a["id"]):
+            dx = float((np.abs(twin.difference(b["position"], a["position"], a["time"]))
+                        .max(axis=1) / a["radius"]).max())
+            if a["temperature"] is not None:
+                dt = float((np.abs(b["temperature"] - a["temperature"])
+                            / a["temperature"]).max())
+        out.append((a["time"], dx, dt))
+    return out, None
+
+
+def judge(name, devs, nudged, chaos, steps, tolerance=None):
+    """A failure text, or None. Beyond its tolerance a twin is judged against the nudged run
+    (`nudged`, called when needed), the drawn scene started with each particle's x one ulp
+    larger: in a chaotic scene any round-off grows to a visible difference. A turned twin's
+    round-off differs from the drawn scene's by a few ulps per step, so it may deviate
+    `chaos` times as far as the nudge; a shifted twin's by an ulp of the offset in every
+    step, so `chaos` times (offset / domain corner) times the steps so far (each step's
+    round-off grows at most as the nudge has since t = 0). Once the nudge itself reaches
+    SATURATED radii the drawn scene is not reproducible to round-off: later snapshots are
+    not compared. Returns (failure, time from which the comparison stopped). `tolerance`
+    replaces the twin's position tolerance (in the unit of `devs`)."""
+    tol = TOLERANCE[name] if tolerance is None else tolerance
+    limits = None
+    for i, (t, dx, dT) in enumerate(devs):
+        if limits is not None and limits[i][1] >= SATURATED:
+            return None, t
+        if dx <= tol and dT <= T_TOLERANCE[name]:
+            continue
+        if limits is None:
+            limits = nudged()
+        _, nx, nT = limits[i]
+        if nx >= SATURATED:
+            return None, t
+        factor = chaos * steps(t)
+        if dx > max(tol, factor * nx):
+            return (f"t = {t}: a particle is {dx:.3g} from where the drawn scene has it "
+                    f"(tolerance {tol:g}; a one-ulp nudge moves it {nx:.2g}, "
+                    f"times {factor:.3g})"), None
+        if dT > max(T_TOLERANCE[name], factor * nT):
+            return (f"t = {t}: a temperature differs by {dT:.3g} relative (tolerance "
+                    f"{T_TOLERANCE[name]:g}; a one-ulp nudge changes it {nT:.2g}, times "
+                    f"{factor:.3g})"), None
+    return None, None
+
+
+class SceneFile:
+    """A scene file (--scene) in place of a drawn scene: its mesh and CSV files are read as
+    text (ASCII STL), its snapshot insertions copied, turned or moved."""
+
+    family = "scene"
+
+    def __init__(self, path, ranks, end):
+        folder = os.path.dirname(os.path.abspath(path))
+        with open(path) as f:
+            self.scene = yaml.safe_load(f)
+        time_ = self.scene["time"]
+        if end:
+            time_["end"] = end
+        out = self.scene.setdefault("output", {})
+        for key in ("checkpoint_interval", "checkpoint_keep", "directory", "start", "stop"):
+            out.pop(key, None)
+        out["snapshot_interval"] = time_["end"] / 10
+        self.ranks = ranks or 1
+        self.files, self.snapshot_files = {}, {}
+        for w in self.scene.get("walls", []):
+            if w.get("type") == "mesh":
+                with open(os.path.join(folder, w["file"]), "rb") as f:
+                    raw = f.read()
+                if not raw.lstrip().startswith(b"solid") or b"facet" not in raw:
+                    raise RuntimeError(f"{w['file']}: only ASCII STL files can be turned")
+                self.files[w["file"]] = raw.decode()
+        for i in self.scene.get("insert", []):
+            if i["type"] == "csv":
+                with open(os.path.join(folder, i["file"])) as f:
+                    self.files[i["file"]] = f.read()
+            elif i["type"] == "snapshot":
+                self.snapshot_files[i["file"]] = os.path.join(folder, i["file"])
+
+
+def copy_snapshots(d, folder, twin=None):
+    """The scene's own snapshot insertions into a case folder, turned or moved by `twin`."""
+    for name, src in getattr(d, "snapshot_files", {}).items():
+        dst = os.path.join(folder, name)
+        os.makedirs(os.path.dirname(dst), exist_ok=True)
+        if twin is None:
+            shutil.copy(src, dst)
+        else:
+            twin.snapshot(src, dst)
+
+
+def check_seed(args, seed, twins):
+    d, scene = hs.draw(seed, args.family)
+    if args.ranks:
+        d.ranks = args.ranks
+    return check(args, seed, d, scene, twins,
+                 os.path.abspath(os.path.join(args.work, f"seed_{seed}")))
+
+
+def check(args, seed, d, scene, twins, work):
+    shutil.rmtree(work, ignore_errors=True)
+    os.makedirs(work)
+    started, snap = start_from_snapshot(args, d, scene, work)
+    results = []
+    if started is None:
+        # The fills themselves are refused: the twins' fills must be refused alike.
+        base_msg = hs.error_line(snap)
+        if "could place only" in base_msg:  # random placement saturated: a turned region
+            return True, "fills saturated (a turned region draws other positions)", work
+        for name in twins:
+            t = Twin(name, seed, domain_size(scene))
+            folder = os.path.join(work, name)
+            write_case(folder, t.scene(scene), t.files(d.files))
+            copy_snapshots(d, folder, t)
+            code, out, _ = hs.run_grain(args, d.ranks, "scene.yaml", folder, args.timeout,
+                                        extra=("--allow-large-dt",))
+            msg = hs.error_line(out)
+            if code == 0 or not same_stop(msg, base_msg):
+                return False, f"{name}: the drawn fills stop with '{base_msg}', the twin's " \
+                              f"with exit {code}: '{msg}'", work
+            results.append(f"{name} refused alike")
+        return True, "fills refused; " + ", ".join(results), work
+    folder = os.path.join(work, "drawn")
+    write_case(folder, started, d.files)
+    copy_snapshots(d, folder)
+    if snap:
+        shutil.copy(snap, os.path.join(folder, "filled.h5"))
+    code, out, _ = hs.run_grain(args, d.ranks, "scene.yaml", folder, args.timeout)
+    if code not in (0, 1, 2):
+        return False, f"the drawn scene ended with exit {code}: {hs.error_line(out)}", work
+    drawn = read_run(folder) if code == 0 else None
+    nudge, nudge_run = [], []
+
+    def nudge_exit():
+        """(exit code, output) of the drawn scene started with every x one ulp larger."""
+        if not nudge_run:
+            t = Twin("nudge", seed)
+            tf = os.path.join(work, "nudge")
+            write_case(tf, started, t.files(d.files))
+            copy_snapshots(d, tf, t)
+            if snap:
+                t.snapshot(snap, os.path.join(tf, "filled.h5"))
+            nudge_run.append(hs.run_grain(args, d.ranks, "scene.yaml", tf, args.timeout)[:2])
+        return nudge_run[0]
+
+    def nudged():
+        """The deviations of the nudged run from the drawn one."""
+        if not nudge:
+            ncode, nout = nudge_exit()
+            devs, failure = (deviations(Twin("nudge", seed), drawn,
+                                        read_run(os.path.join(work, "nudge")))
+                             if ncode == 0 else (None, nout))
+            if failure:
+                raise RuntimeError(f"the nudged run does not compare: {failure[-300:]}")
+            nudge.append(devs)
+        return nudge[0]
+
+    def chaotic_stop():
+        """Whether one ulp changes how the drawn scene ends (then a twin may end otherwise)."""
+        ncode, nout = nudge_exit()
+        return ncode != code or not same_stop(hs.error_line(out), hs.error_line(nout))
+
+    for name in twins:
+        t = Twin(name, seed, domain_size(started))
+        if name == "boost":
+            axis, why = boost_axis(started)
+            dt = hs.startup_dt(out)
+            if axis is None or dt is None or drawn is None:
+                results.append(f"boost not drawn ({why if axis is None else 'no run'})")
+                continue
+            # A twentieth of the smallest radius per step: well within the travel guard.
+            r_min = min(float(s["radius"].min()) for s in drawn if len(s["radius"]))
+            t = Boost(seed, axis, 0.05 * r_min / dt, started["domain"])
+        tf = os.path.join(work, name)
+        write_case(tf, t.scene(started), t.files(d.files))
+        copy_snapshots(d, tf, t)
+        if snap:
+            t.snapshot(snap, os.path.join(tf, "filled.h5"))
+        tcode, tout, _ = hs.run_grain(args, d.ranks, "scene.yaml", tf, args.timeout)
+        if tcode != code or (code != 0 and not same_stop(hs.error_line(out),
+                                                         hs.error_line(tout))):
+            if chaotic_stop():
+                results.append(f"{name} ended otherwise (chaotic: so does the nudge)")
+                continue
+            return False, (f"{name}: exit {tcode}, the drawn scene {code}\n  drawn: "
+                           f"{hs.error_line(out)}\n  twin:  {hs.error_line(tout)}"), work
+        if code != 0:
+            results.append(f"{name} stopped alike")
+            continue
+        if summary(out) != summary(tout):
+            return False, f"{name}: summary {summary(tout)}, the drawn scene's {summary(out)}", work
+        devs, failure = deviations(t, drawn, read_run(tf))
+        chaos, steps = CHAOS, (lambda _: 1)
+        if t.offset.any() or name == "boost":
+            # Round-off in every step: an ulp of the offset against one of the domain (shift),
+            # or of the positions, moved at other speeds (boost).
+            chaos = CHAOS_EVERY_STEP
+            if t.offset.any():
+                extent = max(abs(v) for v in started["domain"]["min"] + started["domain"]["max"])
+                chaos *= 1 + np.abs(t.offset).max() / extent
+            n, t_end = int(summary(out)[0]), drawn[-1]["time"]
+            steps = (lambda when: max(1.0, n * when / t_end))  # noqa: E731
+        chaotic = None
+        if not failure:
+            failure, chaotic = judge(name, devs, nudged, chaos, steps)
+        if failure:
+            return False, f"{name}: {failure}", work
+        dx, dT = max(v[1] for v in devs), max(v[2] for v in devs)
+        results.append(f"{name} {dx:.2g} r" + (f" T {dT:.2g}" if dT else "")
+                       + (f" (chaotic: the nudge {max(v[1] for v in nudge[0]):.2g} r"
+                          + (f", compared until t = {chaotic:.3g} s" if chaotic else "") + ")"
+                          if nudge else ""))
+    how = "ran" if code == 0 else "stopped"
+    return True, f"{how}; " + ", ".join(results), work
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--grain", required=True)
+    ap.add_argument("--mpiexec", default="mpiexec")
+    ap.add_argument("--seeds", type=hs.parse_seeds,
+                    help="ranges A:B (B excluded) and seeds, comma-separated: 0:16,608")
+    ap.add_argument("--scene", action="append", default=[],
+                    help="a scene file instead of drawn ones (repeatable); its meshes must "
+                         "be ASCII STL")
+    ap.add_argument("--end", type=float, help="with --scene: time.end instead of the file's")
+    ap.add_argument("--family", choices=hs.EXTRA_FAMILIES,
+                    help="draw this extra family's scene for every seed (thermal)")
+    ap.add_argument("--twins", default="turn1,turn2,shift",
+                    help="comma-separated: turn1, turn2, shift, boost")
+    ap.add_argument("--ranks", type=int, choices=[1, 2], help="instead of the drawn count")
+    ap.add_argument("--timeout", type=float, default=60, help="per run [s]")
+    ap.add_argument("--work", default="twin_scenes_work")
+    ap.add_argument("--keep", action="store_true", help="keep the folders of passing seeds")
+    args = ap.parse_args()
+    twins = args.twins.split(",")
+    for name in twins:
+        if name not in TOLERANCE:
+            ap.error(f"--twins: unknown twin '{name}'; allowed: {', '.join(TOLERANCE)}")
+    if os.sep in args.grain:
+        args.grain = os.path.abspath(args.grain)
+    if not args.seeds and not args.scene:
+        ap.error("give --seeds or --scene")
+    if args.end is not None and args.end <= 0:
+        ap.error(f"--end: {args.end} is not a time > 0")
+    os.makedirs(args.work, exist_ok=True)
+    start = time.monotonic()
+    failed = []
+    for k, path in enumerate(args.scene):
+        t0 = time.monotonic()
+        work = os.path.abspath(os.path.join(args.work, f"scene_{k}"))
+        try:
+            d = SceneFile(path, args.ranks, args.end)
+            ok, note, _ = check(args, k, d, d.scene, twins, work)
+        except (OSError, RuntimeError, KeyError, yaml.YAMLError) as e:
+            ok, note = False, f"{type(e).__name__}: {e}"
+        print(f"scene {path} {time.monotonic() - t0:6.2f} s  {'ok' if ok else 'FAIL'} ({note})",
+              flush=True)
+        if ok and not args.keep:
+            shutil.rmtree(work, ignore_errors=True)
+        if not ok:
+            failed.append(path)
+    for seed in args.seeds or []:
+        t0 = time.monotonic()
+        try:
+            ok, note, work = check_seed(args, seed, twins)
+        except Exception as e:  # a generator fault is a failure of the seed, named
+            ok, note, work = False, f"{type(e).__name__}: {e}", None
+        family = args.family or hs.FAMILIES[seed % len(hs.FAMILIES)]
+        print(f"seed {seed:5d} {family:13s} {time.monotonic() - t0:6.2f} s  "
+              f"{'ok' if ok else 'FAIL'} ({note})", flush=True)
+        if ok and work and not args.keep:
+            shutil.rmtree(work, ignore_errors=True)
+        if not ok:
+            failed.append(seed)
+    print(f"\n{len(args.seeds or []) + len(args.scene)} scenes in "
+          f"{time.monotonic() - start:.1f} s, {len(failed)} failed"
+          + (f": {' '.join(map(str, failed))} (folders under {args.work})" if failed else ""))
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
