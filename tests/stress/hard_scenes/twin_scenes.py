@@ -34,7 +34,7 @@ A twin passes when it exits as the drawn scene did and
   * after a stop: the message is the same with its numbers and axis letters set aside;
   * after a run: every snapshot holds the same particle ids, each particle's position mapped
     back lies within the twin's tolerance times its radius of the drawn scene's (turned 1e-9,
-    shifted 1e-6), each temperature within 1e-9 relative (shifted: 1e-3, see T_TOLERANCE);
+    shifted 1e-6), each temperature within 1e-9 relative (shifted: 1e-2, see T_TOLERANCE);
     the summaries (steps, particles, removed) are equal. Beyond the tolerance, a chaotic
     scene is judged against a nudge of one ulp (judge()).
 A failing seed keeps its folder under --work: drawn/, the twins' and nudge/ (when run).
