@@ -38,10 +38,12 @@ set_tests_properties(hard_scenes.thermal_ci PROPERTIES ENVIRONMENT "${GRAINFLOW_
 # motions, periodic axes and processor grid turned with it) and moved 0.01-10 m from the
 # origin; the twins must stop with the same message or end with every particle where the
 # drawn scene has it (turned: to 1e-9 of its radius, moved: 1e-6), temperatures alike.
-# Seeds 0-7 hold each family once; thermal seeds 1 and 4 carry heat and parcels.
+# Seeds 0, 1, 3, 4 and 6: a pour, a drum, a mesh plate, a periodic gas and a fluid (the rod,
+# closed-gas and limits families stop early: the sweeps in docs/stability.md hold them);
+# thermal seeds 1 and 4 carry heat and parcels.
 add_test(NAME hard_scenes.twins_ci
          COMMAND ${GRAINFLOW_HARD_SCENES_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/twin_scenes.py
-                 --grain $<TARGET_FILE:grain> --mpiexec ${MPIEXEC_EXECUTABLE} --seeds 0:8
+                 --grain $<TARGET_FILE:grain> --mpiexec ${MPIEXEC_EXECUTABLE} --seeds 0,1,3,4,6
                  --twins turn1,shift --timeout 25
                  --work ${PROJECT_BINARY_DIR}/test_output/twin_scenes)
 add_test(NAME hard_scenes.thermal_twins_ci
