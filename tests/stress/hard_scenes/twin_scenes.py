@@ -89,6 +89,22 @@ SATURATED = 1e-2
 NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
 
 
+def add_to_cell(cells, header, column, value, nudge=False):
+    """Add `value` to a CSV row's cell of `column` (then one ulp up with `nudge`); a row
+    without that cell, or with a cell that is not a number, stays as it is (hostile rows
+    stay hostile)."""
+    if column not in header or header.index(column) >= len(cells):
+        return
+    j = header.index(column)
+    if not value and not nudge:
+        return
+    try:
+        v = float(cells[j]) + value
+    except ValueError:
+        return
+    cells[j] = repr(float(np.nextafter(v, np.inf)) if nudge else v)
+
+
 class Twin:
     """A proper rotation that cycles the axes s times, or a shift by an offset."""
 
@@ -152,6 +168,8 @@ class Twin:
         return "\n".join(out) + "\n"
 
     def csv(self, text):
+        """A particle file as the twin holds it: its header and each row through the hooks
+        csv_header() and csv_row(); comments and blank lines as written."""
         lines = text.splitlines()
         header = None
         for i, line in enumerate(lines):
@@ -159,27 +177,25 @@ class Twin:
                 continue
             if header is None:
                 header = [c.strip() for c in line.split(",")]
-                names = {}
-                for trip in (("x", "y", "z"), ("vx", "vy", "vz"), ("wx", "wy", "wz")):
-                    for a in range(3):  # the drawn axis a is the twin's (a + s) % 3
-                        names[trip[a]] = trip[(a + self.s) % 3]
-                lines[i] = ",".join(names.get(c, c) for c in header)
-                continue
-            if self.offset.any() or self.name == "nudge":
-                # Move each position (the renamed columns hold the turn), or nudge its x.
-                cells = line.split(",")
-                for a, name in enumerate("xyz"):
-                    if name in header and header.index(name) < len(cells):
-                        j = header.index(name)
-                        try:
-                            v = float(cells[j]) + self.offset[(a + self.s) % 3]
-                            if self.name == "nudge" and name == "x":
-                                v = float(np.nextafter(v, np.inf))
-                            cells[j] = repr(v)
-                        except ValueError:
-                            pass  # a hostile row stays hostile
-                lines[i] = ",".join(cells)
+                lines[i] = ",".join(self.csv_header(header))
+            else:
+                lines[i] = ",".join(self.csv_row(header, line.split(",")))
         return "\n".join(lines) + "\n"
+
+    def csv_header(self, header):
+        """Columns renamed: the drawn axis a is the twin's (a + s) % 3."""
+        names = {}
+        for trip in (("x", "y", "z"), ("vx", "vy", "vz"), ("wx", "wy", "wz")):
+            for a in range(3):
+                names[trip[a]] = trip[(a + self.s) % 3]
+        return [names.get(c, c) for c in header]
+
+    def csv_row(self, header, cells):
+        """Positions moved (the renamed columns hold the turn), or x nudged by one ulp."""
+        for a, name in enumerate("xyz"):
+            nudge = self.name == "nudge" and name == "x"
+            add_to_cell(cells, header, name, self.offset[(a + self.s) % 3], nudge)
+        return cells
 
     def dataset(self, name, data):
         """A snapshot dataset as the twin holds it: vectors turned, positions moved."""
@@ -269,30 +285,15 @@ class Boost(Twin):
     def stl(self, text):
         return text
 
-    def csv(self, text):
-        lines = text.splitlines()
-        header = None
-        for i, line in enumerate(lines):
-            if not line.strip() or line.startswith("#"):
-                continue
-            if header is None:
-                header = [c.strip() for c in line.split(",")]
-                if "vx" not in header:
-                    lines[i] = line + ",vx,vy,vz"
-                continue
-            cells = line.split(",")
-            if "vx" in header:
-                for k, name in enumerate(("vx", "vy", "vz")):
-                    j = header.index(name)
-                    if j < len(cells):
-                        try:
-                            cells[j] = repr(float(cells[j]) + self.v[k])
-                        except ValueError:
-                            pass  # a hostile row stays hostile
-            else:
-                cells += [repr(float(v)) for v in self.v]
-            lines[i] = ",".join(cells)
-        return "\n".join(lines) + "\n"
+    def csv_header(self, header):
+        return header if "vx" in header else header + ["vx", "vy", "vz"]
+
+    def csv_row(self, header, cells):
+        if "vx" not in header:
+            return cells + [repr(float(v)) for v in self.v]
+        for k, name in enumerate(("vx", "vy", "vz")):
+            add_to_cell(cells, header, name, self.v[k])
+        return cells
 
     def dataset(self, name, data):
         return data + self.v if name == "velocity" else data
