@@ -36,29 +36,32 @@ set_tests_properties(hard_scenes.thermal_ci PROPERTIES ENVIRONMENT "${GRAINFLOW_
 # Twin scenes (tests/stress/hard_scenes/twin_scenes.py, docs/stability.md "Twin scenes"):
 # each drawn scene also runs turned (the axes cycled: gravity along -x, walls, meshes,
 # motions, periodic axes and processor grid turned with it) and moved 0.01-10 m from the
-# origin; the twins must stop with the same message or end with every particle where the
-# drawn scene has it (turned: to 1e-9 of its radius, moved: 1e-6), temperatures alike.
+# origin, and in other units (scale: lengths, times and masses times powers of two, every
+# number converted by its dimension); the twins must stop with the same message or end with
+# every particle where the drawn scene has it (turned or rescaled: to 1e-9 of its radius,
+# moved: 1e-6), temperatures alike.
 # Seeds 0, 1, 3, 4 and 6: a pour, a drum, a mesh plate, a periodic gas and a fluid (the rod,
 # closed-gas and limits families stop early: the sweeps in docs/stability.md hold them);
 # thermal seeds 1 and 4 carry heat and parcels.
 add_test(NAME hard_scenes.twins_ci
          COMMAND ${GRAINFLOW_HARD_SCENES_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/twin_scenes.py
                  --grain $<TARGET_FILE:grain> --mpiexec ${MPIEXEC_EXECUTABLE} --seeds 0,1,3,4,6
-                 --twins turn1,shift --timeout 25
+                 --twins turn1,shift,scale --timeout 25
                  --work ${PROJECT_BINARY_DIR}/test_output/twin_scenes)
 add_test(NAME hard_scenes.thermal_twins_ci
          COMMAND ${GRAINFLOW_HARD_SCENES_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/twin_scenes.py
                  --grain $<TARGET_FILE:grain> --mpiexec ${MPIEXEC_EXECUTABLE} --family thermal
-                 --seeds 1,4 --twins turn1,shift --timeout 25
+                 --seeds 1,4 --twins turn1,shift,scale --timeout 25
                  --work ${PROJECT_BINARY_DIR}/test_output/twin_scenes_thermal)
 # A bed resting on a floor, periodic along x and y (tests/data/scenes/twins/resting_bed.yaml),
 # also boosted: floor, beads and fluid moving along x, which contacts, friction, rolling,
-# cohesion and drag must not see (walls moved at 0.9 of their velocity fail it at 8 ms).
+# cohesion and drag must not see (walls moved at 0.9 of their velocity fail it at 8 ms); and
+# rescaled (an EPSD rolling stiffness with 1 mm written in place of one R* fails it at 8 ms).
 add_test(NAME hard_scenes.resting_bed_twins
          COMMAND ${GRAINFLOW_HARD_SCENES_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/twin_scenes.py
                  --grain $<TARGET_FILE:grain> --mpiexec ${MPIEXEC_EXECUTABLE}
                  --scene ${PROJECT_SOURCE_DIR}/tests/data/scenes/twins/resting_bed.yaml
-                 --twins turn1,shift,boost --timeout 60
+                 --twins turn1,shift,boost,scale --timeout 60
                  --work ${PROJECT_BINARY_DIR}/test_output/twin_scenes_bed)
 set_tests_properties(hard_scenes.twins_ci hard_scenes.thermal_twins_ci
                      hard_scenes.resting_bed_twins PROPERTIES

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Twin scenes: a hard scene turned or moved must run as the scene itself (docs/stability.md).
+"""Twin scenes: a hard scene turned, moved or rescaled must run as the scene itself
+(docs/stability.md).
 
     twin_scenes.py --grain build/bin/grain --seeds 0:24
     twin_scenes.py --grain build/bin/grain --family thermal --seeds 0:16 --twins turn1,shift
@@ -22,6 +23,14 @@ scene (drawn by hard_scenes.py, every family) is run as drawn and as its twins:
     twentieth of the smallest radius per step (particles, walls and the fluid all faster by
     that velocity), where that is a symmetry (boost_axis()); positions to 1e-6 of the radius
     after taking the frame's motion back.
+  * scale: the scene in other units, lengths times 2^a, times 2^b, masses 2^c (a, b, c even,
+    nonzero, |a|, |b|, |c| <= 12, drawn per seed): every number of the scene, of its CSV and
+    STL files and of its snapshots converted by its dimension (DIMENSIONS, COLUMNS,
+    DATASETS); a default with a unit (expected_max_speed) is written out first. Powers of two
+    convert exactly, so a scene whose physics is written in dimensionless groups does the
+    same arithmetic and must end where the drawn one does to 1e-9 of a radius (fifth roots,
+    as in the Hooke stiffness from a characteristic velocity, round otherwise); a length,
+    time or speed written into the code makes it differ.
 --scene FILE twins a scene file instead of drawn ones (tests/data/scenes/twins/resting_bed.yaml
 is written for the boost).
 A fill draws its random positions axis by axis, so a turned region holds other particles:
@@ -33,10 +42,10 @@ as written; a CSV file's columns are renamed (turn) or its positions moved (shif
 A twin passes when it exits as the drawn scene did and
   * after a stop: the message is the same with its numbers and axis letters set aside;
   * after a run: every snapshot holds the same particle ids, each particle's position mapped
-    back lies within the twin's tolerance times its radius of the drawn scene's (turned 1e-9,
-    shifted 1e-6), each temperature within 1e-9 relative (shifted: 1e-2, see T_TOLERANCE);
-    the summaries (steps, particles, removed) are equal. Beyond the tolerance, a chaotic
-    scene is judged against a nudge of one ulp (judge()).
+    back lies within the twin's tolerance times its radius of the drawn scene's (turned or
+    rescaled 1e-9, shifted 1e-6), each temperature within 1e-9 relative (shifted: 1e-2, see
+    T_TOLERANCE); the summaries (steps, particles, removed) are equal. Beyond the
+    tolerance, a chaotic scene is judged against a nudge of one ulp (judge()).
 A failing seed keeps its folder under --work: drawn/, the twins' and nudge/ (when run).
 
 Needs numpy, h5py and yaml (scripts/python.sh finds a Python that has them).
@@ -70,14 +79,14 @@ POINTS = {"min", "max", "point", "axis_point", "base", "centre", "origin", "tran
 VECTORS = {"gravity", "normal", "axis", "velocity", "surface_velocity", "u", "flow_direction",
            "gradient_direction", "gradient", "periodic", "grid"}
 LISTS = {"values", "weights"}  # radius distributions: numbers, not coordinates
-TOLERANCE = {"turn1": 1e-9, "turn2": 1e-9, "shift": 1e-6, "boost": 1e-6}
+TOLERANCE = {"turn1": 1e-9, "turn2": 1e-9, "shift": 1e-6, "boost": 1e-6, "scale": 1e-9}
 # Temperatures, relative. A shift rounds each overlap differently by an ulp of the moved
 # coordinates, and conduction goes as the contact radius sqrt(R* overlap), whose sensitivity
 # is unbounded at zero overlap: beads that touch (the thermal family's blocks, written with
 # 17 digits) conduct through overlaps of a few ulps or none, and with the generator's largest
 # conductivities (1e5 W/(m K)) that moved a cold bead's temperature by 0.17 K of 268 K in
 # 0.4 ms (thermal seed 90 moved by 0.01 m; its positions agreed to 6e-8 r).
-T_TOLERANCE = {"turn1": 1e-9, "turn2": 1e-9, "shift": 1e-2, "boost": 1e-6}
+T_TOLERANCE = {"turn1": 1e-9, "turn2": 1e-9, "shift": 1e-2, "boost": 1e-6, "scale": 1e-9}
 # How far a twin may deviate beyond its tolerance, in units of the nudge's deviation at the
 # same snapshot (judge()). These bound round-off growth, which cannot be derived exactly: a
 # turn's round-off differs once per sum, CHAOS; a shift's or a boost's in every step, whose
@@ -137,6 +146,14 @@ class Twin:
     def difference(self, x, drawn, time):
         """A twin's positions mapped back, minus the drawn scene's."""
         return self.back(x) - drawn
+
+    def time(self, t):
+        """A twin's time in the drawn scene's unit."""
+        return t
+
+    def attribute(self, name, value):
+        """A snapshot's root attribute as the twin holds it."""
+        return value
 
     def scene(self, x, key=None):
         if isinstance(x, dict):
@@ -211,7 +228,7 @@ class Twin:
         """A copy of a snapshot with every dataset as the twin holds it (checksummed)."""
         with h5py.File(src, "r") as f, h5py.File(dst, "w") as g:
             for k, v in f.attrs.items():
-                g.attrs[k] = v
+                g.attrs[k] = self.attribute(k, v)
             for name in f:
                 ds = f[name]
                 h = g.create_dataset(name, data=self.dataset(name, ds[...]), chunks=ds.chunks,
@@ -305,6 +322,141 @@ class Boost(Twin):
         return d
 
 
+# Dimensions (length, time, mass exponents) of every number a scene may hold, by its key path
+# (list entries dropped from the path); temperatures are kept in kelvin. A number under any
+# other path stops the scale twin: a new key must be classified here.
+L, T, M, ONE = (1, 0, 0), (0, 1, 0), (0, 0, 1), (0, 0, 0)
+SPEED, RATE, DENSITY, PRESSURE = (1, -1, 0), (0, -1, 0), (-3, 0, 1), (-1, -2, 1)
+CONDUCTIVITY, HEAT_CAPACITY = (1, -3, 1), (2, -2, 0)  # W/(m K), J/(kg K)
+DIMENSIONS = {
+    "gravity": (1, -2, 0), "domain.min": L, "domain.max": L, "domain.periodic": ONE,
+    "time.end": T, "time.step": T, "time.expected_max_speed": SPEED, "time.max_overlap": ONE,
+    "time.rayleigh_fraction": ONE, "time.min_steps_per_contact": ONE,
+    "time.max_step_travel": ONE,
+    "contact.epsd.damping_ratio": ONE, "contact.hooke.characteristic_velocity": SPEED,
+    "contact.hooke.stiffness.normal": (0, -2, 1), "contact.hooke.stiffness.tangential": (0, -2, 1),
+    "fluid.conductivity": CONDUCTIVITY, "fluid.density": DENSITY,
+    "fluid.heat_capacity": HEAT_CAPACITY, "fluid.pressure.gradient": (-2, -2, 1),
+    "fluid.shear.flow_direction": ONE, "fluid.shear.gradient_direction": ONE,
+    "fluid.shear.origin": L, "fluid.shear.rate": RATE, "fluid.temperature": ONE,
+    "fluid.velocity": SPEED, "fluid.virtual_mass_coefficient": ONE,
+    "fluid.viscosity": (-1, -1, 1), "fluid.void_fraction": ONE,
+    "fluid.void_fraction.cell_size": L, "fluid.void_fraction.minimum": ONE,
+    "insert.coarse_grain": ONE, "insert.count": ONE, "insert.count_rate": RATE,
+    "insert.mass_rate": (0, -1, 1), "insert.seed": ONE, "insert.temperature": ONE,
+    "insert.velocity": SPEED, "insert.face.rectangle.centre": L,
+    "insert.face.rectangle.normal": ONE, "insert.face.rectangle.size": L,
+    "insert.face.rectangle.u": ONE, "insert.radius.max": L, "insert.radius.mean": L,
+    "insert.radius.min": L, "insert.radius.stddev": L, "insert.radius.value": L,
+    "insert.radius.values": L, "insert.radius.weights": ONE, "insert.region.box.min": L,
+    "insert.region.box.max": L, "insert.region.cylinder.axis": ONE,
+    "insert.region.cylinder.base": L, "insert.region.cylinder.height": L,
+    "insert.region.cylinder.radius": L,
+    "interaction_defaults.cohesion_energy_density": PRESSURE,
+    "interaction_defaults.friction": ONE, "interaction_defaults.restitution": ONE,
+    "interaction_defaults.rolling_friction": ONE,
+    "interactions.cohesion_energy_density": PRESSURE, "interactions.friction": ONE,
+    "interactions.restitution": ONE, "interactions.rolling_friction": ONE,
+    "materials.conductivity": CONDUCTIVITY, "materials.density": DENSITY,
+    "materials.heat_capacity": HEAT_CAPACITY, "materials.heat_source": (2, -3, 0),  # W/kg
+    "materials.poisson_ratio": ONE, "materials.real_youngs_modulus": PRESSURE,
+    "materials.youngs_modulus": PRESSURE,
+    "output.checkpoint_interval": T, "output.checkpoint_keep": ONE,
+    "output.snapshot_interval": T, "output.log_interval": T,
+    "parallel.grid": ONE,
+    "walls.angular_velocity": RATE, "walls.axis": ONE, "walls.axis_point": L,
+    "walls.heat_flux": (0, -3, 1), "walls.motion.angular_velocity": RATE,
+    "walls.motion.axis": ONE, "walls.motion.axis_point": L, "walls.motion.velocity": SPEED,
+    "walls.normal": ONE, "walls.point": L, "walls.radius": L, "walls.rotate.angle": ONE,
+    "walls.rotate.axis": ONE, "walls.surface_velocity": SPEED, "walls.temperature": ONE,
+    "walls.translate": L,
+}
+# Snapshot datasets and CSV columns.
+DATASETS = {"id": ONE, "position": L, "velocity": SPEED, "angular_velocity": RATE,
+            "radius": L, "diameter": L, "mass": M, "material": ONE, "force": (1, -2, 1),
+            "torque": (2, -2, 1), "coordination": ONE, "fluid_force": (1, -2, 1),
+            "overlap_max": ONE, "temperature": ONE, "coarse_grain": ONE, "real_count": ONE}
+COLUMNS = {"x": L, "y": L, "z": L, "radius": L, "vx": SPEED, "vy": SPEED, "vz": SPEED,
+           "wx": RATE, "wy": RATE, "wz": RATE, "material": None, "T": ONE}
+
+
+class Scale(Twin):
+    """The drawn scene in other units: lengths times 2^a, times 2^b, masses 2^c (a, b, c
+    even, drawn per seed), every number converted by its dimension (DIMENSIONS). Physics
+    written in dimensionless groups does the same arithmetic on scaled numbers, exactly
+    (powers of two; even ones keep square roots exact): a length, time or speed written into
+    the code (an absolute tolerance, a default in metres) is what makes a scaled twin differ
+    -- a powder of 10 um beads or a bed of boulders running otherwise."""
+
+    def __init__(self, seed):
+        super().__init__("scale", seed)
+        rng = random.Random(7919 * seed + 11)
+        self.exponents = [2 * rng.choice([k for k in range(-6, 7) if k]) for _ in range(3)]
+
+    def factor(self, dim):
+        return float(2.0 ** sum(e * d for e, d in zip(self.exponents, dim)))
+
+    def scene(self, x, key=None):
+        x = json.loads(json.dumps(x))
+        # A default in metres per second is written out, so that it converts.
+        x.setdefault("time", {}).setdefault("expected_max_speed", 1.0)
+        return self.convert(x, "")
+
+    def convert(self, x, path):
+        if isinstance(x, dict):
+            return {k: self.convert(v, f"{path}.{k}" if path else k) for k, v in x.items()}
+        if isinstance(x, list):
+            return [self.convert(v, path) for v in x]
+        if isinstance(x, bool) or not isinstance(x, (int, float)):
+            return x
+        if path not in DIMENSIONS:
+            raise RuntimeError(f"twin_scenes: the number under '{path}' has no dimension in "
+                               "DIMENSIONS; add it")
+        f = self.factor(DIMENSIONS[path])
+        return x if f == 1 else float(x * f)
+
+    def back(self, x):
+        return x / self.factor(L)
+
+    def time(self, t):
+        return t / self.factor(T)
+
+    def stl(self, text):
+        f = self.factor(L)
+        out = []
+        for line in text.splitlines():
+            m = re.match(r"(\s*)vertex\s+(\S+)\s+(\S+)\s+(\S+)\s*$", line)
+            if m:
+                v = [float(m.group(k)) * f for k in (2, 3, 4)]
+                line = f"{m.group(1)}vertex {v[0]!r} {v[1]!r} {v[2]!r}"
+            out.append(line)
+        return "\n".join(out) + "\n"
+
+    def csv_header(self, header):
+        for c in header:
+            if c not in COLUMNS:
+                raise RuntimeError(f"twin_scenes: CSV column '{c}' has no dimension in COLUMNS")
+        return header
+
+    def csv_row(self, header, cells):
+        for j, c in enumerate(header):
+            if j < len(cells) and COLUMNS[c] is not None and COLUMNS[c] != ONE:
+                try:
+                    cells[j] = repr(float(cells[j]) * self.factor(COLUMNS[c]))
+                except ValueError:
+                    pass  # a hostile cell stays hostile
+        return cells
+
+    def dataset(self, name, data):
+        if name not in DATASETS:
+            raise RuntimeError(f"twin_scenes: snapshot dataset '{name}' has no dimension")
+        f = self.factor(DATASETS[name])
+        return data if f == 1 else data * f
+
+    def attribute(self, name, value):
+        return value * self.factor(T) if name == "time" else value
+
+
 def write_case(folder, scene, files):
     shutil.rmtree(folder, ignore_errors=True)
     os.makedirs(folder)
@@ -388,8 +540,8 @@ def deviations(twin, drawn, other):
         return None, f"{len(drawn)} snapshots, the twin {len(other)}"
     out = []
     for a, b in zip(drawn, other):
-        if abs(a["time"] - b["time"]) > 1e-9 * max(abs(a["time"]), 1e-30):
-            return None, f"snapshot at t = {a['time']}, the twin's at {b['time']}"
+        if abs(a["time"] - twin.time(b["time"])) > 1e-9 * max(abs(a["time"]), 1e-30):
+            return None, f"snapshot at t = {a['time']}, the twin's at {twin.time(b['time'])}"
         if not np.array_equal(a["id"], b["id"]):
             return None, f"t = {a['time']}: the twin holds other particle ids"
         dx = dt = 0.0
@@ -438,6 +590,18 @@ def judge(name, devs, nudged, chaos, steps, tolerance=None):
     return None, None
 
 
+def numbers(x):
+    """A scene read by PyYAML with the numbers it leaves as strings (YAML 1.1 wants a dot in
+    5.0e6; grain reads 5e6 too) made numbers, so that the twins turn, move and scale them."""
+    if isinstance(x, dict):
+        return {k: numbers(v) for k, v in x.items()}
+    if isinstance(x, list):
+        return [numbers(v) for v in x]
+    if isinstance(x, str) and NUMBER.fullmatch(x.strip()):
+        return float(x)
+    return x
+
+
 class SceneFile:
     """A scene file (--scene) in place of a drawn scene: its mesh and CSV files are read as
     text (ASCII STL), its snapshot insertions copied, turned or moved."""
@@ -447,7 +611,7 @@ class SceneFile:
     def __init__(self, path, ranks, end):
         folder = os.path.dirname(os.path.abspath(path))
         with open(path) as f:
-            self.scene = yaml.safe_load(f)
+            self.scene = numbers(yaml.safe_load(f))
         time_ = self.scene["time"]
         if end:
             time_["end"] = end
@@ -502,7 +666,7 @@ def check(args, seed, d, scene, twins, work):
         if "could place only" in base_msg:  # random placement saturated: a turned region
             return True, "fills saturated (a turned region draws other positions)", work
         for name in twins:
-            t = Twin(name, seed, domain_size(scene))
+            t = Scale(seed) if name == "scale" else Twin(name, seed, domain_size(scene))
             folder = os.path.join(work, name)
             write_case(folder, t.scene(scene), t.files(d.files))
             copy_snapshots(d, folder, t)
@@ -555,7 +719,7 @@ def check(args, seed, d, scene, twins, work):
         return ncode != code or not same_stop(hs.error_line(out), hs.error_line(nout))
 
     for name in twins:
-        t = Twin(name, seed, domain_size(started))
+        t = Scale(seed) if name == "scale" else Twin(name, seed, domain_size(started))
         if name == "boost":
             axis, why = boost_axis(started)
             dt = hs.startup_dt(out)
@@ -621,7 +785,7 @@ def main():
     ap.add_argument("--family", choices=hs.EXTRA_FAMILIES,
                     help="draw this extra family's scene for every seed (thermal)")
     ap.add_argument("--twins", default="turn1,turn2,shift",
-                    help="comma-separated: turn1, turn2, shift, boost")
+                    help="comma-separated: turn1, turn2, shift, boost, scale")
     ap.add_argument("--ranks", type=int, choices=[1, 2], help="instead of the drawn count")
     ap.add_argument("--timeout", type=float, default=60, help="per run [s]")
     ap.add_argument("--work", default="twin_scenes_work")
