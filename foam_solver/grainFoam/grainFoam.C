@@ -27,7 +27,8 @@
 // With couplingProperties facePressure dragSeries the cell gradient of p in the predictor and
 // in the corrected U = HbyA - rAU c grad p is ParticleCoupling::seriesGradient (face pressures
 // of half cells crossed in series with their drag resistances); otherwise Gauss linear and
-// U = HbyA - reconstruct(rAU_f c_f snGrad p).
+// U = HbyA - reconstruct(rAU_f c_f snGrad p) (coupling/foam/fluxReconstruction.H, not
+// fvc::reconstruct, which v1912 compiles wrong).
 #include <mpi.h>
 
 #include <cmath>
@@ -37,6 +38,7 @@
 #include <string>
 
 #include "coupling/floating_point_traps.hpp"
+#include "coupling/foam/fluxReconstruction.H"
 #include "coupling/foam/particleCoupling.H"
 #include "coupling/written_files.hpp"
 #include "dem/engine/stop_signals.hpp"
@@ -458,7 +460,7 @@ void solve(const Foam::argList& args) {
             if (series)
               U = HbyA - rAU * c * particles.seriesGradient(p);
             else
-              U = HbyA - fvc::reconstruct(pEqn.flux() / epsf);
+              U = HbyA - grainflow::foam::reconstructFlux(pEqn.flux() / epsf);
             U.correctBoundaryConditions();
           }
         }
