@@ -24,9 +24,15 @@ bed's core (CORE parcel diameters away from its bottom and top), H = solid volum
 AVERAGE seconds, when the bed has come to rest.
 
 Checks:
-  * each k: |dp / Ergun - 1| <= TOLERANCE, the tolerance k = 1 meets: measured -5.1 % at
-    k = 1 (docs/models/bed-surface.md: -4.7 % at 4 d cells), -3.5 % at k = 2, -1.3 % at k = 3;
-    without sharpInterface -11.5, -15.7 and -18.2 % (the half-full top cell);
+  * each k: |dp / Ergun - 1| <= TOLERANCE[k]. The pour is chaotic (the gas's round-off
+    changes where each bead lands), and one pour's error scatters. Over the fill seeds 1-7:
+      k = 1  -6.3 to -4.6 % (mean -5.3 %; seed 7, this test's: -5.1 %);
+      k = 2  -4.5 to +1.2 % (mean -1.4 %; seed 7: +0.05 %);
+      k = 3  -2.8 to +10.1 % (mean +3.3 %, standard deviation 4.7 %; seed 7: +8.2 %),
+    the parcels 1.33 diameters across the cells. So 6 % for k = 1 and 2, 12 % for one pour of
+    k = 3: the mean of seven pours is within k = 1's 6 %, one pour is not. Without
+    sharpInterface (seed 7, before the velocity-reconstruction fix): -11.5, -15.7 and -18.2 %
+    (the half-full top cell);
   * each bed at rest when dp is averaged (mean particle speed < 5 mm/s; a surface bead may
     still rattle);
   * each k: every parcel's snapshot coarse_grain = k and real_count = k^3, and the particle
@@ -43,8 +49,9 @@ Checks:
     within BALANCE, less the bed's momentum gain over the interval (snapshots); and the
     line's own share of the weight agrees with the distributor's load. Also on 2 ranks,
     while the parcels land (the distributor carrying 2.6-2.8 times the weight, the bed
-    gaining 1.9-2.1 weights of momentum per second): measured +0.06 % (k = 2) and -0.36 %
-    (k = 3).
+    gaining 1.9-2.1 weights of momentum per second), within BALANCE_LANDING: the snapshots'
+    momentum difference over a landing is less certain; measured for k = 3 -0.17 % (seed 7),
+    -0.67 % (seed 3), +0.67 % (seed 1).
 Exit status 0 when every check holds.
 """
 import math
@@ -68,13 +75,14 @@ DT = 1e-5                     # DEM step at k = 1 [s]
 END = 0.2                     # simulated time [s]: the pour settles by about 0.15 s
 AVERAGE = 0.03                # the pressure drop is averaged over the run's last 0.03 s
 CORE = 1.5                    # eps from the core, this many parcel diameters from the ends
-TOLERANCE = 0.06              # k = 1 reaches -5.1 % (see the module docstring)
+TOLERANCE = {1: 0.06, 2: 0.06, 3: 0.12}  # one pour's scatter (see the module docstring)
 # The momentum balance's tolerance. Measured: -0.02 % (k = 1), -0.04 % (k = 2), -0.25 % (k = 3).
 # k = 3 puts 3 mm parcels in 4 mm cells: 0.5 % of their volume is clamped away from the gas's
 # void fraction (minVoidFraction, reported), which then misses V_clamped |grad p| ~ 0.08 % of
 # the weight, and a parcel rattling on the surface (up to 0.08 m/s) makes the snapshots'
 # momentum uncertain by ~0.15 %.
 BALANCE = 5e-3
+BALANCE_LANDING = 1e-2        # the 2-rank runs, while the parcels land (module docstring)
 RHO_P, G = 2500.0, 9.81
 NP2_END = 0.05                # the 2-rank runs: parcels falling across the processor plane
 
@@ -126,7 +134,7 @@ def wall_loads(log):
     return float(interval), loads, float(share)
 
 
-def momentum_balance(checks, label, log, case, real):
+def momentum_balance(checks, label, log, case, real, tolerance=BALANCE):
     """Inlet dp x area + the distributor's load = the real beads' buoyant weight."""
     found = wall_loads(log)
     checks.expect(found is not None, f"{label}: grainFoam printed the wall loads")
@@ -151,8 +159,9 @@ def momentum_balance(checks, label, log, case, real):
           f"distributor {floor / weight:.5f} of the buoyant weight {weight:.6g} N, the bed's "
           f"momentum gain {gain / weight:+.5f} (snapshots {t0:g}-{t1:g} s): "
           f"{100 * closure:+.3f} %", flush=True)
-    checks.expect(abs(closure) <= BALANCE,
-                  f"{label}: dp A + distributor load = buoyant weight within {100 * BALANCE:g} % "
+    checks.expect(abs(closure) <= tolerance,
+                  f"{label}: dp A + distributor load = buoyant weight within "
+                  f"{100 * tolerance:g} % "
                   f"({100 * closure:+.3f} %)")
     checks.expect(loads.get("lid") == (0.0, 0.0, 0.0) and abs(share - floor / weight) < 1e-6,
                   f"{label}: the line's share {share:.6f} = the distributor's {floor / weight:.6f}; "
@@ -228,8 +237,9 @@ def parcel_bed_ergun(runner, checks):
               f"{wall:.1f} s wall", flush=True)
         checks.expect(mean_speed < 5e-3, f"{label}: the bed is at rest (mean particle speed "
                                          f"{mean_speed:.2g} m/s < 5 mm/s)")
-        checks.expect(abs(error) <= TOLERANCE,
-                      f"{label}: dp within {100 * TOLERANCE:g} % of Ergun ({100 * error:+.2f} %)")
+        checks.expect(abs(error) <= TOLERANCE[k],
+                      f"{label}: dp within {100 * TOLERANCE[k]:g} % of Ergun "
+                      f"({100 * error:+.2f} %)")
         real = last["real_count"].sum() if "real_count" in last else len(last["id"])
         momentum_balance(checks, label, log, case, real)
     # Refused with parcels: the undisturbed-velocity correction (one particle's disturbance).
@@ -247,7 +257,7 @@ def parcel_bed_ergun(runner, checks):
         log = runner.solve(case, 2)
         last = check_run(checks, f"k = {k}, 2 ranks", k, log, case)
         real = last["real_count"].sum() if "real_count" in last else len(last["id"])
-        momentum_balance(checks, f"k = {k}, 2 ranks", log, case, real)
+        momentum_balance(checks, f"k = {k}, 2 ranks", log, case, real, BALANCE_LANDING)
     print("  k  particles  eps     H [mm]  dp [Pa]  Ergun [Pa]  error    wall [s]")
     for k, n, eps, h, dp, ref, err, wall in rows:
         print(f"  {k}  {n:9d}  {eps:.4f}  {h * 1e3:6.2f}  {dp:7.2f}  {ref:10.2f}  "
