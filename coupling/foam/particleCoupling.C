@@ -765,6 +765,16 @@ Foam::label ParticleCoupling::locate(const Foam::point& x) const {
   return mesh_.findCell(x);
 }
 
+Foam::label ParticleCoupling::locateNear(const Foam::point& x, Foam::label near) const {
+  if (structured_ || near < 0) return locate(x);
+  // A point inside a cell is inside no other: the cell found first is the one findCell finds
+  // (a point on a face shared by two cells may be given either, by either search).
+  if (mesh_.pointInCell(x, near, Foam::polyMesh::CELL_TETS)) return near;
+  for (const Foam::label n : mesh_.cellCells()[near])
+    if (mesh_.pointInCell(x, n, Foam::polyMesh::CELL_TETS)) return n;
+  return mesh_.findCell(x);
+}
+
 void ParticleCoupling::buildFootprints() {
   dem_->view(particles_);  // the DEM's arrays, no copy
   const std::size_t n = particles_.size();
@@ -816,7 +826,7 @@ void ParticleCoupling::buildFootprints() {
       if (image) continue;
       // The centre itself (the `centre` footprint, or a centred part): its cell is known.
       const bool atCentre = x[0] == centre[0] && x[1] == centre[1] && x[2] == centre[2];
-      const Foam::label c = atCentre ? centreCell : locate(x);
+      const Foam::label c = atCentre ? centreCell : locateNear(x, centreCell);
       if (c >= 0) points_.push_back({c, q.weight});
     }
     mergeFootprintCells(first_[i]);

@@ -121,17 +121,18 @@ if(GRAINFLOW_HINDERED_PYTHON)
     TIMEOUT 300)
   # coupling.hindered_settling_skewed: the same random suspension on a mesh whose interior
   # points are moved by up to 0.3 cell edges (non-orthogonal cells, up to 16 degrees; the
-  # cyclic faces stay; hindered_settling.py --skew), the centre footprint (on a mesh of
-  # non-box cells every footprint point is found by OpenFOAM's cell search: the divided
-  # footprint's 29 points per particle take 98 s instead of 3): the same bounds (measured
-  # -0.48 % against the drag law). The velocity correction's reconstruction from fluxes is
-  # what a skewed mesh tests: with OpenFOAM v1912's fvc::reconstruct the fluid ran at 120 m/s
-  # and two beads met at 6.5 m/s within 38 DEM steps (docs/coupling.md, "Non-orthogonal
-  # meshes"). About 4 s CPU.
+  # cyclic faces stay; hindered_settling.py --skew), over 0.03 s: the same bounds (measured
+  # +0.32 % against the drag law). What a skewed mesh tests:
+  # - the velocity correction's reconstruction from fluxes: with OpenFOAM v1912's
+  #   fvc::reconstruct the fluid ran at 2.2e4 m/s and two beads met at 657 m/s at DEM step 42
+  #   (docs/coupling.md, "Non-orthogonal meshes");
+  # - the footprint's points located on a mesh of other cells than boxes (locateNear: the
+  #   particle's cell and its neighbours before OpenFOAM's search of the mesh; the same
+  #   result, 25 s instead of 98 s over 0.06 s). About 12 s CPU.
   add_test(NAME coupling.hindered_settling_skewed
            COMMAND ${GRAINFLOW_HINDERED_PYTHON} ${PROJECT_SOURCE_DIR}/benchmarks/accuracy_cost/coupled/hindered_settling.py
-                   --eps 0.8 --arrangement random --bandwidth 2.83 --footprint centre --skew 0.3
-                   --end 0.06 --skip 0.03 --ranks 1 --check 2,10,1
+                   --eps 0.8 --arrangement random --bandwidth 2.83 --skew 0.3
+                   --end 0.03 --skip 0.015 --ranks 1 --check 2,10,1
                    --work ${CMAKE_CURRENT_BINARY_DIR}/hindered_settling_skewed --build ${PROJECT_BINARY_DIR})
   set_tests_properties(coupling.hindered_settling_skewed PROPERTIES
     LABELS "foam;coupling;accuracy_cost"
