@@ -413,6 +413,8 @@ def main():
     ap.add_argument("--work", default="/tmp/hindered_settling")
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     a = ap.parse_args()
+    if not 0 <= a.skew < 0.5:  # half a cell edge folds a cell over its neighbour
+        ap.error(f"--skew: {a.skew} is not in [0, 0.5) cell edges")
     a.build = os.path.abspath(a.build)
     mu = viscosity_for(a.re)
     u_t = terminal(mu)
