@@ -55,7 +55,7 @@ VoidFractionGrid::VoidFractionGrid(const Domain& domain, const VoidFractionGridS
     cell_volume_ *= edge_[a];
   }
   const std::size_t cells = static_cast<std::size_t>(n_[0]) * n_[1] * n_[2];
-  solid_.assign(cells, 0.0);
+  solid_.assign(cells, 0);
   eps_.assign(cells, 1.0);
 }
 
@@ -73,12 +73,29 @@ std::size_t VoidFractionGrid::cell_of(const Vec3& x) const {
 }
 
 void VoidFractionGrid::update(const Particles& p, MPI_Comm comm) {
-  std::fill(solid_.begin(), solid_.end(), 0.0);
-  for (std::size_t i = 0; i < p.size(); ++i) solid_[cell_of(p.x[i])] += sphere_volume(p.radius[i]);
-  MPI_Allreduce(MPI_IN_PLACE, solid_.data(), static_cast<int>(solid_.size()), MPI_DOUBLE, MPI_SUM,
-                comm);
+  // The solid volume of each cell is summed in integers: each particle's volume in units of
+  // 2^-e cell volumes, rounded. Integer sums do not depend on their order, so eps is the same
+  // whichever rank holds a particle and in whatever order a rank stores them: bit for bit on
+  // any number of ranks (docs/parallel.md, "Reproducible results"). A floating-point sum
+  // differed in the last bit between 2 and 3 ranks, and a chaotic scene grew that.
+  // e is the largest exponent for which no cell can overflow: no cell holds more than the
+  // particle count times the largest particle (count and maximum are exact on any ranks).
+  long long count = static_cast<long long>(p.size());
+  double largest = 0;  // [cell volumes]
+  for (std::size_t i = 0; i < p.size(); ++i)
+    largest = std::max(largest, sphere_volume(p.radius[i]) / cell_volume_);
+  MPI_Allreduce(MPI_IN_PLACE, &count, 1, MPI_LONG_LONG, MPI_SUM, comm);
+  MPI_Allreduce(MPI_IN_PLACE, &largest, 1, MPI_DOUBLE, MPI_MAX, comm);
+  const double bound = std::max(static_cast<double>(count) * largest, 1.0);
+  const int e = 61 - static_cast<int>(std::ceil(std::log2(bound)));
+  std::fill(solid_.begin(), solid_.end(), 0);
+  for (std::size_t i = 0; i < p.size(); ++i)
+    solid_[cell_of(p.x[i])] +=
+        std::llround(std::ldexp(sphere_volume(p.radius[i]) / cell_volume_, e));
+  MPI_Allreduce(MPI_IN_PLACE, solid_.data(), static_cast<int>(solid_.size()), MPI_LONG_LONG,
+                MPI_SUM, comm);
   for (std::size_t c = 0; c < solid_.size(); ++c) {
-    const double eps = 1 - solid_[c] / cell_volume_;
+    const double eps = 1 - std::ldexp(static_cast<double>(solid_[c]), -e);
     if (eps < minimum_) {
       ++clamped_total_;
       clamped_volume_ += (minimum_ - eps) * cell_volume_;

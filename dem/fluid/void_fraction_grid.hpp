@@ -20,11 +20,11 @@
 
 namespace grainflow {
 
-// The most cells a void-fraction grid may have: 2^26 = 67 108 864. Each cell holds two
-// doubles (solid volume, eps): 1 GiB on every rank, summed over the ranks by one reduction
-// of that size per step. Finer grids are refused before allocation (docs/stability.md).
+// The most cells a void-fraction grid may have: 2^26 = 67 108 864. Each cell holds its solid
+// volume (a 64-bit integer) and eps (a double): 1 GiB on every rank, summed over the ranks by one
+// reduction of that size per step. Finer grids are refused before allocation (docs/stability.md).
 constexpr double kMaxVoidFractionCells = 67108864;
-constexpr double kVoidFractionBytesPerCell = 2 * sizeof(double);
+constexpr double kVoidFractionBytesPerCell = sizeof(long long) + sizeof(double);
 
 // The cells along each axis the grid takes for a domain (cell_size rounded to fit it).
 std::array<double, 3> void_fraction_grid_cells(const Domain& domain,
@@ -56,7 +56,8 @@ class VoidFractionGrid {
   std::array<int, 3> n_{};
   Vec3 edge_;
   double cell_volume_ = 0;
-  std::vector<double> solid_, eps_;
+  std::vector<long long> solid_;  // [2^-e cell volumes] (update)
+  std::vector<double> eps_;
   long clamped_total_ = 0;
   double clamped_volume_ = 0;
 };
