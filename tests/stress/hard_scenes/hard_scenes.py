@@ -5,6 +5,7 @@
     hard_scenes.py --grain build/bin/grain --seed 17          # one scene, reproducibly
     hard_scenes.py --grain build/bin/grain --seeds 0:16,608   # ranges and single seeds
     hard_scenes.py --grain build/bin/grain --first 1000 --count 400 --budget 1200
+    hard_scenes.py --grain build/bin/grain --seeds 0:24 --jobs 2  # seeds side by side, 2 cores
 
 Each seed draws one valid scene (numbers from Python's seeded `random.Random(seed)`, so a
 seed is the same scene on every machine): sizes over a ratio up to 100 and densities up to
@@ -51,6 +52,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import threading
 import time
 
 try:
@@ -958,7 +960,11 @@ def limit_memory():
 def run_grain(args, ranks, scene_path, cwd, timeout, extra=(), output="out"):
     cmd = [args.grain, "run", scene_path, "--output", output, "--no-progress", *extra]
     if ranks > 1:
-        cmd = [args.mpiexec, "-np", str(ranks), "--oversubscribe", *cmd]
+        # mpiexec binds the ranks to cores 0, 1, ...: when --jobs leaves room for another
+        # multi-rank run beside this one, both would be bound to the same cores. Otherwise
+        # binding stays (a bound 2-rank run is ~15 % faster here).
+        bind = ("--bind-to", "none") if getattr(args, "jobs", 1) - ranks >= 2 else ()
+        cmd = [args.mpiexec, "-np", str(ranks), "--oversubscribe", *bind, *cmd]
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
                OMPI_MCA_rmaps_base_oversubscribe="1")
     start = time.monotonic()
@@ -1647,6 +1653,70 @@ def check_scene(args, seed, d, scene, workdir, depth=0):
     return f"stopped, proposal {how}", seconds + s2
 
 
+class Cores:
+    """The N cores of --jobs N, counted out to the running seeds: a seed of r ranks holds
+    min(r, N) of them (one wider than N runs alone), and no two seeds of one key (one work
+    folder: a seed listed twice) run at once. One counter under one condition: a seed takes
+    all its cores at once or waits, so no two seeds each hold part of what the other needs."""
+
+    def __init__(self, n):
+        self.n, self.used, self.keys = n, 0, set()
+        self.changed = threading.Condition()
+
+    def take(self, ranks, key, stop=lambda: False):
+        """Waits until the cores are free (or stop() holds); returns how many it took."""
+        need = min(max(ranks, 1), self.n)
+        with self.changed:
+            self.changed.wait_for(lambda: stop() or (self.used + need <= self.n and
+                                                     key not in self.keys))
+            self.used += need
+            self.keys.add(key)
+        return need
+
+    def give(self, need, key):
+        with self.changed:
+            self.used -= need
+            self.keys.discard(key)
+            self.changed.notify_all()
+
+
+def run_concurrently(jobs, tasks, may_start, ended):
+    """Runs tasks side by side on threads (the work is in the `grain` subprocesses): `tasks`
+    yields (ranks, key, run) in order; each starts, in that order, once Cores(jobs) has its
+    ranks' cores and may_start() holds (False: stop starting, as --budget does). ended(i,
+    result) is called as each task ends, one at a time, with the task's index and the value
+    run() returned. Returns the number of tasks started. A task that raises stops the
+    starting; the first such exception is raised here once the running tasks have ended."""
+    cores = Cores(jobs)
+    lock = threading.Lock()
+    errors, threads = [], []
+
+    def work(i, need, key, run):
+        try:
+            result = run()
+            with lock:
+                ended(i, result)
+        except BaseException as e:  # raised again by the main thread
+            with lock:
+                errors.append(e)
+        finally:
+            cores.give(need, key)
+
+    for i, (ranks, key, run) in enumerate(tasks):
+        need = cores.take(ranks, key, stop=lambda: bool(errors))
+        if errors or not may_start():
+            cores.give(need, key)
+            break
+        t = threading.Thread(target=work, args=(i, need, key, run), name=f"task {i}")
+        t.start()
+        threads.append(t)
+    for t in threads:
+        t.join()
+    if errors:
+        raise errors[0]
+    return len(threads)
+
+
 STOP_CAUSES = [
     ("key time.min_steps_per_contact", "steps-per-contact guard"),
     ("key time.max_step_travel", "travel guard"),
@@ -1692,6 +1762,70 @@ def summarise(path):
         print(f"       e.g. seed {rs[0]['seed']}: {rs[0]['detail'][:400]}")
 
 
+def check_seed(args, seed, d, scene):
+    """One drawn seed checked in its own folder under --work, seed_<seed> (removed when it
+    passes, unless --keep): (its --report line, its result line, (seed, d, Failure, folder)
+    when it failed, else None)."""
+    workdir = os.path.abspath(os.path.join(args.work, f"seed_{seed}"))
+    shutil.rmtree(workdir, ignore_errors=True)
+    t0 = time.monotonic()
+    head = f"seed {seed:6d} {d.family:13s} {d.ranks}r {'+'.join(combo_of(seed)):28s} "
+    try:
+        how, _ = check_scene(args, seed, d, scene, workdir)
+    except Failure as f:
+        line = {"seed": seed, "family": d.family, "ranks": d.ranks, "result": "FAIL",
+                "class": f.cls, "detail": f.detail}
+        return line, head + f"{time.monotonic() - t0:6.2f} s  FAIL {f.cls}: {f.detail}", \
+            (seed, d, f, workdir)
+    msg = getattr(d, "message", "")
+    line = {"seed": seed, "family": d.family, "ranks": d.ranks, "result": how, "message": msg}
+    text = head + f"{time.monotonic() - t0:6.2f} s  ok ({how})" + \
+        (f": {msg[:200]}" if args.verbose and msg else "")
+    if not args.keep:
+        shutil.rmtree(workdir, ignore_errors=True)
+    return line, text, None
+
+
+def run_seeds_concurrently(args, seeds, extra, report, start):
+    """--jobs N > 1: the seeds side by side, the ranks of the running ones summing to at most
+    N (run_concurrently). Result lines print as seeds end; the --report lines are written in
+    the seeds' order, each once the seeds before it have ended. --budget stops the starting
+    of seeds. Returns (scenes done, failures in the seeds' order), as the sequential loop."""
+    results = {}
+    written = [0]
+    budget_used = []
+
+    def tasks():
+        for seed in seeds:
+            if args.family and not extra and FAMILIES[seed % len(FAMILIES)] != args.family:
+                continue
+            d, scene = draw(seed, extra)
+            if args.ranks != "mixed":
+                d.ranks = int(args.ranks)
+            yield d.ranks, seed, (lambda seed=seed, d=d, scene=scene:
+                                  check_seed(args, seed, d, scene))
+
+    def may_start():
+        if args.budget and time.monotonic() - start > args.budget:
+            budget_used.append(True)
+            return False
+        return True
+
+    def ended(i, result):
+        results[i] = result
+        print(result[1], flush=True)
+        while report and written[0] in results:
+            report.write(json.dumps(results[written[0]][0]) + "\n")
+            report.flush()
+            written[0] += 1
+
+    run_concurrently(args.jobs, tasks(), may_start, ended)
+    done = len(results)
+    if budget_used:
+        print(f"time budget of {args.budget:g} s used after {done} scenes")
+    return done, [results[i][2] for i in sorted(results) if results[i][2]]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--grain")
@@ -1717,7 +1851,13 @@ def main():
                     help="do not rerun the overlap guard's remedies")
     ap.add_argument("--no-restarts", action="store_true",
                     help="do not restart the runs that ended from their checkpoint")
+    ap.add_argument("--jobs", type=int, default=1, metavar="N",
+                    help="run seeds side by side on N cores, the running seeds' ranks summing "
+                         "to at most N (a seed of more ranks runs alone); result lines print "
+                         "as seeds end, the summary and --report as in seed order (default 1)")
     args = ap.parse_args()
+    if args.jobs < 1:
+        ap.error(f"--jobs: {args.jobs} is not a count of cores >= 1")
     if args.summarise:
         summarise(args.summarise)
         return 0
@@ -1736,42 +1876,30 @@ def main():
     start = time.monotonic()
     failures = []
     done = 0
-    for seed in seeds:
-        if args.budget and time.monotonic() - start > args.budget:
-            print(f"time budget of {args.budget:g} s used after {done} scenes")
-            break
-        extra = args.family if args.family in EXTRA_FAMILIES else None
-        if args.family and not extra and FAMILIES[seed % len(FAMILIES)] != args.family:
-            continue
-        d, scene = draw(seed, extra)
-        if args.ranks != "mixed":
-            d.ranks = int(args.ranks)
-        if args.print_scene:
-            print(scene_yaml(seed, scene, d))
-            continue
-        workdir = os.path.abspath(os.path.join(args.work, f"seed_{seed}"))
-        shutil.rmtree(workdir, ignore_errors=True)
-        t0 = time.monotonic()
-        try:
-            how, _ = check_scene(args, seed, d, scene, workdir)
-            msg = getattr(d, "message", "")
-            line = {"seed": seed, "family": d.family, "ranks": d.ranks, "result": how,
-                    "message": msg}
-            print(f"seed {seed:6d} {d.family:13s} {d.ranks}r {'+'.join(combo_of(seed)):28s} "
-                  f"{time.monotonic() - t0:6.2f} s  ok ({how})"
-                  + (f": {msg[:200]}" if args.verbose and msg else ""), flush=True)
-            if not args.keep:
-                shutil.rmtree(workdir, ignore_errors=True)
-        except Failure as f:
-            line = {"seed": seed, "family": d.family, "ranks": d.ranks, "result": "FAIL",
-                    "class": f.cls, "detail": f.detail}
-            failures.append((seed, d, f, workdir))
-            print(f"seed {seed:6d} {d.family:13s} {d.ranks}r {'+'.join(combo_of(seed)):28s} "
-                  f"{time.monotonic() - t0:6.2f} s  FAIL {f.cls}: {f.detail}", flush=True)
-        if report:
-            report.write(json.dumps(line) + "\n")
-            report.flush()
-        done += 1
+    extra = args.family if args.family in EXTRA_FAMILIES else None
+    if args.jobs > 1 and not args.print_scene:
+        done, failures = run_seeds_concurrently(args, seeds, extra, report, start)
+    else:
+        for seed in seeds:
+            if args.budget and time.monotonic() - start > args.budget:
+                print(f"time budget of {args.budget:g} s used after {done} scenes")
+                break
+            if args.family and not extra and FAMILIES[seed % len(FAMILIES)] != args.family:
+                continue
+            d, scene = draw(seed, extra)
+            if args.ranks != "mixed":
+                d.ranks = int(args.ranks)
+            if args.print_scene:
+                print(scene_yaml(seed, scene, d))
+                continue
+            line, text, failure = check_seed(args, seed, d, scene)
+            print(text, flush=True)
+            if failure:
+                failures.append(failure)
+            if report:
+                report.write(json.dumps(line) + "\n")
+                report.flush()
+            done += 1
     if args.print_scene:
         return 0
     elapsed = time.monotonic() - start

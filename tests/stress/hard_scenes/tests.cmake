@@ -6,7 +6,8 @@
 # side before the checkpoint (its restart must keep the run's interaction range and removed
 # count).
 # Bound: under 3 minutes on 2 shared cores (measured figure in docs/stability.md); a run over
-# 25 s counts as a failure of its seed.
+# 25 s counts as a failure of its seed. --jobs 2: the seeds run side by side on the 2 cores the
+# test holds, two 1-rank seeds at once, a 2-rank seed alone (the summary as in seed order).
 # h5py reads the particle snapshots (scripts/python.sh picks the Python).
 grainflow_find_python(GRAINFLOW_HARD_SCENES_PYTHON "h5py,numpy,yaml" "the test hard_scenes.ci is")
 if(NOT GRAINFLOW_HARD_SCENES_PYTHON)
@@ -15,7 +16,7 @@ endif()
 add_test(NAME hard_scenes.ci
          COMMAND ${GRAINFLOW_HARD_SCENES_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/hard_scenes.py
                  --grain $<TARGET_FILE:grain> --mpiexec ${MPIEXEC_EXECUTABLE} --seeds 0:24,32
-                 --timeout 25 --work ${PROJECT_BINARY_DIR}/test_output/hard_scenes)
+                 --timeout 25 --jobs 2 --work ${PROJECT_BINARY_DIR}/test_output/hard_scenes)
 set_tests_properties(hard_scenes.ci PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}"
                      LABELS stress PROCESSORS 2 TIMEOUT 240)
 
@@ -29,7 +30,8 @@ set_tests_properties(hard_scenes.ci PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_
 add_test(NAME hard_scenes.thermal_ci
          COMMAND ${GRAINFLOW_HARD_SCENES_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/hard_scenes.py
                  --grain $<TARGET_FILE:grain> --mpiexec ${MPIEXEC_EXECUTABLE} --family thermal
-                 --seeds 0:16,46,608,695 --timeout 25 --work ${PROJECT_BINARY_DIR}/test_output/hard_scenes_thermal)
+                 --seeds 0:16,46,608,695 --timeout 25 --jobs 2
+                 --work ${PROJECT_BINARY_DIR}/test_output/hard_scenes_thermal)
 set_tests_properties(hard_scenes.thermal_ci PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}"
                      LABELS stress PROCESSORS 2 TIMEOUT 240)
 
@@ -42,16 +44,17 @@ set_tests_properties(hard_scenes.thermal_ci PROPERTIES ENVIRONMENT "${GRAINFLOW_
 # moved: 1e-6), temperatures alike.
 # Seeds 0, 1, 3, 4 and 6: a pour, a drum, a mesh plate, a periodic gas and a fluid (the rod,
 # closed-gas and limits families stop early: the sweeps in docs/stability.md hold them);
-# thermal seeds 1 and 4 carry heat and parcels.
+# thermal seeds 1 and 4 carry heat and parcels. These seeds run on 1 rank, two at a time
+# (--jobs 2); the resting bed below is one scene, its twins run one after another.
 add_test(NAME hard_scenes.twins_ci
          COMMAND ${GRAINFLOW_HARD_SCENES_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/twin_scenes.py
                  --grain $<TARGET_FILE:grain> --mpiexec ${MPIEXEC_EXECUTABLE} --seeds 0,1,3,4,6
-                 --twins turn1,shift,scale --timeout 25
+                 --twins turn1,shift,scale --timeout 25 --jobs 2
                  --work ${PROJECT_BINARY_DIR}/test_output/twin_scenes)
 add_test(NAME hard_scenes.thermal_twins_ci
          COMMAND ${GRAINFLOW_HARD_SCENES_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/twin_scenes.py
                  --grain $<TARGET_FILE:grain> --mpiexec ${MPIEXEC_EXECUTABLE} --family thermal
-                 --seeds 1,4 --twins turn1,shift,scale --timeout 25
+                 --seeds 1,4 --twins turn1,shift,scale --timeout 25 --jobs 2
                  --work ${PROJECT_BINARY_DIR}/test_output/twin_scenes_thermal)
 # A bed resting on a floor, periodic along x and y (tests/data/scenes/twins/resting_bed.yaml),
 # also boosted: floor, beads and fluid moving along x, which contacts, friction, rolling,

@@ -5,6 +5,7 @@
     twin_scenes.py --grain build/bin/grain --seeds 0:24
     twin_scenes.py --grain build/bin/grain --family thermal --seeds 0:16 --twins turn1,shift
     twin_scenes.py --grain build/bin/grain --scene tutorials/dem/hopper/fill.yaml --end 0.02
+    twin_scenes.py --grain build/bin/grain --seeds 0:24 --jobs 2  # seeds side by side, 2 cores
 
 The physics knows neither which way the axes point nor where the origin lies; the scenes of
 the other tests all have gravity along -z and the domain's corner at the origin. Each seed's
@@ -655,6 +656,16 @@ def check_seed(args, seed, twins):
                  os.path.abspath(os.path.join(args.work, f"seed_{seed}")))
 
 
+def seed_ranks(args, seed):
+    """The ranks a seed runs on (--jobs counts them before it starts)."""
+    if args.ranks:
+        return args.ranks
+    try:
+        return hs.draw(seed, args.family)[0].ranks
+    except Exception:  # a generator fault: check_seed names it as the seed's failure
+        return 1
+
+
 def check(args, seed, d, scene, twins, work):
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
@@ -790,7 +801,13 @@ def main():
     ap.add_argument("--timeout", type=float, default=60, help="per run [s]")
     ap.add_argument("--work", default="twin_scenes_work")
     ap.add_argument("--keep", action="store_true", help="keep the folders of passing seeds")
+    ap.add_argument("--jobs", type=int, default=1, metavar="N",
+                    help="run seeds (and scene files) side by side on N cores, the running "
+                         "ones' ranks summing to at most N (one of more ranks runs alone); "
+                         "result lines print as they end (default 1)")
     args = ap.parse_args()
+    if args.jobs < 1:
+        ap.error(f"--jobs: {args.jobs} is not a count of cores >= 1")
     twins = args.twins.split(",")
     for name in twins:
         if name not in TOLERANCE:
@@ -803,8 +820,9 @@ def main():
         ap.error(f"--end: {args.end} is not a time > 0")
     os.makedirs(args.work, exist_ok=True)
     start = time.monotonic()
-    failed = []
-    for k, path in enumerate(args.scene):
+
+    def check_file(k, path):
+        """A --scene file: (its result line, its path when it failed, else None)."""
         t0 = time.monotonic()
         work = os.path.abspath(os.path.join(args.work, f"scene_{k}"))
         try:
@@ -812,25 +830,42 @@ def main():
             ok, note, _ = check(args, k, d, d.scene, twins, work)
         except (OSError, RuntimeError, KeyError, yaml.YAMLError) as e:
             ok, note = False, f"{type(e).__name__}: {e}"
-        print(f"scene {path} {time.monotonic() - t0:6.2f} s  {'ok' if ok else 'FAIL'} ({note})",
-              flush=True)
+        text = f"scene {path} {time.monotonic() - t0:6.2f} s  {'ok' if ok else 'FAIL'} ({note})"
         if ok and not args.keep:
             shutil.rmtree(work, ignore_errors=True)
-        if not ok:
-            failed.append(path)
-    for seed in args.seeds or []:
+        return text, None if ok else path
+
+    def check_drawn(seed):
+        """A drawn seed: (its result line, the seed when it failed, else None)."""
         t0 = time.monotonic()
         try:
             ok, note, work = check_seed(args, seed, twins)
         except Exception as e:  # a generator fault is a failure of the seed, named
             ok, note, work = False, f"{type(e).__name__}: {e}", None
         family = args.family or hs.FAMILIES[seed % len(hs.FAMILIES)]
-        print(f"seed {seed:5d} {family:13s} {time.monotonic() - t0:6.2f} s  "
-              f"{'ok' if ok else 'FAIL'} ({note})", flush=True)
+        text = (f"seed {seed:5d} {family:13s} {time.monotonic() - t0:6.2f} s  "
+                f"{'ok' if ok else 'FAIL'} ({note})")
         if ok and work and not args.keep:
             shutil.rmtree(work, ignore_errors=True)
-        if not ok:
-            failed.append(seed)
+        return text, None if ok else seed
+
+    # (ranks, work folder, run) of the scene files, then of the seeds; the ranks only count
+    # with --jobs (hard_scenes.run_concurrently).
+    tasks = [(args.ranks or 1, f"scene_{k}", lambda k=k, path=path: check_file(k, path))
+             for k, path in enumerate(args.scene)]
+    tasks += [(seed_ranks(args, seed) if args.jobs > 1 else 1, f"seed_{seed}",
+               lambda seed=seed: check_drawn(seed)) for seed in args.seeds or []]
+    results = {}
+    if args.jobs > 1:
+        def ended(i, result):
+            results[i] = result
+            print(result[0], flush=True)
+        hs.run_concurrently(args.jobs, tasks, lambda: True, ended)
+    else:
+        for i, (_, _, run) in enumerate(tasks):
+            results[i] = run()
+            print(results[i][0], flush=True)
+    failed = [results[i][1] for i in sorted(results) if results[i][1] is not None]
     print(f"\n{len(args.seeds or []) + len(args.scene)} scenes in "
           f"{time.monotonic() - start:.1f} s, {len(failed)} failed"
           + (f": {' '.join(map(str, failed))} (folders under {args.work})" if failed else ""))
