@@ -1105,6 +1105,19 @@ bool Simulation::check_contacts(const ContactGuards& s, bool finite_here) const 
   }
   const bool overlap = worst[0] > limit;  // the overlap guard speaks first
   const WorstContact& w = overlap ? s.worst : s.unresolved.contact;
+  // Every ghost gets its owner's force (collective), so that the load describe_overlap finds
+  // on a particle held by another rank (or on a periodic image) is the force itself, not its
+  // weight: the message is then the same on any number of ranks.
+  if (overlap) {
+    std::vector<double> local(3 * p_.size());
+    for (std::size_t i = 0; i < p_.size(); ++i) {
+      Vec3 f = p_.force[i];
+      if (i < drag_.coefficient.size())
+        f += drag_.coefficient[i] * (drag_.fluid_velocity[i] - p_.v[i]);
+      for (int a = 0; a < 3; ++a) local[3 * i + a] = f[a];
+    }
+    exchange_->forward_values(local, 3, ghost_force_);
+  }
   if (overlap ? mine[0] != worst[0] : mine[1] != worst[1]) {
     agree_on_error(comm_, "");  // another rank holds the contact and speaks
     return worst[3] == 0;       // not reached
@@ -1183,6 +1196,7 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
     int material = 0;
     long local = -1;  // index among this rank's particles (their force is known), or -1
     Vec3 v = Vec3::Zero();
+    long ghost = -1;  // index among the ghosts (their owner's force in ghost_force_), or -1
   };
   const auto find = [&](GlobalId id) {
     Body b;
@@ -1192,8 +1206,8 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
              static_cast<long>(i), p_.v[i]};
     for (std::size_t q = 0; q < ghosts_.id.size() && !b.found; ++q)
       if (ghosts_.id[q] == id)
-        b = {true, ghosts_.position(q), ghosts_.radius[q], ghosts_.mass[q], ghosts_.material[q],
-             -1,   ghosts_.v[q]};
+        b = {true, ghosts_.position(q), ghosts_.radius[q],   ghosts_.mass[q], ghosts_.material[q],
+             -1,   ghosts_.v[q],        static_cast<long>(q)};
     return b;
   };
   const Body a = find(w.a);
@@ -1237,11 +1251,12 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
   c.y_star = pc.y_star;
   if (!c.hertz) c.kn = HookeNormal::coefficients(pc, constants_, c.r_star, c.m_star, 0).kn;
   if (scene_.contact.cohesion == CohesionModel::sjkr) c.cohesion = pc.cohesion_energy_density;
-  // The load pressing the contact: for a partner held here, every force on it but this
+  // The load pressing the contact: for a partner, every force on it but this
   // contact's (its weight, the particles and walls pressing on it, fluid forces), along n;
   // this contact's own force is taken as its elastic part less cohesion (its damping, which
-  // resists the approach, is left in, so the load is if anything underestimated). For a
-  // partner on another rank, its weight.
+  // resists the approach, is left in, so the load is if anything underestimated). A partner
+  // held by another rank, or a periodic image, is a ghost: its owner's force was forwarded to
+  // it (check_contacts), so the load is the same on any number of ranks.
   std::string load_by;
   const Body* pressed = nullptr;  // the body whose load that is, and the direction it is
   Vec3 into = Vec3::Zero();       // pressed in: towards its partner in the contact
@@ -1252,11 +1267,22 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
       f += drag_.coefficient[i] * (drag_.fluid_velocity[i] - p_.v[i]);
     return f;
   };
+  // A body's force when it is known (held here, or a ghost given its owner's force).
+  const auto known_force = [&](long local, long ghost, Vec3& f) {
+    if (local >= 0) {
+      f = force_on(local);
+      return true;
+    }
+    if (ghost < 0 || static_cast<std::size_t>(3 * ghost + 2) >= ghost_force_.size()) return false;
+    f = Vec3(ghost_force_[3 * ghost], ghost_force_[3 * ghost + 1], ghost_force_[3 * ghost + 2]);
+    return true;
+  };
   if (n.squaredNorm() > 0) {
     const double own = elastic_force(c, c.overlap) - cohesion_force(c, c.overlap);
     const auto pressing = [&](const Body& body, double sign, GlobalId id) {
-      const double load =
-          body.local >= 0 ? own - sign * force_on(body.local).dot(n) : -sign * body.m * g.dot(n);
+      Vec3 f;
+      const double load = known_force(body.local, body.ghost, f) ? own - sign * f.dot(n)
+                                                                 : -sign * body.m * g.dot(n);
       if (load > c.load) {
         c.load = load;
         load_by = "particle " + std::to_string(id);
@@ -1287,10 +1313,10 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
       Vec3 x = Vec3::Zero(), v = Vec3::Zero();
       double r = 0, m = 0;
       int material = 0;
-      long local = -1;
+      long local = -1, ghost = -1;
     };
     const auto ball = [](GlobalId id, const Body& body) {
-      return Ball{id, body.x, body.v, body.r, body.m, body.material, body.local};
+      return Ball{id, body.x, body.v, body.r, body.m, body.material, body.local, body.ghost};
     };
     // The contact of sphere p with a sphere (or, with q == nullptr, a wall of `wall_material`)
     // at `overlap`: its coefficients and elastic force.
@@ -1309,7 +1335,8 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
       return c.hertz ? std::pow(k.y_star * std::sqrt(k.r_star), 2.0 / 3.0) : k.kn;
     };
     const auto others = [&](const Ball& body, const Vec3& u) {
-      return body.local >= 0 ? force_on(body.local).dot(u) : body.m * g.dot(u);
+      Vec3 f;
+      return known_force(body.local, body.ghost, f) ? f.dot(u) : body.m * g.dot(u);
     };
     // Each sphere touching p (not `skip1`, `skip2`) whose push on p lies within 60 degrees
     // of `dir`: f(ball, unit push direction, overlap).
@@ -1327,7 +1354,7 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
                  static_cast<long>(i)});
       for (std::size_t q = 0; q < ghosts_.id.size(); ++q)
         one(Ball{ghosts_.id[q], ghosts_.position(q), ghosts_.v[q], ghosts_.radius[q],
-                 ghosts_.mass[q], ghosts_.material[q], -1});
+                 ghosts_.mass[q], ghosts_.material[q], -1, static_cast<long>(q)});
     };
     // D drives P towards X along u; `dp` and `px` are the two contacts, `dp_checked` whether
     // D-P is the contact that passed the limit (else P-X is). For a wall, x == nullptr.
@@ -1359,13 +1386,14 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
           elastic_force(dp, dp.overlap) - (dp_checked ? cohesion_force(dp, dp.overlap) : 0);
       const double f_px =
           elastic_force(px, px.overlap) - (dp_checked ? 0 : cohesion_force(px, px.overlap));
-      // Every force on the group and on P along u but the two contacts' (for a sphere on
-      // another rank, its weight).
+      // Every force on the group and on P along u but the two contacts' (for a sphere whose
+      // force is not known here, its weight).
+      const auto known = [](const Ball& s) { return s.local >= 0 || s.ghost >= 0; };
       double mass = p.m, kinetic = 0;
-      double load = p.local >= 0 ? others(p, u) - f_dp + f_px : others(p, u);
+      double load = known(p) ? others(p, u) - f_dp + f_px : others(p, u);
       for (const Ball& m : group) {
         mass += m.m;
-        load += others(m, u) + (m.id == d.id && m.local >= 0 ? f_dp : 0.0);
+        load += others(m, u) + (m.id == d.id && known(m) ? f_dp : 0.0);
       }
       const auto approach = [&](const Ball& m) { return std::max(0.0, (m.v - v_x).dot(u)); };
       kinetic += 0.5 * p.m * approach(p) * approach(p);

@@ -320,6 +320,9 @@ class Simulation {
   std::vector<std::unique_ptr<ForceTerm>> terms_;
   std::unique_ptr<HeatTransfer> heat_;       // scene.heat; null: no thermal code runs
   std::vector<double> ghost_temperature_;    // each ghost's, at the step's start (heat on)
+  // Each ghost's owner's force (3 per ghost), forwarded on the overlap guard's error path
+  // only (check_contacts) for describe_overlap's loads.
+  mutable std::vector<double> ghost_force_;
   ImplicitDrag drag_;
   std::vector<TermLimit> force_limits_;
   std::vector<std::string> force_limit_notes_;

@@ -54,19 +54,38 @@ add_test(NAME hard_scenes.twins_ci
 add_test(NAME hard_scenes.thermal_twins_ci
          COMMAND ${GRAINFLOW_HARD_SCENES_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/twin_scenes.py
                  --grain $<TARGET_FILE:grain> --mpiexec ${MPIEXEC_EXECUTABLE} --family thermal
-                 --seeds 1,4 --twins turn1,shift,scale --timeout 25 --jobs 2
+                 --seeds 1,4 --twins turn1,shift,scale,ranks --timeout 25 --jobs 2
                  --work ${PROJECT_BINARY_DIR}/test_output/twin_scenes_thermal)
+# Rank twins (twin_scenes.py --twins ranks, docs/parallel.md "Reproducible results"): drawn
+# scenes with parallel: {reproducible: true} on their drawn ranks and on another count and
+# grid (1, 2 or 3 ranks, balanced or not) must write the same bits. Seeds 0-5 and 9: a pour,
+# drums, a rod, a mesh plate, periodic and closed gases; 14: a one-way fluid with a computed
+# void fraction, whose eps once differed by an ulp between 2 and 3 ranks; 17: a balanced
+# 3-rank drum.
+add_test(NAME hard_scenes.ranks_twins
+         COMMAND ${GRAINFLOW_HARD_SCENES_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/twin_scenes.py
+                 --grain $<TARGET_FILE:grain> --mpiexec ${MPIEXEC_EXECUTABLE}
+                 --seeds 0:6,9,14,17 --twins ranks --timeout 25 --jobs 2
+                 --work ${PROJECT_BINARY_DIR}/test_output/twin_scenes_ranks)
+# Thermal seed 18 stops on the overlap guard at step 4296 on 1 and on 3 ranks; its message
+# once differed (the load of a partner held by another rank was its weight only).
+add_test(NAME hard_scenes.thermal_ranks_twins
+         COMMAND ${GRAINFLOW_HARD_SCENES_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/twin_scenes.py
+                 --grain $<TARGET_FILE:grain> --mpiexec ${MPIEXEC_EXECUTABLE} --family thermal
+                 --seeds 18 --twins ranks --timeout 25
+                 --work ${PROJECT_BINARY_DIR}/test_output/twin_scenes_thermal_ranks)
 # A bed resting on a floor, periodic along x and y (tests/data/scenes/twins/resting_bed.yaml),
 # also boosted: floor, beads and fluid moving along x, which contacts, friction, rolling,
 # cohesion and drag must not see (walls moved at 0.9 of their velocity fail it at 8 ms); and
-# rescaled (an EPSD rolling stiffness with 1 mm written in place of one R* fails it at 8 ms).
+# rescaled (an EPSD rolling stiffness with 1 mm written in place of one R* fails it at 8 ms);
+# and on 2 ranks with parallel.reproducible (the same bits as on 1).
 add_test(NAME hard_scenes.resting_bed_twins
          COMMAND ${GRAINFLOW_HARD_SCENES_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/twin_scenes.py
                  --grain $<TARGET_FILE:grain> --mpiexec ${MPIEXEC_EXECUTABLE}
                  --scene ${PROJECT_SOURCE_DIR}/tests/data/scenes/twins/resting_bed.yaml
-                 --twins turn1,shift,boost,scale --timeout 60
+                 --twins turn1,shift,boost,scale,ranks --timeout 60
                  --work ${PROJECT_BINARY_DIR}/test_output/twin_scenes_bed)
-set_tests_properties(hard_scenes.twins_ci hard_scenes.thermal_twins_ci
-                     hard_scenes.resting_bed_twins PROPERTIES
+set_tests_properties(hard_scenes.twins_ci hard_scenes.thermal_twins_ci hard_scenes.ranks_twins
+                     hard_scenes.thermal_ranks_twins hard_scenes.resting_bed_twins PROPERTIES
                      ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}" LABELS stress PROCESSORS 2
                      TIMEOUT 180)

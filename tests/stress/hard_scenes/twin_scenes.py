@@ -32,6 +32,12 @@ scene (drawn by hard_scenes.py, every family) is run as drawn and as its twins:
     same arithmetic and must end where the drawn one does to 1e-9 of a radius (fifth roots,
     as in the Hooke stiffness from a characteristic velocity, round otherwise); a length,
     time or speed written into the code makes it differ.
+  * ranks: the scene as drawn (its fills included) with parallel: {reproducible: true}, on its
+    drawn ranks and on another count and grid (2 or 3 ranks for a 1-rank scene, 1 or 3 for a
+    2-rank one; a grid along a drawn axis or the default rule, balanced or not): the mode
+    promises the same bits on any ranks (docs/parallel.md), so every dataset of every
+    snapshot (the owner rank aside) must be equal; not compared when the twin's grid is
+    refused as thinner than the interaction range.
 --scene FILE twins a scene file instead of drawn ones (tests/data/scenes/twins/resting_bed.yaml
 is written for the boost).
 A fill draws its random positions axis by axis, so a turned region holds other particles:
@@ -80,14 +86,16 @@ POINTS = {"min", "max", "point", "axis_point", "base", "centre", "origin", "tran
 VECTORS = {"gravity", "normal", "axis", "velocity", "surface_velocity", "u", "flow_direction",
            "gradient_direction", "gradient", "periodic", "grid"}
 LISTS = {"values", "weights"}  # radius distributions: numbers, not coordinates
-TOLERANCE = {"turn1": 1e-9, "turn2": 1e-9, "shift": 1e-6, "boost": 1e-6, "scale": 1e-9}
+TOLERANCE = {"turn1": 1e-9, "turn2": 1e-9, "shift": 1e-6, "boost": 1e-6, "scale": 1e-9,
+             "ranks": 0.0}
 # Temperatures, relative. A shift rounds each overlap differently by an ulp of the moved
 # coordinates, and conduction goes as the contact radius sqrt(R* overlap), whose sensitivity
 # is unbounded at zero overlap: beads that touch (the thermal family's blocks, written with
 # 17 digits) conduct through overlaps of a few ulps or none, and with the generator's largest
 # conductivities (1e5 W/(m K)) that moved a cold bead's temperature by 0.17 K of 268 K in
 # 0.4 ms (thermal seed 90 moved by 0.01 m; its positions agreed to 6e-8 r).
-T_TOLERANCE = {"turn1": 1e-9, "turn2": 1e-9, "shift": 1e-2, "boost": 1e-6, "scale": 1e-9}
+T_TOLERANCE = {"turn1": 1e-9, "turn2": 1e-9, "shift": 1e-2, "boost": 1e-6, "scale": 1e-9,
+               "ranks": 0.0}
 # How far a twin may deviate beyond its tolerance, in units of the nudge's deviation at the
 # same snapshot (judge()). These bound round-off growth, which cannot be derived exactly: a
 # turn's round-off differs once per sum, CHAOS; a shift's or a boost's in every step, whose
@@ -648,6 +656,82 @@ def copy_snapshots(d, folder, twin=None):
             twin.snapshot(src, dst)
 
 
+
+# The ranks twin compares every per-particle dataset of every snapshot but the owner rank.
+RANKS_SKIP = {"rank"}
+# A twin's decomposition refused because the domain is too thin for it: no comparison.
+TOO_THIN = "thinner than the interaction range"
+
+
+def ranks_layout(seed, ranks):
+    """The ranks twin's rank count and `parallel` block: 2 or 3 ranks for a 1-rank scene, 1 or
+    3 for a 2-rank one; a grid along a drawn axis (or the default rule), balanced or not."""
+    rng = random.Random(7877 * seed + 3)
+    n = rng.choice([2, 3]) if ranks == 1 else rng.choice([1, 3])
+    block = {"reproducible": True}
+    if n > 1 and rng.random() < 0.7:
+        grid = [1, 1, 1]
+        grid[rng.randrange(3)] = n
+        block["grid"] = grid
+        if rng.random() < 0.5:
+            block["balance"] = True
+    return n, block
+
+
+def read_datasets(folder):
+    snaps = []
+    for path in snapshot_files(folder):
+        with h5py.File(path, "r") as f:
+            order = np.argsort(f["id"][...])
+            data = {k: f[k][...][order] for k in f.keys()
+                    if k not in RANKS_SKIP and isinstance(f[k], h5py.Dataset)
+                    and f[k].shape[:1] == order.shape}
+            snaps.append((float(f.attrs["time"]), data))
+    return snaps
+
+
+def check_ranks(args, seed, d, scene, work):
+    """The drawn scene (its fills included) with parallel.reproducible on its drawn ranks and
+    on another count and grid (ranks_layout): (failure or None, note). The mode promises the
+    same bits (docs/parallel.md), so every dataset must be equal, the summaries and stops
+    alike."""
+    runs = []
+    n, block = ranks_layout(seed, d.ranks)
+    drawn_block = dict(scene.get("parallel", {}), reproducible=True)
+    for name, ranks, parallel in (("ranks_drawn", d.ranks, drawn_block), ("ranks", n, block)):
+        s = json.loads(json.dumps(scene))
+        s["parallel"] = parallel
+        folder = os.path.join(work, name)
+        write_case(folder, s, d.files)
+        copy_snapshots(d, folder)
+        code, out, _ = hs.run_grain(args, ranks, "scene.yaml", folder, args.timeout)
+        runs.append((code, out, folder))
+    (code, out, f0), (tcode, tout, f1) = runs
+    how = f"ranks {d.ranks} -> {n}" + (f" {block['grid']}" if "grid" in block else "") + \
+        (" balanced" if block.get("balance") else "")
+    if tcode != 0 and TOO_THIN in hs.error_line(tout):
+        return None, f"{how} not run (the domain is too thin for it)"
+    if tcode != code or (code != 0 and not same_stop(hs.error_line(out), hs.error_line(tout))):
+        return (f"{how}: exit {tcode}, on the drawn ranks {code}\n  drawn: "
+                f"{hs.error_line(out)}\n  twin:  {hs.error_line(tout)}"), None
+    if code != 0:
+        return None, f"{how} stopped alike"
+    if summary(out) != summary(tout):
+        return f"{how}: summary {summary(tout)}, on the drawn ranks {summary(out)}", None
+    a, b = read_datasets(f0), read_datasets(f1)
+    if len(a) != len(b):
+        return f"{how}: {len(b)} snapshots, on the drawn ranks {len(a)}", None
+    for (t, x), (_, y) in zip(a, b):
+        for key, values in x.items():
+            if key not in y or values.shape != y[key].shape:
+                return f"{how}: t = {t}: dataset {key} missing or of another shape", None
+            if not np.array_equal(values, y[key], equal_nan=True):
+                bad = np.nonzero(np.any((values != y[key]).reshape(len(values), -1), axis=1))[0]
+                return (f"{how}: t = {t}: {key} differs in {len(bad)} particles (first id "
+                        f"{x['id'][bad[0]]}: {values[bad[0]]} against {y[key][bad[0]]})"), None
+    return None, f"{how} bit for bit ({len(a)} snapshots)"
+
+
 def check_seed(args, seed, twins):
     d, scene = hs.draw(seed, args.family)
     if args.ranks:
@@ -658,24 +742,34 @@ def check_seed(args, seed, twins):
 
 def seed_ranks(args, seed):
     """The ranks a seed runs on (--jobs counts them before it starts)."""
-    if args.ranks:
-        return args.ranks
     try:
-        return hs.draw(seed, args.family)[0].ranks
+        ranks = args.ranks or hs.draw(seed, args.family)[0].ranks
     except Exception:  # a generator fault: check_seed names it as the seed's failure
         return 1
+    if "ranks" in args.twins.split(","):
+        ranks = max(ranks, ranks_layout(seed, ranks)[0])
+    return ranks
 
 
 def check(args, seed, d, scene, twins, work):
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
+    ranks_note = None
+    if "ranks" in twins:
+        failure, ranks_note = check_ranks(args, seed, d, scene, work)
+        if failure:
+            return False, failure, work
+        twins = [t for t in twins if t != "ranks"]
+        if not twins:
+            return True, ranks_note, work
     started, snap = start_from_snapshot(args, d, scene, work)
     results = []
     if started is None:
         # The fills themselves are refused: the twins' fills must be refused alike.
         base_msg = hs.error_line(snap)
         if "could place only" in base_msg:  # random placement saturated: a turned region
-            return True, "fills saturated (a turned region draws other positions)", work
+            return True, "fills saturated (a turned region draws other positions)" + \
+                (f"; {ranks_note}" if ranks_note else ""), work
         for name in twins:
             t = Scale(seed) if name == "scale" else Twin(name, seed, domain_size(scene))
             folder = os.path.join(work, name)
@@ -688,7 +782,7 @@ def check(args, seed, d, scene, twins, work):
                 return False, f"{name}: the drawn fills stop with '{base_msg}', the twin's " \
                               f"with exit {code}: '{msg}'", work
             results.append(f"{name} refused alike")
-        return True, "fills refused; " + ", ".join(results), work
+        return True, "fills refused; " + ", ".join(results + ([ranks_note] if ranks_note else [])), work
     folder = os.path.join(work, "drawn")
     write_case(folder, started, d.files)
     copy_snapshots(d, folder)
@@ -780,7 +874,7 @@ def check(args, seed, d, scene, twins, work):
                           + (f", compared until t = {chaotic:.3g} s" if chaotic else "") + ")"
                           if nudge else ""))
     how = "ran" if code == 0 else "stopped"
-    return True, f"{how}; " + ", ".join(results), work
+    return True, f"{how}; " + ", ".join(results + ([ranks_note] if ranks_note else [])), work
 
 
 def main():
@@ -796,7 +890,7 @@ def main():
     ap.add_argument("--family", choices=hs.EXTRA_FAMILIES,
                     help="draw this extra family's scene for every seed (thermal)")
     ap.add_argument("--twins", default="turn1,turn2,shift",
-                    help="comma-separated: turn1, turn2, shift, boost, scale")
+                    help="comma-separated: turn1, turn2, shift, boost, scale, ranks")
     ap.add_argument("--ranks", type=int, choices=[1, 2], help="instead of the drawn count")
     ap.add_argument("--timeout", type=float, default=60, help="per run [s]")
     ap.add_argument("--work", default="twin_scenes_work")
