@@ -10,6 +10,7 @@
 
 #include "coupling/accuracy_table.hpp"
 #include "coupling/floating_point_traps.hpp"
+#include "coupling/foam/cellSearch.H"
 #include "coupling/foam/gaussLinearGrad.H"
 #include "coupling/foam/particleCoupling.H"
 #include "coupling/shared_decomposition.hpp"
@@ -766,13 +767,8 @@ Foam::label ParticleCoupling::locate(const Foam::point& x) const {
 }
 
 Foam::label ParticleCoupling::locateNear(const Foam::point& x, Foam::label near) const {
-  if (structured_ || near < 0) return locate(x);
-  // A point inside a cell is inside no other: the cell found first is the one findCell finds
-  // (a point on a face shared by two cells may be given either, by either search).
-  if (mesh_.pointInCell(x, near, Foam::polyMesh::CELL_TETS)) return near;
-  for (const Foam::label n : mesh_.cellCells()[near])
-    if (mesh_.pointInCell(x, n, Foam::polyMesh::CELL_TETS)) return n;
-  return mesh_.findCell(x);
+  if (structured_) return locate(x);
+  return findCellNear(mesh_, x, near);  // findCell's cell, `near` and its neighbours first
 }
 
 void ParticleCoupling::buildFootprints() {

@@ -23,7 +23,14 @@
 // ten below what a wrong diagonal gives (above). The line printed:
 //
 //   cellPointCheck: cells=.. boxCells=.. points=.. boxPoints=.. outside=.. maxBox=..
-//   maxOther=.. exactOther=.. status=ok
+//   maxOther=.. exactOther=.. searches=.. sameCell=.. faceTies=.. wrongCell=0 status=ok
+//
+// Also the coupling's cell search (coupling/foam/cellSearch.H, findCellNear): every point
+// above, with five hints each (its cell, a random face neighbour, a neighbour's neighbour, a
+// random cell, none), must be given the cell OpenFOAM's findCell gives (sameCell), or, for a
+// point on a face the two cells share, the other of them (faceTies: pointInCell holds for the
+// cell given); -1 exactly where findCell gives -1. A search that took the hint or a
+// neighbour without testing it gives wrongCell > 0.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -34,10 +41,11 @@
 #include "Time.H"
 #include "argList.H"
 #include "coupling/foam/cellPointWeights.H"
-#include "tests/coupling/foamTestFields.H"
+#include "coupling/foam/cellSearch.H"
 #include "fvMesh.H"
 #include "interpolationCellPoint.H"
 #include "polyMeshTetDecomposition.H"
+#include "tests/coupling/foamTestFields.H"
 #include "volFields.H"
 #include "volPointInterpolation.H"
 
@@ -107,7 +115,38 @@ std::vector<Foam::point> testPoints(const Foam::fvMesh& mesh, Foam::label c, std
 struct Result {
   double maxBox = 0, maxOther = 0;
   long points = 0, boxPoints = 0, exactOther = 0, otherPoints = 0;
+  long searches = 0, sameCell = 0, faceTies = 0, wrongCell = 0;
 };
+
+// findCellNear against findCell for every test point, with five hints (see the header).
+void checkCellSearch(const Foam::fvMesh& mesh, const std::vector<std::vector<Foam::point>>& points,
+                     std::mt19937& rng, Result& r) {
+  const Foam::labelListList& neighbours = mesh.cellCells();
+  std::uniform_int_distribution<Foam::label> anyCell(0, mesh.nCells() - 1);
+  auto pick = [&rng](const Foam::labelList& cells, Foam::label fallback) {
+    if (cells.empty()) return fallback;
+    return cells[std::uniform_int_distribution<Foam::label>(0, cells.size() - 1)(rng)];
+  };
+  for (std::size_t c = 0; c < points.size(); ++c) {
+    const Foam::label cell = static_cast<Foam::label>(c);
+    for (const Foam::point& x : points[c]) {
+      const Foam::label expected = mesh.findCell(x);
+      const Foam::label neighbour = pick(neighbours[cell], cell);
+      const Foam::label hints[5] = {cell, neighbour, pick(neighbours[neighbour], neighbour),
+                                    anyCell(rng), -1};
+      for (const Foam::label hint : hints) {
+        const Foam::label got = grainflow::foam::findCellNear(mesh, x, hint);
+        ++r.searches;
+        if (got == expected)
+          ++r.sameCell;
+        else if (got >= 0 && expected >= 0 && mesh.pointInCell(x, got, Foam::polyMesh::CELL_TETS))
+          ++r.faceTies;
+        else
+          ++r.wrongCell;
+      }
+    }
+  }
+}
 
 template <class Type>
 void compare(const Foam::fvMesh& mesh,
@@ -170,16 +209,19 @@ int run(const Foam::argList& args) {
   Result r;
   compare(mesh, U(), ours, points, box, r);
   compare(mesh, eps(), ours, points, box, r);
+  checkCellSearch(mesh, points, rng, r);
 
   // The bound and its reason: see the header.
   constexpr double kTolerance = 1e-12;
-  const bool ok =
-      r.maxBox <= kTolerance && r.maxOther <= kTolerance && ours.boxCells() == expectedBoxes;
+  const bool ok = r.maxBox <= kTolerance && r.maxOther <= kTolerance &&
+                  ours.boxCells() == expectedBoxes && r.wrongCell == 0;
   std::printf(
       "cellPointCheck: cells=%d boxCells=%d points=%ld boxPoints=%ld outside=%ld maxBox=%.3g "
-      "maxOther=%.3g exactOther=%ld/%ld status=%s\n",
+      "maxOther=%.3g exactOther=%ld/%ld searches=%ld sameCell=%ld faceTies=%ld wrongCell=%ld "
+      "status=%s\n",
       mesh.nCells(), ours.boxCells(), r.points, r.boxPoints, ours.outside(), r.maxBox, r.maxOther,
-      r.exactOther, r.otherPoints, ok ? "ok" : "FAIL");
+      r.exactOther, r.otherPoints, r.searches, r.sameCell, r.faceTies, r.wrongCell,
+      ok ? "ok" : "FAIL");
   if (ours.boxCells() != expectedBoxes)
     std::printf("cellPointCheck: %d cells took the closed form, %ld are boxes\n", ours.boxCells(),
                 expectedBoxes);

@@ -6,7 +6,9 @@
 #            cells of every size and aspect ratio);
 #   skewed   9 x 6 x 7 skewed, twisted, graded cells (OpenFOAM's tetrahedra, table path).
 # Each must print status=ok (its bound, 1e-12 of the field's magnitude, is explained in
-# cellPointCheck.C); here also: uniform and graded have every cell a box, skewed none.
+# cellPointCheck.C; the same line holds the coupling's cell search, coupling/foam/
+# cellSearch.H, against findCell: wrongCell=0); here also: uniform and graded have every cell
+# a box, skewed none.
 #
 #   cmake -DFOAM_ENV=scripts/foam_env.sh -DCHECK=bin/cellPointCheck
 #         -DCASES=tests/coupling/cellpoint -DWORK=<scratch> -P cellpoint.cmake
