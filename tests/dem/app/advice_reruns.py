@@ -43,6 +43,10 @@ import subprocess
 import sys
 import time
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.realpath(__file__)), "..", "..",
+                                "support"))
+from singleton import isolated_singleton  # noqa: E402  (tests/support/singleton.py)
+
 grain, work = (os.path.abspath(a) for a in sys.argv[1:3])
 MPIEXEC = sys.argv[sys.argv.index("--mpiexec") + 1] if "--mpiexec" in sys.argv else "mpiexec"
 only = sys.argv[sys.argv.index("--only") + 1] if "--only" in sys.argv else None
@@ -113,12 +117,13 @@ class Context:
         if command == "run":
             cmd += ["--output", "out", "--no-progress"]
         cmd += list(extra)
-        env = dict(os.environ)
         if ranks > 1:
             cmd = [MPIEXEC, "-np", str(ranks), "--oversubscribe"] + cmd
+            p = subprocess.run(cmd, cwd=folder, capture_output=True, text=True, timeout=120)
         else:  # a singleton without Open MPI's daemon: 0.2 s less per run, the same program
-            env["OMPI_MCA_ess_singleton_isolated"] = "1"
-        p = subprocess.run(cmd, cwd=folder, capture_output=True, text=True, timeout=120, env=env)
+            with isolated_singleton() as env:
+                p = subprocess.run(cmd, cwd=folder, capture_output=True, text=True, timeout=120,
+                                   env=env)
         self.runs += 1
         with open(os.path.join(folder, f"grain_{self.runs}.out"), "w") as out:
             out.write(" ".join(cmd) + f"\n(exit {p.returncode})\n" + p.stdout + p.stderr)

@@ -38,6 +38,10 @@ import threading
 import h5py
 import numpy as np
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.realpath(__file__)), "..", "..",
+                                "support"))
+from singleton import isolated_singleton  # noqa: E402  (tests/support/singleton.py)
+
 grain, reference, work = (os.path.abspath(a) for a in sys.argv[1:4])
 MPIEXEC = sys.argv[sys.argv.index("--mpiexec") + 1] if "--mpiexec" in sys.argv else "mpiexec"
 only = sys.argv[sys.argv.index("--only") + 1] if "--only" in sys.argv else None
@@ -195,12 +199,13 @@ def outcome(folder, scene, command="run", extra_files=(), ranks=1):
     with open(os.path.join(folder, "scene.yaml"), "w") as out:
         json.dump(scene, out, indent=1)  # JSON is YAML
     cmd = [grain, command, "scene.yaml"]
-    env = dict(os.environ)
     if ranks > 1:
         cmd = [MPIEXEC, "-np", str(ranks), "--oversubscribe"] + cmd
+        r = subprocess.run(cmd, cwd=folder, capture_output=True, text=True, timeout=300)
     else:  # a singleton without Open MPI's daemon: 0.2 s less per run, the same program
-        env["OMPI_MCA_ess_singleton_isolated"] = "1"
-    r = subprocess.run(cmd, cwd=folder, capture_output=True, text=True, timeout=300, env=env)
+        with isolated_singleton() as env:
+            r = subprocess.run(cmd, cwd=folder, capture_output=True, text=True, timeout=300,
+                               env=env)
     result = {"status": r.returncode, "report": normalised_report(r.stdout + r.stderr)}
     inputs = {"scene.yaml"} | {os.path.basename(f) for f in extra_files}
     for dirpath, _, files in os.walk(folder):
