@@ -58,7 +58,8 @@ add_test(NAME hard_scenes.thermal_twins_ci
                  --work ${PROJECT_BINARY_DIR}/test_output/twin_scenes_thermal)
 # Rank twins (twin_scenes.py --twins ranks, docs/parallel.md "Reproducible results"): drawn
 # scenes with parallel: {reproducible: true} on their drawn ranks and on another count and
-# grid (1, 2 or 3 ranks, balanced or not) must write the same bits. Seeds 0-5 and 9: a pour,
+# grid (1, 2 or 3 ranks, balanced or not) must write the same bits, and the drawn run's
+# checkpoint restarted on the other ranks must end with its bits. Seeds 0-5 and 9: a pour,
 # drums, a rod, a mesh plate, periodic and closed gases; 14: a one-way fluid with a computed
 # void fraction, whose eps once differed by an ulp between 2 and 3 ranks; 17: a balanced
 # 3-rank drum.

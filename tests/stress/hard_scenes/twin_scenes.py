@@ -36,8 +36,9 @@ scene (drawn by hard_scenes.py, every family) is run as drawn and as its twins:
     drawn ranks and on another count and grid (2 or 3 ranks for a 1-rank scene, 1 or 3 for a
     2-rank one; a grid along a drawn axis or the default rule, balanced or not): the mode
     promises the same bits on any ranks (docs/parallel.md), so every dataset of every
-    snapshot (the owner rank aside) must be equal; not compared when the twin's grid is
-    refused as thinner than the interaction range.
+    snapshot (the owner rank aside) must be equal; and the drawn run's checkpoint continued
+    (grain run --restart) on the twin's ranks and grid must end with the drawn run's bits;
+    not compared when the twin's grid is refused as thinner than the interaction range.
 --scene FILE twins a scene file instead of drawn ones (tests/data/scenes/twins/resting_bed.yaml
 is written for the boost).
 A fill draws its random positions axis by axis, so a turned region holds other particles:
@@ -477,8 +478,8 @@ def write_case(folder, scene, files):
             f.write(text)
 
 
-def snapshot_files(folder):
-    out = os.path.join(folder, "out")
+def snapshot_files(folder, out="out"):
+    out = os.path.join(folder, out)
     if not os.path.isdir(out):
         return []
     return [os.path.join(out, n) for n in sorted(os.listdir(out))
@@ -678,9 +679,9 @@ def ranks_layout(seed, ranks):
     return n, block
 
 
-def read_datasets(folder):
+def read_datasets(folder, out="out"):
     snaps = []
-    for path in snapshot_files(folder):
+    for path in snapshot_files(folder, out):
         with h5py.File(path, "r") as f:
             order = np.argsort(f["id"][...])
             data = {k: f[k][...][order] for k in f.keys()
@@ -721,15 +722,48 @@ def check_ranks(args, seed, d, scene, work):
     a, b = read_datasets(f0), read_datasets(f1)
     if len(a) != len(b):
         return f"{how}: {len(b)} snapshots, on the drawn ranks {len(a)}", None
+    failure = same_datasets(how, a, b)
+    if failure:
+        return failure, None
+    # The drawn ranks' checkpoint continued on the twin's ranks and grid must end as the
+    # drawn run did (docs/parallel.md: "after a restart from a checkpoint on another rank
+    # count").
+    cps = sorted(n for n in os.listdir(os.path.join(f0, "out"))
+                 if n.startswith("checkpoint_") and n.endswith(".h5"))
+    if not cps:
+        return None, f"{how} bit for bit ({len(a)} snapshots; no checkpoint to restart)"
+    shutil.copy(os.path.join(f0, "out", cps[-1]), os.path.join(f1, "restart.h5"))
+    rcode, rout, _ = hs.run_grain(args, n, "scene.yaml", f1, args.timeout,
+                                  extra=("--restart", "restart.h5"), output="out_restart")
+    with open(os.path.join(f1, "restart.out"), "w") as f:
+        f.write(rout)
+    if rcode != 0:
+        return (f"{how}: the restart of {cps[-1]} (written on {d.ranks} rank(s)) on the twin's "
+                f"ranks: exit {rcode}: {hs.error_line(rout)}"), None
+    if summary(rout) != summary(out):
+        return (f"{how}: the restart of {cps[-1]} on the twin's ranks: summary "
+                f"{summary(rout)}, the run's {summary(out)}"), None
+    r = read_datasets(f1, "out_restart")
+    if not r or r[-1][0] != a[-1][0]:
+        return (f"{how}: the restart of {cps[-1]} on the twin's ranks ends at "
+                f"t = {r[-1][0] if r else None}, the run at {a[-1][0]}"), None
+    failure = same_datasets(f"{how}, restarted from {cps[-1]}", a[-1:], r[-1:])
+    if failure:
+        return failure, None
+    return None, f"{how} bit for bit ({len(a)} snapshots; restarted from {cps[-1]} alike)"
+
+
+def same_datasets(how, a, b):
+    """None when the snapshots a and b (read_datasets) hold the same bits, else what differs."""
     for (t, x), (_, y) in zip(a, b):
         for key, values in x.items():
             if key not in y or values.shape != y[key].shape:
-                return f"{how}: t = {t}: dataset {key} missing or of another shape", None
+                return f"{how}: t = {t}: dataset {key} missing or of another shape"
             if not np.array_equal(values, y[key], equal_nan=True):
                 bad = np.nonzero(np.any((values != y[key]).reshape(len(values), -1), axis=1))[0]
                 return (f"{how}: t = {t}: {key} differs in {len(bad)} particles (first id "
-                        f"{x['id'][bad[0]]}: {values[bad[0]]} against {y[key][bad[0]]})"), None
-    return None, f"{how} bit for bit ({len(a)} snapshots)"
+                        f"{x['id'][bad[0]]}: {values[bad[0]]} against {y[key][bad[0]]})")
+    return None
 
 
 def check_seed(args, seed, twins):
