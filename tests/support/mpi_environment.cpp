@@ -26,10 +26,12 @@ class MpiEnvironment : public ::testing::Environment {
         // singletons all take one name and one session directory, which one that ends
         // removes while another makes it (tests/support/singleton.py): this one gets a base
         // of its own, removed at the end.
-        char base[] = "/tmp/grainflow-test-ompi-XXXXXX";
-        if (mkdtemp(base)) {
+        std::error_code no_tmp;
+        std::string base =
+            (std::filesystem::temp_directory_path(no_tmp) / "grainflow-test-ompi-XXXXXX").string();
+        if (!no_tmp && mkdtemp(base.data())) {
           session_base_ = base;
-          setenv("OMPI_MCA_orte_tmpdir_base", base, 1);
+          setenv("OMPI_MCA_orte_tmpdir_base", base.c_str(), 1);
           setenv("OMPI_MCA_ess_singleton_isolated", "1", 1);
         }
       }
