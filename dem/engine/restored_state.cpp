@@ -162,6 +162,53 @@ void check_checkpoint(const CheckpointData& d, const Scene& scene, std::size_t w
   }
 
   const Particles& p = d.particles;
+  // A class the checkpoint's particles use but the scene no longer has (coarse_grain removed
+  // or set to 1 before the restart; a checkpoint without the insertions' record).
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const auto m = static_cast<std::size_t>(p.material[i]);
+    if (p.material[i] < 0 || m < scene.materials.size() || m >= d.material_coarse_grain.size())
+      continue;
+    throw StateError(d.file + ": error: dataset '/particles/material', index " + std::to_string(i) +
+                     " (" + particle(p.id[i]) + "): material index " + std::to_string(m) +
+                     " was parcels of k = " + number(d.material_coarse_grain[m]) +
+                     " of listed material " + std::to_string(d.material_real[m]) +
+                     " when the checkpoint was written (attribute 'material_coarse_grain'), but " +
+                     scene.file + " has only " + std::to_string(scene.materials.size()) +
+                     " material index(es): the scene's materials or coarse_grain changed since; "
+                     "restart with the scene the checkpoint was written with, or start the "
+                     "changed scene afresh");
+  }
+  // A density changed in the scene since the checkpoint: every particle of a material is off
+  // by the same factor, which the rule below would blame on a damaged file.
+  for (std::size_t m = 0; m < scene.materials.size(); ++m) {
+    double low = 0, high = 0;
+    long count = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (p.material[i] != static_cast<int>(m)) continue;
+      const double rho = p.mass[i] / sphere_volume(p.radius[i]);
+      if (!std::isfinite(rho)) {
+        count = 0;
+        break;
+      }
+      low = count ? std::min(low, rho) : rho;
+      high = count ? std::max(high, rho) : rho;
+      ++count;
+    }
+    const Material& mat = scene.materials[m];
+    if (count == 0 || !near(high, low) || near(low, mat.density)) continue;
+    const std::string& listed =  // a parcel class has its listed material's density
+        scene.materials[mat.real_material < 0 ? m : static_cast<std::size_t>(mat.real_material)]
+            .name;
+    throw StateError(scene.file + ": error: materials: '" + listed + "' has density " +
+                     number(mat.density) + " kg/m^3, but each of its " + std::to_string(count) +
+                     " particle(s) in checkpoint '" + d.file +
+                     "' has mass / volume = " + number(low) +
+                     " kg/m^3: the density changed since the checkpoint was written, and the "
+                     "particles would continue with their old masses. Restart with density " +
+                     number(low) +
+                     " as the checkpoint's run had it, or start the changed scene "
+                     "afresh");
+  }
   check_particle_records(p, scene, src, true);
 
   // The range the run chose at its start: at least as large as every radius it holds.

@@ -147,7 +147,7 @@ void print_coarse_grain_report(const Scene& scene, const Particles& p, MPI_Comm 
   o << "coarse graining (docs/models/coarse-graining.md):\n";
   for (const ParcelClass& c : classes)
     o << "  '" << c.name << "': " << c.parcels << " parcels of k = " << c.k << " stand for "
-      << c.real << " real particles of mass " << c.mass << " kg (real radius up to "
+      << c.real << " real particles, " << c.mass << " kg in all (real radius up to "
       << c.largest_diameter / (2 * c.k) << " m, parcel radius up to " << c.largest_diameter / 2
       << " m)\n";
   o << "  all particles: " << parcels << " computed, " << real << " real, mass " << mass

@@ -11,6 +11,7 @@
 #include "dem/contact/normal_hooke.hpp"
 #include "dem/core/number_format.hpp"
 #include "dem/engine/finite_guard.hpp"
+#include "dem/engine/insertion_record.hpp"
 #include "dem/engine/restored_state.hpp"
 #include "dem/insert/insertion.hpp"
 #include "dem/walls/stl_reader.hpp"
@@ -685,6 +686,9 @@ void Simulation::restore(const CheckpointData& checkpoint) {
   // Stream insertions continue where they were: delivered totals, radii drawn but not yet
   // placed and the generators, so the restart inserts what the uninterrupted run would.
   const std::string where = "checkpoint '" + checkpoint.file + "'";
+  // The scene's insertions must be the run's (a changed one would be skipped or, a stream's
+  // rate, applied back to t = 0).
+  if (checkpoint.insertions) check_insertions(*checkpoint.insertions, scene_, checkpoint.file);
   if (!checkpoint.streams && !streams_.empty())
     throw SetupError(scene_.file + ": error: the scene has " + std::to_string(streams_.size()) +
                      " stream insertion(s), but " + where +
@@ -796,6 +800,7 @@ void Simulation::write_checkpoint(const std::string& path) {
     d.drag_fluid_velocity = drag_.fluid_velocity;
   }
   d.streams = streams_.save_state();
+  d.insertions = insertion_record(scene_);
   if (!wall_impulse_.empty()) {
     d.wall_impulse.reserve(3 * wall_impulse_.size() + 1);
     for (const Vec3& j : wall_impulse_)

@@ -238,6 +238,10 @@ void fill_region(const Scene& scene, const WallSet* walls, const Insertion& ins,
           << volume / region_volume(ins.region) << " solid fraction) without overlap in the fill "
           << "region after " << budget << " attempts; enlarge the region, or lower `count` / "
           << "`volume_fraction` (random insertion saturates near 0.35)";
+      if (ins.coarse_grain != 1)
+        msg << "; the particles are parcels of radius up to " << max_radius(ins.radius)
+            << " m, coarse_grain " << ins.coarse_grain
+            << " times the real radius: a lower coarse_grain fits more of them";
       throw InsertionError(msg.str());
     }
     const double r = sample_radius(ins.radius, rng);

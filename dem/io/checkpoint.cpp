@@ -52,12 +52,13 @@ std::uintmax_t expected_bytes(const CheckpointData& d) {
   const std::uintmax_t n = d.particles.size(), per_particle = 8 + 5 * 24 + 3 * 8 + 4;
   const std::uintmax_t drag =
       (d.drag_coefficient.empty() ? 0 : 32) + (d.has_temperature ? 8 : 0);
-  const std::uintmax_t streams = d.streams ? d.streams->size() : 0;
+  const std::uintmax_t streams =
+      (d.streams ? d.streams->size() : 0) + (d.insertions ? d.insertions->size() : 0);
   std::uintmax_t grid = 0;
   if (d.grid)
     for (const auto& c : d.grid->cuts) grid += 8 * c.size();
   return n * (per_particle + drag) + d.springs.size() * (2 * 8 + 2 * 24) + streams + grid +
-         22 * 3072 + 8192;
+         23 * 3072 + 8192;
 }
 
 // Appends the records of one rank's buffer to `out`.
@@ -293,6 +294,10 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
     fail.check(s >= 0 && write_array(fail, s, "state", H5T_NATIVE_UCHAR, d.streams->size(), 1,
                                      d.streams->data()),
                "writing the group 'streams'");
+    if (fail.ok() && d.insertions)
+      fail.check(write_array(fail, s, "insertions", H5T_NATIVE_UCHAR, d.insertions->size(), 1,
+                             d.insertions->data()),
+                 "writing the dataset '/streams/insertions'");
     if (s >= 0) H5Gclose(s);
   }
   if (fail.ok() && d.grid) {
@@ -379,6 +384,7 @@ void write_checkpoint(MPI_Comm comm, const std::string& path, const CheckpointDa
     d.largest_radius = local.largest_radius;
     d.removed = local.removed;
     d.streams = local.streams;
+    d.insertions = local.insertions;
     d.grid = local.grid;
     d.material_coarse_grain = local.material_coarse_grain;
     d.material_real = local.material_real;
@@ -550,6 +556,13 @@ CheckpointData read_checkpoint(const std::string& path) {
       const auto text = read_array<unsigned char>(f, "/streams/state", H5T_NATIVE_UCHAR, 1, length,
                                                   error, sealed);
       if (error.empty()) d.streams = std::string(text.begin(), text.end());
+      // Optional (written since restarts compare the scene's insertions with the run's).
+      if (error.empty() && H5Lexists(f, "/streams/insertions", H5P_DEFAULT) > 0) {
+        std::size_t chars = static_cast<std::size_t>(-1);
+        const auto record = read_array<unsigned char>(f, "/streams/insertions", H5T_NATIVE_UCHAR, 1,
+                                                      chars, error, sealed);
+        if (error.empty()) d.insertions = std::string(record.begin(), record.end());
+      }
     }
     // Optional (format 3): the shapes here, the values in check_checkpoint.
     if (error.empty() && H5Lexists(f, "decomposition", H5P_DEFAULT) > 0) {

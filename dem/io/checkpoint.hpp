@@ -86,6 +86,10 @@ struct CheckpointData {
   // The stream insertions' progress (taken from rank 0 when writing); absent in a format 1
   // file, which cannot continue a scene with streams.
   std::optional<std::string> streams;
+  // The run's insertions (insertion_record, dem/engine/insertion_record.hpp), compared with
+  // the scene's on restart; the dataset /streams/insertions, absent in files written before it
+  // (not checked then).
+  std::optional<std::string> insertions;
   // The processor grid (taken from rank 0 when writing); absent in format 1 and 2 files.
   std::optional<CheckpointGrid> grid;
   // Each material index's coarse-graining factor and listed material (Scene's materials:

@@ -632,18 +632,40 @@ void parse_fill(const Map& m, const Scene& scene, Insertion& ins) {
   ins.radius = parse_size_distribution(
       m.get("radius", "add `radius: {distribution: constant, value: <m>}`"));
   parse_coarse_grain(m, ins);
+  {
+    // Every particle lies whole inside the region (sample_centre, dem/insert/insertion.cpp):
+    // a region thinner than the smallest sphere would place none, whatever the count.
+    const Region& g = ins.region;
+    const double across =
+        g.kind == Region::Kind::box ? (g.hi - g.lo).minCoeff() : std::min(2 * g.radius, g.height);
+    const double d = 2 * smallest_radius(ins.radius), k = ins.coarse_grain;
+    if (d > across)
+      m.get("region").fail(
+          "the region is " + format_number(across) + " m across at its narrowest, less than " +
+          "the smallest particle the fill inserts, " + format_number(d) + " m in diameter" +
+          (k != 1 ? " (a parcel: the real diameter " + format_number(d / k) +
+                        " m times coarse_grain " + format_number(k) + ")"
+                  : std::string()) +
+          "; every particle lies whole inside the region: make it at least " + format_number(d) +
+          " m across" + (k != 1 ? ", or lower coarse_grain" : ""));
+  }
   if (ins.count) {
     // Even the smallest spheres the distribution can draw must fit by volume alone;
     // this also bounds what insertion will try to allocate.
     const double r = smallest_radius(ins.radius);
     const double solid = static_cast<double>(*ins.count) * 4.0 / 3.0 * std::acos(-1.0) * r * r * r;
     if (solid > region_volume(ins.region))
-      m.get("count").fail(std::to_string(*ins.count) + " spheres of radius at least " +
-                          format_number(r) + " m have a volume of " + format_number(solid) +
-                          " m^3, more than the region's " +
-                          format_number(region_volume(ins.region)) +
-                          " m^3; lower the count or enlarge the region (random filling "
-                          "reaches a solid fraction near 0.35)");
+      m.get("count").fail(
+          std::to_string(*ins.count) + " spheres of radius at least " + format_number(r) +
+          " m have a volume of " + format_number(solid) + " m^3, more than the region's " +
+          format_number(region_volume(ins.region)) +
+          " m^3; lower the count or enlarge the region (random filling "
+          "reaches a solid fraction near 0.35)" +
+          (ins.coarse_grain != 1
+               ? "; the spheres are parcels, coarse_grain " + format_number(ins.coarse_grain) +
+                     " times the real radius: a count of real particles is " +
+                     "count times coarse_grain^3"
+               : std::string()));
   }
   ins.velocity = m.vec3_or("velocity", Vec3::Zero());
   if (const auto s = m.find("seed"))
@@ -710,6 +732,29 @@ void parse_stream(const Map& m, const Scene& scene, Insertion& ins) {
   ins.radius = parse_size_distribution(
       m.get("radius", "add `radius: {distribution: constant, value: <m>}`"));
   parse_coarse_grain(m, ins);
+  // Each particle enters whole inside the face's outline (StreamInsertion::sample); a face
+  // narrower than the largest one would put it at the centre, sticking out of the outline.
+  const SizeDistribution& r = ins.radius;
+  double r_max = r.value;
+  if (r.kind == SizeDistribution::Kind::uniform || r.kind == SizeDistribution::Kind::normal)
+    r_max = r.max;
+  else if (r.kind == SizeDistribution::Kind::discrete && !r.values.empty())
+    r_max = *std::max_element(r.values.begin(), r.values.end());
+  const bool rectangle = ins.face.kind == InsertionFace::Kind::rectangle;
+  const double across =
+      rectangle ? std::min(ins.face.length_u, ins.face.length_v) : 2 * ins.face.radius;
+  if (2 * r_max > across) {
+    const double k = ins.coarse_grain;
+    face.fail(std::string(rectangle ? "the rectangle's shorter side is " : "the disc is ") +
+              format_number(across) + " m" + (rectangle ? "" : " across") +
+              ", narrower than the largest particle the stream inserts, " +
+              format_number(2 * r_max) + " m in diameter" +
+              (k != 1 ? " (a parcel: the radius up to " + format_number(r_max / k) +
+                            " m times coarse_grain " + format_number(k) + ")"
+                      : std::string()) +
+              "; every particle enters whole inside the face: make it at least " +
+              format_number(2 * r_max) + " m across" + (k != 1 ? ", or lower coarse_grain" : ""));
+  }
   ins.velocity = m.vec3_or("velocity", Vec3::Zero());
   if (const auto s = m.find("seed"))
     ins.seed = static_cast<unsigned>(s->integer(Range{0, double(UINT_MAX), true, true}));

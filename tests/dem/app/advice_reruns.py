@@ -770,6 +770,123 @@ def _(c):
     return f"end {s['time']['end']:g} s: " + r.lines("done:")[0].split(",")[0]
 
 
+def checkpointed(c, s, every):
+    """Runs `s` with checkpoints every `every` s; returns (the run, the first checkpoint's path
+    relative to its folder)."""
+    s["output"]["checkpoint_interval"] = every
+    r = c.run("first", s, "run")
+    checkpoints = sorted(glob.glob(os.path.join(r.folder, "out", "checkpoint_*.h5")))
+    if r.rc != 0 or not checkpoints:
+        raise Setup(f"the run that writes the checkpoint: exit {r.rc}, {tail(r.out)}")
+    return r, os.path.relpath(checkpoints[0], r.folder)
+
+
+def stream_bed(mass_rate=0.01):
+    """0.1 g of glass beads (radius 0.4-0.6 mm) streamed at `mass_rate` kg/s over 10 ms onto
+    the floor of a 10 x 10 x 20 mm box."""
+    s = bed(end=0.012)
+    s["insert"] = [{"type": "stream",
+                    "face": {"rectangle": {"centre": [0.005, 0.005, 0.018], "normal": [0, 0, -1],
+                                           "u": [1, 0, 0], "size": [0.01, 0.01]}},
+                    "mass_rate": mass_rate, "start": 0, "stop": 0.01, "material": "glass",
+                    "velocity": [0, 0, -0.5], "seed": 3,
+                    "radius": {"distribution": "uniform", "min": 4e-4, "max": 6e-4}}]
+    return s
+
+
+INSERTION_CHANGED = (r"error: insert\[(\d+)\] \((\w+)\) is not the insertion the run that wrote "
+                     r"checkpoint '[^']*' had: (\w+) is ([^\n]*?) here, ([^\n]*?) in that run\. "
+                     r"[^\n]*Restore the `insert` section as the checkpoint's run had it")
+
+
+@case("restart_stream_rate", "restart with a stream's mass_rate changed, 'restore the insert "
+      "section as the checkpoint's run had it' (dem/engine/insertion_record.cpp)", "run --restart")
+def _(c):
+    s = stream_bed()
+    r, checkpoint = checkpointed(c, s, 0.005)
+    first = float(re.search(r"particles, " + NUM + r" kg delivered since t = 0", r.out).group(1))
+    s["insert"][0]["mass_rate"] = 0.02  # restarted with another rate: it would owe 0.1 g at once
+    r = c.run("", s, "run", ["--restart", checkpoint], folder=r.folder, scene_name="rate.yaml")
+    m = c.expect(r, 1, INSERTION_CHANGED)
+    if m.group(3) != "mass_rate" or float(m.group(4)) != 0.02:
+        raise Setup(f"the message names {m.group(3)} = {m.group(4)}, not mass_rate = 0.02")
+    s["insert"][0]["mass_rate"] = float(m.group(5))  # the run's rate, as the message gives it
+    r = c.run("", s, "run", ["--restart", checkpoint], folder=r.folder, scene_name="rate.yaml")
+    c.rerun_passes(r, r"is not the insertion the run", "the run's mass_rate")
+    # The restored rate delivers what the uninterrupted run did: rate x (stop - start) = 0.1 g,
+    # within half the heaviest bead (the stream's guarantee).
+    delivered = float(re.search(r"particles, " + NUM + r" kg delivered since t = 0",
+                                r.out).group(1))
+    half = 0.5 * 2500 * 4 / 3 * 3.141592653589793 * 6e-4**3
+    if abs(delivered - 1e-4) > half or delivered != first:
+        raise Broken(f"the restored stream delivered {delivered:g} kg, the uninterrupted run "
+                     f"{first:g} kg, rate x time 1e-4 kg (within {half:.3g})")
+    return f"mass_rate {m.group(5)}: {delivered:.6g} kg delivered, as without the restart"
+
+
+@case("restart_fill_added", "restart with a fill added, 'restore the insert section as the "
+      "checkpoint's run had it' (dem/engine/insertion_record.cpp)", "run --restart")
+def _(c):
+    s = bed(step=2e-5, end=0.004)
+    r, checkpoint = checkpointed(c, s, 0.002)
+    added = copy.deepcopy(s)
+    added["insert"].append(dict(s["insert"][0], count=5, seed=9))
+    r = c.run("", added, "run", ["--restart", checkpoint], folder=r.folder,
+              scene_name="added.yaml")
+    c.expect(r, 1, r"error: insert\[1\] \(fill\) is not in the run that wrote checkpoint '[^']*', "
+             r"which had 1 insertion\(s\)\. [^\n]*Restore the `insert` section as the "
+             r"checkpoint's run had it")
+    r = c.run("", s, "run", ["--restart", checkpoint], folder=r.folder, scene_name="added.yaml")
+    c.rerun_passes(r, r"is not in the run that wrote", "the insert section restored")
+    return "the fill taken out again: " + r.lines("done:")[0].split(",")[0]
+
+
+@case("stream_face_narrow", "a stream face narrower than its parcels, 'make it at least X m "
+      "across' (dem/scene/scene_parser.cpp)", "check")
+def _(c):
+    s = stream_bed()
+    s["insert"][0]["coarse_grain"] = 2  # parcels up to 2.4 mm across, through a 1.5 mm face
+    s["insert"][0]["face"]["rectangle"]["size"] = [0.0015, 0.01]
+    m = c.expect(c.run("first", s), 2, r"insert\[0\]\.face: the rectangle's shorter side is "
+                 r"0\.0015 m, narrower than the largest particle the stream inserts, " + NUM +
+                 r" m in diameter \(a parcel[^\n]*make it at least " + NUM + r" m across, or "
+                 r"lower coarse_grain")
+    s["insert"][0]["face"]["rectangle"]["size"] = [float(m.group(2)), 0.01]
+    c.rerun_passes(c.run("rerun", s), r"narrower than the largest particle", "the face's size")
+    return f"size [{m.group(2)}, 0.01]: accepted"
+
+
+@case("fill_region_thin", "a fill region thinner than its parcels, 'make it at least X m "
+      "across' (dem/scene/scene_parser.cpp)", "check")
+def _(c):
+    s = bed(count=5)
+    s["insert"][0]["coarse_grain"] = 3  # parcels 3 mm across, in a layer 2.5 mm thick
+    s["insert"][0]["region"]["box"] = {"min": [0, 0, 0.001], "max": [0.01, 0.01, 0.0035]}
+    m = c.expect(c.run("first", s), 2, r"insert\[0\]\.region: the region is 0\.0025 m across "
+                 r"at its narrowest, less than the smallest particle the fill inserts, " + NUM +
+                 r" m in diameter \(a parcel[^\n]*make it at least " + NUM + r" m across, or "
+                 r"lower coarse_grain")
+    s["insert"][0]["region"]["box"]["max"][2] = 0.001 + float(m.group(2))
+    c.rerun_passes(c.run("rerun", s), r"across at its narrowest", "the region's height")
+    return f"height {m.group(2)}: 5 parcels placed"
+
+
+@case("restart_density", "restart with a material's density changed, 'restart with density X' "
+      "(dem/engine/restored_state.cpp)", "run --restart")
+def _(c):
+    s = bed(step=2e-5, end=0.004)
+    r, checkpoint = checkpointed(c, s, 0.002)
+    s["materials"][0]["density"] = 3000
+    r = c.run("", s, "run", ["--restart", checkpoint], folder=r.folder, scene_name="dense.yaml")
+    m = c.expect(r, 1, r"error: materials: 'glass' has density 3000 kg/m\^3, but each of its 20 "
+                 r"particle\(s\) in checkpoint '[^']*' has mass / volume = " + NUM +
+                 r" kg/m\^3[^\n]*Restart with density " + NUM)
+    s["materials"][0]["density"] = float(m.group(2))
+    r = c.run("", s, "run", ["--restart", checkpoint], folder=r.folder, scene_name="dense.yaml")
+    c.rerun_passes(r, r"the density changed since", "density")
+    return f"density {m.group(2)}: " + r.lines("done:")[0].split(",")[0]
+
+
 @case("output_start", "output.start after time.end, 'give a start <= time.end' "
       "(dem/scene/scene_parser.cpp)", "check")
 def _(c):

@@ -626,12 +626,50 @@ TEST(CoarseGrain, RestartRefusesAChangedFactor) {
     e = x.what();
   }
   std::printf("%s\n", e.c_str());
-  EXPECT_NE(e.find(checkpoint + ": error: attributes 'material_coarse_grain', 'material_real' of "
-                                "the root group: material index 1 was parcels of k = 2 of listed "
-                                "material 0 when the checkpoint was written, but in restart.yaml "
-                                "it is 'glass[k=3]', parcels of k = 3 of listed material 0"),
+  // The checkpoint's record of the run's insertions names the fill and the key.
+  EXPECT_NE(e.find(": error: insert[0] (fill) is not the insertion the run that wrote "
+                   "checkpoint '" +
+                   checkpoint + "' had: coarse_grain is 3 here, 2 in that run"),
             std::string::npos)
       << e;
+  // A checkpoint without that record (written before it): the parcel classes, as attributes.
+  const fs::path old = dir / "without_record.h5";
+  fs::copy_file(checkpoint, old);
+  {
+    const hid_t f = H5Fopen(old.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    ASSERT_GE(f, 0);
+    EXPECT_GE(H5Ldelete(f, "/streams/insertions", H5P_DEFAULT), 0);
+    H5Fclose(f);
+  }
+  options.restart = old.string();
+  e = "no error";
+  try {
+    run_scene(scene("3"), options, MPI_COMM_WORLD, log);
+  } catch (const std::exception& x) {
+    e = x.what();
+  }
+  EXPECT_NE(e.find(old.string() + ": error: attributes 'material_coarse_grain', 'material_real' "
+                                  "of the root group: material index 1 was parcels of k = 2 of "
+                                  "listed material 0 when the checkpoint was written, but in "
+                                  "restart.yaml it is 'glass[k=3]', parcels of k = 3 of listed "
+                                  "material 0"),
+            std::string::npos)
+      << e;
+  // coarse_grain taken out (k = 1): the class is gone, which the same attributes name, not a
+  // damaged file.
+  e = "no error";
+  try {
+    run_scene(scene("1"), options, MPI_COMM_WORLD, log);
+  } catch (const std::exception& x) {
+    e = x.what();
+  }
+  EXPECT_NE(e.find("material index 1 was parcels of k = 2 of listed material 0 when the "
+                   "checkpoint was written (attribute 'material_coarse_grain'), but restart.yaml "
+                   "has only 1 material index(es): the scene's materials or coarse_grain changed "
+                   "since"),
+            std::string::npos)
+      << e;
+  options.restart = checkpoint;
   std::ostringstream again;
   EXPECT_NO_THROW(run_scene(scene("2"), options, MPI_COMM_WORLD, again));
   EXPECT_NE(again.str().find("done: "), std::string::npos) << again.str();

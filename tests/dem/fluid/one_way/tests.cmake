@@ -27,6 +27,6 @@ grain_cli_test(fluid_lift_refused 1
 # the 10 mm domain is narrower than 10 parcel diameters and that the 2.5 mm void-fraction cell
 # is smaller than 3 parcel diameters (2.08), but not that it is smaller than a parcel.
 grain_cli_test(coarse_grain_check 0
-               "Rayleigh time t_R = [0-9.e-]+ s \\(smallest 'glass\\[k=2\\]' particle\\);'glass\\[k=2\\]': 20 parcels of k = 2 stand for 160 real particles of mass 4.5238[0-9]*e-05 kg;warning: the domain's narrowest side \\(0.01 m\\) is less than 10 diameters of parcels 'glass\\[k=2\\]' \\(0.0012 m\\);warning: parcels 'glass\\[k=2\\]' \\(diameter up to 0.0012 m\\) are wider than a third of the void-fraction cell \\(smallest 0.0025 m, typical 0.0025 m\\): cells of 2.08 parcel diameters"
+               "Rayleigh time t_R = [0-9.e-]+ s \\(smallest 'glass\\[k=2\\]' particle\\);'glass\\[k=2\\]': 20 parcels of k = 2 stand for 160 real particles, 4.5238[0-9]*e-05 kg in all;warning: the domain's narrowest side \\(0.01 m\\) is less than 10 diameters of parcels 'glass\\[k=2\\]' \\(0.0012 m\\);warning: parcels 'glass\\[k=2\\]' \\(diameter up to 0.0012 m\\) are wider than a third of the void-fraction cell \\(smallest 0.0025 m, typical 0.0025 m\\): cells of 2.08 parcel diameters"
                FORBID "are wider than the void-fraction cell"
                CMD ${_grain} check ${_scenes}/fluid/parcels.yaml)

@@ -1,0 +1,29 @@
+#pragma once
+// What a checkpoint keeps of its run's insertions, so that a restart with a changed `insert`
+// section stops instead of going on as another run than the one it says it continues.
+//
+// A restart inserts nothing at t = 0 (fills, csv and snapshot insertions are in the state
+// already) and continues each stream from its delivered total. An insertion added, removed or
+// changed in the scene before a restart was therefore skipped, or (a stream's rate) applied back
+// to t = 0, delivering at once what the new rate owed since the start. The checkpoint stores
+// the record below (dataset /streams/insertions); the restart compares it with the scene's and
+// names the first insertion and key that differ.
+#include <string>
+
+#include "dem/scene/scene.hpp"
+
+namespace grainflow {
+
+// One line per insertion of the scene, in its order: "kind=fill; material=glass;
+// coarse_grain=2; seed=7; ...", every number to 17 significant digits, optional keys absent
+// when not given. File names (csv, snapshot) are left out: a case folder may move between the
+// run and its restart, and those insertions have been read into the state already.
+std::string insertion_record(const Scene& scene);
+
+// Throws StateError (restored_state.hpp) when `written`, the record of the checkpoint
+// `checkpoint_file`, differs from the scene's record: the message names the scene's insertion
+// (its file:line), the first key that differs with both values, and what to do.
+void check_insertions(const std::string& written, const Scene& scene,
+                      const std::string& checkpoint_file);
+
+}  // namespace grainflow
