@@ -222,6 +222,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   check_grids(scene);
   const std::string dir = options.output_directory.value_or(scene.output.directory);
   prepare_output_directory(dir);  // before any work: an unwritable directory fails now
+  const OutputLock lock(comm, dir);  // one run per folder: a second is refused, naming this one
   std::ostream& say = speaker(comm, out);
 
   // A restart takes its particles from the checkpoint instead of inserting them.
@@ -288,6 +289,27 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
         << "/log.csv and the snapshot series after " << kept << " earlier snapshot(s)\n";
   } else {
     log_table.emplace(comm, log_path, wall_columns);
+    // An earlier run's files in the folder: this run overwrites the snapshots it writes under
+    // the same numbers; the others stay beside them (a script taking the newest file takes
+    // theirs), and so do its checkpoints. Said, not deleted.
+    int rank = 0;
+    MPI_Comm_rank(comm, &rank);
+    if (rank == 0) {
+      long earlier_snapshots = 0, earlier_checkpoints = 0;
+      std::error_code ec;
+      for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+        const std::string name = e.path().filename().string();
+        const bool h5 = name.ends_with(".h5");
+        if (h5 && name.starts_with("particles_")) ++earlier_snapshots;
+        if (h5 && name.starts_with("checkpoint_")) ++earlier_checkpoints;
+      }
+      if (earlier_snapshots + earlier_checkpoints > 0)
+        say << "note: " << dir << " holds " << earlier_snapshots << " snapshot(s) and "
+            << earlier_checkpoints
+            << " checkpoint(s) of an earlier run; this run overwrites the snapshots it writes "
+               "under the same numbers and leaves the others (particles.xdmf lists only this "
+               "run's): remove them, or give another --output, to keep one run per folder\n";
+    }
   }
   LogTable& log = *log_table;
   ProgressLine progress(comm, scene.time.end, options.progress && scene.output.progress, out);

@@ -1,6 +1,7 @@
 #include "dem/io/output_directory.hpp"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -62,6 +63,54 @@ std::string no_space_note(const std::string& dir, std::uintmax_t bytes) {
   return "No space left on device: " + std::to_string(space.available) +
          " bytes are free on the file system of '" + dir + "', the file needs about " +
          std::to_string(bytes);
+}
+
+OutputLock::OutputLock(MPI_Comm comm, const std::string& dir)
+    : path_((std::filesystem::path(dir) / ".grain.lock").string()) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  std::string error;
+  if (rank == 0) {
+    fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ >= 0 && ::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      const int why = errno;
+      if (why == EWOULDBLOCK) {
+        char holder[256] = {0};
+        const ssize_t n = ::pread(fd_, holder, sizeof holder - 1, 0);
+        std::string who(holder, n > 0 ? static_cast<std::size_t>(n) : 0);
+        while (!who.empty() && (who.back() == '\n' || who.back() == ' ')) who.pop_back();
+        const std::size_t space = who.find(' ');
+        error = "output directory '" + dir + "' is in use by another running grain (" +
+                (space == std::string::npos
+                     ? std::string("a process")
+                     : "process " + who.substr(0, space) + " on " + who.substr(space + 1)) +
+                ", lock file '" + path_ +
+                "'): two runs in one folder would write snapshots, log rows and checkpoints of "
+                "the same names; wait for that run to end, or give this one another --output "
+                "(or output.directory)";
+      }
+      ::close(fd_);  // another holder, or no flock on this file system: run unlocked
+      fd_ = -1;
+    } else if (fd_ >= 0) {
+      char host[256] = {0};
+      ::gethostname(host, sizeof host - 1);
+      const std::string me = std::to_string(::getpid()) + " " + host + "\n";
+      // Without the note the lock still holds; a refused second run then names no process.
+      [[maybe_unused]] const bool noted =
+          ::ftruncate(fd_, 0) == 0 && ::pwrite(fd_, me.data(), me.size(), 0) >= 0;
+    }
+  }
+  int length = static_cast<int>(error.size());
+  MPI_Bcast(&length, 1, MPI_INT, 0, comm);
+  error.resize(static_cast<std::size_t>(length));
+  MPI_Bcast(error.data(), length, MPI_CHAR, 0, comm);
+  if (!error.empty()) throw OutputError(error);
+}
+
+OutputLock::~OutputLock() {
+  if (fd_ < 0) return;
+  ::unlink(path_.c_str());  // while still locked: a run waiting for it takes a fresh file
+  ::close(fd_);
 }
 
 }  // namespace grainflow

@@ -871,6 +871,41 @@ def _(c):
     return f"height {m.group(2)}: 5 parcels placed"
 
 
+@case("output_in_use", "a second run into the folder of a running one, 'give this one another "
+      "--output' (dem/io/output_directory.cpp)", "run")
+def _(c):
+    s = bed(count=400, step=2e-5, end=20.0)  # 10^6 steps: runs on while the second one starts
+    folder = os.path.join(c.root, "first")
+    os.makedirs(folder)
+    with open(os.path.join(folder, "scene.yaml"), "w") as out:
+        json.dump(s, out)
+    with isolated_singleton() as env:
+        first = subprocess.Popen([grain, "run", "scene.yaml", "--output", "out", "--no-progress"],
+                                 cwd=folder, env=env, stdout=subprocess.DEVNULL,
+                                 stderr=subprocess.DEVNULL)
+    try:
+        lock = os.path.join(folder, "out", ".grain.lock")
+        for _ in range(600):  # the first run holds the folder once its lock file exists
+            if os.path.exists(lock) or first.poll() is not None:
+                break
+            time.sleep(0.05)
+        short = bed(step=2e-5, end=0.002)
+        if first.poll() is not None or not os.path.exists(lock):
+            raise Setup(f"the first run ended (exit {first.returncode}) or holds no lock file")
+        r = c.run("", short, "run", folder=folder, scene_name="second.yaml")
+        m = c.expect(r, 1, r"error: output directory 'out' is in use by another running grain "
+                     r"\(process (\d+) on [^,]+, lock file '[^']*'\)[^\n]*give this one "
+                     r"another --output")
+        if int(m.group(1)) != first.pid:
+            raise Broken(f"the message names process {m.group(1)}, the first run is {first.pid}")
+        r = c.run("rerun", short, "run")  # its own folder, so another --output
+        c.rerun_passes(r, r"is in use by another running grain", "another --output")
+    finally:
+        first.kill()
+        first.wait()
+    return "another --output: " + r.lines("done:")[0].split(",")[0]
+
+
 @case("restart_density", "restart with a material's density changed, 'restart with density X' "
       "(dem/engine/restored_state.cpp)", "run --restart")
 def _(c):
