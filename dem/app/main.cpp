@@ -1,6 +1,7 @@
 // grain: the standalone DEM executable.
 #include <mpi.h>
 
+#include <algorithm>
 #include <cstring>
 #include <iostream>
 #include <string>
@@ -24,7 +25,9 @@ commands:
                  [--restart CHECKPOINT.h5]
                       run a DEM scene: HDF5 snapshots + XDMF index (ParaView) and a
                       CSV log in the scene's output directory; --restart continues
-                      from a checkpoint. SIGTERM/SIGINT write a checkpoint and stop
+                      from a checkpoint. SIGTERM/SIGINT write a checkpoint and stop.
+                      Options go before or after the scene, as --key value or
+                      --key=value, each at most once. One run per output folder
   check SCENE.yaml    parse and validate the scene, insert its particles, and print
                       the Rayleigh time, the contact time at the expected impact
                       speed and the time step as a fraction of both
@@ -54,24 +57,51 @@ int dispatch(const std::string& program, const std::vector<std::string>& args, i
   }
   if (cmd != "run" && cmd != "check")
     return usage_error("unknown command '" + cmd + "'; allowed: run, check, --help, --version");
-  if (args.size() < 2) return usage_error("'" + cmd + "' needs a scene file");
-
+  // Options before or after the scene file, `--key value` or `--key=value`; each at most once.
   RunOptions options;
   options.program = program;
-  for (std::size_t k = 2; k < args.size(); ++k) {
-    if (cmd == "run" && args[k] == "--output" && k + 1 < args.size())
-      options.output_directory = args[++k];
-    else if (cmd == "run" && args[k] == "--no-progress")
-      options.progress = false;
-    else if (cmd == "run" && args[k] == "--allow-large-dt")
-      options.allow_large_time_step = true;
-    else if (cmd == "run" && args[k] == "--restart" && k + 1 < args.size())
-      options.restart = args[++k];
-    else
-      return usage_error("unknown option '" + args[k] + "' for '" + cmd + "'");
+  std::string scene_file;
+  std::vector<std::string> given;
+  for (std::size_t k = 1; k < args.size(); ++k) {
+    const std::string& a = args[k];
+    if (!a.starts_with("--")) {
+      if (!scene_file.empty())
+        return usage_error("'" + cmd + "' takes one scene file, got '" + scene_file + "' and '" +
+                           a + "'");
+      scene_file = a;
+      continue;
+    }
+    const std::size_t eq = a.find('=');
+    const std::string key = a.substr(0, eq);
+    const bool takes_value = key == "--output" || key == "--restart";
+    const bool known = takes_value || key == "--no-progress" || key == "--allow-large-dt";
+    if (!known) return usage_error("unknown option '" + a + "' for '" + cmd + "'");
+    if (cmd != "run")
+      return usage_error("option '" + key + "' is for 'run'; 'check' takes only the scene file");
+    if (std::find(given.begin(), given.end(), key) != given.end())
+      return usage_error("option '" + key + "' is given twice; give it once");
+    given.push_back(key);
+    std::string value;
+    if (takes_value) {
+      if (eq != std::string::npos) {
+        value = a.substr(eq + 1);
+      } else if (k + 1 < args.size() && !args[k + 1].starts_with("--")) {
+        value = args[++k];
+      }
+      if (value.empty())
+        return usage_error("option '" + key + "' needs a value: " + key +
+                           (key == "--output" ? " DIR" : " CHECKPOINT.h5"));
+    } else if (eq != std::string::npos) {
+      return usage_error("option '" + key + "' takes no value, got '" + a + "'");
+    }
+    if (key == "--output") options.output_directory = value;
+    if (key == "--restart") options.restart = value;
+    if (key == "--no-progress") options.progress = false;
+    if (key == "--allow-large-dt") options.allow_large_time_step = true;
   }
+  if (scene_file.empty()) return usage_error("'" + cmd + "' needs a scene file");
   try {
-    const Scene scene = load_scene(args[1]);
+    const Scene scene = load_scene(scene_file);
     if (cmd == "check") return check_scene(scene, std::cout);
     run_scene(scene, options, MPI_COMM_WORLD, std::cout);
     return 0;

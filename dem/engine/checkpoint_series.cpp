@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <system_error>
 #include <vector>
 
 #include "dem/engine/simulation.hpp"
+#include "dem/io/checkpoint.hpp"
 
 namespace grainflow {
 
@@ -38,7 +40,7 @@ long step_of(const std::string& name, const std::string& suffix) {
 }  // namespace
 
 CheckpointSeries::CheckpointSeries(MPI_Comm comm, std::string directory, int keep,
-                                   long adopt_up_to_step)
+                                   long adopt_up_to_step, const std::string& record)
     : comm_(comm), directory_(std::move(directory)), keep_(std::max(1, keep)) {
   MPI_Comm_rank(comm_, &rank_);
   std::vector<std::string> found;
@@ -46,8 +48,14 @@ CheckpointSeries::CheckpointSeries(MPI_Comm comm, std::string directory, int kee
   for (const fs::directory_entry& e : fs::directory_iterator(directory_, ec)) {
     const std::string name = e.path().filename().string();
     const long step = step_of(name, "");
-    if (adopt_up_to_step >= 0 && step >= 0 && step <= adopt_up_to_step)
-      found.push_back(e.path().string());
+    if (adopt_up_to_step >= 0 && step >= 0 && step <= adopt_up_to_step) {
+      const std::optional<std::string> theirs =
+          record.empty() ? std::nullopt : read_checkpoint_insertions(e.path().string());
+      if (theirs && *theirs != record)
+        foreign_.push_back(e.path().string());
+      else
+        found.push_back(e.path().string());
+    }
     // A killed run's partial file: a later write of the same step would replace it, but
     // it must never be mistaken for a checkpoint nor pile up.
     if (rank_ == 0 && step_of(name, ".part") >= 0) {
@@ -60,6 +68,7 @@ CheckpointSeries::CheckpointSeries(MPI_Comm comm, std::string directory, int kee
     }
   }
   std::sort(found.begin(), found.end());  // 9-digit steps: name order is step order
+  std::sort(foreign_.begin(), foreign_.end());
   if (!found.empty()) newest_ = found.back();
   if (rank_ == 0) files_.assign(found.begin(), found.end());
 }

@@ -18,7 +18,11 @@ class CheckpointSeries {
   // step <= it count as the series' oldest members. Files of other runs are left alone.
   // Partial checkpoints (checkpoint_<step>.h5.part) that a killed run left behind are
   // deleted: they are never complete checkpoints (see removed_partial()).
-  CheckpointSeries(MPI_Comm comm, std::string directory, int keep, long adopt_up_to_step = -1);
+  // With `record` (the scene's insertion_record, dem/engine/insertion_record.hpp), a checkpoint
+  // whose own record differs was written by another scene's run: it is not adopted, so never
+  // deleted (see foreign()); a checkpoint without a record predates it and is adopted.
+  CheckpointSeries(MPI_Comm comm, std::string directory, int keep, long adopt_up_to_step = -1,
+                   const std::string& record = {});
 
   // Collective: writes the checkpoint of the simulation's current step (which also rebuilds
   // its neighbour lists, see Simulation::write_checkpoint), then deletes the
@@ -30,6 +34,8 @@ class CheckpointSeries {
   const std::string& warning() const { return warning_; }
   // Rank 0: the partial checkpoints the constructor deleted (or could not delete: warning()).
   const std::vector<std::string>& removed_partial() const { return removed_partial_; }
+  // The checkpoints up to the adopted step that another scene's run wrote, left alone.
+  const std::vector<std::string>& foreign() const { return foreign_; }
   // The newest complete checkpoint of the series ("" when none), on every rank.
   const std::string& newest() const { return newest_; }
   // For a failed output write: how to continue ("The newest complete checkpoint is ...; ...
@@ -46,6 +52,7 @@ class CheckpointSeries {
   std::string newest_;
   std::string warning_;
   std::vector<std::string> removed_partial_;
+  std::vector<std::string> foreign_;
 };
 
 }  // namespace grainflow

@@ -169,6 +169,18 @@ std::string insertion_record(const Scene& scene) {
   return out;
 }
 
+std::uint64_t scene_fingerprint(const Scene& scene) {
+  std::string text = insertion_record(scene);
+  for (const Material& m : scene.materials)
+    text += m.name + " " + number(m.density) + " " + number(m.coarse_grain) + "\n";
+  std::uint64_t h = 14695981039346656037ull;  // FNV-1a, 64 bits
+  for (const unsigned char c : text) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
 void check_insertions(const std::string& written, const Scene& scene,
                       const std::string& checkpoint_file) {
   std::vector<std::string> before = lines_of(written);

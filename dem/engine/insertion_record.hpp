@@ -8,6 +8,7 @@
 // to t = 0, delivering at once what the new rate owed since the start. The checkpoint stores
 // the record below (dataset /streams/insertions); the restart compares it with the scene's and
 // names the first insertion and key that differ.
+#include <cstdint>
 #include <string>
 
 #include "dem/scene/scene.hpp"
@@ -19,6 +20,12 @@ namespace grainflow {
 // when not given. File names (csv, snapshot) are left out: a case folder may move between the
 // run and its restart, and those insertions have been read into the state already.
 std::string insertion_record(const Scene& scene);
+
+// A 64-bit hash (FNV-1a) of insertion_record(scene) and each material's name, density and
+// coarse-graining factor: the same for every run of the same scene (whatever its output, time
+// or parallel settings), different for another scene's run. Each snapshot carries it (root
+// attribute `scene_fingerprint`), so that a restart continues only its own run's snapshot series.
+std::uint64_t scene_fingerprint(const Scene& scene);
 
 // Throws StateError (restored_state.hpp) when `written`, the record of the checkpoint
 // `checkpoint_file`, differs from the scene's record: the message names the scene's insertion

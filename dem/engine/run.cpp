@@ -12,6 +12,7 @@
 #include "dem/core/number_format.hpp"
 #include "dem/engine/checkpoint_series.hpp"
 #include "dem/engine/finite_guard.hpp"
+#include "dem/engine/insertion_record.hpp"
 #include "dem/engine/parcel_limits.hpp"
 #include "dem/engine/restored_state.hpp"
 #include "dem/engine/simulation.hpp"
@@ -221,6 +222,15 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   };
   check_grids(scene);
   const std::string dir = options.output_directory.value_or(scene.output.directory);
+  if (options.restart) {  // before the output folder is made: a mistyped name changes nothing
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(*options.restart, ec))
+      throw OutputError("cannot restart from '" + *options.restart + "': " +
+                        (std::filesystem::exists(*options.restart, ec) ? "it is not a regular file"
+                                                                       : "no such file") +
+                        " (nothing was created or changed); give the path of a "
+                        "checkpoint_<step>.h5 that a run wrote (see output.checkpoint_interval)");
+  }
   prepare_output_directory(dir);  // before any work: an unwritable directory fails now
   const OutputLock lock(comm, dir);  // one run per folder: a second is refused, naming this one
   std::ostream& say = speaker(comm, out);
@@ -271,6 +281,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
 
   SnapshotWriter snapshots(comm, dir, "particles", scene.output.fields);
   snapshots.set_coarse_grain(scene.coarse_grain_table(), scene.real_material_table());
+  snapshots.set_scene_fingerprint(scene_fingerprint(scene));
   const std::string log_path = (std::filesystem::path(dir) / "log.csv").string();
   // output.wall_loads: each wall's mean load since the previous row, and that time span.
   std::vector<std::string> wall_columns;
@@ -287,6 +298,11 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     say << "restart: from " << *options.restart << " at step " << first_step
         << " (t = " << sim.time() << " s); continuing " << dir
         << "/log.csv and the snapshot series after " << kept << " earlier snapshot(s)\n";
+    if (!snapshots.foreign_file().empty())
+      say << "note: " << dir << "/" << snapshots.foreign_file()
+          << " was written by another scene's run (its scene_fingerprint differs): the series "
+             "is continued before it, particles.xdmf lists only this run's snapshots, and this "
+             "run writes its own over that file's number and the ones after it\n";
   } else {
     log_table.emplace(comm, log_path, wall_columns);
     // An earlier run's files in the folder: this run overwrites the snapshots it writes under
@@ -314,7 +330,11 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   LogTable& log = *log_table;
   ProgressLine progress(comm, scene.time.end, options.progress && scene.output.progress, out);
   CheckpointSeries checkpoints(comm, dir, scene.output.checkpoint_keep,
-                               options.restart ? first_step : -1);
+                               options.restart ? first_step : -1, insertion_record(scene));
+  for (const std::string& other : checkpoints.foreign())
+    say << "note: " << other
+        << " was written by another scene's run (its record of insertions differs): not part "
+           "of this run's checkpoints, never deleted by it\n";
   for (const std::string& partial : checkpoints.removed_partial())
     say << "note: deleted the partial checkpoint " << partial
         << " (left by a run killed while writing it; never a complete checkpoint)\n";

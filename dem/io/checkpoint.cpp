@@ -414,6 +414,28 @@ void write_checkpoint(MPI_Comm comm, const std::string& path, const CheckpointDa
                       "; its partial file was deleted and no earlier checkpoint was touched");
 }
 
+std::optional<std::string> read_checkpoint_insertions(const std::string& path) {
+  const QuietHdf5Errors quiet;
+  const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (f < 0) return std::nullopt;
+  std::optional<std::string> out;
+  if (H5Lexists(f, "streams", H5P_DEFAULT) > 0 &&
+      H5Lexists(f, "/streams/insertions", H5P_DEFAULT) > 0) {
+    const hid_t set = H5Dopen2(f, "/streams/insertions", H5P_DEFAULT);
+    const hid_t space = set >= 0 ? H5Dget_space(set) : -1;
+    const hssize_t n = space >= 0 ? H5Sget_simple_extent_npoints(space) : -1;
+    if (n >= 0) {
+      std::string text(static_cast<std::size_t>(n), '\0');
+      if (n == 0 || H5Dread(set, H5T_NATIVE_UCHAR, H5S_ALL, H5S_ALL, H5P_DEFAULT, text.data()) >= 0)
+        out = std::move(text);
+    }
+    if (space >= 0) H5Sclose(space);
+    if (set >= 0) H5Dclose(set);
+  }
+  H5Fclose(f);
+  return out;
+}
+
 std::uint32_t attributes_checksum(const CheckpointData& d) {
   std::vector<unsigned char> bytes;
   const auto put = [&bytes](auto value) {  // a double or a 64-bit integer, little-endian

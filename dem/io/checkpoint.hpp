@@ -126,4 +126,8 @@ void write_checkpoint(MPI_Comm comm, const std::string& path, const CheckpointDa
 // and what is wrong with it.
 CheckpointData read_checkpoint(const std::string& path);
 
+// The record of the run's insertions (/streams/insertions) of the checkpoint at `path`, without
+// reading the rest; empty when the file cannot be read or holds no record.
+std::optional<std::string> read_checkpoint_insertions(const std::string& path);
+
 }  // namespace grainflow

@@ -349,6 +349,7 @@ SnapshotWriter::SnapshotWriter(MPI_Comm comm, std::string directory, std::string
 std::size_t SnapshotWriter::continue_series(long up_to_step) {
   QuietHdf5Errors quiet;
   entries_.clear();
+  foreign_file_.clear();
   index_.reset();  // the next write() rewrites the index with the entries taken over
   for (;;) {
     const std::string file_name = basename_ + "_" + six_digits(entries_.size()) + ".h5";
@@ -366,6 +367,14 @@ std::size_t SnapshotWriter::continue_series(long up_to_step) {
     if (!read("time", H5T_NATIVE_DOUBLE, &t) || !read("step", H5T_NATIVE_INT64, &s) ||
         !read("count", H5T_NATIVE_INT64, &n) || s > up_to_step)
       break;
+    // Another scene's run (a file without the attribute predates it and is taken over).
+    std::int64_t fingerprint = 0;
+    if (fingerprint_ != 0 && H5Aexists(file.get(), "scene_fingerprint") > 0 &&
+        read("scene_fingerprint", H5T_NATIVE_INT64, &fingerprint) &&
+        static_cast<std::uint64_t>(fingerprint) != fingerprint_) {
+      foreign_file_ = file_name;
+      break;
+    }
     SnapshotFieldSet held = 0;
     for (std::size_t k = 0; k < snapshot_fields.size(); ++k)
       if (H5Lexists(file.get(), snapshot_fields[k].name, H5P_DEFAULT) > 0)
@@ -548,6 +557,11 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step,
                     write_scalar_attribute(file.get(), "count", i64, &total) &&
                     write_string_attribute(file.get(), "grainflow_version", GRAINFLOW_VERSION));
     agreement.check(ok, "writing the root attributes (time, step, count)");
+    if (fingerprint_ != 0) {
+      const auto fingerprint = static_cast<std::int64_t>(fingerprint_);
+      ok = !opens || write_scalar_attribute(file.get(), "scene_fingerprint", i64, &fingerprint);
+      agreement.check(ok, "writing the root attribute scene_fingerprint");
+    }
     if (!coarse_grain_.empty()) {
       const std::vector<std::int64_t> real(real_material_.begin(), real_material_.end());
       ok = !opens ||

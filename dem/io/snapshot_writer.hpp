@@ -15,6 +15,7 @@
 //   (contact_network.hpp).
 #include <mpi.h>
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <utility>
@@ -79,10 +80,19 @@ class SnapshotWriter {
     coarse_grain_ = std::move(per_material);
     real_material_ = std::move(real_material);
   }
+  // The scene's fingerprint (scene_fingerprint, dem/engine/insertion_record.hpp), written as
+  // the root attribute `scene_fingerprint` of each snapshot (0: none). continue_series stops at
+  // a file that carries another fingerprint: another scene's run wrote it.
+  void set_scene_fingerprint(std::uint64_t fingerprint) { fingerprint_ = fingerprint; }
+  // After continue_series: the first file it left out because another scene's run wrote it
+  // ("" when none).
+  const std::string& foreign_file() const { return foreign_file_; }
 
  private:
   std::vector<double> coarse_grain_;
   std::vector<int> real_material_;
+  std::uint64_t fingerprint_ = 0;
+  std::string foreign_file_;
   MPI_Comm comm_;
   int rank_ = 0;
   int size_ = 1;

@@ -22,6 +22,19 @@ grain_cli_test(help 0 "usage: grain" CMD ${_grain} --help)
 grain_cli_test(no_command 2 "no command given" CMD ${_grain})
 grain_cli_test(unknown_command 2 "unknown command 'frobnicate'; allowed: run, check" CMD ${_grain} frobnicate)
 grain_cli_test(unknown_option 2 "unknown option '--fast' for 'run'" CMD ${_grain} run x.yaml --fast)
+# Options: before or after the scene, `--key value` or `--key=value`, each at most once; a
+# missing value and a run option given to check are named as such.
+grain_cli_test(option_without_value 2 "option '--restart' needs a value: --restart CHECKPOINT.h5"
+               CMD ${_grain} run x.yaml --restart)
+grain_cli_test(option_given_twice 2 "option '--output' is given twice; give it once"
+               CMD ${_grain} run x.yaml --output a --output b)
+grain_cli_test(run_option_to_check 2 "option '--restart' is for 'run'"
+               CMD ${_grain} check x.yaml --restart c.h5)
+grain_cli_test(two_scene_files 2 "'run' takes one scene file, got 'a.yaml' and 'b.yaml'"
+               CMD ${_grain} run a.yaml b.yaml)
+grain_cli_test(options_before_scene 0 "done: 2000 steps, 1 particles \\(0 removed\\)"
+               CMD ${_grain} run --output=out --no-progress ${_scenes}/fluid/lone_bead.yaml
+               WORKDIR ${_work}/options_before_scene FILES out/log.csv)
 grain_cli_test(missing_scene_file 2 "no_such.yaml: error: cannot open the scene file"
                CMD ${_grain} check ${_scenes}/no_such.yaml)
 grain_cli_test(check_minimal 0 "Rayleigh time t_R = ;contact time t_c = ;steps per impact"
@@ -223,7 +236,8 @@ if(GRAINFLOW_PYTHON3)
     endforeach()
   endforeach()
 endif()
-grain_cli_test(restart_missing_checkpoint 1 "no_such_checkpoint.h5"
+grain_cli_test(restart_missing_checkpoint 1
+               "cannot restart from 'no_such_checkpoint.h5': no such file \\(nothing was created or changed\\)"
                CMD ${_grain} run ${_scenes}/periodic_bed.yaml --output out --no-progress
                    --restart no_such_checkpoint.h5
                WORKDIR ${_work}/restart_missing)
@@ -231,6 +245,13 @@ grain_cli_test(restart_missing_checkpoint 1 "no_such_checkpoint.h5"
 # parallel.reproducible through the command line (docs/parallel.md): snapshots on 1, 2 and 3
 # ranks and a restart on 3 ranks equal bit for bit (about 15 s of CPU).
 if(GRAINFLOW_PYTHON3)
+  # A restart into a folder that also holds another scene's run takes over only its own
+  # snapshots and never deletes the other run's checkpoints (foreign_files.py; about 5 s).
+  add_test(NAME grain.foreign_files
+           COMMAND ${GRAINFLOW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/foreign_files.py ${_grain}
+                   ${_scenes}/stop_signal.yaml ${_work}/foreign_files)
+  set_tests_properties(grain.foreign_files PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}"
+                                                      TIMEOUT 300)
   add_test(NAME grain.reproducible_snapshots
            COMMAND ${GRAINFLOW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/reproducible_snapshots.py
                    ${_grain} ${_scenes}/periodic_bed_reproducible.yaml
