@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """A restart into a folder that also holds another scene's run (grain.foreign_files;
-docs/reliability.md, "Another run's files in the output folder").
+docs/scene-reference.md, "One run per output folder").
 
     foreign_files.py GRAIN SCENE WORKDIR
 
