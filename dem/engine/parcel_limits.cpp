@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "dem/core/number_format.hpp"
+#include "dem/insert/insertion.hpp"
 
 namespace grainflow {
 
@@ -22,9 +23,17 @@ std::vector<ParcelClass> parcel_classes(const Scene& scene, const Particles& p, 
   }
   MPI_Allreduce(MPI_IN_PLACE, sum.data(), static_cast<int>(sum.size()), MPI_DOUBLE, MPI_SUM, comm);
   MPI_Allreduce(MPI_IN_PLACE, largest.data(), static_cast<int>(n), MPI_DOUBLE, MPI_MAX, comm);
+  // A stream's parcels count before the first is inserted: the limits hold for what comes.
+  std::vector<bool> streamed(n, false);
+  for (const Insertion& in : scene.insertions) {
+    const auto m = static_cast<std::size_t>(in.material);
+    if (in.kind != Insertion::Kind::stream || m >= n) continue;
+    streamed[m] = true;
+    largest[m] = std::max(largest[m], max_radius(in.radius));
+  }
   std::vector<ParcelClass> out;
   for (std::size_t m = 0; m < n; ++m) {
-    if (k[m] == 1 || sum[3 * m] == 0) continue;
+    if (k[m] == 1 || (sum[3 * m] == 0 && !streamed[m])) continue;
     out.push_back({scene.materials[m].name, k[m], static_cast<long long>(sum[3 * m]),
                    sum[3 * m + 1], sum[3 * m + 2], 2 * largest[m]});
   }

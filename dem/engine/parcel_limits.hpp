@@ -23,8 +23,9 @@ struct ParcelClass {
   double largest_diameter = 0;  // of a parcel [m]
 };
 
-// The scene's parcel classes with at least one parcel among the particles of every rank
-// (collective over comm); empty without parcels. In material order.
+// The scene's parcel classes with at least one parcel among the particles of every rank, or
+// inserted by a stream (whose largest parcel then counts, before the first is in; collective
+// over comm); empty without parcels. In material order.
 std::vector<ParcelClass> parcel_classes(const Scene& scene, const Particles& p, MPI_Comm comm);
 
 // Parcels against fluid cells (Radl et al. 2011): one line per class whose largest parcel is

@@ -150,7 +150,7 @@ void print_coarse_grain_report(const Scene& scene, const Particles& p, MPI_Comm 
     o << "  '" << c.name << "': " << c.parcels << " parcels of k = " << c.k << " stand for "
       << c.real << " real particles, " << c.mass << " kg in all (real radius up to "
       << c.largest_diameter / (2 * c.k) << " m, parcel radius up to " << c.largest_diameter / 2
-      << " m)\n";
+      << " m)" << (c.parcels == 0 ? "; none yet: a stream inserts them" : "") << "\n";
   o << "  all particles: " << parcels << " computed, " << real << " real, mass " << mass
     << " kg\n";
   const Vec3 extent = scene.domain.hi - scene.domain.lo;

@@ -30,3 +30,8 @@ grain_cli_test(coarse_grain_check 0
                "Rayleigh time t_R = [0-9.e-]+ s \\(smallest 'glass\\[k=2\\]' particle\\);'glass\\[k=2\\]': 20 parcels of k = 2 stand for 160 real particles, 4.5238[0-9]*e-05 kg in all;warning: the domain's narrowest side \\(0.01 m\\) is less than 10 diameters of parcels 'glass\\[k=2\\]' \\(0.0012 m\\);warning: parcels 'glass\\[k=2\\]' \\(diameter up to 0.0012 m\\) are wider than a third of the void-fraction cell \\(smallest 0.0025 m, typical 0.0025 m\\): cells of 2.08 parcel diameters"
                FORBID "are wider than the void-fraction cell"
                CMD ${_grain} check ${_scenes}/fluid/parcels.yaml)
+# The same parcels from a stream: none exists at the start, and the class, its sizes and both
+# warnings are there all the same (they were not: the limits saw only the particles present).
+grain_cli_test(coarse_grain_check_stream 0
+               "'glass\\[k=2\\]': 0 parcels of k = 2 stand for 0 real particles, 0 kg in all \\(real radius up to 0.0003 m, parcel radius up to 0.0006 m\\); none yet: a stream inserts them;warning: the domain's narrowest side \\(0.01 m\\) is less than 10 diameters of parcels 'glass\\[k=2\\]' \\(0.0012 m\\);warning: parcels 'glass\\[k=2\\]' \\(diameter up to 0.0012 m\\) are wider than a third of the void-fraction cell"
+               CMD ${_grain} check ${_scenes}/fluid/parcel_stream.yaml)
