@@ -586,6 +586,20 @@ double smallest_radius(const SizeDistribution& s) {
   return s.value;
 }
 
+double largest_radius(const SizeDistribution& s) {
+  using K = SizeDistribution::Kind;
+  switch (s.kind) {
+    case K::constant:
+      return s.value;
+    case K::uniform:
+    case K::normal:
+      return s.max;
+    case K::discrete:
+      return *std::max_element(s.values.begin(), s.values.end());
+  }
+  return s.value;
+}
+
 double region_volume(const Region& r) {
   if (r.kind == Region::Kind::box) return (r.hi - r.lo).prod();
   return std::acos(-1.0) * r.radius * r.radius * r.height;
@@ -734,12 +748,7 @@ void parse_stream(const Map& m, const Scene& scene, Insertion& ins) {
   parse_coarse_grain(m, ins);
   // Each particle enters whole inside the face's outline (StreamInsertion::sample); a face
   // narrower than the largest one would put it at the centre, sticking out of the outline.
-  const SizeDistribution& r = ins.radius;
-  double r_max = r.value;
-  if (r.kind == SizeDistribution::Kind::uniform || r.kind == SizeDistribution::Kind::normal)
-    r_max = r.max;
-  else if (r.kind == SizeDistribution::Kind::discrete && !r.values.empty())
-    r_max = *std::max_element(r.values.begin(), r.values.end());
+  const double r_max = largest_radius(ins.radius);
   const bool rectangle = ins.face.kind == InsertionFace::Kind::rectangle;
   const double across =
       rectangle ? std::min(ins.face.length_u, ins.face.length_v) : 2 * ins.face.radius;
