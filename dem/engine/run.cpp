@@ -242,10 +242,12 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
                       "was killed, possibly incomplete; restart from a complete "
                       "checkpoint_<step>.h5");
   Simulation sim(scene, !options.restart, comm);
+  std::optional<std::string> checkpoint_log;  // the log table the checkpoint keeps
   if (options.restart) {
     const CheckpointData checkpoint = read_checkpoint(*options.restart);
     check_restart_step(scene, checkpoint);
     sim.restore(checkpoint);
+    checkpoint_log = checkpoint.log;
   }
   // fluid_force needs the force terms' share kept, at the steps that write a snapshot.
   const bool wants_fluid_force = (scene.output.fields & snapshot_field_bit("fluid_force")) != 0;
@@ -294,7 +296,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   std::optional<LogTable> log_table;
   if (options.restart) {
     const std::size_t kept = snapshots.continue_series(first_step);
-    log_table.emplace(comm, log_path, first_step, wall_columns);
+    log_table.emplace(comm, log_path, first_step, wall_columns, checkpoint_log);
     say << "restart: from " << *options.restart << " at step " << first_step
         << " (t = " << sim.time() << " s); continuing " << dir
         << "/log.csv and the snapshot series after " << kept << " earlier snapshot(s)\n";
@@ -328,6 +330,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     }
   }
   LogTable& log = *log_table;
+  if (!log.note().empty()) say << "note: " << log.note() << "\n";
+  sim.set_log_record(&log.record());  // each checkpoint keeps the log up to its step
   ProgressLine progress(comm, scene.time.end, options.progress && scene.output.progress, out);
   CheckpointSeries checkpoints(comm, dir, scene.output.checkpoint_keep,
                                options.restart ? first_step : -1, insertion_record(scene));
@@ -366,18 +370,21 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
                                        : checkpoints.resume_hint(continue_command(
                                              scene.file, options, ranks, newest))));
   };
-  auto write_log = [&] {
+  // `recorded` false: a row that the uninterrupted run does not write (the stop signal's); it
+  // leaves the wall-load sums running and stays out of the checkpoints' copy of the log.
+  auto write_log = [&](bool recorded = true) {
     const GlobalState g = sim.global_state();
     std::vector<double> loads;
     if (scene.output.wall_loads) {
-      const Simulation::WallLoads w = sim.take_wall_loads();
+      const Simulation::WallLoads w = sim.take_wall_loads(/*reset=*/recorded);
       for (const Vec3& f : w.force) loads.insert(loads.end(), {f[0], f[1], f[2]});
       loads.push_back(w.interval);
     }
     try {
       log.write({sim.time(), sim.counters().steps, g.particles, g.kinetic_translational,
                  g.kinetic_rotational, g.max_overlap_ratio, g.contacts, sim.counters().rebuilds,
-                 g.removed, wall(), std::move(loads)});
+                 g.removed, wall(), std::move(loads)},
+                recorded);
     } catch (const OutputError& e) {
       throw resumable(e);
     }
@@ -489,7 +496,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     if (k % 100 == 0 && !last) {
       const int signal = StopSignals::agreed(comm);
       if (signal != 0) {
-        if (log_step != k) write_log();
+        if (log_step != k) write_log(/*recorded=*/false);
         sum.stop_checkpoint = write_checkpoint();
         stop_message << "grain: received " << StopSignals::name(signal) << "; stopped after step "
                      << k << " (t = " << t << " s) and wrote the checkpoint " << sum.stop_checkpoint

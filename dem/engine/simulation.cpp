@@ -801,6 +801,7 @@ void Simulation::write_checkpoint(const std::string& path) {
   }
   d.streams = streams_.save_state();
   d.insertions = insertion_record(scene_);
+  if (log_record_) d.log = *log_record_;
   if (!wall_impulse_.empty()) {
     d.wall_impulse.reserve(3 * wall_impulse_.size() + 1);
     for (const Vec3& j : wall_impulse_)
@@ -1816,7 +1817,7 @@ void Simulation::step() {
   ++counters_.steps;
 }
 
-Simulation::WallLoads Simulation::take_wall_loads() {
+Simulation::WallLoads Simulation::take_wall_loads(bool reset) {
   WallLoads out;
   if (wall_impulse_.empty()) return out;
   const std::size_t n = wall_impulse_.size();
@@ -1829,6 +1830,7 @@ Simulation::WallLoads Simulation::take_wall_loads() {
   if (wall_load_time_ > 0)  // the load: the reaction to the walls' forces on the particles
     for (std::size_t w = 0; w < n; ++w)
       out.force[w] = -Vec3(sum[3 * w], sum[3 * w + 1], sum[3 * w + 2]) / wall_load_time_;
+  if (!reset) return out;
   std::fill(wall_impulse_.begin(), wall_impulse_.end(), Vec3::Zero());
   wall_load_time_ = 0;
   return out;

@@ -118,6 +118,9 @@ class Simulation {
   // rebuilds the neighbour lists exactly as a restart from that file will, so that a
   // run restarted on the same rank count continues bit-identically. Collective.
   void write_checkpoint(const std::string& path);
+  // The run's log table as the checkpoints written from now on store it (LogTable::record(),
+  // read on rank 0 when a checkpoint is written); null (the default): no log in them.
+  void set_log_record(const std::string* record) { log_record_ = record; }
 
   // Checks the time step, distributes particles to their ranks, builds lists and
   // the first forces. Collective. Called by the first step() if not before.
@@ -197,12 +200,13 @@ class Simulation {
   // exerted on it by contact (minus the sum of the wall's contact forces on them) over
   // `interval`, the simulated time since the last call, the start, or the checkpoint
   // restored (one written with output.wall_loads carries the time before it). Resets the
-  // sums. Collective; `force` is empty when output.wall_loads is off.
+  // sums, unless `reset` is false (a log row that is not part of the run's record, see
+  // LogTable::write). Collective; `force` is empty when output.wall_loads is off.
   struct WallLoads {
     std::vector<Vec3> force;  // [N]
     double interval = 0;      // [s]
   };
-  WallLoads take_wall_loads();
+  WallLoads take_wall_loads(bool reset = true);
 
   // Largest over mean particle count per rank (1 = perfectly balanced). Collective.
   double load_imbalance() const;
@@ -336,6 +340,7 @@ class Simulation {
   // take_wall_loads() (on rank 0 also a restored checkpoint's global sums).
   std::vector<Vec3> wall_forces_, wall_impulse_;
   double wall_load_time_ = 0;
+  const std::string* log_record_ = nullptr;  // set_log_record()
   bool record_contacts_ = false;   // record_contacts()
   bool network_recorded_ = false;  // network_ is the last force evaluation's
   ContactNetwork network_;

@@ -52,8 +52,9 @@ std::uintmax_t expected_bytes(const CheckpointData& d) {
   const std::uintmax_t n = d.particles.size(), per_particle = 8 + 5 * 24 + 3 * 8 + 4;
   const std::uintmax_t drag =
       (d.drag_coefficient.empty() ? 0 : 32) + (d.has_temperature ? 8 : 0);
-  const std::uintmax_t streams =
-      (d.streams ? d.streams->size() : 0) + (d.insertions ? d.insertions->size() : 0);
+  const std::uintmax_t streams = (d.streams ? d.streams->size() : 0) +
+                                 (d.insertions ? d.insertions->size() : 0) +
+                                 (d.log ? d.log->size() : 0);
   std::uintmax_t grid = 0;
   if (d.grid)
     for (const auto& c : d.grid->cuts) grid += 8 * c.size();
@@ -300,6 +301,13 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
                  "writing the dataset '/streams/insertions'");
     if (s >= 0) H5Gclose(s);
   }
+  if (fail.ok() && d.log) {
+    const hid_t s = H5Gcreate2(f.id(), "log", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    fail.check(
+        s >= 0 && write_array(fail, s, "table", H5T_NATIVE_UCHAR, d.log->size(), 1, d.log->data()),
+        "writing the dataset '/log/table'");
+    if (s >= 0) H5Gclose(s);
+  }
   if (fail.ok() && d.grid) {
     const CheckpointGrid& grid = *d.grid;
     const hid_t s = H5Gcreate2(f.id(), "decomposition", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
@@ -385,6 +393,7 @@ void write_checkpoint(MPI_Comm comm, const std::string& path, const CheckpointDa
     d.removed = local.removed;
     d.streams = local.streams;
     d.insertions = local.insertions;
+    d.log = local.log;
     d.grid = local.grid;
     d.material_coarse_grain = local.material_coarse_grain;
     d.material_real = local.material_real;
@@ -585,6 +594,13 @@ CheckpointData read_checkpoint(const std::string& path) {
                                                       chars, error, sealed);
         if (error.empty()) d.insertions = std::string(record.begin(), record.end());
       }
+    }
+    // Optional (written since the checkpoint keeps the run's log).
+    if (error.empty() && H5Lexists(f, "log", H5P_DEFAULT) > 0) {
+      std::size_t chars = static_cast<std::size_t>(-1);
+      const auto table =
+          read_array<unsigned char>(f, "/log/table", H5T_NATIVE_UCHAR, 1, chars, error, sealed);
+      if (error.empty()) d.log = std::string(table.begin(), table.end());
     }
     // Optional (format 3): the shapes here, the values in check_checkpoint.
     if (error.empty() && H5Lexists(f, "decomposition", H5P_DEFAULT) > 0) {

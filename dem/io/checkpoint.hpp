@@ -24,6 +24,8 @@
 // has partner = -1 - wall index. A pair's spring may be listed once per partner;
 // /streams/state (uint8 text, StreamInsertion::save_state(): the stream insertions'
 // delivered totals, radii drawn but not placed and generator states);
+// /log/table (uint8 text, optional: the run's log.csv up to this step, LogTable::record(), which
+// a restart makes its log.csv whatever the folder's file holds);
 // /decomposition/{ranks, dims, cuts_x, cuts_y, cuts_z}: the processor grid the run used when
 // it wrote the file — its rank count, ranks per axis and each axis's dims+1 cut planes from
 // the domain's lo to its hi — so that a restart on as many ranks continues on the same boxes
@@ -90,6 +92,9 @@ struct CheckpointData {
   // the scene's on restart; the dataset /streams/insertions, absent in files written before it
   // (not checked then).
   std::optional<std::string> insertions;
+  // The run's log table up to this step (header and rows, as log.csv holds them; taken from
+  // rank 0 when writing); absent in files written before it and in grainFoam's checkpoints.
+  std::optional<std::string> log;
   // The processor grid (taken from rank 0 when writing); absent in format 1 and 2 files.
   std::optional<CheckpointGrid> grid;
   // Each material index's coarse-graining factor and listed material (Scene's materials:

@@ -4,6 +4,7 @@
 #include <mpi.h>
 
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,12 +35,17 @@ class LogTable {
   // by the `extra` column names (each row then carries as many LogRow::extra values); every
   // rank throws OutputError naming the path if that fails.
   LogTable(MPI_Comm comm, const std::string& path, const std::vector<std::string>& extra = {});
-  // Collective: continues the table of a restarted run. Rank 0 keeps the header and the rows
-  // with step <= `continue_after_step` (rows that a stopped run wrote after its checkpoint are
-  // dropped, the restarted run writes them again), then appends. A missing file, or one with
-  // another header, is replaced by a new table.
+  // Collective: continues the table of a restarted run, then appends.
+  // With `record` (the checkpoint's copy of the table up to its step, record() of the run that
+  // wrote it): the table becomes that copy, whatever the file holds — rows a stopped run wrote
+  // after its checkpoint, another run's log, an edited or a missing file (note() says which);
+  // a copy with other columns than this run's (output.wall_loads changed) starts a new table.
+  // Without it (a checkpoint written before it had the copy): rank 0 keeps the file's header and
+  // rows with step <= `continue_after_step`; a missing file, or one with another header, is
+  // replaced by a new table.
   LogTable(MPI_Comm comm, const std::string& path, long continue_after_step,
-           const std::vector<std::string>& extra = {});
+           const std::vector<std::string>& extra = {},
+           const std::optional<std::string>& record = std::nullopt);
   ~LogTable();
   LogTable(const LogTable&) = delete;
   LogTable& operator=(const LogTable&) = delete;
@@ -47,9 +53,17 @@ class LogTable {
   // Collective: rank 0 appends the row (doubles with 17 significant digits, so they read back
   // exactly) and flushes it, so a killed run keeps its log up to the last row. Every rank
   // throws OutputError if the write fails (disk full), so no rank runs on without a log.
-  void write(const LogRow& row);
+  // `recorded` false: the row is written to the file but left out of record(), so that a
+  // restart from the checkpoint written next drops it (the row a stop signal adds at the stop
+  // step, which the uninterrupted run does not write).
+  void write(const LogRow& row, bool recorded = true);
 
   const std::string& path() const { return path_; }
+  // Rank 0: the table's text (header and recorded rows) as a checkpoint stores it; other ranks:
+  // empty.
+  const std::string& record() const { return record_; }
+  // Rank 0, after the continuing constructor: what the restart replaced, as a sentence, or "".
+  const std::string& note() const { return note_; }
 
  private:
   void agree(int error_number, const char* what);
@@ -60,6 +74,8 @@ class LogTable {
   std::string header_;  // header and the extra columns
   std::size_t extra_ = 0;
   std::FILE* file_ = nullptr;  // open on rank 0 only
+  std::string record_;         // rank 0
+  std::string note_;           // rank 0
 };
 
 }  // namespace grainflow

@@ -17,7 +17,11 @@ A's files 3-30 hold steps below B's checkpoint. Checks:
     as another scene's;
   * A's two checkpoints are still there after B's series has kept its newest two, and the
     restart's notes name them;
-  * B's final state is the uninterrupted B's (a run of B to 3 s in a clean folder), bit for bit.
+  * B's final state is the uninterrupted B's (a run of B to 3 s in a clean folder), bit for bit;
+  * B's checkpoint continued in a third folder, where A ran (A's log.csv, whose steps are all
+    below the checkpoint's): that folder's log.csv is the uninterrupted B's row for row (every
+    column but the wall clock), with a note that A's rows were replaced; before, A's rows
+    stayed in front of B's continuation.
 Exit 0 when every check holds.
 """
 import glob
@@ -107,7 +111,25 @@ for p in a_checkpoints:
 ours = sorted(set(glob.glob(os.path.join(work, "out", "checkpoint_*.h5"))) - set(a_checkpoints))
 check(len(ours) == 2, f"B's series keeps its newest 2 checkpoints ({len(ours)})")
 
+grain_run("a.yaml", "other")
+other = grain_run("b3.yaml", "other", "--restart", os.path.relpath(b_checkpoint[0], work))
+check("note: other/log.csv held rows that the checkpoint's run did not write" in other,
+      "the restart in A's folder says that A's log rows were replaced")
+
+
+def log_rows(out):
+    """log.csv's rows without the wall-clock column (the last of the usual ten)."""
+    lines = open(os.path.join(work, out, "log.csv")).read().splitlines()
+    return [",".join(line.split(",")[:9]) for line in lines]
+
+
 grain_run("b3.yaml", "clean")
+clean_rows, other_rows = log_rows("clean"), log_rows("other")
+check(other_rows == clean_rows,
+      f"log.csv of B continued in A's folder is the uninterrupted B's row for row "
+      f"({len(other_rows)} and {len(clean_rows)} lines; first difference at line "
+      f"{next((i for i, (a, b) in enumerate(zip(other_rows, clean_rows)) if a != b), None)})")
+check(log_rows("out") == clean_rows, "so is log.csv of B continued in its own folder")
 t1, x1, v1 = last_state("out")
 t2, x2, v2 = last_state("clean")
 check(t1 == t2 and np.array_equal(x1, x2) and np.array_equal(v1, v2),

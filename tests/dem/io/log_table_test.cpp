@@ -6,10 +6,12 @@
 #include <gtest/gtest.h>
 #include <mpi.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <numbers>
 #include <sstream>
@@ -174,6 +176,71 @@ TEST(LogTable, ContinuingDropsARowCutShort) {
   const std::vector<std::string> lines = read_lines(path);
   ASSERT_EQ(lines.size(), 3u);
   EXPECT_EQ(lines[2], "0.2,20,5,0,0,0,0,2,0,1.0");
+}
+
+// The copy a checkpoint keeps (record()) holds the header and the recorded rows, each exactly
+// as the file has it; a row written with `recorded` false is in the file only. A restart with
+// that copy makes the file the copy, whatever the folder held: here another run's log whose
+// steps are all below the checkpoint's (kept whole by the step rule alone), with a note.
+TEST(LogTable, RestartTakesTheCheckpointsCopy) {
+  const fs::path dir = fresh_directory("record");
+  const fs::path path = dir / "log.csv";
+  std::string copy;
+  {
+    LogTable log(MPI_COMM_WORLD, path.string());
+    log.write(awkward_row(0));
+    log.write(awkward_row(1));
+    copy = log.record();
+    log.write(awkward_row(2), /*recorded=*/false);
+    EXPECT_EQ(log.record(), copy);
+  }
+  std::ifstream in(path);
+  const std::string file{std::istreambuf_iterator<char>(in), {}};
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  if (rank == 0) {
+    EXPECT_EQ(read_lines(path).size(), 4u);
+    EXPECT_TRUE(file.starts_with(copy)) << copy;
+    EXPECT_EQ(std::count(copy.begin(), copy.end(), '\n'), 3);
+  }
+  {  // the stopped run's own file: continued from the copy, the unrecorded row dropped
+    LogTable log(MPI_COMM_WORLD, path.string(), awkward_row(2).step, {}, copy);
+    if (rank == 0) {
+      EXPECT_EQ(log.note(), "");
+    }
+  }
+  if (rank == 0) {
+    EXPECT_EQ(read_lines(path).size(), 3u);
+  }
+  {
+    std::ofstream out(path);
+    out << LogTable::header << "\n0.1,10,5,0,0,0,0,1,0,0.5\n";
+  }
+  {
+    LogTable log(MPI_COMM_WORLD, path.string(), awkward_row(1).step, {}, copy);
+    if (rank == 0) {
+      EXPECT_NE(log.note().find("held rows that the checkpoint's run did not write"),
+                std::string::npos)
+          << log.note();
+      EXPECT_NE(log.note().find("2 row(s), up to step " + std::to_string(awkward_row(1).step)),
+                std::string::npos)
+          << log.note();
+    }
+  }
+  if (rank == 0) {
+    std::ifstream again(path);
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(again), {}), copy);
+  }
+  fs::remove(path);
+  {
+    LogTable log(MPI_COMM_WORLD, path.string(), awkward_row(1).step, {}, copy);
+    if (rank == 0) {
+      EXPECT_NE(log.note().find("was missing: restored"), std::string::npos);
+    }
+  }
+  if (rank == 0) {
+    EXPECT_EQ(read_lines(path).size(), 3u);
+  }
 }
 
 }  // namespace
