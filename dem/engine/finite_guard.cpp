@@ -70,7 +70,9 @@ std::string describe_first_non_finite(const Particles& p, long step, double time
          "whatever the particle's temperature: a wall's negative `heat_flux` (W/m^2 over the "
          "contact area) or a material's negative `heat_source` (W/kg). Lower it, or give the "
          "wall a `temperature` instead, which cools a particle no further than to the wall's "
-         "(docs/models/heat-transfer.md)";
+         "(docs/models/heat-transfer.md). Without such a flow: the conduction step was beyond "
+         "its stability limit (a run with --allow-large-dt); use the time step `grain check` "
+         "gives";
     return s.str();
   }
   const char* what = !finite(p.x[i])   ? "position"

@@ -24,9 +24,8 @@
 namespace grainflow {
 
 // Harmonic effective conductivity of a contact [W/(m K)].
-inline double effective_conductivity(double k_i, double k_j) {
-  return 2 * k_i * k_j / (k_i + k_j);
-}
+// (As 2 / (1/k_i + 1/k_j): the product k_i k_j overflows above 1.3e154 W/(m K).)
+inline double effective_conductivity(double k_i, double k_j) { return 2 / (1 / k_i + 1 / k_j); }
 
 // Contact radius a = sqrt(R* delta) [m] (Hertz; used for Hooke contacts too).
 inline double contact_radius(double r_star, double overlap) { return std::sqrt(r_star * overlap); }

@@ -36,6 +36,7 @@ ThermalLimits check_thermal_limits(const Scene& scene, const Particles& p, TimeS
   const double overlap = scene.time.max_overlap;
   const std::vector<double> factor = contact_radius_factors(scene);  // a = f sqrt(R* delta)
   std::string where;
+  bool wall_limited = false;  // the limit is a fixed-temperature wall's contact
   if (scene.heat->conduction && scene.contacts_possible)
     for (int a = 0; a < nm; ++a) {
       if (r_min[a] == inf) continue;
@@ -59,6 +60,7 @@ ThermalLimits check_thermal_limits(const Scene& scene, const Particles& p, TimeS
         if (capacity(a) / g < out.conduction_time) {
           out.conduction_time = capacity(a) / g;
           where = "'" + scene.materials[a].name + "' on wall '" + w.name + "'";
+          wall_limited = true;
         }
       }
     }
@@ -103,8 +105,13 @@ ThermalLimits check_thermal_limits(const Scene& scene, const Particles& p, TimeS
       rep.refuse_above(round_down_3(kWarnConductionFraction * limit));
       o << "error: dt = " << dt
         << " s is beyond the stability limit of heat conduction (dt <= " << limit
-        << " s); use dt <= " << round_down_3(kWarnConductionFraction * limit)
-        << " s, or switch conduction off with `heat: {conduction: none}`";
+        << " s); use dt <= " << round_down_3(kWarnConductionFraction * limit) << " s";
+      // A fixed-temperature wall needs conduction (the parser refuses it with `none`).
+      if (wall_limited)
+        o << " (the limit is the contact with that wall, whose fixed temperature reaches the "
+             "particles by conduction; a wall with `heat_flux` instead has no such limit)";
+      else
+        o << ", or switch conduction off with `heat: {conduction: none}`";
       rep.notes.push_back(o.str());
       o.str("");
     } else if (dt > kWarnConductionFraction * limit) {

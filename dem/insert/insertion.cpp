@@ -259,13 +259,18 @@ void fill_region(const Scene& scene, const WallSet* walls, const Insertion& ins,
 }
 
 std::vector<std::string> split_csv(const std::string& line) {
+  // Every comma separates two cells, a trailing one too: "1,2," has three (the last empty).
   std::vector<std::string> out;
-  std::stringstream ss(line);
-  std::string cell;
-  while (std::getline(ss, cell, ',')) {
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = line.find(',', start);
+    const std::string cell =
+        line.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
     const auto b = cell.find_first_not_of(" \t\r");
     const auto e = cell.find_last_not_of(" \t\r");
     out.push_back(b == std::string::npos ? "" : cell.substr(b, e - b + 1));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
   }
   return out;
 }
@@ -337,6 +342,11 @@ void read_csv(const Scene& scene, const WallSet* walls, const Insertion& ins, Pa
   std::unordered_map<std::string, int> col;
   for (std::size_t k = 0; k < header.size(); ++k) {
     const std::string& name = header[k];
+    if (name.empty())
+      fail(header_line, "column " + std::to_string(k + 1) +
+                            " of the header has no name (two "
+                            "commas in a row, or one at the end of the line); allowed " +
+                            allowed);
     if (std::find(kCsvColumns.begin(), kCsvColumns.end(), name) == kCsvColumns.end())
       fail(header_line, "unknown column '" + name + "' in the header; allowed " + allowed);
     if (!col.emplace(name, static_cast<int>(k)).second)
@@ -361,6 +371,12 @@ void read_csv(const Scene& scene, const WallSet* walls, const Insertion& ins, Pa
   if (has_t && !scene.heat)
     fail(header_line, "column 'T' (temperature) is given, but heat transfer is off; add a "
                       "top-level `heat: {}` block to the scene, or remove the column");
+  if (has_t && ins.temperature)
+    fail(header_line,
+         "column 'T' gives each row's temperature, and the insertion entry gives "
+         "`temperature: " +
+             format_number(*ins.temperature) +
+             "`; give one of them (the entry's is for a file without a 'T' column)");
   if (scene.heat && !has_t && !ins.temperature)
     fail(header_line, "heat is on, but the file has no column 'T' and the insertion entry no "
                       "`temperature: <K>`; give one of them");
@@ -376,7 +392,8 @@ void read_csv(const Scene& scene, const WallSet* walls, const Insertion& ins, Pa
       const std::string& s = cells[col[name]];
       char* end = nullptr;
       const double v = std::strtod(s.c_str(), &end);
-      if (s.empty() || *end != '\0' || !std::isfinite(v))
+      if (s.empty()) fail(lineno, std::string("column '") + name + "' is empty; give a number");
+      if (*end != '\0' || !std::isfinite(v))
         fail(lineno, std::string("column '") + name + "' is not a finite number: '" +
                          s.substr(0, 40) + (s.size() > 40 ? "..." : "") + "'");
       return v;

@@ -380,6 +380,12 @@ WallThermal parse_wall_thermal(const Map& m, const std::optional<HeatSettings>& 
   if (temperature && flux)
     flux->fail_at_key("a wall has either a fixed `temperature` or a fixed `heat_flux`, not both; "
                       "leave both out for an adiabatic wall");
+  if (temperature && !heat->conduction)
+    temperature->fail_at_key(
+        "a wall's fixed `temperature` heats or cools the particles touching it by contact "
+        "conduction, which `heat: {conduction: none}` switches off; remove this key (an "
+        "adiabatic wall), give the wall a `heat_flux` instead, or set `heat.conduction: "
+        "batchelor_obrien`");
   if (temperature) {
     t.kind = WallThermal::Kind::temperature;
     t.value = temperature->number(kPositive);

@@ -350,6 +350,39 @@ def _(c):
     return f"conduction: {m.group(1)}: accepted"
 
 
+@case("conduction_refusal_wall", "refused time step set by a fixed-temperature wall: 'use dt "
+      "<= X s' without the advice to switch conduction off, which that wall needs "
+      "(dem/heat/thermal_limits.cpp)", "check")
+def _(c):
+    s = heated(bed(step=5e-6), 1.5e5)
+    s["walls"][0]["temperature"] = 400
+    m = c.expect(c.run("first", s), 1, r"beyond the stability limit of heat conduction "
+                 r"\(dt <= [^)]*\); use dt <= " + NUM + r" s \(the limit is the contact with "
+                 r"that wall")
+    if "conduction: none" in m.group(0):
+        raise AssertionError("the advice names `conduction: none`, which the wall refuses")
+    s["time"]["step"] = float(m.group(1))
+    c.rerun_passes(c.run("rerun", s), r"beyond the stability limit of heat conduction",
+                   "time.step")
+    return f"step {m.group(1)}: accepted"
+
+
+@case("wall_temperature_without_conduction", "a wall's `temperature` with `heat: {conduction: "
+      "none}`: 'give the wall a `heat_flux` instead' (dem/scene/scene_parser.cpp)", "check")
+def _(c):
+    s = heated(bed(step=1e-7), 1.0)
+    s["heat"] = {"conduction": "none"}
+    s["walls"][0]["temperature"] = 400
+    c.expect(c.run("first", s), 2, r"scene.yaml:\d+:\d+: error: walls\[0\]\.temperature: a wall's "
+             r"fixed `temperature` heats or cools the particles touching it by contact "
+             r"conduction, which `heat: \{conduction: none\}` switches off;[^\n]*give the wall "
+             r"a `heat_flux` instead")
+    del s["walls"][0]["temperature"]
+    s["walls"][0]["heat_flux"] = 1000
+    c.rerun_passes(c.run("rerun", s), r"switches off", "walls[0].heat_flux")
+    return "heat_flux: accepted"
+
+
 @case("conduction_warning", "warning 'dt is above 0.1 of the stability limit of heat "
       "conduction; dt <= X s is recommended' (dem/heat/thermal_limits.cpp)", "check")
 def _(c):

@@ -595,6 +595,12 @@ insert:
   e = refusal(scene("heat: {}\n", "beads_bad.csv", ""));
   EXPECT_NE(e.find("beads_bad.csv:3"), std::string::npos) << e;
   EXPECT_NE(e.find("temperature T must be > 0 K"), std::string::npos) << e;
+  // Both a column T and the entry's `temperature`: the entry's was silently ignored.
+  e = refusal(scene("heat: {}\n", "beads_t.csv", ", temperature: 500"));
+  EXPECT_NE(e.find("beads_t.csv:1: error: column 'T' gives each row's temperature, and the "
+                   "insertion entry gives `temperature: 500`; give one of them"),
+            std::string::npos)
+      << e;
 }
 
 // A snapshot's temperatures (written with the `temperature` field) start the particles of a
@@ -1022,6 +1028,10 @@ TEST(HeatTransfer, NusseltLaws) {
               1e-12);
   EXPECT_DOUBLE_EQ(effective_conductivity(2, 2), 2);
   EXPECT_DOUBLE_EQ(effective_conductivity(1, 3), 1.5);
+  // Beyond 1.3e154 the product k_i k_j overflows: 2 k_i k_j / (k_i + k_j) gave 0 (then a
+  // conduction limit of dt <= 0 s in grain check).
+  EXPECT_DOUBLE_EQ(effective_conductivity(1e160, 1e160), 1e160);
+  EXPECT_DOUBLE_EQ(effective_conductivity(1e300, 3e300), 1.5e300);
 }
 
 }  // namespace

@@ -262,6 +262,15 @@ TEST_F(BrokenCsv, MissingUnknownRepeatedAndPartialColumns) {
   EXPECT_THAT(error_of("x,y,z,radius\n0,0,0,0.1\n0.5,0.5\n"),
               HasSubstr(at(3) + "expected 4 columns, found 2"));
   EXPECT_THAT(error_of("x,y,z,radius\n0,0,0,0.1,7\n"), HasSubstr(at(2) + "expected 4 columns, found 5"));
+  // A trailing comma makes one more (empty) cell: a row "…,0.1," has five cells, not four
+  // (it was read as four and accepted), and a row whose last value is missing reads "empty".
+  EXPECT_THAT(error_of("x,y,z,radius\n0,0,0,0.1,\n"),
+              HasSubstr(at(2) + "expected 4 columns, found 5"));
+  EXPECT_THAT(error_of("x,y,z,radius\n0,0,0,\n"), HasSubstr(at(2) + "column 'radius' is empty"));
+  EXPECT_THAT(
+      error_of("x,y,z,radius,\n0,0,0,0.1,\n"),
+      HasSubstr(at(1) + "column 5 of the header has no name (two commas in a row, or one at "
+                        "the end of the line)"));
 }
 
 TEST_F(BrokenCsv, NonNumericAndNonFiniteValues) {
@@ -270,7 +279,7 @@ TEST_F(BrokenCsv, NonNumericAndNonFiniteValues) {
   EXPECT_THAT(error_of("x,y,z,radius\n0,0,0.5m,0.1\n"),
               HasSubstr(at(2) + "column 'z' is not a finite number: '0.5m'"));
   EXPECT_THAT(error_of("x,y,z,radius\n0,0,,0.1\n"),
-              HasSubstr(at(2) + "column 'z' is not a finite number: ''"));
+              HasSubstr(at(2) + "column 'z' is empty; give a number"));
   EXPECT_THAT(error_of("x,y,z,radius\nnan,0,0,0.1\n"),
               HasSubstr(at(2) + "column 'x' is not a finite number: 'nan'"));
   EXPECT_THAT(error_of("x,y,z,radius\n0,0,0,1e999\n"),  // overflows to inf
