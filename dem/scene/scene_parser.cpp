@@ -31,6 +31,7 @@
 #include <utility>
 #include <vector>
 
+#include "dem/core/number_format.hpp"
 #include "dem/io/snapshot_reader.hpp"
 #include "dem/io/xdmf_index.hpp"
 #include "dem/scene/fluid_section.hpp"
@@ -396,9 +397,75 @@ WallThermal parse_wall_thermal(const Map& m, const std::optional<HeatSettings>& 
   return t;
 }
 
+// A wall must look the same from both sides of a periodic boundary: a particle that leaves
+// through one side comes back through the other, and sees the walls there without wrapping.
+// A plane whose normal has a component along a periodic axis cuts that axis's sides (the
+// particle comes back behind it and is shot out: energy grew 250-fold in a scene that ran to
+// "done"); so does a cylinder whose axis is tilted to it, or one across it whose surface
+// reaches a periodic side. Meshes are not checked (a floor spanning the periodic width is
+// right; docs/scene-reference.md, "Walls").
+void check_periodic_wall(const Map& m, const Wall& w, const Domain& d) {
+  constexpr const char* axis_name[3] = {"x", "y", "z"};
+  constexpr double tolerance = 1e-9;  // of a unit vector's component
+  const WallMotion& motion = w.motion;
+  for (int a = 0; a < 3; ++a) {
+    if (!d.periodic[a]) continue;
+    const std::string periodic = std::string(axis_name[a]) + " is periodic (domain.periodic)";
+    const std::string unit = "; make " + std::string(axis_name[a]) + " bounded, or ";
+    if (w.kind == Wall::Kind::plane && std::abs(w.plane.normal[a]) > tolerance) {
+      std::ostringstream o;
+      o << "plane '" << w.name << "' has a normal with the component "
+        << significant(w.plane.normal[a]) << " along " << axis_name[a] << ", and " << periodic
+        << ": a particle leaving through one " << axis_name[a]
+        << " side comes back through the other, on the plane's far side" << unit
+        << "give the plane a normal perpendicular to " << axis_name[a];
+      m.get("normal").fail_at_key(o.str());
+    }
+    if (w.kind == Wall::Kind::cylinder) {
+      const CylinderWall& c = w.cylinder;
+      const double along = std::abs(c.axis[a]);
+      if (along > tolerance && along < 1 - tolerance) {
+        std::ostringstream o;
+        o << "cylinder '" << w.name << "' has an axis tilted to " << axis_name[a] << ", and "
+          << periodic << ": its surface crosses the " << axis_name[a]
+          << " sides, where a particle coming back through the other side finds it elsewhere"
+          << unit << "give the cylinder an axis along or perpendicular to " << axis_name[a];
+        m.get("axis").fail_at_key(o.str());
+      }
+      if (along <= tolerance &&
+          (c.axis_point[a] - c.radius < d.lo[a] || c.axis_point[a] + c.radius > d.hi[a])) {
+        std::ostringstream o;
+        o << "cylinder '" << w.name << "' reaches from " << axis_name[a] << " = "
+          << significant(c.axis_point[a] - c.radius) << " to "
+          << significant(c.axis_point[a] + c.radius) << " m, across the domain's "
+          << significant(d.lo[a]) << " to " << significant(d.hi[a]) << " m, and " << periodic
+          << ": a particle coming back through the other side does not see it there" << unit
+          << "keep the cylinder within the periodic range (its axis point and radius)";
+        m.get("radius").fail_at_key(o.str());
+      }
+    }
+    // A rotation turns a plane's normal (a cylinder's axis) towards a periodic axis unless
+    // it is about that axis.
+    if (w.kind != Wall::Kind::mesh && motion.angular_velocity != 0 &&
+        std::abs(motion.axis[a]) < 1 - tolerance) {
+      const Vec3 v = w.kind == Wall::Kind::plane ? w.plane.normal : w.cylinder.axis;
+      const Vec3 turned = motion.axis.cross(v);
+      if (std::abs(turned[a]) > tolerance) {
+        std::ostringstream o;
+        o << "wall '" << w.name << "' rotates (motion.angular_velocity) about an axis that "
+          << "turns its " << (w.kind == Wall::Kind::plane ? "normal" : "axis") << " towards "
+          << axis_name[a] << ", and " << periodic << ": it would then cut the periodic sides"
+          << unit << "rotate it about an axis along " << axis_name[a];
+        m.get("motion").fail_at_key(o.str());
+      }
+    }
+  }
+}
+
 // `names` are the names of the walls already read, to keep them unique.
 Wall parse_wall(const Field& item, const std::unordered_set<std::string>& names,
-                const std::vector<Material>& materials, const std::optional<HeatSettings>& heat) {
+                const std::vector<Material>& materials, const std::optional<HeatSettings>& heat,
+                const Domain& domain) {
   const Map m = item.map();
   Wall w;
   w.kind = m.get("type", "add `type: plane`, `type: cylinder` or `type: mesh`")
@@ -442,6 +509,7 @@ Wall parse_wall(const Field& item, const std::unordered_set<std::string>& names,
   }
   const std::optional<Field> name = m.find("name");
   w.name = name ? name->text() : "wall" + std::to_string(names.size());
+  check_periodic_wall(m, w, domain);
   if (names.count(w.name) > 0)
     (name ? *name : item).fail("duplicate wall name '" + w.name + "'; give each wall a unique name");
   w.material = material_ref(m, "material", materials);
@@ -450,11 +518,11 @@ Wall parse_wall(const Field& item, const std::unordered_set<std::string>& names,
 }
 
 std::vector<Wall> parse_walls(const Field& f, const std::vector<Material>& materials,
-                              const std::optional<HeatSettings>& heat) {
+                              const std::optional<HeatSettings>& heat, const Domain& domain) {
   std::vector<Wall> walls;
   std::unordered_set<std::string> names;  // a set: many walls cost linear, not quadratic, time
   for (const Field& item : f.items()) {
-    walls.push_back(parse_wall(item, names, materials, heat));
+    walls.push_back(parse_wall(item, names, materials, heat, domain));
     names.insert(walls.back().name);
   }
   return walls;
@@ -1096,7 +1164,7 @@ Scene build_scene(const Field& root) {
         "built for `contact: {normal: hertz}` only; with `normal: hooke` use "
         "`contact_radius: geometric`");
   if (const auto n = top.find("neighbour")) s.neighbour = parse_neighbour(*n);
-  if (const auto w = top.find("walls")) s.walls = parse_walls(*w, s.materials, s.heat);
+  if (const auto w = top.find("walls")) s.walls = parse_walls(*w, s.materials, s.heat, s.domain);
   if (const auto i = top.find("insert")) {
     s.insertions = parse_insertions(*i, s);
     add_parcel_classes(s);

@@ -286,9 +286,11 @@ TEST(SceneErrors, ContactKeysAreRequiredWhenParticlesCanTouch) {
   // A wall, with the elastic constants given: the interactions, then the contact law.
   const std::string elastic =
       "  - {name: glass, density: 2500, youngs_modulus: 5e6, poisson_ratio: 0.3}\n";
-  const std::string with_wall = with("  - {name: glass, density: 2500}\n", elastic, kLoneBead) +
-                                "walls:\n  - {type: plane, name: floor, point: [0, 0, 0], normal: "
-                                "[0, 0, 1], material: glass}\n";
+  const std::string with_wall =
+      with("periodic: [true, true, true]", "periodic: [true, true, false]",
+           with("  - {name: glass, density: 2500}\n", elastic, kLoneBead)) +
+      "walls:\n  - {type: plane, name: floor, point: [0, 0, 0], normal: "
+      "[0, 0, 1], material: glass}\n";
   const std::string pairs = error_of(with_wall).what();
   EXPECT_THAT(pairs, HasSubstr("no interaction properties for material pair (glass, glass)"));
   const std::string law = error_of(with_wall + "interaction_defaults: {restitution: 0.5}\n").what();
@@ -843,6 +845,55 @@ TEST(SceneParser, ParallelReproducible) {
   const std::string msg =
       expect_at(error_of(kBase + "parallel: {reproducible: sometimes}\n"), 17, 26);
   EXPECT_THAT(msg, HasSubstr("parallel.reproducible: expected true or false, got 'sometimes'"));
+}
+
+// A wall must look the same from both sides of a periodic boundary. A plane across a periodic
+// axis was accepted, and a particle coming back through the other side landed behind it: the
+// overlap guard stopped the run, and its advice (a larger time.max_overlap) ended in "done"
+// with the kinetic energy grown 250-fold, without gravity or any energy input.
+TEST(SceneErrors, WallsAcrossAPeriodicAxis) {
+  const std::string periodic =
+      with("  max: [1, 1, 1]\n", "  max: [1, 1, 1]\n  periodic: [true, false, false]\n");
+  const auto walls = [&](const std::string& w) { return periodic + "walls:\n  - " + w + "\n"; };
+  const std::string plane = expect_at(
+      error_of(
+          walls("{type: plane, name: left, point: [0, 0, 0], normal: [1, 0, 0], material: glass}")),
+      19, 49);
+  EXPECT_THAT(
+      plane,
+      AllOf(
+          HasSubstr("walls[0].normal: plane 'left' has a normal with the component 1 along x, and "
+                    "x is periodic (domain.periodic)"),
+          HasSubstr("make x bounded, or give the plane a normal perpendicular to x")));
+  // Inclined: the component 0.7071 along x.
+  EXPECT_THAT(
+      error_of(walls("{type: plane, point: [0, 0, 0], normal: [1, 0, 1], material: glass}")).what(),
+      HasSubstr("with the component 0.7071 along x"));
+  EXPECT_THAT(
+      error_of(walls("{type: cylinder, axis_point: [0.5, 0.5, 0], axis: [1, 0, 1], radius: 0.2, "
+                     "material: glass}"))
+          .what(),
+      HasSubstr("cylinder 'wall0' has an axis tilted to x, and x is periodic"));
+  EXPECT_THAT(
+      error_of(walls("{type: cylinder, axis_point: [0.9, 0.5, 0], axis: [0, 0, 1], radius: 0.2, "
+                     "side: outside, material: glass}"))
+          .what(),
+      HasSubstr("cylinder 'wall0' reaches from x = 0.7 to 1.1 m, across the domain's 0 to 1 m"));
+  EXPECT_THAT(
+      error_of(walls("{type: plane, point: [0, 0, 0], normal: [0, 0, 1], material: glass, "
+                     "motion: {angular_velocity: 1, axis: [0, 1, 0]}}"))
+          .what(),
+      HasSubstr("rotates (motion.angular_velocity) about an axis that turns its normal towards x"));
+  // What periodicity allows: a floor, a pipe along x, a drum across x within the range, a
+  // plane rotating about x.
+  for (
+      const char* ok :
+      {"{type: plane, point: [0, 0, 0], normal: [0, 0, 1], material: glass}",
+       "{type: cylinder, axis_point: [0, 0.5, 0.5], axis: [1, 0, 0], radius: 0.4, material: glass}",
+       "{type: cylinder, axis_point: [0.5, 0.5, 0], axis: [0, 0, 1], radius: 0.5, material: glass}",
+       "{type: plane, point: [0, 0, 0], normal: [0, 0, 1], material: glass, "
+       "motion: {angular_velocity: 1, axis: [1, 0, 0]}}"})
+    EXPECT_NO_THROW(parse_scene(walls(ok), kLabel)) << ok;
 }
 
 }  // namespace
