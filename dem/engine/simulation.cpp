@@ -288,6 +288,49 @@ void Simulation::check_walls_travel() {
                             : std::numeric_limits<double>::infinity());
   for (const std::string& note : walls.notes) report_.notes.push_back(note);
   if (!walls.error.empty()) throw SetupError(walls.error);
+  check_mesh_tunnelling(walls, std::isfinite(smallest.radius) ? smallest.radius : 0.0);
+}
+
+void Simulation::check_mesh_tunnelling(const WallTravelReport& walls, double r_min) {
+  // A mesh is a two-sided sheet, and its overlap r - |c - q| falls again once a centre has
+  // crossed it. From an overlap of at most L r on one side to at most L r on the other, a centre
+  // travels at least 2 (1 - L) r relative to the mesh. The particles move at most
+  // max_step_travel radii per step, a moving mesh its own travel per smallest radius: below
+  // 2 (1 - L) together, every crossing passes an overlap above L at the end of some step, which
+  // the overlap guard stops. (Planes and cylinders have a signed distance: always seen.)
+  const double travel = scene_.time.max_step_travel, limit = scene_.time.max_overlap;
+  if (travel <= 0 || r_min <= 0) return;
+  double wall_travel = 0;
+  std::string fastest;
+  bool meshes = false;
+  for (const Wall& w : scene_.walls) meshes |= w.kind == Wall::Kind::mesh;
+  if (!meshes) return;
+  for (const WallTravel& w : walls.walls)
+    if (scene_.walls[w.index].kind == Wall::Kind::mesh && w.travel / r_min > wall_travel) {
+      wall_travel = w.travel / r_min;
+      fastest = w.name;
+    }
+  mesh_walls_ = true;
+  mesh_wall_travel_ = wall_travel;
+  const double crossing = 2 * (1 - limit);
+  if (travel + wall_travel < crossing) return;
+  const double overlap_fit = round_down_3(0.999 * (1 - (travel + wall_travel) / 2));
+  const double travel_fit = round_down_3(0.999 * (crossing - wall_travel));
+  std::ostringstream o;
+  o.precision(4);
+  o << scene_.file << ": error: time.max_overlap = " << limit
+    << " with mesh walls: a centre that crosses a "
+    << "mesh (a two-sided sheet) from an overlap below " << limit << " of its radius on one side "
+    << "to one below it on the other travels only 2 (1 - " << limit << ") = " << crossing
+    << " radii, and a particle may move " << travel << " radii per step (time.max_step_travel)";
+  if (wall_travel > 0) o << ", mesh '" << fastest << "' " << wall_travel << " smallest radii";
+  o << ": such a tunnel would pass between two steps without an overlap the guard sees. ";
+  if (overlap_fit > 0) o << "Lower time.max_overlap to " << overlap_fit;
+  if (overlap_fit > 0 && travel_fit > 0) o << ", or ";
+  if (travel_fit > 0)
+    o << (overlap_fit > 0 ? "lower" : "Lower") << " time.max_step_travel to " << travel_fit;
+  if (overlap_fit <= 0 && travel_fit <= 0) o << "Slow the mesh down, or lower time.step";
+  throw SetupError(o.str());
 }
 
 void Simulation::check_force_limits() {
@@ -1608,14 +1651,26 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
   const double deepest = driven ? chain_stop : stop;
   if (deepest < kNoStop) {
     const double need = round_up(1.1 * deepest / c.r_small);
-    if (need <= 1)
-      o << " set time.max_overlap to at least " << need << " (knowingly: the overlap then "
+    if (need <= 1) {
+      o << " set time.max_overlap to at least " << need;
+      // With mesh walls a larger limit needs a smaller travel per step (check_mesh_tunnelling).
+      const double travel = scene_.time.max_step_travel;
+      if (mesh_walls_ && travel > 0 && travel + mesh_wall_travel_ >= 2 * (1 - need)) {
+        const double fit = round_down_3(0.999 * (2 * (1 - need) - mesh_wall_travel_));
+        if (fit > 0)
+          o << " and, with mesh walls, time.max_step_travel to at most " << fit;
+        else
+          o << " (with mesh walls it needs time.max_step_travel below "
+            << 2 * (1 - need) - mesh_wall_travel_ << ", which a moving mesh's own travel leaves "
+            << "no room for: lower time.step first)";
+      }
+      o << " (knowingly: the overlap then "
         << "stands for that much deformation"
         << (moving.empty() ? ""
                            : "; with a moving wall "
                              "pressing, this only moves the stop later")
         << ");";
-    else
+    } else
       o << " no time.max_overlap (at most 1) carries it;";
   } else {
     o << " no time.max_overlap (at most 1) carries it;";

@@ -35,6 +35,8 @@
 
 namespace grainflow {
 
+struct WallTravelReport;  // dem/walls/wall_travel.hpp
+
 // Run-time problem that is the scene's fault but only visible once particles exist
 // (periodic box too short for the particles, dt needs particles, ...).
 class SetupError : public std::runtime_error {
@@ -274,6 +276,10 @@ class Simulation {
   // The walls' travel guard (dem/walls/wall_travel.hpp): notes into the report, SetupError
   // when a wall moves too far per step.
   void check_walls_travel();
+  // SetupError when a particle could cross a mesh wall within one step without an overlap
+  // above time.max_overlap (r_min: the smallest radius present or to come; 0: none).
+  // Keeps mesh_walls_ and mesh_wall_travel_ for the overlap guard's advice.
+  void check_mesh_tunnelling(const WallTravelReport& walls, double r_min);
   void mark_leaving();  // particles beyond a bounded side of the domain
   // The first half kick and x += dt v in one pass, with mark_leaving()'s test, the skin test
   // and the largest local |v|^2 (for contact_may_be_unresolved()); forces and torques set to
@@ -341,6 +347,10 @@ class Simulation {
   std::vector<Vec3> wall_forces_, wall_impulse_;
   double wall_load_time_ = 0;
   const std::string* log_record_ = nullptr;  // set_log_record()
+  // check_mesh_tunnelling(): the scene has mesh walls (and particles), and the fastest moving
+  // mesh's travel per step in smallest radii.
+  bool mesh_walls_ = false;
+  double mesh_wall_travel_ = 0;
   bool record_contacts_ = false;   // record_contacts()
   bool network_recorded_ = false;  // network_ is the last force evaluation's
   ContactNetwork network_;

@@ -383,6 +383,41 @@ def _(c):
     return "heat_flux: accepted"
 
 
+SHEET = ("solid sheet\n" + "".join(
+    " facet normal 0 0 0\n  outer loop\n" +
+    "".join(f"   vertex {x} {y} 0.005\n" for x, y in tri) + "  endloop\n endfacet\n"
+    for tri in [((0, 0), (0.01, 0), (0.01, 0.01)), ((0, 0), (0.01, 0.01), (0, 0.01))]) +
+    "endsolid sheet\n")
+
+
+@case("mesh_tunnel", "time.max_overlap with mesh walls: 'Lower time.max_overlap to X' "
+      "(Simulation::check_mesh_tunnelling)", "run")
+def _(c):
+    # A soft bead thrown at 3 m/s onto a mesh sheet (z = 5 mm) with max_overlap 0.9: it went
+    # through within one step, its overlap never above 0.9, and the run ended "done" with the
+    # bead below the sheet. Refused now; the advised limit lets the overlap guard stop it.
+    s = {
+        "domain": {"min": [0, 0, -0.02], "max": [0.01, 0.01, 0.01]},
+        "time": {"rayleigh_fraction": 0.1, "end": 0.003, "expected_max_speed": 3,
+                 "max_overlap": 0.9},
+        "materials": [{"name": "soft", "youngs_modulus": 2e4, "poisson_ratio": 0.3,
+                       "density": 2500}],
+        "interactions": [{"materials": ["soft", "soft"], "restitution": 0.9, "friction": 0}],
+        "contact": {"normal": "hertz", "tangential": "none"},
+        "walls": [{"type": "mesh", "name": "sheet", "file": "sheet.stl", "material": "soft"}],
+        "insert": [{"type": "csv", "file": "one.csv", "material": "soft"}],
+        "output": {"snapshot_interval": 0.0005},
+    }
+    files = {"sheet.stl": SHEET, "one.csv": "x,y,z,radius,vx,vy,vz\n0.005,0.005,0.0065,0.001,0,0,-3\n"}
+    m = c.expect(c.run("first", s, "run", files=files), 1,
+                 r"error: time.max_overlap = 0.9 with mesh walls: [^\n]*Lower time.max_overlap to "
+                 + NUM)
+    s["time"]["max_overlap"] = float(m.group(1))
+    c.rerun_next(c.run("rerun", s, "run", files=files), r"with mesh walls", 1,
+                 r"particle 1 and a wall overlap by [0-9.]+ % of the smaller radius", "max_overlap")
+    return f"max_overlap {m.group(1)}: the overlap guard stops the tunnel"
+
+
 @case("conduction_warning", "warning 'dt is above 0.1 of the stability limit of heat "
       "conduction; dt <= X s is recommended' (dem/heat/thermal_limits.cpp)", "check")
 def _(c):
