@@ -232,4 +232,55 @@ void check_insertions(const std::string& written, const Scene& scene,
                      ". " + kWhy);
 }
 
+namespace {
+// "path = value" lines as (path, value) pairs, in their order.
+std::vector<std::pair<std::string, std::string>> model_entries(const std::string& record) {
+  std::vector<std::pair<std::string, std::string>> out;
+  std::istringstream in(record);
+  for (std::string line; std::getline(in, line);) {
+    const auto eq = line.find(" = ");
+    if (eq == std::string::npos) continue;
+    out.emplace_back(line.substr(0, eq), line.substr(eq + 3));
+  }
+  return out;
+}
+}  // namespace
+
+void check_model(const std::string& written, const Scene& scene,
+                 const std::string& checkpoint_file) {
+  if (written == scene.model_record) return;
+  const auto was = model_entries(written), is = model_entries(scene.model_record);
+  const auto value_in = [](const auto& entries, const std::string& path) -> const std::string* {
+    for (const auto& [p, v] : entries)
+      if (p == path) return &v;
+    return nullptr;
+  };
+  std::string where = scene.file, path, here, there;
+  for (std::size_t k = 0; k < is.size() && path.empty(); ++k) {
+    const std::string* w = value_in(was, is[k].first);
+    if (w && *w == is[k].second) continue;
+    path = is[k].first;
+    here = is[k].second;
+    there = w ? *w : std::string("not given (its default)");
+    if (k < scene.model_sources.size()) where = scene.model_sources[k];
+  }
+  for (std::size_t k = 0; k < was.size() && path.empty(); ++k)
+    if (!value_in(is, was[k].first)) {
+      path = was[k].first;
+      here = "not given (its default)";
+      there = was[k].second;
+    }
+  if (path.empty()) return;  // the same entries in another order: the same model
+  std::ostringstream o;
+  o << where << ": error: " << path << " is " << here << " here, " << there
+    << " in the run that wrote checkpoint '" << checkpoint_file
+    << "'. A restart continues that run as it was, with its model (domain, gravity, materials, "
+       "interactions, contact, walls, heat, fluid): a changed one would go on as another run "
+       "under the same name, from a state that run did not make. Restore "
+    << path << (there.starts_with("not given") ? " to its default (leave it out)" : " to " + there)
+    << ", or start the changed scene afresh (to keep the run's particles, insert its last "
+       "snapshot with `type: snapshot`)";
+  throw StateError(o.str());
+}
+
 }  // namespace grainflow

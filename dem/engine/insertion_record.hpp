@@ -33,4 +33,13 @@ std::uint64_t scene_fingerprint(const Scene& scene);
 void check_insertions(const std::string& written, const Scene& scene,
                       const std::string& checkpoint_file);
 
+// Throws StateError when `written`, the model record of the checkpoint `checkpoint_file`
+// (Scene::model_record of the run that wrote it, dataset /scene/model), differs from the scene's:
+// the message names the first key that differs (its file:line here), both values, and what to
+// do. A restart continues its run with the run's model: a changed heat capacity made the
+// particles' thermal energy jump by 37 % at the restart, a changed stiffness or friction would
+// have gone on as another run under the same name.
+void check_model(const std::string& written, const Scene& scene,
+                 const std::string& checkpoint_file);
+
 }  // namespace grainflow

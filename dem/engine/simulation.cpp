@@ -757,6 +757,9 @@ void Simulation::restore(const CheckpointData& checkpoint) {
                      " holds no particle temperatures (it was written by a run without heat "
                      "transfer); run the scene from the start, or restart with a scene whose "
                      "heat settings match the checkpoint's run");
+  // The run's model: after the rules above, whose messages name a changed density or parcel
+  // class more precisely.
+  if (checkpoint.model) check_model(*checkpoint.model, scene_, checkpoint.file);
   p_ = checkpoint.particles;
   restored_drag_.clear();
   for (std::size_t i = 0; i < checkpoint.drag_coefficient.size(); ++i)
@@ -844,6 +847,7 @@ void Simulation::write_checkpoint(const std::string& path) {
   }
   d.streams = streams_.save_state();
   d.insertions = insertion_record(scene_);
+  d.model = scene_.model_record;
   if (log_record_) d.log = *log_record_;
   if (!wall_impulse_.empty()) {
     d.wall_impulse.reserve(3 * wall_impulse_.size() + 1);

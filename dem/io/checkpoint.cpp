@@ -54,7 +54,7 @@ std::uintmax_t expected_bytes(const CheckpointData& d) {
       (d.drag_coefficient.empty() ? 0 : 32) + (d.has_temperature ? 8 : 0);
   const std::uintmax_t streams = (d.streams ? d.streams->size() : 0) +
                                  (d.insertions ? d.insertions->size() : 0) +
-                                 (d.log ? d.log->size() : 0);
+                                 (d.log ? d.log->size() : 0) + (d.model ? d.model->size() : 0);
   std::uintmax_t grid = 0;
   if (d.grid)
     for (const auto& c : d.grid->cuts) grid += 8 * c.size();
@@ -301,6 +301,13 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
                  "writing the dataset '/streams/insertions'");
     if (s >= 0) H5Gclose(s);
   }
+  if (fail.ok() && d.model) {
+    const hid_t s = H5Gcreate2(f.id(), "scene", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    fail.check(s >= 0 && write_array(fail, s, "model", H5T_NATIVE_UCHAR, d.model->size(), 1,
+                                     d.model->data()),
+               "writing the dataset '/scene/model'");
+    if (s >= 0) H5Gclose(s);
+  }
   if (fail.ok() && d.log) {
     const hid_t s = H5Gcreate2(f.id(), "log", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     fail.check(
@@ -394,6 +401,7 @@ void write_checkpoint(MPI_Comm comm, const std::string& path, const CheckpointDa
     d.streams = local.streams;
     d.insertions = local.insertions;
     d.log = local.log;
+    d.model = local.model;
     d.grid = local.grid;
     d.material_coarse_grain = local.material_coarse_grain;
     d.material_real = local.material_real;
@@ -594,6 +602,13 @@ CheckpointData read_checkpoint(const std::string& path) {
                                                       chars, error, sealed);
         if (error.empty()) d.insertions = std::string(record.begin(), record.end());
       }
+    }
+    // Optional (written since restarts compare the scene's model with the run's).
+    if (error.empty() && H5Lexists(f, "scene", H5P_DEFAULT) > 0) {
+      std::size_t chars = static_cast<std::size_t>(-1);
+      const auto model =
+          read_array<unsigned char>(f, "/scene/model", H5T_NATIVE_UCHAR, 1, chars, error, sealed);
+      if (error.empty()) d.model = std::string(model.begin(), model.end());
     }
     // Optional (written since the checkpoint keeps the run's log).
     if (error.empty() && H5Lexists(f, "log", H5P_DEFAULT) > 0) {

@@ -24,6 +24,8 @@
 // has partner = -1 - wall index. A pair's spring may be listed once per partner;
 // /streams/state (uint8 text, StreamInsertion::save_state(): the stream insertions'
 // delivered totals, radii drawn but not placed and generator states);
+// /scene/model (uint8 text, optional: the run's Scene::model_record, which a restart's scene
+// must equal);
 // /log/table (uint8 text, optional: the run's log.csv up to this step, LogTable::record(), which
 // a restart makes its log.csv whatever the folder's file holds);
 // /decomposition/{ranks, dims, cuts_x, cuts_y, cuts_z}: the processor grid the run used when
@@ -92,6 +94,9 @@ struct CheckpointData {
   // the scene's on restart; the dataset /streams/insertions, absent in files written before it
   // (not checked then).
   std::optional<std::string> insertions;
+  // The run's model (Scene::model_record), compared with the scene's on restart; dataset
+  // /scene/model, absent in files written before it (not checked then).
+  std::optional<std::string> model;
   // The run's log table up to this step (header and rows, as log.csv holds them; taken from
   // rank 0 when writing); absent in files written before it and in grainFoam's checkpoints.
   std::optional<std::string> log;

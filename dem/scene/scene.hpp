@@ -267,6 +267,13 @@ struct HeatSettings {
 
 struct Scene {
   std::string file;  // path it was read from
+  // The scene's model as its file gives it: one line "path = value" per key of domain, gravity,
+  // materials, interactions, interaction_defaults, contact, walls, heat and fluid (map keys in
+  // sorted order, numbers in their shortest exact form). A checkpoint keeps it, and a restart
+  // with another model is refused (check_model, dem/engine/model_record.hpp). model_sources:
+  // each line's "file:line", in the same order.
+  std::string model_record;
+  std::vector<std::string> model_sources;
   Domain domain;
   Vec3 gravity = Vec3::Zero();
   TimeSettings time;

@@ -14,8 +14,10 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <climits>
 #include <cmath>
+#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -1134,6 +1136,38 @@ const std::vector<std::string> kTopLevelKeys = {
     "domain",  "gravity",   "time",  "materials", "interactions", "interaction_defaults",
     "contact", "neighbour", "walls", "insert",    "output", "parallel", "fluid", "heat"};
 
+// One line "path = value" per scalar under `node` (Scene::model_record).
+void add_model_lines(const YAML::Node& node, const std::string& path, const Source& src, Scene& s) {
+  if (node.IsMap()) {
+    // Sorted by a std::map, which copy-constructs the nodes: assigning a YAML::Node (as
+    // std::sort does) writes into the node it refers to.
+    std::map<std::string, YAML::Node> entries;
+    for (const auto& kv : node) entries.emplace(kv.first.Scalar(), kv.second);
+    for (const auto& [key, value] : entries) add_model_lines(value, path + "." + key, src, s);
+    return;
+  }
+  if (node.IsSequence()) {
+    for (std::size_t k = 0; k < node.size(); ++k)
+      add_model_lines(node[k], path + "[" + std::to_string(k) + "]", src, s);
+    return;
+  }
+  std::string value = node.IsScalar() ? node.Scalar() : "~";
+  // A number in its shortest exact form: 1e-3 and 0.001 are one value.
+  char* end = nullptr;
+  const double number = std::strtod(value.c_str(), &end);
+  if (!value.empty() && end != nullptr && *end == '\0' && std::isfinite(number)) {
+    char buffer[32];
+    const auto [last, error] = std::to_chars(buffer, buffer + sizeof buffer, number);
+    if (error == std::errc()) value.assign(buffer, last);
+  }
+  std::ostringstream line;
+  line << path << " = " << value << "\n";
+  s.model_record += line.str();
+  std::ostringstream where;
+  where << src.label << ":" << node.Mark().line + 1;
+  s.model_sources.push_back(where.str());
+}
+
 Scene build_scene(const Field& root) {
   if (!root.node().IsDefined() || root.node().IsNull())
     root.fail("the scene is empty; it needs at least domain, time, materials and contact");
@@ -1182,6 +1216,9 @@ Scene build_scene(const Field& root) {
     s.output.fields |= snapshot_field_bit("coarse_grain") | snapshot_field_bit("real_count");
   s.contacts_possible = contacts_possible(s);
   if (s.contacts_possible && !for_contacts.empty()) std::rethrow_exception(for_contacts.front());
+  for (const char* section : {"domain", "gravity", "materials", "interactions",
+                              "interaction_defaults", "contact", "walls", "heat", "fluid"})
+    if (const auto f = top.find(section)) add_model_lines(f->node(), section, root.source(), s);
   // The Rayleigh time needs the elastic constants of every material a particle uses.
   if (s.time.rayleigh_fraction)
     for (const Material& mat : s.materials)

@@ -896,5 +896,24 @@ TEST(SceneErrors, WallsAcrossAPeriodicAxis) {
     EXPECT_NO_THROW(parse_scene(walls(ok), kLabel)) << ok;
 }
 
+// The model record a checkpoint keeps (Scene::model_record): one value, however written, and
+// keys in any order are one record; another value is another record, with its source line.
+TEST(SceneParser, ModelRecordIsTheValuesNotTheirSpelling) {
+  const Scene a = parse_scene(kBase, kLabel);
+  const Scene b = parse_scene(with("    density: 2500\n", "    density: 2.5e3\n",
+                                   with("    youngs_modulus: 5e6\n    poisson_ratio: 0.3\n",
+                                        "    poisson_ratio: 0.30\n    youngs_modulus: 5000000\n")),
+                              kLabel);
+  EXPECT_EQ(a.model_record, b.model_record);
+  EXPECT_NE(a.model_record.find("materials[0].density = 2500\n"), std::string::npos)
+      << a.model_record;
+  EXPECT_NE(a.model_record.find("interactions[0].restitution = 0.9\n"), std::string::npos);
+  EXPECT_EQ(a.model_record.find("time."), std::string::npos);  // time, output: not the model
+  const Scene c = parse_scene(with("restitution: 0.9", "restitution: 0.8"), kLabel);
+  EXPECT_NE(a.model_record, c.model_record);
+  ASSERT_EQ(c.model_sources.size(), static_cast<std::size_t>(std::count(
+                                        c.model_record.begin(), c.model_record.end(), '\n')));
+}
+
 }  // namespace
 }  // namespace grainflow
