@@ -231,13 +231,50 @@ void fill_region(const Scene& scene, const WallSet* walls, const Insertion& ins,
   // (In double: a count near the parser's limit of 9e15 would overflow a long here.)
   const long budget = static_cast<long>(
       std::min(2000.0 * std::max(1000.0, static_cast<double>(target_count)) + 2e6, 9e18));
+  // Why attempts failed, for the message: a wall (counted per wall), the domain, an earlier
+  // particle.
+  std::vector<long> by_wall(scene.walls.size(), 0);
+  long sampled = 0, outside = 0, walled = 0;
+  const auto wall_of = [&](const Vec3& x, double r) {
+    if (walls) return walls->deepest_overlap(x, r).wall;
+    int wall = -1;
+    double deepest = -1;
+    WallTouch t;
+    for (std::size_t k = 0; k < scene.walls.size(); ++k)
+      if (touch_wall(scene.walls[k], x, r, t) && t.overlap > deepest) {
+        wall = static_cast<int>(k);
+        deepest = t.overlap;
+      }
+    return wall;
+  };
   while (!done()) {
     if (++attempts > budget) {
       std::ostringstream msg;
+      msg.precision(4);
       msg << ins.source << ": error: could place only " << placed << " particles ("
           << volume / region_volume(ins.region) << " solid fraction) without overlap in the fill "
-          << "region after " << budget << " attempts; enlarge the region, or lower `count` / "
-          << "`volume_fraction` (random insertion saturates near 0.35)";
+          << "region after " << budget << " attempts";
+      // Most attempts on a wall: the walls, not the region's size or the count, are the cause.
+      const double usable =
+          sampled > 0 ? 1 - static_cast<double>(walled + outside) / static_cast<double>(sampled)
+                      : 1.0;
+      if (walled > 0 && 2 * walled >= sampled) {
+        const auto worst = std::max_element(by_wall.begin(), by_wall.end()) - by_wall.begin();
+        msg << "; " << walled << " of the " << sampled << " centres drawn in the region touched "
+            << "a wall or lay behind it (" << by_wall[worst] << " wall '" << scene.walls[worst].name
+            << "'): the walls leave " << 100 * usable
+            << " % of the region to the particles. Check that wall (a plane's normal points to "
+               "the side the particles live on, a cylinder's `side`), or move the region to "
+               "the walls' inner side";
+      } else {
+        msg << "; enlarge the region, or lower `count` / `volume_fraction` (random insertion "
+               "saturates near 0.35";
+        if (usable < 0.99)
+          msg << " of the space it can use: the walls and the domain leave " << 100 * usable
+              << " % of the region, so that is about " << 0.35 * usable
+              << " of the region's volume";
+        msg << ")";
+      }
       if (ins.coarse_grain != 1)
         msg << "; the particles are parcels of radius up to " << max_radius(ins.radius)
             << " m, coarse_grain " << ins.coarse_grain
@@ -247,9 +284,17 @@ void fill_region(const Scene& scene, const WallSet* walls, const Insertion& ins,
     const double r = sample_radius(ins.radius, rng);
     Vec3 x;
     if (!sample_centre(ins.region, r, rng, x)) continue;
-    if (!inside_domain(scene.domain, x, r) || touches_a_wall(scene, walls, x, r) ||
-        overlaps_with_images(grid, scene.domain, x, r))
+    ++sampled;
+    if (!inside_domain(scene.domain, x, r)) {
+      ++outside;
       continue;
+    }
+    if (touches_a_wall(scene, walls, x, r)) {
+      ++walled;
+      if (const int w = wall_of(x, r); w >= 0) ++by_wall[w];
+      continue;
+    }
+    if (overlaps_with_images(grid, scene.domain, x, r)) continue;
     grid.add(x, r);
     p.add(next_id++, x, ins.velocity, Vec3::Zero(), r, ins.material, density);
     p.temperature.back() = ins.temperature.value_or(0.0);

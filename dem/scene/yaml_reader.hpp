@@ -251,10 +251,13 @@ class Field {
   }
 
   // A direction: any non-zero vector, returned normalised.
+  // Scaled by its largest component first: the squares of components beyond 1.3e154 overflow
+  // (the length was inf, and the direction [0, 0, 0]), and those below 1e-154 underflow.
   Vec3 direction() const {
     const Vec3 v = vec3();
-    if (!(v.norm() > 0)) fail("the direction [0, 0, 0] has no length; give a non-zero vector");
-    return v.normalized();
+    const double largest = v.cwiseAbs().maxCoeff();
+    if (!(largest > 0)) fail("the direction [0, 0, 0] has no length; give a non-zero vector");
+    return (v / largest).normalized();
   }
 
   std::array<bool, 3> bool3() const {

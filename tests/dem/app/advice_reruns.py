@@ -1030,6 +1030,22 @@ def _(c):
     return "; ".join(results) + "; contact.tangential left out: " + r.lines("done:")[0].split(",")[0]
 
 
+@case("fill_behind_wall", "fill refused because of a wall: 'Check that wall (a plane's normal "
+      "points to the side the particles live on ...)' (dem/insert/insertion.cpp)", "check")
+def _(c):
+    # A floor whose normal points out of the domain leaves no room for the fill; the message
+    # said "enlarge the region, or lower count", and a count of 1 failed the same way.
+    s = bed()
+    s["walls"][0]["normal"] = [0, 0, -1]
+    c.expect(c.run("first", s), 2, r"could place only 0 particles [^\n]*centres drawn in the "
+             r"region touched a wall or lay behind it \([0-9]+ wall 'floor'\): the walls leave 0 % "
+             r"of the region[^\n]*Check that wall \(a plane's normal points to the side the "
+             r"particles live on")
+    s["walls"][0]["normal"] = [0, 0, 1]
+    c.rerun_passes(c.run("rerun", s), r"could place only", "walls[0].normal")
+    return "normal [0, 0, 1]: accepted"
+
+
 @case("output_start", "output.start after time.end, 'give a start <= time.end' "
       "(dem/scene/scene_parser.cpp)", "check")
 def _(c):

@@ -915,5 +915,18 @@ TEST(SceneParser, ModelRecordIsTheValuesNotTheirSpelling) {
                                         c.model_record.begin(), c.model_record.end(), '\n')));
 }
 
+// A direction is normalised whatever its length: [0, 0, 1e155] was normalised to [0, 0, 0]
+// (its squared length overflowed), and a floor with that normal refused every particle.
+TEST(SceneParser, DirectionsOfAnyLengthAreNormalised) {
+  for (const char* n : {"[0, 0, 1e155]", "[0, 0, 1e-160]", "[1e300, 0, 1e300]"}) {
+    const Scene s = parse_scene(
+        kBase + "walls:\n  - {type: plane, point: [0, 0, 0], normal: " + n + ", material: glass}\n",
+        kLabel);
+    ASSERT_EQ(s.walls.size(), 1u);
+    EXPECT_NEAR(s.walls[0].plane.normal.norm(), 1.0, 1e-15) << n;
+    EXPECT_GT(s.walls[0].plane.normal[2], 0.7) << n;
+  }
+}
+
 }  // namespace
 }  // namespace grainflow
