@@ -14,6 +14,7 @@
 #include "dem/io/output_directory.hpp"
 #include "dem/scene/scene_error.hpp"
 #include "dem/scene/scene_parser.hpp"
+#include "dem/walls/stl_reader.hpp"
 #include "grainflow_version.hpp"
 
 namespace {
@@ -109,6 +110,9 @@ int dispatch(const std::string& program, const std::vector<std::string>& args, i
     if (rank == 0) std::cerr << e.what() << "\n";
     return 2;
   } catch (const InsertionError& e) {
+    if (rank == 0) std::cerr << e.what() << "\n";
+    return 2;
+  } catch (const GeometryError& e) {  // a mesh wall's STL file, or its placement
     if (rank == 0) std::cerr << e.what() << "\n";
     return 2;
   } catch (const StateError& e) {  // a checkpoint or snapshot that breaks a rule

@@ -134,11 +134,7 @@ Simulation::Simulation(const Scene& scene, bool insert, MPI_Comm comm,
         "the same to the last bit)");
 #endif
   sweep_ = select_sweep(scene.contact, scene.parallel.reproducible);
-  try {
-    walls_ = WallSet(scene_);  // reads STL meshes
-  } catch (const GeometryError& e) {
-    throw SetupError(e.what());
-  }
+  walls_ = WallSet(scene_);  // reads STL meshes (GeometryError: bad input, exit code 2)
   streams_ = StreamInsertion(scene_);
   if (scene_.output.wall_loads) {
     wall_forces_.assign(walls_.walls().size(), Vec3::Zero());

@@ -109,6 +109,7 @@ struct CylinderWall {
 // A triangle mesh read from an STL file and placed by x' = R(axis, angle)(scale x) + translate.
 struct MeshWall {
   std::string file;                      // resolved relative to the scene file's folder
+  std::string file_source;               // "scene file:line" of the `file` key, for messages
   double scale = 1;                      // > 0
   Vec3 rotate_axis = Vec3::UnitZ();      // unit
   double rotate_angle = 0;               // [rad] (degrees in the scene file)

@@ -329,6 +329,9 @@ std::string existing_file(const Field& file, const std::string& what) {
   const fs::path given = file.text();
   const fs::path resolved = given.is_absolute() ? given : file.source().folder / given;
   std::error_code ec;
+  if (fs::is_directory(resolved, ec))
+    file.fail(what + " '" + given.string() + "' is a directory ('" + resolved.string() +
+              "'), not a file; name the file inside it");
   if (!fs::is_regular_file(resolved, ec))
     file.fail(what + " '" + given.string() + "' not found (looked for '" + resolved.string() +
               "'); file names are relative to the scene file's folder");
@@ -479,7 +482,9 @@ Wall parse_wall(const Field& item, const std::unordered_set<std::string>& names,
     m.allow_only({"type", "name", "file", "scale", "rotate", "translate", "surface_velocity",
                   "weld_tolerance", "material", "motion", "temperature", "heat_flux"},
                  " (a mesh wall)");
-    w.mesh.file = existing_file(m.get("file", "add `file: <mesh.stl>`"), "STL file");
+    const Field file = m.get("file", "add `file: <mesh.stl>`");
+    w.mesh.file = existing_file(file, "STL file");
+    w.mesh.file_source = file.source().label + ":" + std::to_string(file.line());
     w.mesh.scale = m.number_or("scale", 1.0, kPositive);
     if (const auto rot = m.find("rotate")) {
       const Map r = rot->map({"axis", "angle"});

@@ -1,8 +1,9 @@
 #include "dem/walls/stl_reader.hpp"
 
 #include <algorithm>
-#include <cmath>
+#include <cctype>
 #include <climits>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -92,8 +93,12 @@ std::vector<RawTriangle> read_ascii(const std::string& b, const std::string& lab
   while (std::getline(in, line)) {
     ++lineno;
     std::istringstream words(line);
-    std::string key;
-    if (!(words >> key)) continue;
+    std::string word;
+    if (!(words >> word)) continue;
+    // Keywords in any case: some exporters write "SOLID", "FACET NORMAL", "VERTEX".
+    std::string key = word;
+    std::transform(key.begin(), key.end(), key.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
     if (key == "solid" || key == "endsolid") {
       if (in_facet) fail(label, at(lineno), "'" + key + "' inside the facet begun at line " +
                                                 std::to_string(facet_line));
@@ -143,9 +148,10 @@ std::vector<RawTriangle> read_ascii(const std::string& b, const std::string& lab
       out.push_back(cur);
       in_facet = false;
     } else {
-      fail(label, at(lineno), "unexpected " + as_shown(key) +
-                                  " in an ASCII STL file (expected solid, facet, outer loop, "
-                                  "vertex, endloop, endfacet, endsolid)");
+      fail(label, at(lineno),
+           "unexpected " + as_shown(word) +
+               " in an ASCII STL file (expected solid, facet, outer loop, "
+               "vertex, endloop, endfacet, endsolid)");
     }
   }
   if (in_facet)
@@ -287,7 +293,10 @@ TriangleMesh parse_stl(const std::string& bytes, const std::string& label,
   const std::size_t first = bytes.find_first_not_of(" \t\r\n");
   std::vector<RawTriangle> raw;
   StlReport rep;
-  const bool starts_solid = first != std::string::npos && bytes.compare(first, 5, "solid") == 0;
+  const auto lower = [](unsigned char c) { return static_cast<char>(std::tolower(c)); };
+  bool starts_solid = first != std::string::npos && bytes.size() >= first + 5;
+  for (std::size_t k = 0; starts_solid && k < 5; ++k)
+    starts_solid = lower(bytes[first + k]) == "solid"[k];
   if (looks_binary(bytes, count)) {
     rep.binary = true;
     raw = read_binary(bytes, count, label);

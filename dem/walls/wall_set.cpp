@@ -31,7 +31,42 @@ WallSet::WallSet(const Scene& scene) {
       t.rotation_angle = w.mesh.rotate_angle;
       t.translation = w.mesh.translate;
       StlReport rep;
-      TriangleMesh m = read_stl(w.mesh.file, t, &rep, w.mesh.weld_tolerance);
+      const std::string of_wall =
+          " (the mesh of wall '" + w.name + "'" +
+          (w.mesh.file_source.empty() ? std::string() : ", " + w.mesh.file_source) + ")";
+      TriangleMesh m = [&] {
+        try {
+          return read_stl(w.mesh.file, t, &rep, w.mesh.weld_tolerance);
+        } catch (const GeometryError& error) {
+          throw GeometryError(error.what() + of_wall);
+        }
+      }();
+      // A static mesh none of whose triangles reaches into the domain (by a particle radius)
+      // touches no particle: a mistake, most often an STL in millimetres read as metres (a
+      // 12 m box around a 12 mm domain).
+      const Domain& d = scene.domain;
+      const bool moves = w.motion.velocity.squaredNorm() > 0 || w.motion.angular_velocity != 0;
+      const Vec3 reach = Vec3::Constant(r_hint);
+      const auto reaches_in = [&](const std::array<int, 3>& tri) {
+        const Vec3& a = m.vertices()[tri[0]];
+        const Vec3& b = m.vertices()[tri[1]];
+        const Vec3& c = m.vertices()[tri[2]];
+        const Vec3 lo = a.cwiseMin(b).cwiseMin(c), hi = a.cwiseMax(b).cwiseMax(c);
+        return (lo.array() <= (d.hi + reach).array()).all() &&
+               (hi.array() >= (d.lo - reach).array()).all();
+      };
+      if (!moves && std::none_of(m.triangles().begin(), m.triangles().end(), reaches_in)) {
+        std::ostringstream o;
+        o.precision(4);
+        o << w.mesh.file << ": error: the mesh spans (" << m.lo()[0] << ", " << m.lo()[1] << ", "
+          << m.lo()[2] << ") to (" << m.hi()[0] << ", " << m.hi()[1] << ", " << m.hi()[2]
+          << ") m after its placement (scale " << w.mesh.scale << "); the domain spans (" << d.lo[0]
+          << ", " << d.lo[1] << ", " << d.lo[2] << ") to (" << d.hi[0] << ", " << d.hi[1] << ", "
+          << d.hi[2] << ") m, and none of its triangles reaches into the "
+          << "domain: no particle can touch it. An STL in millimetres "
+          << "needs `scale: 0.001`; else check `translate` and `rotate`" << of_wall;
+        throw GeometryError(o.str());
+      }
       // Cells of one particle diameter: a query visits at most 8 small cells, each
       // holding only the few triangles that pass near it. Without a known radius
       // (CSV or snapshot particles only), cells of the mean triangle edge.

@@ -1,18 +1,20 @@
 // STL reading: format detection, placement, welding, counted repairs and errors
 // that name the file and the line or triangle.
+#include "dem/walls/stl_reader.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <limits>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <numbers>
 
 #include "dem/scene/scene_parser.hpp"
-#include "dem/walls/stl_reader.hpp"
 #include "dem/walls/wall_set.hpp"
 #include "tests/dem/walls/mesh_support.hpp"
 
@@ -351,6 +353,68 @@ TEST(StlReader, AsciiVertexWithExtraNumbersAndBinaryGarbageAreClearErrors) {
   EXPECT_THAT(error_of(garbage), HasSubstr("mesh.stl:2: error: unexpected '" +
                                            std::string(40, 'A') + "...' in an ASCII STL file"));
   EXPECT_THAT(error_of("solid x\nfa\x01" "cet\n"), HasSubstr("unexpected 'fa?cet'"));
+}
+
+// Exporters that write the keywords in capitals ("SOLID", "FACET NORMAL", "VERTEX"): the same
+// mesh. The file was taken for binary and refused ("binary STL header declares 1444945952
+// triangles").
+TEST(StlReader, AsciiKeywordsInAnyCase) {
+  std::string upper = kTwoTriangles;
+  for (const char* word :
+       {"solid", "facet", "normal", "outer", "loop", "vertex", "endloop", "endfacet", "endsolid"}) {
+    std::string capital = word;
+    for (char& c : capital) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    for (std::size_t at = upper.find(word); at != std::string::npos; at = upper.find(word, at))
+      upper.replace(at, capital.size(), capital);
+  }
+  ASSERT_EQ(upper.find("vertex"), std::string::npos) << upper;
+  StlReport rep;
+  const TriangleMesh m = parse_stl(upper, "upper.stl", {}, &rep);
+  EXPECT_FALSE(rep.binary);
+  EXPECT_EQ(m.triangle_count(), 2u);
+  EXPECT_EQ(m.vertex_count(), 4u);
+}
+
+// A static mesh whose triangles all miss the domain touches no particle: refused, naming the
+// wall and the scale that a mesh in millimetres needs (a 1 m square 5 m above a 1 m domain; the
+// square scaled to 12 m, 6 m below a 2 cm domain: the bottom face of a box in millimetres
+// around it, whose bounding box holds the domain while no face reaches in). The square moving
+// is accepted (it may come in).
+TEST(StlReader, StaticMeshOutsideTheDomainIsRefused) {
+  const auto dir = std::filesystem::temp_directory_path() / "grainflow_stl_outside";
+  std::filesystem::create_directories(dir);
+  std::ofstream((dir / "square.stl").string(), std::ios::binary) << kTwoTriangles;
+  const auto scene = [&](const std::string& domain, const std::string& placement) {
+    return parse_scene("domain: " + domain + R"(
+time: {step: 1.0e-5, end: 0.01}
+materials: [{name: glass, youngs_modulus: 1.0e7, poisson_ratio: 0.3, density: 2500}]
+interaction_defaults: {restitution: 0.5}
+contact: {normal: hertz}
+walls: [{type: mesh, name: plate, file: square.stl, material: glass)" +
+                           placement + "}]\n",
+                       (dir / "scene.yaml").string());
+  };
+  const auto error = [&](const Scene& s) {
+    try {
+      const WallSet walls(s);
+    } catch (const GeometryError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string far =
+      error(scene("{min: [0, 0, -1], max: [1, 1, 0]}", ", translate: [0, 0, 5]"));
+  EXPECT_THAT(far, HasSubstr("none of its triangles reaches into the domain: no particle can "
+                             "touch it. An STL in millimetres needs `scale: 0.001`"));
+  EXPECT_THAT(far, HasSubstr("(the mesh of wall 'plate', "));
+  EXPECT_THAT(error(scene("{min: [0, 0, 0], max: [0.02, 0.02, 0.02]}",
+                          ", scale: 12, translate: [-6, -6, -6]")),
+              HasSubstr("none of its triangles reaches into the domain"));
+  EXPECT_EQ(error(scene("{min: [0, 0, -1], max: [1, 1, 0]}",
+                        ", translate: [0, 0, 5], "
+                        "motion: {velocity: [0, 0, -1]}")),
+            "no error");
+  EXPECT_EQ(error(scene("{min: [0, 0, -1], max: [1, 1, 0]}", "")), "no error");
 }
 
 }  // namespace

@@ -118,8 +118,9 @@ TEST(WallsScene, Errors) {
   try {
     Simulation sim(s, false);
     FAIL() << "no error";
-  } catch (const SetupError& e) {
+  } catch (const GeometryError& e) {  // bad input (grain: exit code 2), naming the wall too
     EXPECT_THAT(e.what(), HasSubstr("bad.stl:4: error: the file ends inside the facet begun at line 2"));
+    EXPECT_THAT(e.what(), HasSubstr("(the mesh of wall 'wall0', "));
   }
 }
 
