@@ -1171,10 +1171,18 @@ bool Simulation::check_contacts(const ContactGuards& s, bool finite_here) const 
     agree_on_error(comm_, "");  // another rank holds the contact and speaks
     return worst[3] == 0;       // not reached
   }
-  if (w.b >= 0)
+  if (w.b >= 0) {
     o << "particles " << w.a << " and " << w.b;
-  else
-    o << "particle " << w.a << " and a wall";
+  } else {
+    // The wall it overlaps most (this rank holds the particle): named, among several walls.
+    int wall = -1;
+    for (std::size_t i = 0; i < p_.size() && wall < 0; ++i)
+      if (p_.id[i] == w.a) wall = walls_.deepest_overlap(p_.x[i], p_.radius[i]).wall;
+    if (wall >= 0)
+      o << "particle " << w.a << " and wall '" << walls_.walls()[wall].name << "'";
+    else
+      o << "particle " << w.a << " and a wall";
+  }
   if (!overlap) {
     const double tc =
         hertz_contact_time(w.y_star, w.r_star, w.m_star, std::max(std::abs(w.speed), 1e-12));

@@ -414,7 +414,7 @@ def _(c):
                  + NUM)
     s["time"]["max_overlap"] = float(m.group(1))
     c.rerun_next(c.run("rerun", s, "run", files=files), r"with mesh walls", 1,
-                 r"particle 1 and a wall overlap by [0-9.]+ % of the smaller radius", "max_overlap")
+                 r"particle 1 and wall 'sheet' overlap by [0-9.]+ % of the smaller radius", "max_overlap")
     return f"max_overlap {m.group(1)}: the overlap guard stops the tunnel"
 
 

@@ -119,7 +119,7 @@ grain_cli_test(travel_guard_stops_run 1
                    --no-progress --output out
                WORKDIR ${_work}/travel_guard)
 grain_cli_test(overlap_guard_stops_run 1
-               "particle [0-9]+ and a wall overlap by [0-9.]+ % of the smaller radius"
+               "particle [0-9]+ and wall '[^']+' overlap by [0-9.]+ % of the smaller radius"
                CMD ${_grain} run ${_scenes}/bad/huge_time_step_no_steps_guard.yaml --allow-large-dt
                    --no-progress --output out
                WORKDIR ${_work}/overlap_guard)

@@ -146,7 +146,7 @@ TEST_P(TooLargeStep, StopsWithAWorkingStepBeforeGainingEnergy) {
   if (c.layer)
     EXPECT_NE(m.find("particle"), std::string::npos) << m;
   else
-    EXPECT_NE(m.find("particle 1 and a wall"), std::string::npos) << m;
+    EXPECT_NE(m.find("particle 1 and wall '"), std::string::npos) << m;
   const double suggested = test::number_after(m, "at most ");
   ASSERT_GT(suggested, 0.0) << m;
   ASSERT_LT(suggested, kDt) << m;

@@ -164,7 +164,7 @@ TEST_P(WallTravel, RefusedWithSpeedLimitAndStepsThatWork) {
   const Outcome at_fit = run(c, fit);
   EXPECT_EQ(at_fit.setup_error, "");
   EXPECT_FALSE(at_fit.passed);
-  EXPECT_TRUE(at_fit.contacts > 0 || at_fit.stop.find("particle 1 and a wall") != std::string::npos)
+  EXPECT_TRUE(at_fit.contacts > 0 || at_fit.stop.find("particle 1 and wall '") != std::string::npos)
       << at_fit.stop;
 
   // The impact step resolves the impact: (1 + e) U within 3 %.
