@@ -65,6 +65,9 @@ inline double nusselt_ranz_marshall(double re, double pr) {
   return 2 + 0.6 * std::sqrt(re) * std::cbrt(pr);
 }
 
+// Gunn (1978): fitted for void fractions from this to 1 (grain check warns below it).
+inline constexpr double kGunnLowestVoidFraction = 0.35;
+
 inline double nusselt_gunn(double eps, double re, double pr) {
   const double pr3 = std::cbrt(pr);
   return (7 - 10 * eps + 5 * eps * eps) * (1 + 0.7 * std::pow(re, 0.2) * pr3) +

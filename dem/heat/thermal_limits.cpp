@@ -126,6 +126,22 @@ ThermalLimits check_thermal_limits(const Scene& scene, const Particles& p, TimeS
   } else if (!scene.heat->conduction) {
     rep.notes.push_back("heat conduction: off (heat.conduction: none)");
   }
+  // Gunn (1978) fitted his Nusselt number for 0.35 <= eps <= 1: below, it is extrapolated.
+  if (scene.fluid && scene.fluid->thermal && scene.fluid->thermal->nusselt == NusseltLaw::gunn) {
+    const auto& grid = scene.fluid->computed_void_fraction;
+    const double lowest = grid ? grid->minimum : scene.fluid->field.void_fraction;
+    if (lowest < kGunnLowestVoidFraction) {
+      escalate(TimeStepReport::Verdict::warn);
+      o << "warning: Gunn's Nusselt number is fitted for " << kGunnLowestVoidFraction
+        << " <= eps <= 1, and here eps "
+        << (grid ? "computed from the particles may fall to its minimum " : "is ") << lowest
+        << (grid ? " (fluid.void_fraction.minimum)" : " (fluid.void_fraction)") << ": below "
+        << kGunnLowestVoidFraction << " the correlation is extrapolated"
+        << (grid ? " (a random packing of spheres keeps eps above about 0.36)" : "");
+      rep.notes.push_back(o.str());
+      o.str("");
+    }
+  }
   if (out.convection_time < inf) {
     o << "heat convection: time scale m c / (h A) = " << out.convection_time
       << " s (smallest '" << smallest << "' particle at rest in the prescribed flow, "

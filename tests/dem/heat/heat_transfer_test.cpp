@@ -1014,6 +1014,30 @@ insert:
   const double h_area = (7 - 10 * eps + 5 * eps * eps) * kf * kPi * 2 * r;  // h A = Nu k_f pi d
   EXPECT_NEAR(check(scene_with("{}", "", fluid), 1e-9).first.convection_time / (m * c / h_area), 1,
               1e-12);
+  // Gunn's range is 0.35 <= eps <= 1: an eps that may fall below it (a fixed one, or a
+  // computed one's minimum) is warned of (it was extrapolated silently); 0.4 is not.
+  const auto gunn_warning = [&](const std::string& f) {
+    TimeStepReport rep;
+    rep.dt = 1e-9;
+    check_thermal_limits(scene_with("{}", "", f), p, rep);
+    for (const std::string& note : rep.notes)
+      if (note.find("Gunn's Nusselt number is fitted for 0.35 <= eps <= 1") != std::string::npos)
+        return std::make_pair(note, rep.verdict);
+    return std::make_pair(std::string(), rep.verdict);
+  };
+  EXPECT_EQ(gunn_warning(fluid).first, "");
+  std::string low = fluid;
+  low.replace(low.find("minimum: 0.4"), 12, "minimum: 0.3");
+  const auto [computed, computed_verdict] = gunn_warning(low);
+  EXPECT_NE(computed.find("may fall to its minimum 0.3 (fluid.void_fraction.minimum)"),
+            std::string::npos)
+      << computed;
+  EXPECT_EQ(computed_verdict, TimeStepReport::Verdict::warn);
+  std::string fixed = fluid;
+  fixed.replace(fixed.find("{cell_size: 0.002, minimum: 0.4}"), 32, "0.25");
+  EXPECT_NE(gunn_warning(fixed).first.find("here eps is 0.25 (fluid.void_fraction): below 0.35 "
+                                           "the correlation is extrapolated"),
+            std::string::npos);
 }
 
 // Gunn (1978) at eps = 1 is 2 + 0.7 Re^0.2 Pr^1/3 + 0.13 Re^0.7 Pr^1/3 (his eq. 21 evaluated),
