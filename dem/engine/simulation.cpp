@@ -141,7 +141,10 @@ Simulation::Simulation(const Scene& scene, bool insert, MPI_Comm comm,
     wall_impulse_ = wall_forces_;
   }
   if (scene_.heat) heat_ = std::make_unique<HeatTransfer>(scene_);
-  if (insert) insert_particles(scene_, p_, next_id_, &walls_);
+  if (insert) {
+    insert_particles(scene_, p_, next_id_, &walls_);
+    walls_.check_closed_meshes(p_.x);  // every rank holds every inserted particle here
+  }
 }
 
 void Simulation::initialise() {

@@ -224,4 +224,27 @@ int TriangleMesh::touches_brute_force(const Vec3& c, double r, MeshTouch* out) c
       out);
 }
 
+bool TriangleMesh::encloses(const Vec3& x) const {
+  if ((x.array() < lo_.array()).any() || (x.array() > hi_.array()).any()) return false;
+  // A skew direction, so that the ray meets no edge or vertex of an axis-aligned mesh exactly
+  // (Moller & Trumbore 1997, ray-triangle intersection).
+  const Vec3 d = Vec3(1, 0.0014142135623730951, 0.0017320508075688772).normalized();
+  bool inside = false;
+  for (const auto& t : tris_) {
+    const Vec3& a = verts_[t[0]];
+    const Vec3 e1 = verts_[t[1]] - a, e2 = verts_[t[2]] - a;
+    const Vec3 pv = d.cross(e2);
+    const double det = e1.dot(pv);
+    if (std::abs(det) < 1e-300) continue;  // parallel to the ray
+    const Vec3 tv = x - a;
+    const double u = tv.dot(pv) / det;
+    if (u < 0 || u > 1) continue;
+    const Vec3 qv = tv.cross(e1);
+    const double v = d.dot(qv) / det;
+    if (v < 0 || u + v > 1) continue;
+    if (e2.dot(qv) / det > 0) inside = !inside;
+  }
+  return inside;
+}
+
 }  // namespace grainflow

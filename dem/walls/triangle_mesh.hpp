@@ -50,6 +50,10 @@ class TriangleMesh {
   std::size_t vertex_count() const { return verts_.size(); }
   const std::vector<Vec3>& vertices() const { return verts_; }
   const std::vector<std::array<int, 3>>& triangles() const { return tris_; }
+  // Whether the point lies inside the surface (body frame): the parity of its crossings by a
+  // ray from x along a fixed, skew direction. Meaningful for a closed surface (no open edges);
+  // every triangle is tested, after the bounding box.
+  bool encloses(const Vec3& x) const;
   Vec3 lo() const { return lo_; }  // bounding box
   Vec3 hi() const { return hi_; }
   double cell_size() const { return cell_; }

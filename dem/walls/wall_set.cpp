@@ -94,11 +94,34 @@ WallSet::WallSet(const Scene& scene) {
         notes_.push_back(warn.str());
       }
       e.mesh = static_cast<int>(meshes_.size());
+      e.closed = rep.open_edges == 0;
       e.surface_velocity = w.mesh.surface_velocity;
       meshes_.push_back(std::move(m));
     }
     columns_ += columns_of(e);
     walls_.push_back(std::move(e));
+  }
+}
+
+void WallSet::check_closed_meshes(const std::vector<Vec3>& centres, double budget) {
+  for (const Entry& e : walls_) {
+    if (e.kind != Wall::Kind::mesh || !e.closed || centres.empty()) continue;
+    const TriangleMesh& m = meshes_[e.mesh];
+    long in_box = 0;
+    for (const Vec3& x : centres)
+      in_box += (x.array() >= m.lo().array()).all() && (x.array() <= m.hi().array()).all();
+    if (static_cast<double>(in_box) * static_cast<double>(m.triangle_count()) > budget) continue;
+    long inside = 0;
+    for (const Vec3& x : centres) inside += m.encloses(x);
+    const long outside = static_cast<long>(centres.size()) - inside;
+    if (inside == 0 || outside == 0) continue;
+    std::ostringstream o;
+    o << "warning: wall '" << e.name << "' is a closed surface, and " << inside << " of the "
+      << centres.size() << " particles start inside it, " << outside
+      << " outside: the two groups never meet, and those inside a solid obstacle stay trapped "
+         "in it. If the mesh is an obstacle, keep the insertions out of it (fill regions "
+         "beside it, or csv rows outside it); if it is a container, keep them in it";
+    notes_.push_back(o.str());
   }
 }
 

@@ -31,6 +31,7 @@ class WallSet {
     PlaneWall plane;        // current position (plane, cylinder)
     CylinderWall cylinder;  // current position
     int mesh = -1;          // index into meshes()
+    bool closed = false;    // a mesh without open edges: a closed surface
     Vec3 surface_velocity = Vec3::Zero();  // mesh conveyor velocity in the body frame
     WallPose pose;
     int column = 0;  // first history column
@@ -43,6 +44,11 @@ class WallSet {
   // Reads every mesh's STL file (GeometryError on a bad file). The largest radius
   // of the scene's fill and stream insertions sizes the mesh search grids.
   explicit WallSet(const Scene& scene);
+
+  // A closed mesh with particle centres (at t = 0) on both sides of it: a warning among notes(),
+  // naming the counts (those inside a solid obstacle are trapped there). A mesh with more than
+  // `budget` centre-triangle tests is left unchecked.
+  void check_closed_meshes(const std::vector<Vec3>& centres, double budget = 2e8);
 
   // Places every moving wall at time t.
   void move_to(double t);

@@ -124,5 +124,39 @@ TEST(WallsScene, Errors) {
   }
 }
 
+// A closed mesh with particles on both sides: the fill placed 7 of 100 beads inside a solid
+// cube obstacle, where they stayed trapped, without a word. encloses() against the box's own
+// inequalities (the reference), on a grid of points that includes the box's faces' planes
+// offset by a tenth of a cell; then the start-up warning with its counts, and none when every
+// particle is on one side (a container).
+TEST(WallsScene, ClosedMeshWithParticlesOnBothSidesIsWarnedOf) {
+  const Vec3 lo(-0.2, -0.2, -0.2), hi(0.2, 0.2, 0.2);
+  test::write_mesh(test::box(lo, hi), "closed_box.stl");
+  const Scene s = parse_scene(kHead +
+                                  "walls: [{type: mesh, name: block, file: closed_box.stl, "
+                                  "material: glass}]\n",
+                              label());
+  WallSet walls(s);
+  const TriangleMesh& m = walls.mesh(walls.walls()[0]);
+  long checked = 0;
+  for (double x = -0.31; x < 0.31; x += 0.05)
+    for (double y = -0.29; y < 0.31; y += 0.07)
+      for (double z = -0.33; z < 0.31; z += 0.06) {
+        const Vec3 q(x, y, z);
+        const bool in = (q.array() > lo.array()).all() && (q.array() < hi.array()).all();
+        EXPECT_EQ(m.encloses(q), in) << q.transpose();
+        ++checked;
+      }
+  EXPECT_GT(checked, 1000);
+  std::vector<Vec3> centres = {Vec3(0, 0, 0), Vec3(0.5, 0.5, 0.5), Vec3(-0.5, 0, 0)};
+  walls.check_closed_meshes(centres);
+  ASSERT_EQ(walls.notes().size(), 2u);
+  EXPECT_THAT(walls.notes()[1], HasSubstr("warning: wall 'block' is a closed surface, and 1 of "
+                                          "the 3 particles start inside it, 2 outside"));
+  WallSet container(s);
+  container.check_closed_meshes({Vec3(0, 0, 0), Vec3(0.1, 0.1, 0.1)});
+  EXPECT_EQ(container.notes().size(), 1u);  // the mesh's own line only
+}
+
 }  // namespace
 }  // namespace grainflow
