@@ -452,10 +452,16 @@ void read_csv(const Scene& scene, const WallSet* walls, const Insertion& ins, Pa
     if (col.count("material")) {
       const std::string& name = cells[col["material"]];
       mat = scene.material_index(name);
-      if (mat < 0) {
+      // A parcel class (glass[k=2], made by a fill or stream with coarse_grain) is a material
+      // index, not a material a file may name: its rows would be parcels of that class.
+      if (mat < 0 || scene.materials[mat].real_material >= 0) {
         std::string known;
-        for (const Material& m : scene.materials) known += (known.empty() ? "" : ", ") + m.name;
-        fail(lineno, "unknown material '" + name + "'; known materials: " + known);
+        for (const Material& m : scene.materials)
+          if (m.real_material < 0) known += (known.empty() ? "" : ", ") + m.name;
+        fail(lineno, "unknown material '" + name + "'; known materials: " + known +
+                         (mat >= 0 ? " (a parcel class of `coarse_grain`, which a csv file "
+                                     "cannot insert: csv rows are real particles)"
+                                   : ""));
       }
     }
     // A sphere that touches a bounded side, written with every digit, may cross it by the

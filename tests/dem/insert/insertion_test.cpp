@@ -205,7 +205,8 @@ class BrokenCsv : public ::testing::Test {
  protected:
   // The error inserting a CSV file with `text` gives (or "no error"), in the scene of
   // one_material_scene: domain [-1, 1]^3, one material 'm'.
-  std::string error_of(const std::string& text, bool periodic = false) {
+  // `parcels`: the scene also has the parcel class 'm[k=2]' (as a fill with coarse_grain 2 makes).
+  std::string error_of(const std::string& text, bool periodic = false, bool parcels = false) {
     // One directory per test: CTest runs the tests of this suite in parallel.
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     const auto dir = std::filesystem::temp_directory_path() /
@@ -215,6 +216,13 @@ class BrokenCsv : public ::testing::Test {
     std::ofstream(file_) << text;
     Scene s = test::one_material_scene(1e7, 0.3, 2500, 0.5);
     if (periodic) s.domain.periodic = {true, true, true};
+    if (parcels) {
+      Material parcel = s.materials[0];
+      parcel.name = "m[k=2]";
+      parcel.coarse_grain = 2;
+      parcel.real_material = 0;
+      s.materials.push_back(parcel);
+    }
     Insertion ins;
     ins.kind = Insertion::Kind::csv;
     ins.csv_file = file_;
@@ -287,6 +295,11 @@ TEST_F(BrokenCsv, NonNumericAndNonFiniteValues) {
   EXPECT_THAT(error_of("x,y,z,radius\n0,0,0,-0.1\n"), HasSubstr(at(2) + "radius must be > 0, got -0.1"));
   EXPECT_THAT(error_of("x,y,z,radius,material\n0,0,0,0.1,glas\n"),
               HasSubstr(at(2) + "unknown material 'glas'; known materials: m"));
+  // A parcel class is not a material a file names (its rows became parcels of k = 2, undocumented).
+  EXPECT_THAT(error_of("x,y,z,radius,material\n0,0,0,0.1,m[k=2]\n", false, true),
+              HasSubstr(at(2) + "unknown material 'm[k=2]'; known materials: m (a parcel class of "
+                                "`coarse_grain`, which a csv file cannot insert"));
+  EXPECT_EQ(error_of("x,y,z,radius,material\n0,0,0,0.1,m\n", false, true), "no error");
 }
 
 TEST_F(BrokenCsv, OutsideTheDomainAndOverlapping) {
