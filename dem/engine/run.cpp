@@ -285,7 +285,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   snapshots.set_coarse_grain(scene.coarse_grain_table(), scene.real_material_table());
   snapshots.set_scene_fingerprint(scene_fingerprint(scene));
   const std::string log_path = (std::filesystem::path(dir) / "log.csv").string();
-  // output.wall_loads: each wall's mean load since the previous row, and that time span.
+  // output.wall_loads: each wall's mean load since the previous row, and that time span; with
+  // heat, the particles' thermal energy.
   std::vector<std::string> wall_columns;
   if (scene.output.wall_loads) {
     for (const WallSet::Entry& w : sim.walls().walls())
@@ -293,6 +294,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
         wall_columns.push_back(w.name + "_load_" + axis + "_N");
     wall_columns.emplace_back("wall_load_interval_s");
   }
+  if (sim.heat() != nullptr) wall_columns.emplace_back("thermal_J");
   std::optional<LogTable> log_table;
   if (options.restart) {
     const std::size_t kept = snapshots.continue_series(first_step);
@@ -379,6 +381,11 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
       const Simulation::WallLoads w = sim.take_wall_loads(/*reset=*/recorded);
       for (const Vec3& f : w.force) loads.insert(loads.end(), {f[0], f[1], f[2]});
       loads.push_back(w.interval);
+    }
+    if (sim.heat() != nullptr) {  // sum m c T of every particle (parcels: their k^3 real ones)
+      double thermal = sim.heat()->thermal_energy(sim.particles());
+      MPI_Allreduce(MPI_IN_PLACE, &thermal, 1, MPI_DOUBLE, MPI_SUM, comm);
+      loads.push_back(thermal);
     }
     try {
       log.write({sim.time(), sim.counters().steps, g.particles, g.kinetic_translational,

@@ -252,6 +252,13 @@ if(GRAINFLOW_PYTHON3)
                    ${_scenes}/stop_signal.yaml ${_work}/foreign_files)
   set_tests_properties(grain.foreign_files PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}"
                                                       TIMEOUT 300)
+  # log.csv's thermal_J against the energy balance of heat sources in an adiabatic box, on 1
+  # and 2 ranks (heat_log.py; about 2 s).
+  add_test(NAME grain.heat_log
+           COMMAND ${GRAINFLOW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/heat_log.py ${_grain}
+                   ${_work}/heat_log ${MPIEXEC_EXECUTABLE})
+  set_tests_properties(grain.heat_log PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}"
+                                                 TIMEOUT 300 PROCESSORS 2)
   add_test(NAME grain.reproducible_snapshots
            COMMAND ${GRAINFLOW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/reproducible_snapshots.py
                    ${_grain} ${_scenes}/periodic_bed_reproducible.yaml

@@ -543,7 +543,7 @@ walls:
   }
 }
 
-// Initial temperatures (docs/models/heat-transfer.md, "Snapshots and restarts"): a CSV
+// Initial temperatures (docs/models/heat-transfer.md, "Snapshots, log and restarts"): a CSV
 // column `T` gives each row its own, exactly as written; without the column the entry's
 // `temperature` applies to every row; a `T` column with heat off, a file with neither, and
 // T <= 0 are refused naming the file and line.
