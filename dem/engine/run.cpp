@@ -302,6 +302,10 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     say << "restart: from " << *options.restart << " at step " << first_step
         << " (t = " << sim.time() << " s); continuing " << dir
         << "/log.csv and the snapshot series after " << kept << " earlier snapshot(s)\n";
+    for (const std::string& gap : snapshots.missing())
+      say << "note: " << dir << "/" << gap
+          << " is a gap in the snapshot series (deleted or damaged since it was written): "
+             "particles.xdmf lists the snapshots around it\n";
     if (!snapshots.foreign_file().empty())
       say << "note: " << dir << "/" << snapshots.foreign_file()
           << " was written by another scene's run (its scene_fingerprint differs): the series "

@@ -2,6 +2,7 @@
 
 #include <hdf5.h>
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <cstdint>
@@ -350,23 +351,46 @@ std::size_t SnapshotWriter::continue_series(long up_to_step) {
   QuietHdf5Errors quiet;
   entries_.clear();
   foreign_file_.clear();
+  missing_.clear();
+  next_number_ = 0;
   index_.reset();  // the next write() rewrites the index with the entries taken over
-  for (;;) {
-    const std::string file_name = basename_ + "_" + six_digits(entries_.size()) + ".h5";
+  // The highest number in the folder: a file missing or unreadable below it is a gap (deleted,
+  // damaged), not the end of the series; the files after it are taken over too.
+  long highest = -1;
+  {
+    std::error_code ec;
+    const std::string prefix = basename_ + "_";
+    for (const auto& e : std::filesystem::directory_iterator(directory_, ec)) {
+      const std::string name = e.path().filename().string();
+      if (name.size() != prefix.size() + 9 || !name.starts_with(prefix) || !name.ends_with(".h5"))
+        continue;
+      const std::string digits = name.substr(prefix.size(), 6);
+      if (digits.find_first_not_of("0123456789") == std::string::npos)
+        highest = std::max(highest, std::stol(digits));
+    }
+  }
+  std::vector<std::string> skipped;  // numbers without a readable snapshot of this run
+  for (long number = 0; number <= highest; ++number) {
+    const std::string file_name = basename_ + "_" + six_digits(number) + ".h5";
     const std::string path = (std::filesystem::path(directory_) / file_name).string();
     std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) break;
+    if (!std::filesystem::is_regular_file(path, ec)) {
+      skipped.push_back(file_name + " (missing)");
+      continue;
+    }
     Hid file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
-    if (!file.valid()) break;
     double t = 0;
     std::int64_t s = 0, n = 0;
     auto read = [&](const char* name, hid_t type, void* out) {
       Hid attr(H5Aopen(file.get(), name, H5P_DEFAULT), H5Aclose);
       return attr.valid() && H5Aread(attr.get(), type, out) >= 0;
     };
-    if (!read("time", H5T_NATIVE_DOUBLE, &t) || !read("step", H5T_NATIVE_INT64, &s) ||
-        !read("count", H5T_NATIVE_INT64, &n) || s > up_to_step)
-      break;
+    if (!file.valid() || !read("time", H5T_NATIVE_DOUBLE, &t) ||
+        !read("step", H5T_NATIVE_INT64, &s) || !read("count", H5T_NATIVE_INT64, &n)) {
+      skipped.push_back(file_name + " (unreadable)");
+      continue;
+    }
+    if (s > up_to_step) break;  // the stopped run's, after its checkpoint: written again
     // Another scene's run (a file without the attribute predates it and is taken over).
     std::int64_t fingerprint = 0;
     if (fingerprint_ != 0 && H5Aexists(file.get(), "scene_fingerprint") > 0 &&
@@ -389,6 +413,10 @@ std::size_t SnapshotWriter::continue_series(long up_to_step) {
     }
     entries_.push_back({file_name, t, static_cast<long>(s), static_cast<long>(n), held,
                         static_cast<long>(counts[0]), static_cast<long>(counts[1])});
+    next_number_ = number + 1;
+    // The gaps before this file are the series' own.
+    missing_.insert(missing_.end(), skipped.begin(), skipped.end());
+    skipped.clear();
   }
   H5Eclear2(H5E_DEFAULT);
   return entries_.size();
@@ -412,7 +440,7 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step,
   check_size("coordination", extras.coordination.size());
   check_size("fluid_force", extras.fluid_force.size());
   check_size("overlap_max", extras.overlap_max.size());
-  const std::string file_name = basename_ + "_" + six_digits(entries_.size()) + ".h5";
+  const std::string file_name = basename_ + "_" + six_digits(next_number_) + ".h5";
   const std::string path = (std::filesystem::path(directory_) / file_name).string();
   // Written under a temporary name and renamed once closed: a run killed mid-write never
   // leaves a truncated file under a name the index lists.
@@ -584,6 +612,7 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step,
 
   entries_.push_back({file_name, t, static_cast<long>(s), static_cast<long>(total), fields_,
                       static_cast<long>(pair_contacts), static_cast<long>(wall_contacts)});
+  ++next_number_;
   std::string index_error;
   if (rank_ == 0) {
     try {

@@ -63,10 +63,15 @@ class SnapshotWriter {
                     const ContactNetwork* contacts = nullptr);
 
   // Continues an existing series (a restarted run): takes the snapshots already in the
-  // directory, in index order, up to the first one missing, unreadable or past `up_to_step`,
-  // so the next write() gets the next number and later files of a stopped run are
-  // overwritten. Every rank reads the files' attributes (no communication). Returns how many.
+  // directory, in number order, up to the first one past `up_to_step` or of another scene's
+  // run, so the next write() gets the number after the last one taken and later files of a
+  // stopped run are overwritten. A number missing or unreadable before the last one taken is a
+  // gap (missing()); the files after it are taken over. Every rank reads the files' attributes
+  // (no communication). Returns how many.
   std::size_t continue_series(long up_to_step);
+  // After continue_series: the gaps it stepped over ("particles_000003.h5 (missing)" or
+  // "(unreadable)").
+  const std::vector<std::string>& missing() const { return missing_; }
 
   std::size_t snapshots_written() const { return entries_.size(); }
   std::string index_path() const;
@@ -93,6 +98,8 @@ class SnapshotWriter {
   std::vector<int> real_material_;
   std::uint64_t fingerprint_ = 0;
   std::string foreign_file_;
+  std::vector<std::string> missing_;
+  long next_number_ = 0;  // the number of the next file write() makes
   MPI_Comm comm_;
   int rank_ = 0;
   int size_ = 1;

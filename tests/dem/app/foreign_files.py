@@ -22,6 +22,8 @@ A's files 3-30 hold steps below B's checkpoint. Checks:
     below the checkpoint's): that folder's log.csv is the uninterrupted B's row for row (every
     column but the wall clock), with a note that A's rows were replaced; before, A's rows
     stayed in front of B's continuation.
+A last run checks gaps: A again, its snapshot 5 deleted and 9 cut short, continued from its
+checkpoint: both named as gaps, the index lists the other 29, each number at its own time.
 Exit 0 when every check holds.
 """
 import glob
@@ -135,5 +137,31 @@ t2, x2, v2 = last_state("clean")
 check(t1 == t2 and np.array_equal(x1, x2) and np.array_equal(v1, v2),
       f"B continued beside A's files ends as B alone, bit for bit (t = {t1:g} and {t2:g} s; "
       f"largest position difference {np.abs(x1 - x2).max() if x1.shape == x2.shape else 'n/a'})")
+# Gaps: A run again in a folder of its own, its snapshot 5 deleted and 9 cut short, then
+# continued from its checkpoint at 0.2 s (step of snapshot 20) to 0.3 s. The takeover ended at
+# the first gap (the index lost 18 of A's snapshots, and the restart wrote over numbers 5-14
+# with later times); now it steps over both, naming them, and every number keeps its time.
+grain_run("a.yaml", "gaps")
+index_before = open(os.path.join(work, "gaps", "particles.xdmf")).read()
+times_before = [float(t) for t in re.findall(r'<Time Value="([^"]+)"', index_before)]
+os.remove(os.path.join(work, "gaps", "particles_000005.h5"))
+with open(os.path.join(work, "gaps", "particles_000009.h5"), "r+b") as f:
+    f.truncate(100)
+a_checkpoint = sorted(glob.glob(os.path.join(work, "gaps", "checkpoint_*.h5")))[0]
+out = grain_run("a.yaml", "gaps", "--restart", os.path.relpath(a_checkpoint, work))
+check("note: gaps/particles_000005.h5 (missing) is a gap" in out and
+      "note: gaps/particles_000009.h5 (unreadable) is a gap" in out,
+      "the restart names the deleted and the damaged snapshot as gaps")
+index = open(os.path.join(work, "gaps", "particles.xdmf")).read()
+listed = re.findall(r"particles_(\d+)\.h5", index)
+numbers = sorted({int(n) for n in listed})
+check(numbers == [n for n in range(31) if n not in (5, 9)],
+      f"particles.xdmf lists 0-30 but 5 and 9 ({len(numbers)} files)")
+times = {}
+for n in numbers:
+    with h5py.File(os.path.join(work, "gaps", f"particles_{n:06d}.h5"), "r") as f:
+        times[n] = float(f.attrs["time"])
+check(all(abs(times[n] - times_before[n]) < 1e-9 for n in numbers),
+      "every number holds the time the uninterrupted run gave it")
 print(f"grain.foreign_files: {len(failures)} failed checks")
 sys.exit(1 if failures else 0)
