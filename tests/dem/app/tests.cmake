@@ -246,7 +246,8 @@ grain_cli_test(restart_missing_checkpoint 1
 # ranks and a restart on 3 ranks equal bit for bit (about 15 s of CPU).
 if(GRAINFLOW_PYTHON3)
   # A restart into a folder that also holds another scene's run takes over only its own
-  # snapshots and never deletes the other run's checkpoints (foreign_files.py; about 5 s).
+  # snapshots and never deletes the other run's checkpoints, and steps over gaps (foreign_files.py;
+  # about 20 s).
   add_test(NAME grain.foreign_files
            COMMAND ${GRAINFLOW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/foreign_files.py ${_grain}
                    ${_scenes}/stop_signal.yaml ${_work}/foreign_files)
