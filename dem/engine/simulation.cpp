@@ -847,7 +847,7 @@ void Simulation::write_checkpoint(const std::string& path) {
   d.streams = streams_.save_state();
   d.insertions = insertion_record(scene_);
   d.model = scene_.model_record;
-  if (log_record_) d.log = *log_record_;
+  if (log_record_ && !log_record_->empty()) d.log = *log_record_;  // (empty: not kept)
   if (!wall_impulse_.empty()) {
     d.wall_impulse.reserve(3 * wall_impulse_.size() + 1);
     for (const Vec3& j : wall_impulse_)

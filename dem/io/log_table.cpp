@@ -141,7 +141,14 @@ void LogTable::write(const LogRow& r, bool recorded) {
     errno = 0;
     if (std::fputs(line.c_str(), file_) == EOF || std::fflush(file_) != 0)
       err = errno ? errno : EIO;
-    if (recorded) record_ += line;
+    if (recorded && !record_dropped_) {
+      if (record_.size() + line.size() > record_limit_) {
+        record_dropped_ = true;
+        std::string().swap(record_);
+      } else {
+        record_ += line;
+      }
+    }
   }
   agree(err, "cannot append to the log table");
 }

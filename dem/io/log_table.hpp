@@ -59,9 +59,14 @@ class LogTable {
   void write(const LogRow& row, bool recorded = true);
 
   const std::string& path() const { return path_; }
-  // Rank 0: the table's text (header and recorded rows) as a checkpoint stores it; other ranks:
-  // empty.
+  // Rank 0: the table's text (header and recorded rows) as a checkpoint stores it; other ranks,
+  // and a table whose text grew beyond record_limit() bytes: empty (its checkpoints then keep no
+  // copy, and a restart keeps the file's rows up to its step).
   const std::string& record() const { return record_; }
+  // 64 MiB by default (about 300 000 rows): a log written every step of a long run is not
+  // copied into memory and into every checkpoint.
+  std::size_t record_limit() const { return record_limit_; }
+  void set_record_limit(std::size_t bytes) { record_limit_ = bytes; }
   // Rank 0, after the continuing constructor: what the restart replaced, as a sentence, or "".
   const std::string& note() const { return note_; }
 
@@ -75,6 +80,8 @@ class LogTable {
   std::size_t extra_ = 0;
   std::FILE* file_ = nullptr;  // open on rank 0 only
   std::string record_;         // rank 0
+  std::size_t record_limit_ = std::size_t{64} << 20;
+  bool record_dropped_ = false;  // record_ grew beyond the limit
   std::string note_;           // rank 0
 };
 

@@ -241,6 +241,16 @@ TEST(LogTable, RestartTakesTheCheckpointsCopy) {
   if (rank == 0) {
     EXPECT_EQ(read_lines(path).size(), 3u);
   }
+  // Beyond its limit the copy is dropped (empty: checkpoints keep none), the file goes on.
+  {
+    LogTable log(MPI_COMM_WORLD, path.string());
+    log.set_record_limit(log.record().size() + 400);  // room for a row or two
+    for (int i = 0; i < 100; ++i) log.write(awkward_row(i));
+    EXPECT_EQ(log.record(), "");
+  }
+  if (rank == 0) {
+    EXPECT_EQ(read_lines(path).size(), 101u);
+  }
 }
 
 }  // namespace
