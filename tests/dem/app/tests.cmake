@@ -108,7 +108,7 @@ set_tests_properties(grain.runs_on_two_ranks PROPERTIES PROCESSORS 2)
 # than one radius per step); with both off, by the overlap guard (docs/stability.md).
 # The refusal itself is then a warning, not an error.
 grain_cli_test(steps_guard_stops_run 1
-               "warning: dt is too large to resolve contacts;[(]running anyway: --allow-large-dt[)];particles? [0-9]+ and [a-z0-9 ]+ approach at [0-9.e-]+ m/s;only [0-9.e-]+ steps of dt = 0.001 s [(]fewer than 5, key time.min_steps_per_contact[)]"
+               "warning: dt is too large to resolve contacts;[(]running anyway: --allow-large-dt[)];particles? [0-9]+ and [a-z0-9 ']+ approach at [0-9.e-]+ m/s;only [0-9.e-]+ steps of dt = 0.001 s [(]fewer than 5, key time.min_steps_per_contact[)]"
                CMD ${_grain} run ${_scenes}/bad/huge_time_step.yaml --allow-large-dt --no-progress
                    --output out
                FORBID "error: dt is too large"
