@@ -125,6 +125,21 @@ DemLink::DemLink(const std::string& scene_file, double fluid_density, double flu
            "the fluid block (the fluid temperature itself comes from grainFoam's 0/T; "
            "docs/models/heat-transfer.md, \"Coupled to grainFoam\")\n";
   m.heat = m.scene.heat && f.thermal;
+  // The keys that prescribe the fluid for grain's one-way runs: grainFoam solves the fluid.
+  for (const auto& [key, where] : f.prescribed_keys) {
+    const char* instead =
+        key == "void_fraction"
+            ? "grainFoam computes the void fraction from the particles on its mesh "
+              "(constant/couplingProperties: voidFraction, minVoidFraction)"
+        : key == "pressure.gradient"
+            ? "the pressure gradient is grainFoam's solved p (drive the flow through the "
+              "boundary conditions of 0/U and 0/p, or meanPressureGradient in "
+              "constant/couplingProperties for a box periodic along gravity)"
+            : "the fluid velocity is grainFoam's solved U (set the flow through 0/U)";
+    why << where << ": error: fluid." << key
+        << " prescribes the fluid for a one-way `grain run`; a coupled run does not use it: "
+        << instead << "; remove it\n";
+  }
   // The output keys that belong to grain's own run loop: grainFoam's write times replace them.
   for (const auto& [key, where] : m.scene.output.given) {
     const char* instead = nullptr;

@@ -17,6 +17,8 @@
 #include "coupling/written_files.hpp"
 #include "dem/io/output_directory.hpp"
 #include "extrapolatedCalculatedFvPatchField.H"
+#include "processorFvPatch.H"
+#include "uniformDimensionedFields.H"
 #include "volPointInterpolation.H"
 #include "wallFvPatch.H"
 #include "zeroGradientFvPatchFields.H"
@@ -310,6 +312,31 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
                                     "block (the heat exchange is deposited and sampled "
                                     "without the averaging); set diffusionBandwidth 0"
                                  << exit(FatalIOError);
+  // OpenFOAM's own place for gravity: grainFoam takes it from the scene, so a constant/g that
+  // says otherwise would be a setting with no effect.
+  {
+    IOobject gHeader("g", mesh.time().constant(), mesh, IOobject::READ_IF_PRESENT,
+                     IOobject::NO_WRITE, false);
+    if (gHeader.typeHeaderOk<uniformDimensionedVectorField>(true)) {
+      const uniformDimensionedVectorField g(gHeader);
+      const std::array<double, 3> sg = dem_->gravity();
+      const double size = std::max({mag(g.value()), std::hypot(sg[0], sg[1], sg[2]), 1e-300});
+      const auto text = [](double x, double y, double z) {
+        std::ostringstream o;
+        o << '(' << x << ' ' << y << ' ' << z << ')';
+        return o.str();
+      };
+      if (mag(g.value() - vector(sg[0], sg[1], sg[2])) > 1e-12 * size)
+        FatalErrorInFunction
+            << "constant/g is " << text(g.value().x(), g.value().y(), g.value().z()).c_str()
+            << " m/s^2 but the scene's gravity is " << text(sg[0], sg[1], sg[2]).c_str()
+            << " m/s^2 (gravity: in " << sceneFile
+            << "); grainFoam takes gravity from the scene and does not read "
+               "constant/g. Set `gravity:` in the scene to the value you want, and remove "
+               "constant/g (or make it equal)"
+            << exit(FatalError);
+    }
+  }
   model_ = dem_->vans_model();
   domain_ = dem_->domain();
   periodic_ = dem_->periodic();
@@ -376,6 +403,7 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
                          << " m^3; the coupling needs a box-shaped mesh whose processor "
                             "meshes are boxes (decomposeParDict method simple or hierarchical)"
                          << exit(FatalError);
+  checkPeriodicSides(mesh, sceneFile);
   dem_->use_processor_grid(grid);
   // The scene's output.directory, relative to the case folder (not processorN/), or
   // <case>/particles.
@@ -672,6 +700,30 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
       Info << "grainFoam coupling: " << w.c_str() << endl;
     for (const std::string& w : dem_->parcel_domain_warnings())
       Info << "grainFoam coupling: " << w.c_str() << endl;
+    // voidFraction centre puts a particle's whole volume in the cell that holds its centre: a
+    // particle wider than the cell would fill more than the cell, and the clamp at
+    // minVoidFraction then removes the rest of its volume (and drag) from the fluid.
+    if (voidFractionMethod_ == "centre") {
+      double largest = 0;
+      for (std::size_t i = 0; i < particles_.local(); ++i)
+        largest = std::max(largest, 2 * particles_.radius(i));
+      reduce(largest, maxOp<double>());
+      const auto text = [](double x) {
+        std::ostringstream o;
+        o.precision(4);
+        o << x;
+        return o.str();
+      };
+      if (largest > smallest)
+        Info << "grainFoam coupling: warning: particles up to " << text(largest).c_str()
+             << " m across are wider than the smallest fluid cell (" << text(smallest).c_str()
+             << " m, the cube root of its volume) and voidFraction is centre: each puts its "
+                "whole volume into the one cell that holds its centre, where the clamp at "
+                "minVoidFraction removes what does not fit (counted in the log, `void "
+                "fraction clamped`). Use voidFraction divided (or smoothed), which spreads a "
+                "particle over the cells it covers"
+             << endl;
+    }
   }
 
   voidFraction_.oldTime();  // keep old times for ddt(voidfraction)
@@ -697,6 +749,14 @@ void ParticleCoupling::continueVoidFraction() {
   if (difference <= 1e-9) {
     voidFraction_.primitiveFieldRef() = written.primitiveField();
     voidFraction_.correctBoundaryConditions();
+    // dragVoidFraction sharpInterface: the layers (the drag's eps, the scales on U and grad p,
+    // and the one on Ksl) were read off the deposit; read them again off the written eps, as
+    // the uninterrupted run had them.
+    if (sharpInterface_) {
+      const scalarField before(velocityScale_);
+      reconstructLayers();
+      forAll(Ksl_, c) if (before[c] != 0) Ksl_[c] *= velocityScale_[c] / before[c];
+    }
     Info << "grainFoam coupling: restart void fraction: the written field and the "
             "particles' deposit differ by "
          << difference << "; continuing with the written one, as the uninterrupted run does"
@@ -2183,6 +2243,58 @@ void ParticleCoupling::write() {
       if (line.rfind("undisturbed velocity", 0) == 0)
         Foam::Info << "grainFoam " << line.c_str()
                    << (Pstream::parRun() ? " (particles of rank 0)" : "") << Foam::endl;
+}
+
+void ParticleCoupling::checkPeriodicSides(const fvMesh& mesh, const fileName& sceneFile) const {
+  // Per axis and side: the first patch (by index; the patches are the same on every rank)
+  // with faces on that side of the box, periodic (cyclic, not processor) or not. A particle
+  // crosses a side where the scene's domain is periodic, and stays where it is not: the
+  // fluid must do the same, or the particles' volume and drag land where the fluid cannot
+  // follow (and a particle passes through the fluid's wall).
+  static const char* axis = "xyz";
+  const label none = labelMax;
+  label walled[3] = {none, none, none}, cyclic[3] = {none, none, none};
+  forAll(mesh.boundary(), patch) {
+    const fvPatch& fp = mesh.boundary()[patch];
+    if (fp.size() == 0 || isA<processorFvPatch>(fp)) continue;
+    const vectorField n(fp.nf());
+    const vectorField c(fp.Cf());
+    forAll(n, f) for (int a = 0; a < 3; ++a) {
+      if (std::abs(n[f][a]) < 0.999) continue;
+      const double tol = 1e-9 * (domain_.hi[a] - domain_.lo[a]);
+      if (std::abs(c[f][a] - domain_.lo[a]) > tol && std::abs(c[f][a] - domain_.hi[a]) > tol)
+        continue;
+      label& first = fp.coupled() ? cyclic[a] : walled[a];
+      first = std::min(first, label(patch));
+    }
+  }
+  for (int a = 0; a < 3; ++a) {
+    reduce(walled[a], minOp<label>());
+    reduce(cyclic[a], minOp<label>());
+    const label patch = periodic_[a] ? walled[a] : cyclic[a];
+    if (patch == none) continue;
+    const fvPatch& fp = mesh.boundary()[patch];
+    if (periodic_[a])
+      FatalErrorInFunction
+          << "the scene's domain is periodic along " << axis[a] << " (domain.periodic in "
+          << sceneFile << ") but the mesh closes the " << axis[a] << " sides with patch '"
+          << fp.name() << "' (type " << fp.type() << "): a particle would pass through the "
+          << "fluid's boundary and come back on the other side, with its volume and drag on "
+             "the wrong side. Make the mesh periodic along "
+          << axis[a]
+          << " (a cyclic patch pair in system/blockMeshDict), or make the scene "
+             "bounded along "
+          << axis[a] << " (domain.periodic false, with wall planes where the mesh has walls)"
+          << exit(FatalError);
+    FatalErrorInFunction
+        << "the mesh is periodic along " << axis[a] << " (patch '" << fp.name() << "', type "
+        << fp.type() << ") but the scene's domain is not (domain.periodic in " << sceneFile
+        << "): the fluid would leave through one side and come back through the other while "
+           "the particles stop at the side or are removed there. Make the scene periodic "
+           "along "
+        << axis[a] << " (domain.periodic), or give the mesh walls or an outlet on the " << axis[a]
+        << " sides" << exit(FatalError);
+  }
 }
 
 std::string ParticleCoupling::wallLoadLine() {

@@ -6,6 +6,7 @@
 //   ∇·τ = μ∇²u = 0;  ∇×u = G n_g × n_u;  Du/Dt = (u·∇)u = G (n_g·u₀) n_u.
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dem/fluid/fluid_sample.hpp"
@@ -66,6 +67,10 @@ struct FluidSettings {
   VansModel model = VansModel::B;
   double virtual_mass_coefficient = kSphereVirtualMassCoefficient;
   std::string source;                         // "file:line" of the block, for messages
+  // The keys that prescribe the fluid itself (velocity, shear, void_fraction,
+  // pressure.gradient) as given, each with its "file:line": a coupled run solves the fluid
+  // and refuses them.
+  std::vector<std::pair<std::string, std::string>> prescribed_keys;
   std::optional<FluidThermal> thermal;        // `temperature:` given (heat on)
   // Coarse graining (docs/models/coarse-graining.md): each material's factor k, indexed by
   // material (Scene::coarse_grain_table); empty when every particle is a real one. A parcel's

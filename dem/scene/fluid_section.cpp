@@ -99,7 +99,13 @@ FluidSettings parse_fluid_section(const Field& f, const Vec3& gravity,
     const Map pm = p->map({"hydrostatic", "gradient"});
     if (const auto h = pm.find("hydrostatic")) field.hydrostatic_pressure = h->boolean();
     field.pressure_gradient = pm.vec3_or("gradient", Vec3::Zero());
+    if (const auto g = pm.find("gradient"))
+      s.prescribed_keys.emplace_back("pressure.gradient",
+                                     g->source().label + ":" + std::to_string(g->line()));
   }
+  for (const char* key : {"velocity", "shear", "void_fraction"})
+    if (const auto k = m.find(key))
+      s.prescribed_keys.emplace_back(key, k->source().label + ":" + std::to_string(k->line()));
 
   const Field drag = m.get("drag", "add `drag: <law>` (e.g. schiller_naumann)");
   const std::vector<std::string> names = drag_law_names();

@@ -129,6 +129,20 @@ def void_fraction_volume(runner, checks):
             diff = float(np.max(np.abs(a - b)))
             checks.expect(diff < ROUND_OFF, f"t = {folder}: max |eps(np 1) - eps(np 2)| = "
                                             f"{diff:.3g} < 1e-12 (min eps {a.min():.4f})")
+    # A bead of 3 mm in the 2 mm cells of neutral_particle: with voidFraction centre its whole
+    # volume goes into one cell, and the clamp removes most of it (1.41e-8 m^3 in a cell of
+    # 8e-9 m^3): warned at start-up, naming divided; divided spreads it, with no warning.
+    for method, warned in (("centre", True), ("divided", False)):
+        case = runner.fresh_case("neutral_particle", f"wide_bead_{method}", [
+            ("particle.csv", "0.00437,0.00512,0.00463,0.6e-3", "0.005,0.005,0.005,1.5e-3"),
+            ("constant/couplingProperties", "voidFraction    divided;",
+             f"voidFraction    {method};"),
+            ("system/controlDict", "endTime         0.1;", "endTime         0.002;")])
+        log = runner.solve(case, 1)
+        said = ("warning: particles up to 0.003 m across are wider than the smallest fluid cell "
+                "(0.002 m" in log and "Use voidFraction divided" in log)
+        checks.expect(said == warned, f"a 3 mm bead in 2 mm cells, voidFraction {method}: "
+                                      f"{'warned' if warned else 'no warning'}")
 
 
 # --- coupling.exchange_balance ----------------------------------------------------------
@@ -458,6 +472,55 @@ def refuses_bad_setup(runner, checks):
                   and re.search(r"couplingProperties\D+line \d+", log) is not None,
                   "facePressure harmonic: refused, naming linear, dragSeries and "
                   "constant/couplingProperties with its line")
+
+    # 7. The scene and the mesh periodic along different axes. The closed box with the scene
+    # periodic along y: a particle would leave through the fluid's wall and come back on the
+    # other side (it did, with exit 0). The mesh cyclic along y with the scene bounded: the
+    # fluid would cross the sides the particles stop at. The advice (both periodic along y)
+    # runs: cellpoint_ranks' "cyclic" variant.
+    for label, edits, words in (
+            ("scene_periodic_mesh_walled", CYCLIC_Y[-1:],
+             "the scene's domain is periodic along y (domain.periodic in "),
+            ("mesh_cyclic_scene_bounded", CYCLIC_Y[:-1],
+             "the mesh is periodic along y (patch 'front', type cyclic) but the scene's domain "
+             "is not")):
+        case = runner.fresh_case("neutral_particle", label, edits)
+        runner.run(case, "blockMesh", "blockMesh")
+        log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+        checks.expect(words in log and ("closes the y sides with patch 'walls' (type wall)" in log
+                                        or "give the mesh walls or an outlet" in log),
+                      f"{label}: refused, naming the axis y and the patch")
+
+    # 8. The fluid block's keys that prescribe the fluid for a one-way `grain run` (velocity,
+    # shear, void_fraction, pressure.gradient): grainFoam solves the fluid, and ran with them
+    # as if they were not there (exit 0, the same settling speed to every digit).
+    case = runner.fresh_case("neutral_particle", "prescribed_fluid_keys", [
+        ("particle.yaml", "  viscosity: 1e-3\n",
+         "  viscosity: 1e-3\n  velocity: [0, 0, 0.05]\n  void_fraction: 0.5\n"),
+        ("particle.yaml", "pressure: {hydrostatic: false}",
+         "pressure: {hydrostatic: false, gradient: [0, 0, 5000]}")])
+    runner.run(case, "blockMesh", "blockMesh")
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    for key, line in (("pressure.gradient", 23), ("velocity", 19), ("void_fraction", 20)):
+        checks.expect(f"particle.yaml:{line}: error: fluid.{key} prescribes the fluid for a "
+                      f"one-way `grain run`; a coupled run does not use it" in log,
+                      f"fluid.{key} in a coupled run: refused at particle.yaml:{line}")
+
+    # 9. constant/g, OpenFOAM's place for gravity, which grainFoam does not read (it takes the
+    # scene's): one that differs from the scene's is refused (it was ignored, exit 0); one
+    # equal to it runs.
+    for label, value, fails in (("g_differs", "(0 0 -20)", True), ("g_equal", "(0 0 -9.81)", False)):
+        case = runner.fresh_case("neutral_particle", label, [])
+        with open(os.path.join(case, "constant", "g"), "w") as f:
+            f.write("FoamFile { version 2.0; format ascii; class uniformDimensionedVectorField; "
+                    f"object g; }}\ndimensions [0 1 -2 0 0 0 0];\nvalue {value};\n")
+        runner.run(case, "blockMesh", "blockMesh")
+        log = runner.run(case, "grainFoam", runner.solver, expect_failure=fails)
+        if fails:
+            checks.expect("constant/g is (0 0 -20) m/s^2 but the scene's gravity is (0 0 -9.81)"
+                          in log and "does not read constant/g" in log,
+                          "constant/g (0 0 -20) against the scene's (0 0 -9.81): refused, "
+                          "naming both")
 
 
 def hostile_fields(runner, checks):
