@@ -9,6 +9,7 @@
 #include "dem/contact/normal_hooke.hpp"
 #include "dem/core/number_format.hpp"
 #include "dem/heat/thermal_limits.hpp"
+#include "dem/insert/insertion.hpp"
 #include "dem/walls/wall_travel.hpp"
 
 namespace grainflow {

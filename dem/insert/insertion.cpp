@@ -36,6 +36,19 @@ double sample_radius(const SizeDistribution& d, std::mt19937_64& rng) {
   return d.value;
 }
 
+double min_radius(const SizeDistribution& d) {
+  switch (d.kind) {
+    case SizeDistribution::Kind::constant:
+      return d.value;
+    case SizeDistribution::Kind::uniform:
+    case SizeDistribution::Kind::normal:
+      return d.min;
+    case SizeDistribution::Kind::discrete:
+      return *std::min_element(d.values.begin(), d.values.end());
+  }
+  return d.value;
+}
+
 double max_radius(const SizeDistribution& d) {
   switch (d.kind) {
     case SizeDistribution::Kind::constant: return d.value;
@@ -225,7 +238,6 @@ void fill_region(const Scene& scene, const WallSet* walls, const Insertion& ins,
   const long target_count = ins.count ? *ins.count : 0;
   long placed = 0, attempts = 0;
   double volume = 0;
-  auto done = [&] { return ins.count ? placed >= target_count : volume >= target_volume; };
   // Random sequential addition saturates near 38 % solids for equal spheres; the
   // attempt budget turns an impossible request into a clear error, not a hang.
   // (In double: a count near the parser's limit of 9e15 would overflow a long here.)
@@ -247,7 +259,23 @@ void fill_region(const Scene& scene, const WallSet* walls, const Insertion& ins,
       }
     return wall;
   };
-  while (!done()) {
+  // The radii are drawn first, all of them (for a volume fraction, until their volume reaches
+  // it), and placed largest first. Drawing a radius at every attempt would place small
+  // particles more readily than large ones, so that a dense fill held fewer large ones than
+  // the distribution asks for; largest first, the small ones fill the gaps the large ones
+  // leave, and dense fills reach the packing they would in any order or more.
+  std::vector<double> radii;
+  if (ins.count) {
+    radii.reserve(static_cast<std::size_t>(target_count));
+    for (long k = 0; k < target_count; ++k) radii.push_back(sample_radius(ins.radius, rng));
+  } else {
+    for (double v = 0; v < target_volume;) {
+      radii.push_back(sample_radius(ins.radius, rng));
+      v += sphere_volume(radii.back());
+    }
+  }
+  std::stable_sort(radii.begin(), radii.end(), std::greater<>());
+  while (static_cast<std::size_t>(placed) < radii.size()) {
     if (++attempts > budget) {
       std::ostringstream msg;
       msg.precision(4);
@@ -281,7 +309,7 @@ void fill_region(const Scene& scene, const WallSet* walls, const Insertion& ins,
             << " times the real radius: a lower coarse_grain fits more of them";
       throw InsertionError(msg.str());
     }
-    const double r = sample_radius(ins.radius, rng);
+    const double r = radii[static_cast<std::size_t>(placed)];
     Vec3 x;
     if (!sample_centre(ins.region, r, rng, x)) continue;
     ++sampled;

@@ -22,6 +22,7 @@ double sample_radius(const SizeDistribution& d, std::mt19937_64& rng);
 
 // Largest radius the distribution can produce (for neighbour and insertion grids).
 double max_radius(const SizeDistribution& d);
+double min_radius(const SizeDistribution& d);  // the smallest radius d can give
 
 // Appends the particles of every insertion entry of the scene, ids continuing
 // from `next_id`. New particles overlap neither each other, earlier particles,

@@ -49,6 +49,8 @@ class StreamInsertion {
   long lag(std::size_t k) const { return streams_[k].lag; }
   std::size_t size() const { return streams_.size(); }
   const std::string& source(std::size_t k) const { return streams_[k].entry.source; }
+  // Stream k's coarse-graining factor (1: real particles; k: parcels of k^3 real ones).
+  double coarse_grain(std::size_t k) const { return streams_[k].entry.coarse_grain; }
 
   // The streams' progress (delivered totals, radii drawn but not placed, generator
   // states) as text, for checkpoints: a run restored with restore_state() inserts

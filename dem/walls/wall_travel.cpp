@@ -32,19 +32,6 @@ bool parallel(const Vec3& a, const Vec3& b) { return a.cross(b).norm() <= 1e-12;
 
 }  // namespace
 
-double min_radius(const SizeDistribution& d) {
-  switch (d.kind) {
-    case SizeDistribution::Kind::constant:
-      return d.value;
-    case SizeDistribution::Kind::uniform:
-    case SizeDistribution::Kind::normal:
-      return d.min;
-    case SizeDistribution::Kind::discrete:
-      return *std::min_element(d.values.begin(), d.values.end());
-  }
-  return d.value;
-}
-
 double wall_sweep_speed(const Scene& scene, const WallSet& walls, std::size_t k) {
   const Wall& w = scene.walls[k];
   const WallMotion& m = w.motion;

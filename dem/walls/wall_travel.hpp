@@ -57,7 +57,4 @@ WallTravelReport check_wall_travel(const Scene& scene, const WallSet& walls, dou
                                    double r_min, int material, const PairTable& table,
                                    double startup_step = std::numeric_limits<double>::infinity());
 
-// The smallest radius a distribution can draw.
-double min_radius(const SizeDistribution& d);
-
 }  // namespace grainflow
