@@ -119,6 +119,25 @@ void check_grids(const Scene& scene) {
       throw SetupError(scene.fluid->source + ": error: fluid.void_fraction: " + why);
 }
 
+// Every particle, real ones (k = 1) included: how many are computed, the real particles they
+// stand for (k^3 each) and their mass. Collective over comm.
+struct ParticleTotals {
+  long long computed = 0;
+  double real = 0, mass = 0;
+};
+ParticleTotals particle_totals(const Scene& scene, const Particles& p, MPI_Comm comm) {
+  const std::vector<double> k = scene.coarse_grain_table();
+  double sum[3] = {0, 0, 0};
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double ki = k.empty() ? 1.0 : k[static_cast<std::size_t>(p.material[i])];
+    sum[0] += 1;
+    sum[1] += ki * ki * ki;
+    sum[2] += p.mass[i];
+  }
+  MPI_Allreduce(MPI_IN_PLACE, sum, 3, MPI_DOUBLE, MPI_SUM, comm);
+  return {static_cast<long long>(sum[0]), sum[1], sum[2]};
+}
+
 // Coarse graining (docs/models/coarse-graining.md): per parcel class the parcels, the real
 // particles they stand for and their mass, and warnings where the literature says parcels
 // stop standing for the real particles (dem/engine/parcel_limits.hpp, the rules grainFoam
@@ -127,23 +146,9 @@ void print_coarse_grain_report(const Scene& scene, const Particles& p, MPI_Comm 
                                std::ostream& out) {
   if (scene.coarse_grain_table().empty()) return;
   const std::vector<ParcelClass> classes = parcel_classes(scene, p, comm);
-  long long parcels = 0;
-  double real = 0, mass = 0;
-  {
-    // Every particle, real ones (k = 1) included, for the totals.
-    const std::vector<double> k = scene.coarse_grain_table();
-    double sum[3] = {0, 0, 0};
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      const double ki = k[static_cast<std::size_t>(p.material[i])];
-      sum[0] += 1;
-      sum[1] += ki * ki * ki;
-      sum[2] += p.mass[i];
-    }
-    MPI_Allreduce(MPI_IN_PLACE, sum, 3, MPI_DOUBLE, MPI_SUM, comm);
-    parcels = static_cast<long long>(sum[0]);
-    real = sum[1];
-    mass = sum[2];
-  }
+  const ParticleTotals totals = particle_totals(scene, p, comm);
+  const long long parcels = totals.computed;
+  const double real = totals.real, mass = totals.mass;
   std::ostream& o = speaker(comm, out);
   o << "coarse graining (docs/models/coarse-graining.md):\n";
   for (const ParcelClass& c : classes)
@@ -179,6 +184,15 @@ namespace {
 
 // The advice of a refused step: the smallest step the refusing checks propose, which every
 // one of them allows (following the first error alone may meet the next one).
+// The steps a run takes: the whole number nearest to end / dt, at least one, so that it ends
+// within half a step of time.end (`grain check` prints the same count).
+// When the last step's time misses time.end by more than this share of it, `grain check` and
+// `grain run` say at which time the run ends.
+constexpr double kEndTolerance = 1e-3;
+long steps_to_end(double end, double dt) {
+  return std::max(1L, static_cast<long>(std::ceil(end / dt - 0.5 - 1e-9)));
+}
+
 std::string refusal_remedy(const TimeStepReport& rep) {
   if (!std::isfinite(rep.refusal_step) || !(rep.refusal_step > 0))
     return "lower time.step / time.rayleigh_fraction";
@@ -204,10 +218,18 @@ int check_scene(const Scene& scene, std::ostream& out) {
   print_report(sim, MPI_COMM_WORLD, out);
   print_coarse_grain_report(scene, sim.particles(), MPI_COMM_WORLD, out);
   const TimeStepReport& rep = sim.time_step_report();
-  if (rep.dt > 0 && std::isfinite(rep.dt))
-    speaker(MPI_COMM_WORLD, out) << "steps to reach t_end = " << scene.time.end << " s: "
-                                 << static_cast<long>(std::ceil(scene.time.end / rep.dt - 0.5))
-                                 << "\n";
+  if (rep.dt > 0 && std::isfinite(rep.dt)) {
+    const long steps = steps_to_end(scene.time.end, rep.dt);
+    const double last = static_cast<double>(steps) * rep.dt;
+    std::ostream& say = speaker(MPI_COMM_WORLD, out);
+    say << "steps to reach t_end = " << scene.time.end << " s: " << steps;
+    if (std::abs(last - scene.time.end) > kEndTolerance * scene.time.end)
+      say << " (end / step = " << significant(scene.time.end / rep.dt, 6)
+          << " is not whole: the run takes the nearest whole number of steps, at least one, "
+             "and ends at t = "
+          << significant(last, 9) << " s)";
+    say << "\n";
+  }
   if (rep.verdict != TimeStepReport::Verdict::refuse) return 0;
   speaker(MPI_COMM_WORLD, out) << scene.file << ": error: `grain run` would refuse this time step; "
                                << refusal_remedy(rep) << "\n";
@@ -269,8 +291,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   guard_finite(sim, has_non_finite(sim.particles(), sim.heat() != nullptr), dir, comm);
   // A restart whose scene ends before the checkpoint would run no step, and would first cut
   // the snapshot series and log back to the checkpoint: refused before anything is touched.
-  const long end_step =
-      std::max(1L, static_cast<long>(std::ceil(scene.time.end / sim.dt() - 0.5 - 1e-9)));
+  const long end_step = steps_to_end(scene.time.end, sim.dt());
   if (options.restart && end_step < first_step) {
     std::ostringstream m;
     m << scene.time.end_source << ": error: time.end = " << scene.time.end
@@ -280,6 +301,11 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
          "checkpoint (nothing was changed or deleted)";
     throw SetupError(m.str());
   }
+  if (const double last = static_cast<double>(end_step) * sim.dt();
+      std::abs(last - scene.time.end) > kEndTolerance * scene.time.end)
+    say << "note: time.end / step = " << significant(scene.time.end / sim.dt(), 6)
+        << " is not whole: the run takes " << end_step << " steps, the nearest whole number, and "
+        << "ends at t = " << significant(last, 9) << " s\n";
 
   SnapshotWriter snapshots(comm, dir, "particles", scene.output.fields);
   snapshots.set_coarse_grain(scene.coarse_grain_table(), scene.real_material_table());
@@ -519,6 +545,20 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   }
   progress.finish();
   say << stop_message.str();
+  // After a restart, the stopped run's snapshots after its checkpoint that this run did not
+  // write over (another snapshot_interval, an earlier end): said, not deleted, as for a fresh
+  // run in a used folder. (A script taking the last file by name would take theirs.)
+  if (options.restart) {
+    int rank = 0;
+    MPI_Comm_rank(comm, &rank);
+    if (rank == 0)
+      if (const std::vector<std::string> left = snapshots.files_after_series(); !left.empty())
+        say << "note: " << dir << " still holds " << left.size() << " snapshot(s) numbered after "
+            << "this run's last (" << left.front()
+            << (left.size() > 1 ? " to " + left.back() : std::string()) << "), written before "
+            << "the restart and not written over by it; particles.xdmf does not list them. "
+               "Remove them, so that the files in number order are this run's series\n";
+  }
 
   MPI_Allreduce(MPI_IN_PLACE, &particle_steps, 1, MPI_DOUBLE, MPI_SUM, comm);
   const GlobalState g = sim.global_state();
@@ -533,6 +573,12 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
       << " neighbour rebuilds, " << sum.wall_seconds << " s wall, " << sum.particle_steps_per_second
       << " particle-steps/s\n"
       << "output: " << dir << "/particles.xdmf (open in ParaView), " << dir << "/log.csv\n";
+  if (!scene.coarse_grain_table().empty()) {
+    const ParticleTotals end = particle_totals(scene, sim.particles(), comm);
+    say << "coarse graining: the " << end.computed << " particles stand for " << end.real
+        << " real particles (" << end.mass << " kg); each parcel counts as one particle in the "
+        << "counts above, in the removed ones and in log.csv\n";
+  }
   sum.startup_seconds = setup_seconds + first_snapshot_seconds;
   sum.snapshot_seconds = snapshot_seconds;
   sum.snapshot_bytes = snapshot_bytes;
@@ -549,8 +595,14 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   const StreamInsertion& streams = sim.streams();
   for (std::size_t k = 0; k < streams.size(); ++k) {
     sum.streams.push_back({streams.count_inserted(k), streams.mass_inserted(k), streams.lag(k)});
-    say << "stream " << streams.source(k) << ": " << streams.count_inserted(k) << " particles, "
-        << streams.mass_inserted(k) << " kg delivered since t = 0"
+    const double kc = streams.coarse_grain(k);
+    say << "stream " << streams.source(k) << ": " << streams.count_inserted(k) << " particles"
+        << (kc != 1 ? " (parcels of k = " + significant(kc, 6) + ": " +
+                          significant(static_cast<double>(streams.count_inserted(k)) * kc * kc * kc,
+                                      6) +
+                          " real particles)"
+                    : std::string())
+        << ", " << streams.mass_inserted(k) << " kg delivered since t = 0"
         << (streams.lag(k) > 0 ? ", " + std::to_string(streams.lag(k)) + " behind (face blocked)"
                                : std::string())
         << "\n";

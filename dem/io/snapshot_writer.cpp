@@ -422,6 +422,25 @@ std::size_t SnapshotWriter::continue_series(long up_to_step) {
   return entries_.size();
 }
 
+std::vector<std::string> SnapshotWriter::files_after_series() const {
+  std::vector<std::pair<long, std::string>> found;
+  std::error_code ec;
+  const std::string prefix = basename_ + "_";
+  for (const auto& e : std::filesystem::directory_iterator(directory_, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.size() != prefix.size() + 9 || !name.starts_with(prefix) || !name.ends_with(".h5"))
+      continue;
+    const std::string digits = name.substr(prefix.size(), 6);
+    if (digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    if (const long number = std::stol(digits); number >= next_number_)
+      found.emplace_back(number, name);
+  }
+  std::sort(found.begin(), found.end());
+  std::vector<std::string> out;
+  for (auto& [number, name] : found) out.push_back(std::move(name));
+  return out;
+}
+
 std::string SnapshotWriter::index_path() const {
   return (std::filesystem::path(directory_) / (basename_ + ".xdmf")).string();
 }

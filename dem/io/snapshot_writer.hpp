@@ -92,6 +92,10 @@ class SnapshotWriter {
   // After continue_series: the first file it left out because another scene's run wrote it
   // ("" when none).
   const std::string& foreign_file() const { return foreign_file_; }
+  // The series' files in the folder numbered at or after the next one write() would make,
+  // in number order: after a restart's run, those the stopped run wrote after its checkpoint
+  // and this run did not write over (another snapshot interval, an earlier end).
+  std::vector<std::string> files_after_series() const;
 
  private:
   std::vector<double> coarse_grain_;

@@ -24,6 +24,7 @@ A's files 3-30 hold steps below B's checkpoint. Checks:
     stayed in front of B's continuation.
 A last run checks gaps: A again, its snapshot 5 deleted and 9 cut short, continued from its
 checkpoint: both named as gaps, the index lists the other 29, each number at its own time.
+And A continued with snapshots every 0.02 s: the older files 21-30 it leaves are named.
 Exit 0 when every check holds.
 """
 import glob
@@ -163,5 +164,19 @@ for n in numbers:
         times[n] = float(f.attrs["time"])
 check(all(abs(times[n] - times_before[n]) < 1e-9 for n in numbers),
       "every number holds the time the uninterrupted run gave it")
+# A longer snapshot interval after the restart: A continued from its checkpoint at 0.1 s with
+# snapshots every 0.02 s writes numbers 11-20 (t = 0.12 ... 0.3 s), and the stopped run's 21-30
+# stay. The restart says so at its end, naming them (they were left without a word, and a
+# script taking the last file by name read t = 0.3 s from the run before the restart).
+scene("a_longer.yaml", 300, 0.3, 0.02, 0.1)
+grain_run("a.yaml", "longer")
+a_checkpoint = sorted(glob.glob(os.path.join(work, "longer", "checkpoint_*.h5")))[0]
+out = grain_run("a_longer.yaml", "longer", "--restart", os.path.relpath(a_checkpoint, work))
+check("note: longer still holds 10 snapshot(s) numbered after this run's last "
+      "(particles_000021.h5 to particles_000030.h5), written before the restart" in out,
+      "a restart with a longer snapshot interval names the 10 older files left after its series")
+listed = sorted({int(n) for n in re.findall(r"particles_(\d+)\.h5",
+                                            open(os.path.join(work, "longer", "particles.xdmf")).read())})
+check(listed == list(range(21)), f"its particles.xdmf lists 0-20 ({len(listed)} files)")
 print(f"grain.foreign_files: {len(failures)} failed checks")
 sys.exit(1 if failures else 0)

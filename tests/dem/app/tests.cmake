@@ -35,6 +35,15 @@ grain_cli_test(two_scene_files 2 "'run' takes one scene file, got 'a.yaml' and '
 grain_cli_test(options_before_scene 0 "done: 2000 steps, 1 particles \\(0 removed\\)"
                CMD ${_grain} run --output=out --no-progress ${_scenes}/fluid/lone_bead.yaml
                WORKDIR ${_work}/options_before_scene FILES out/log.csv)
+# time.end between two steps (2.5 steps): check and run agree on 2 steps and say that the run
+# ends at t = 8e-4 s, not at time.end; the log's last row is at that time.
+grain_cli_test(check_end_between_steps 0
+               "steps to reach t_end = 0.001 s: 2 \\(end / step = 2.5 is not whole.*ends at t = 0.0008 s\\)"
+               CMD ${_grain} check ${_scenes}/end_between_steps.yaml)
+grain_cli_test(run_end_between_steps 0
+               "note: time.end / step = 2.5 is not whole: the run takes 2 steps, the nearest whole number, and ends at t = 0.0008 s;done: 2 steps"
+               CMD ${_grain} run ${_scenes}/end_between_steps.yaml --output out --no-progress
+               WORKDIR ${_work}/end_between_steps)
 grain_cli_test(missing_scene_file 2 "no_such.yaml: error: cannot open the scene file"
                CMD ${_grain} check ${_scenes}/no_such.yaml)
 grain_cli_test(check_minimal 0 "Rayleigh time t_R = ;contact time t_c = ;steps per impact"

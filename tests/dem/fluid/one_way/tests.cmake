@@ -35,3 +35,10 @@ grain_cli_test(coarse_grain_check 0
 grain_cli_test(coarse_grain_check_stream 0
                "'glass\\[k=2\\]': 0 parcels of k = 2 stand for 0 real particles, 0 kg in all \\(real radius up to 0.0003 m, parcel radius up to 0.0006 m\\); none yet: a stream inserts them;warning: the domain's narrowest side \\(0.01 m\\) is less than 10 diameters of parcels 'glass\\[k=2\\]' \\(0.0012 m\\);warning: parcels 'glass\\[k=2\\]' \\(diameter up to 0.0012 m\\) are wider than a third of the void-fraction cell"
                CMD ${_grain} check ${_scenes}/fluid/parcel_stream.yaml)
+# Run to its end (0.02 s at 1000 parcels/s: 20 parcels of k = 2), the stream's line and the
+# closing line give the parcels and the 8 x 20 = 160 real particles they stand for; the counts
+# of particles and removed ones count each parcel as one, and say so.
+grain_cli_test(coarse_grain_run_stream 0
+               "done: [0-9]+ steps, 20 particles \\(0 removed\\);coarse graining: the 20 particles stand for 160 real particles \\(4.5238[0-9]*e-05 kg\\); each parcel counts as one particle;stream .*parcel_stream.yaml:18: 20 particles \\(parcels of k = 2: 160 real particles\\)"
+               CMD ${_grain} run ${_scenes}/fluid/parcel_stream.yaml --output out --no-progress
+               WORKDIR ${_work}/coarse_grain_run_stream)
