@@ -182,6 +182,16 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
                                  << " is outside [1, 2] (kernel radius in particle radii; "
                                     "the ghost range covers at most 2 radii)"
                                  << exit(FatalIOError);
+  // A key of another method is a setting with no effect: said (a sweep over the methods may
+  // keep one case's keys).
+  if (dict.found("dividedResolution") && vf != coupling::VoidFractionMethod::divided)
+    Info << "grainFoam coupling: warning: dividedResolution (constant/couplingProperties) is a "
+            "setting of voidFraction divided and has no effect with voidFraction "
+         << method << endl;
+  if (dict.found("smoothingFactor") && vf != coupling::VoidFractionMethod::smoothed)
+    Info << "grainFoam coupling: warning: smoothingFactor (constant/couplingProperties) is a "
+            "setting of voidFraction smoothed and has no effect with voidFraction "
+         << method << endl;
   footprint_ = coupling::Footprint(vf, static_cast<int>(resolution), smoothing);
   {
     // The footprint's spread per axis in particle radii: its points' standard deviation.

@@ -132,13 +132,18 @@ def void_fraction_volume(runner, checks):
     # A bead of 3 mm in the 2 mm cells of neutral_particle: with voidFraction centre its whole
     # volume goes into one cell, and the clamp removes most of it (1.41e-8 m^3 in a cell of
     # 8e-9 m^3): warned at start-up, naming divided; divided spreads it, with no warning.
+    # (Both were silent, and so was a smoothingFactor given with either.)
     for method, warned in (("centre", True), ("divided", False)):
         case = runner.fresh_case("neutral_particle", f"wide_bead_{method}", [
             ("particle.csv", "0.00437,0.00512,0.00463,0.6e-3", "0.005,0.005,0.005,1.5e-3"),
             ("constant/couplingProperties", "voidFraction    divided;",
-             f"voidFraction    {method};"),
+             f"voidFraction    {method};\nsmoothingFactor 1.5;"),
             ("system/controlDict", "endTime         0.1;", "endTime         0.002;")])
         log = runner.solve(case, 1)
+        # smoothingFactor, a key of voidFraction smoothed, has no effect here: said.
+        checks.expect("warning: smoothingFactor (constant/couplingProperties) is a setting of "
+                      f"voidFraction smoothed and has no effect with voidFraction {method}" in log,
+                      f"smoothingFactor with voidFraction {method}: warned")
         said = ("warning: particles up to 0.003 m across are wider than the smallest fluid cell "
                 "(0.002 m" in log and "Use voidFraction divided" in log)
         checks.expect(said == warned, f"a 3 mm bead in 2 mm cells, voidFraction {method}: "

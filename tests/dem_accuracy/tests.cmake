@@ -11,23 +11,24 @@ set_tests_properties(accuracy_cost.dem_short PROPERTIES
   LABELS "accuracy_cost"
   TIMEOUT 120)
 
-# accuracy_cost.coarse_grain_hopper (benchmarks/coarse_grain/hopper.py --ks 2,3 --check 0.12):
+# accuracy_cost.coarse_grain_hopper (benchmarks/coarse_grain/hopper.py --ks 2,3 --seeds 3):
 # the real mass of 19 656 glass beads (d = 2 mm) as parcels of k = 2 and 3 discharging from a
-# flat-bottomed bin through a 36 mm orifice (9 and 6 parcel diameters). The parcels flow at
-# Beverloo's rate for their own size (-24 % and -43 % against the beads); with Beverloo's
-# annulus put back to the real size (x Bev(d)/Bev(k d)) each k's rate must lie within 12 % of
-# the beads' (the error the beads reach against Beverloo; measured -3.2 % and -5.8 %). Real
-# mass: every parcel carries k and k^3 and k^3 real masses; the mass in the domain plus the
-# removed parcels' equals the settled bed's to 1e-12; removed parcels match the log; parcels x
-# k^3 = the real count. Independently of any earlier run, each k's rate must lie within 20 % of
-# Beverloo's correlation evaluated with the parcel size and that run's own bulk density (the
-# beads reach -11.7 % in this shallow bin, C's own spread is +-9 %; measured -12.6 %, -16.2 %).
-# docs/models/coarse-graining.md, "Hopper discharge".
+# flat-bottomed bin through a 36 mm orifice (9 and 6 parcel diameters), three fills each (one
+# fill's rate scatters by 2.4 % at k = 2 and 10.5 % at k = 3: the means are tested). The
+# parcels flow at Beverloo's rate for their own size (-26 % and -41 % against the beads); with
+# Beverloo's annulus put back to the real size (x Bev(d)/Bev(k d)) each k's mean rate must lie
+# within 12 % of the beads' (the error the beads reach against Beverloo; measured -4.6 % and
+# -0.8 %). Real mass: every parcel carries k and k^3 and k^3 real masses; the mass in the
+# domain plus the removed parcels' equals the settled bed's to 1e-12; removed parcels match the
+# log; parcels x k^3 = the real count. Independently of any earlier run, each k's mean rate
+# must lie within 20 % of Beverloo's correlation evaluated with the parcel size and the first
+# fill's own bulk density (the beads reach -10.0 % in this shallow bin, C's own spread is +-9 %;
+# measured -11.8 %, -9.6 %). docs/models/coarse-graining.md, "Hopper discharge".
 grainflow_find_python(GRAINFLOW_HOPPER_PYTHON "h5py,numpy" "accuracy_cost.coarse_grain_hopper is")
 if(GRAINFLOW_HOPPER_PYTHON)
   add_test(NAME accuracy_cost.coarse_grain_hopper
            COMMAND ${GRAINFLOW_HOPPER_PYTHON} ${PROJECT_SOURCE_DIR}/benchmarks/coarse_grain/hopper.py
-                   --ks 2,3 --check 0.12 --check-beverloo 0.20
+                   --ks 2,3 --seeds 3 --check 0.12 --check-beverloo 0.20
                    --grain $<TARGET_FILE:grain>
                    --work ${CMAKE_CURRENT_BINARY_DIR}/coarse_grain_hopper)
   set_tests_properties(accuracy_cost.coarse_grain_hopper PROPERTIES
