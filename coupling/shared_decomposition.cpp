@@ -63,10 +63,13 @@ ProcessorGrid processor_grid_from_boxes(const std::vector<Box>& boxes, int rank,
   }
   if (grid.dims[0] * grid.dims[1] * grid.dims[2] != ranks) {
     std::ostringstream s;
-    s << "the " << ranks << " processor meshes do not form a grid of boxes: their faces lie on "
-      << grid.dims[0] + 1 << " x " << grid.dims[1] + 1 << " x " << grid.dims[2] + 1
-      << " planes, which would make " << grid.dims[0] * grid.dims[1] * grid.dims[2]
-      << " boxes; " << kMethods;
+    s << "the " << ranks << " processor meshes do not form a grid of boxes: the bounding boxes "
+      << "of their cells have sides on " << grid.dims[0] + 1 << " x " << grid.dims[1] + 1 << " x "
+      << grid.dims[2] + 1 << " planes, which would cut the domain into "
+      << grid.dims[0] * grid.dims[1] * grid.dims[2] << " boxes, not " << ranks
+      << " (a processor whose cells are not one box, such as scattered cells or slabs, does "
+         "this); "
+      << kMethods;
     throw DecompositionMismatch(s.str());
   }
   std::set<std::array<int, 3>> taken;

@@ -218,10 +218,18 @@ void Simulation::initialise() {
   report_ = check_time_step(scene_, p_, table_, constants_,
                             restored_ ? std::optional<double>(dt_) : std::nullopt);
   if (dt_ <= 0) dt_ = report_.dt;
-  if (dt_ <= 0)
-    throw SetupError(scene_.file +
-                     ": error: time.rayleigh_fraction needs particles to size the time step; "
-                     "give time.step instead");
+  if (dt_ <= 0) {
+    const std::string where =
+        scene_.time.step_source.empty() ? scene_.file : scene_.time.step_source;
+    throw SetupError(
+        where + ": error: time.rayleigh_fraction sizes the step by the Rayleigh time of the " +
+        (p_.size() == 0
+             ? std::string("particles present at the start, and there are none")
+             : "contacts, and no contact can happen in this scene (" + std::to_string(p_.size()) +
+                   " particle(s), " +
+                   (scene_.walls.empty() ? "no walls" : "nothing they can touch") + ")") +
+        "; give time.step instead (`grain check` prints the fluid forces' limits on it)");
+  }
   check_walls_travel();
 
   std::vector<char> foreign(p_.size());

@@ -55,6 +55,11 @@ grain_cli_test(check_minimal 0 "Rayleigh time t_R = ;contact time t_c = ;steps p
 grain_cli_test(check_lone_bead 0
                "contact law: none needed;no contact can happen \\(no walls, one particle\\)"
                CMD ${_grain} check ${_scenes}/fluid/lone_bead.yaml)
+# The same bead with the step as a Rayleigh fraction: no contact can happen, so there is no
+# Rayleigh time to size it by, and the error says why (it said the scene had no particles).
+grain_cli_test(check_lone_bead_rayleigh 1
+               "lone_bead_rayleigh.yaml:10: error: time.rayleigh_fraction sizes the step by the Rayleigh time of the contacts, and no contact can happen in this scene \\(1 particle\\(s\\), no walls\\); give time.step instead"
+               CMD ${_grain} check ${_scenes}/fluid/lone_bead_rayleigh.yaml)
 grain_cli_test(run_lone_bead 0 "done: 2000 steps, 1 particles \\(0 removed\\)"
                CMD ${_grain} run ${_scenes}/fluid/lone_bead.yaml --output out --no-progress
                WORKDIR ${_work}/lone_bead)
