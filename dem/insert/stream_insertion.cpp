@@ -13,7 +13,7 @@ namespace {
 constexpr long kMaxPerStep = 100000;  // particles one stream inserts in one step, at most
 }  // namespace
 
-StreamInsertion::StreamInsertion(const Scene& scene) {
+StreamInsertion::StreamInsertion(const Scene& scene) : domain_(scene.domain) {
   for (const Insertion& ins : scene.insertions) {
     if (ins.kind != Insertion::Kind::stream) continue;
     Stream s;
@@ -71,6 +71,26 @@ Vec3 StreamInsertion::sample(Stream& s, double r) {
   return f.centre + rho * (std::cos(phi) * e1 + std::sin(phi) * e2);
 }
 
+Vec3 StreamInsertion::wrap(Vec3 x) const {
+  for (int a = 0; a < 3; ++a) {
+    if (!domain_.periodic[a]) continue;
+    const double length = domain_.hi[a] - domain_.lo[a];
+    x[a] -= length * std::floor((x[a] - domain_.lo[a]) / length);
+    if (x[a] >= domain_.hi[a]) x[a] = domain_.lo[a];  // round-off just below lo
+  }
+  return x;
+}
+
+double StreamInsertion::squared_distance(const Vec3& a, const Vec3& b) const {
+  Vec3 d = a - b;
+  for (int k = 0; k < 3; ++k) {
+    if (!domain_.periodic[k]) continue;
+    const double length = domain_.hi[k] - domain_.lo[k];
+    d[k] -= length * std::round(d[k] / length);
+  }
+  return d.squaredNorm();
+}
+
 long StreamInsertion::insert(double t, Particles& p, const Ghosts& ghosts, const WallSet& walls,
                              const Decomposition& decomp, GlobalId& next_id, MPI_Comm comm) {
   constexpr int kAttempts = 12;  // placement tries per particle and step
@@ -84,7 +104,13 @@ long StreamInsertion::insert(double t, Particles& p, const Ghosts& ghosts, const
     std::vector<Vec3> near_x;
     std::vector<double> near_r;
     auto consider = [&](const Vec3& x, double r) {
-      if (std::abs((x - f.centre).dot(f.normal)) < r + r_max_) {
+      Vec3 d = x - f.centre;  // the nearest image's offset from the face's plane
+      for (int a = 0; a < 3; ++a)
+        if (domain_.periodic[a]) {
+          const double length = domain_.hi[a] - domain_.lo[a];
+          d[a] -= length * std::round(d[a] / length);
+        }
+      if (std::abs(d.dot(f.normal)) < r + r_max_) {
         near_x.push_back(x);
         near_r.push_back(r);
       }
@@ -98,11 +124,11 @@ long StreamInsertion::insert(double t, Particles& p, const Ghosts& ghosts, const
       const double r = pending_radius(s, static_cast<std::size_t>(j));
       for (int a = 0; a < kAttempts; ++a) {
         const std::size_t c = static_cast<std::size_t>(j) * kAttempts + a;
-        cand[c] = sample(s, r);
+        cand[c] = wrap(sample(s, r));
         bool hit = walls.touches_any(cand[c], r);
         for (std::size_t k = 0; k < near_x.size() && !hit; ++k) {
           const double reach = r + near_r[k];
-          hit = (cand[c] - near_x[k]).squaredNorm() < reach * reach;
+          hit = squared_distance(cand[c], near_x[k]) < reach * reach;
         }
         blocked[c] = hit;
       }
@@ -123,7 +149,7 @@ long StreamInsertion::insert(double t, Particles& p, const Ghosts& ghosts, const
         bool hit = blocked[c] != 0;
         for (std::size_t k = 0; k < placed_x.size() && !hit; ++k) {
           const double reach = r + placed_r[k];
-          hit = (cand[c] - placed_x[k]).squaredNorm() < reach * reach;
+          hit = squared_distance(cand[c], placed_x[k]) < reach * reach;
         }
         if (!hit) found = a;
       }

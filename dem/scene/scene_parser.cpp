@@ -449,6 +449,23 @@ void check_periodic_wall(const Map& m, const Wall& w, const Domain& d) {
         m.get("radius").fail_at_key(o.str());
       }
     }
+    // A translation along a periodic axis carries a cylinder across (unless along its own
+    // axis, along which it does not end) and a mesh out of the periodic range: neither is
+    // repeated across the periodic sides.
+    const bool along_own_axis =
+        w.kind == Wall::Kind::cylinder && std::abs(w.cylinder.axis[a]) > 1 - tolerance;
+    if (w.kind != Wall::Kind::plane && !along_own_axis && std::abs(motion.velocity[a]) > 0) {
+      std::ostringstream o;
+      o << (w.kind == Wall::Kind::mesh ? "mesh" : "cylinder") << " '" << w.name << "' moves along "
+        << axis_name[a] << " (motion.velocity " << axis_name[a] << " = "
+        << significant(motion.velocity[a]) << " m/s), and " << periodic
+        << ": a wall is not repeated across the periodic sides, so it would cross them (and "
+           "particles coming back through the other side would not find it)"
+        << unit << "keep the wall still along " << axis_name[a]
+        << (w.kind == Wall::Kind::mesh ? " (a conveyor belt: a still mesh with `surface_velocity`)"
+                                       : "");
+      m.get("motion").fail_at_key(o.str());
+    }
     // A rotation turns a plane's normal (a cylinder's axis) towards a periodic axis unless
     // it is about that axis.
     if (w.kind != Wall::Kind::mesh && motion.angular_velocity != 0 &&
@@ -845,6 +862,44 @@ void parse_stream(const Map& m, const Scene& scene, Insertion& ins) {
               "; every particle enters whole inside the face: make it at least " +
               format_number(2 * r_max) + " m across" + (k != 1 ? ", or lower coarse_grain" : ""));
   }
+  // Along a bounded axis every particle the face can place must lie whole inside the domain:
+  // a face reaching beyond a bounded side delivers particles that are removed at once (they
+  // were counted as delivered). Across a periodic side the candidates wrap.
+  for (const double r : {largest_radius(ins.radius), smallest_radius(ins.radius)}) {
+    for (int a = 0; a < 3; ++a) {
+      if (scene.domain.periodic[a]) continue;
+      double reach = r;  // how far a particle of radius r can reach from the face centre
+      if (rectangle) {
+        const Vec3 v = ins.face.normal.cross(ins.face.u);
+        reach += std::abs(ins.face.u[a]) * std::max(0.0, ins.face.length_u / 2 - r) +
+                 std::abs(v[a]) * std::max(0.0, ins.face.length_v / 2 - r);
+      } else {
+        const double n = ins.face.normal[a];
+        reach += std::max(0.0, ins.face.radius - r) * std::sqrt(std::max(0.0, 1 - n * n));
+      }
+      const double c = ins.face.centre[a];
+      const double tol = 1e-9 * (scene.domain.hi[a] - scene.domain.lo[a]);  // round-off
+      if (c - reach < scene.domain.lo[a] - tol || c + reach > scene.domain.hi[a] + tol) {
+        const char* axis = "xyz";
+        const double from = scene.domain.lo[a] + reach, to = scene.domain.hi[a] - reach;
+        face.fail(std::string("the face reaches beyond the domain along ") + axis[a] +
+                  ": particles entering through it span " + axis[a] + " from " +
+                  format_number(c - reach) + " to " + format_number(c + reach) +
+                  " m, and the domain is bounded there, from " + format_number(scene.domain.lo[a]) +
+                  " to " + format_number(scene.domain.hi[a]) +
+                  " m; particles outside it would be removed at once. " +
+                  (from <= to ? "Move the face's centre to " + std::string(1, axis[a]) +
+                                    " between " + format_number(from) + " and " +
+                                    format_number(to) + " m, or shrink the face"
+                              : std::string("Shrink the face")) +
+                  ", or make " + axis[a] + " periodic (domain.periodic)");
+      }
+    }
+  }
+  if (ins.start >= scene.time.end)
+    m.get("start").fail("start " + format_number(ins.start) + " s is not before time.end (" +
+                        format_number(scene.time.end) +
+                        " s): the stream would insert nothing; lower start or raise time.end");
   ins.velocity = m.vec3_or("velocity", Vec3::Zero());
   if (const auto s = m.find("seed"))
     ins.seed = static_cast<unsigned>(s->integer(Range{0, double(UINT_MAX), true, true}));

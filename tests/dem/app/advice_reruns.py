@@ -924,6 +924,19 @@ def _(c):
     return f"size [{m.group(2)}, 0.01]: accepted"
 
 
+@case("stream_face_outside", "a stream face reaching beyond a bounded side, 'move the face's "
+      "centre to y between X and Y m' (dem/scene/scene_parser.cpp)", "check")
+def _(c):
+    s = stream_bed()
+    s["insert"][0]["face"]["rectangle"]["centre"] = [0.005, 0.002, 0.018]  # y from -0.003
+    m = c.expect(c.run("first", s), 2, r"insert\[0\]\.face: the face reaches beyond the domain "
+                 r"along y: [^\n]*Move the face's centre to y between " + NUM + r" and " + NUM +
+                 r" m, or shrink the face")
+    s["insert"][0]["face"]["rectangle"]["centre"][1] = float(m.group(1))
+    c.rerun_passes(c.run("rerun", s), r"reaches beyond the domain", "the face's centre")
+    return f"centre y = {m.group(1)}: accepted"
+
+
 @case("fill_region_thin", "a fill region thinner than its parcels, 'make it at least X m "
       "across' (dem/scene/scene_parser.cpp)", "check")
 def _(c):

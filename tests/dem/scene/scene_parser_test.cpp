@@ -884,16 +884,50 @@ TEST(SceneErrors, WallsAcrossAPeriodicAxis) {
                      "motion: {angular_velocity: 1, axis: [0, 1, 0]}}"))
           .what(),
       HasSubstr("rotates (motion.angular_velocity) about an axis that turns its normal towards x"));
+  // A translation along x carries a drum across the periodic sides (it was accepted and blew
+  // particles out when it got there) and a mesh out of the range.
+  EXPECT_THAT(
+      error_of(walls("{type: cylinder, axis_point: [0.5, 0.5, 0], axis: [0, 0, 1], radius: 0.3, "
+                     "material: glass, motion: {velocity: [0.1, 0, 0]}}"))
+          .what(),
+      HasSubstr("walls[0].motion: cylinder 'wall0' moves along x (motion.velocity x = 0.1 m/s), "
+                "and x is periodic"));
   // What periodicity allows: a floor, a pipe along x, a drum across x within the range, a
-  // plane rotating about x.
+  // plane rotating about x, a floor and a pipe moving along x.
   for (
       const char* ok :
       {"{type: plane, point: [0, 0, 0], normal: [0, 0, 1], material: glass}",
        "{type: cylinder, axis_point: [0, 0.5, 0.5], axis: [1, 0, 0], radius: 0.4, material: glass}",
        "{type: cylinder, axis_point: [0.5, 0.5, 0], axis: [0, 0, 1], radius: 0.5, material: glass}",
        "{type: plane, point: [0, 0, 0], normal: [0, 0, 1], material: glass, "
-       "motion: {angular_velocity: 1, axis: [1, 0, 0]}}"})
+       "motion: {angular_velocity: 1, axis: [1, 0, 0]}}",
+       "{type: plane, point: [0, 0, 0], normal: [0, 0, 1], material: glass, "
+       "motion: {velocity: [0.1, 0, 0]}}",
+       "{type: cylinder, axis_point: [0, 0.5, 0.5], axis: [1, 0, 0], radius: 0.4, material: glass, "
+       "motion: {velocity: [0.1, 0, 0]}}"})
     EXPECT_NO_THROW(parse_scene(walls(ok), kLabel)) << ok;
+}
+
+// A stream that would deliver particles the domain removes at once (a face reaching beyond a
+// bounded side: they were counted as delivered), or nothing (starting after time.end): refused
+// at the key. Across a periodic side a face may reach: its particles wrap.
+TEST(SceneErrors, StreamsThatCannotDeliver) {
+  const auto stream = [](const std::string& centre, const std::string& extra) {
+    return kBase + "insert:\n  - {type: stream, face: {rectangle: {centre: " + centre +
+           ", normal: [0, 0, -1], u: [1, 0, 0], size: [0.4, 0.4]}}, count_rate: 100, "
+           "material: glass, radius: {distribution: constant, value: 0.01}" +
+           extra + "}\n";
+  };
+  EXPECT_THAT(error_of(stream("[0.5, 0.1, 0.9]", "")).what(),
+              AllOf(HasSubstr("insert[0].face: the face reaches beyond the domain along y: "
+                              "particles entering through it span y from -0.1 to 0.3 m"),
+                    HasSubstr("Move the face's centre to y between 0.2 and 0.8 m")));
+  EXPECT_THAT(error_of(stream("[0.5, 0.5, 0.9]", ", start: 0.5")).what(),
+              HasSubstr("insert[0].start: start 0.5 s is not before time.end (0.5 s)"));
+  EXPECT_NO_THROW(
+      parse_scene(with("  max: [1, 1, 1]\n", "  max: [1, 1, 1]\n  periodic: [false, true, false]\n",
+                       stream("[0.5, 0.1, 0.9]", "")),
+                  kLabel));
 }
 
 // The model record a checkpoint keeps (Scene::model_record): one value, however written, and
