@@ -78,7 +78,7 @@ TEST(WallsScene, StreamAndSnapshotInsertion) {
   - type: stream
     face: {rectangle: {centre: [0, 0, 0.5], normal: [0, 0, -1], u: [1, 0, 0.3], size: [0.2, 0.1]}}
     mass_rate: 0.5
-    start: 0.1
+    start: 0.001
     stop: 0.5
     material: glass
     radius: {distribution: constant, value: 0.002}
