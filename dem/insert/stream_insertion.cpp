@@ -81,14 +81,14 @@ Vec3 StreamInsertion::wrap(Vec3 x) const {
   return x;
 }
 
-double StreamInsertion::squared_distance(const Vec3& a, const Vec3& b) const {
+Vec3 StreamInsertion::nearest_offset(const Vec3& a, const Vec3& b) const {
   Vec3 d = a - b;
   for (int k = 0; k < 3; ++k) {
     if (!domain_.periodic[k]) continue;
     const double length = domain_.hi[k] - domain_.lo[k];
     d[k] -= length * std::round(d[k] / length);
   }
-  return d.squaredNorm();
+  return d;
 }
 
 long StreamInsertion::insert(double t, Particles& p, const Ghosts& ghosts, const WallSet& walls,
@@ -104,13 +104,7 @@ long StreamInsertion::insert(double t, Particles& p, const Ghosts& ghosts, const
     std::vector<Vec3> near_x;
     std::vector<double> near_r;
     auto consider = [&](const Vec3& x, double r) {
-      Vec3 d = x - f.centre;  // the nearest image's offset from the face's plane
-      for (int a = 0; a < 3; ++a)
-        if (domain_.periodic[a]) {
-          const double length = domain_.hi[a] - domain_.lo[a];
-          d[a] -= length * std::round(d[a] / length);
-        }
-      if (std::abs(d.dot(f.normal)) < r + r_max_) {
+      if (std::abs(nearest_offset(x, f.centre).dot(f.normal)) < r + r_max_) {
         near_x.push_back(x);
         near_r.push_back(r);
       }
@@ -128,7 +122,7 @@ long StreamInsertion::insert(double t, Particles& p, const Ghosts& ghosts, const
         bool hit = walls.touches_any(cand[c], r);
         for (std::size_t k = 0; k < near_x.size() && !hit; ++k) {
           const double reach = r + near_r[k];
-          hit = squared_distance(cand[c], near_x[k]) < reach * reach;
+          hit = nearest_offset(cand[c], near_x[k]).squaredNorm() < reach * reach;
         }
         blocked[c] = hit;
       }
@@ -149,7 +143,7 @@ long StreamInsertion::insert(double t, Particles& p, const Ghosts& ghosts, const
         bool hit = blocked[c] != 0;
         for (std::size_t k = 0; k < placed_x.size() && !hit; ++k) {
           const double reach = r + placed_r[k];
-          hit = squared_distance(cand[c], placed_x[k]) < reach * reach;
+          hit = nearest_offset(cand[c], placed_x[k]).squaredNorm() < reach * reach;
         }
         if (!hit) found = a;
       }

@@ -73,7 +73,7 @@ class StreamInsertion {
   // A face that reaches across a periodic side: candidates are wrapped into the domain and
   // compared by their nearest periodic images.
   Vec3 wrap(Vec3 x) const;
-  double squared_distance(const Vec3& a, const Vec3& b) const;
+  Vec3 nearest_offset(const Vec3& a, const Vec3& b) const;  // a - b's nearest periodic image
   Domain domain_;
   static double pending_radius(Stream& s, std::size_t k);
   static long due(Stream& s, double t);

@@ -356,19 +356,8 @@ std::size_t SnapshotWriter::continue_series(long up_to_step) {
   index_.reset();  // the next write() rewrites the index with the entries taken over
   // The highest number in the folder: a file missing or unreadable below it is a gap (deleted,
   // damaged), not the end of the series; the files after it are taken over too.
-  long highest = -1;
-  {
-    std::error_code ec;
-    const std::string prefix = basename_ + "_";
-    for (const auto& e : std::filesystem::directory_iterator(directory_, ec)) {
-      const std::string name = e.path().filename().string();
-      if (name.size() != prefix.size() + 9 || !name.starts_with(prefix) || !name.ends_with(".h5"))
-        continue;
-      const std::string digits = name.substr(prefix.size(), 6);
-      if (digits.find_first_not_of("0123456789") == std::string::npos)
-        highest = std::max(highest, std::stol(digits));
-    }
-  }
+  const std::vector<std::pair<long, std::string>> numbered = numbered_files();
+  const long highest = numbered.empty() ? -1 : numbered.back().first;
   std::vector<std::string> skipped;  // numbers without a readable snapshot of this run
   for (long number = 0; number <= highest; ++number) {
     const std::string file_name = basename_ + "_" + six_digits(number) + ".h5";
@@ -422,7 +411,7 @@ std::size_t SnapshotWriter::continue_series(long up_to_step) {
   return entries_.size();
 }
 
-std::vector<std::string> SnapshotWriter::files_after_series() const {
+std::vector<std::pair<long, std::string>> SnapshotWriter::numbered_files() const {
   std::vector<std::pair<long, std::string>> found;
   std::error_code ec;
   const std::string prefix = basename_ + "_";
@@ -431,13 +420,17 @@ std::vector<std::string> SnapshotWriter::files_after_series() const {
     if (name.size() != prefix.size() + 9 || !name.starts_with(prefix) || !name.ends_with(".h5"))
       continue;
     const std::string digits = name.substr(prefix.size(), 6);
-    if (digits.find_first_not_of("0123456789") != std::string::npos) continue;
-    if (const long number = std::stol(digits); number >= next_number_)
-      found.emplace_back(number, name);
+    if (digits.find_first_not_of("0123456789") == std::string::npos)
+      found.emplace_back(std::stol(digits), name);
   }
   std::sort(found.begin(), found.end());
+  return found;
+}
+
+std::vector<std::string> SnapshotWriter::files_after_series() const {
   std::vector<std::string> out;
-  for (auto& [number, name] : found) out.push_back(std::move(name));
+  for (const auto& [number, name] : numbered_files())
+    if (number >= next_number_) out.push_back(name);
   return out;
 }
 

@@ -96,6 +96,8 @@ class SnapshotWriter {
   // in number order: after a restart's run, those the stopped run wrote after its checkpoint
   // and this run did not write over (another snapshot interval, an earlier end).
   std::vector<std::string> files_after_series() const;
+  // The series' files in the folder (<basename>_NNNNNN.h5) with their numbers, in order.
+  std::vector<std::pair<long, std::string>> numbered_files() const;
 
  private:
   std::vector<double> coarse_grain_;
