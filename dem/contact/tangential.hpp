@@ -2,8 +2,8 @@
 // Tangential slot. `history`: incremental spring with Coulomb limit
 // (Cundall & Strack 1979; Mindlin 1949 stiffness via the normal slot):
 //   xi <- xi rotated into the current tangent plane, xi += v_t dt,
-//   F_t = -k_t xi - gamma_t v_t*, and if |F_t| > mu F_n: F_t scaled to mu F_n and xi reset to
-//   the spring length consistent with it (xi = -(F_t + gamma_t v_t*) / k_t).
+//   F_t = -k_t xi - gamma_t v_t*, and if |F_t| > mu F_n: F_t scaled to mu F_n, and the
+//   spring-dashpot, in series with the slider, relaxes towards xi = -F_t / k_t (slid_spring).
 // v_t is the half-step tangential velocity (the spring's increment over the step: midpoint
 // rule), v_t* the one the dashpot sees (ContactGeometry::v_pred).
 #include "dem/contact/contact_geometry.hpp"
@@ -35,13 +35,14 @@ struct HistoryTangential {
                                             V coulomb_limit, const V3<V>& n, V3<V>& xi,
                                             double dt) {
     rotate_into_tangent_plane(xi, n);
+    const V3<V> xi_start = xi;
     xi += vt * dt;
     V3<V> ft = -kt * xi - gt * vt_pred;
     const V f2 = squared_norm(ft);
     const auto sliding = f2 > coulomb_limit * coulomb_limit;
     if (any(sliding)) {  // lanes that stick keep ft and xi
       const V3<V> ft_slip = ft * (coulomb_limit / lane_sqrt(f2));
-      xi = select(sliding, V3<V>(-(ft_slip + gt * vt_pred) / kt), xi);
+      xi = select(sliding, slid_spring(xi_start, ft_slip, coulomb_limit, vt_pred, kt, gt, dt), xi);
       ft = select(sliding, ft_slip, ft);
     }
     return ft;
@@ -70,6 +71,7 @@ struct HistoryTangential {
                                                  V gt, const TangentialCell<V>& c,
                                                  const V3<V>& n, V3<V>& xi, double dt) {
     rotate_into_tangent_plane(xi, n);
+    const V3<V> xi_start = xi;
     xi += vt * c.spring_time;
     const V x = gt * dt * c.inv_mass;
     const V theta = 0.5 + 0.25 * x * x;
@@ -88,9 +90,35 @@ struct HistoryTangential {
     const auto sliding = g2 > c.limit_now * c.limit_now;
     if (any(sliding)) {
       const V3<V> f_slip = f_now * (c.limit_now / lane_sqrt(g2));
-      xi = select(sliding, V3<V>(-(f_slip + gt * v_end) / kt), xi);
+      xi = select(sliding, slid_spring(xi_start, f_slip, c.limit_now, v_end, kt, gt, c.spring_time),
+                  xi);
     }
     return ft;
+  }
+
+  // The spring after a step of sliding with the Coulomb limit `limit` (docs/models/
+  // contact-models.md, "Tangential slot"): the spring and the dashpot in parallel, in series
+  // with the Coulomb slider. While it slides, the slider carries the force f, so
+  // -k xi - gamma dxi/dt = f: the spring relaxes from xi_start towards -f / k with the time
+  // constant tau = gamma / k, and the slip takes the rest of v_t. Over the step h,
+  // xi = -f/k + (xi_start + f/k) rho, with rho the L-stable (2,0) Pade approximant of
+  // exp(-h / tau), 1 / (1 + a + a^2 / 2), a = h / tau; without a dashpot, xi = -f/k (Cundall
+  // & Strack). The spring does not store the dashpot's share gamma v_t, which, where k and
+  // gamma grow with the overlap (Hertz), pulled the next step's trial force inside the
+  // Coulomb limit while the contact still slid.
+  // With no normal load (limit 0: the normal dashpot's pull at the end of a contact) the
+  // spring is set so that the spring-dashpot's force at v_t is zero, xi = -gamma v_t / k: if the
+  // normal force comes back (it does not in the continuous contact, but the discrete normal
+  // dashpot can bring it back for a step at low restitution) the tangential force resumes
+  // from zero, as the continuous contact's, which has ended, does.
+  template <class V, class H>
+  [[gnu::always_inline]] static V3<V> slid_spring(const V3<V>& xi_start, const V3<V>& f, V limit,
+                                                  const V3<V>& v, V k, V gamma, H h) {
+    const V kh = k * h;  // h = 0 (the springs of the initial state): no relaxation
+    const V rho =
+        select(kh > 0.0, gamma * gamma / (gamma * gamma + gamma * kh + 0.5 * kh * kh), V{} + 1.0);
+    const V3<V> rest = f / (-k);
+    return select(limit > 0.0, V3<V>(rest + (xi_start - rest) * rho), V3<V>(v * (-gamma / k)));
   }
 };
 
