@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Cost of each fluid force, switched on one at a time (one-way mode in `grain`).
 
-The same scene (4000 glass beads, d = 1 mm, settling through water in a periodic box with a
-linear shear, so that every lift force has something to act on) runs with: no fluid block;
+The same scene (4000 glass beads, d = 1 mm, settling through water in a box periodic
+sideways, between a floor and a lid, with a linear shear along the height, so that every lift
+force has something to act on) runs with: no fluid block;
 the smallest valid list [drag, pressure_gradient, viscous]; that list plus one more force;
 and the smallest list with each drag law. Cost: CPU seconds of the `grain` process (the
 machine may be shared), median of interleaved rounds, relative to the run without fluid.
@@ -21,13 +22,16 @@ import tempfile
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 
-SCENE = """domain: {{min: [0, 0, 0], max: [0.03, 0.03, 0.03], periodic: [true, true, true]}}
+SCENE = """domain: {{min: [0, 0, 0], max: [0.03, 0.03, 0.03], periodic: [true, true, false]}}
 gravity: [0, 0, -9.81]
 time: {{step: 1e-5, end: {end}, expected_max_speed: 0.5}}
 materials:
   - {{name: glass, youngs_modulus: 5e7, poisson_ratio: 0.25, density: 2500}}
 interaction_defaults: {{restitution: 0.5, friction: 0.5}}
 contact: {{normal: hertz, tangential: history}}
+walls:
+  - {{type: plane, name: floor, point: [0, 0, 0], normal: [0, 0, 1], material: glass}}
+  - {{type: plane, name: lid, point: [0, 0, 0.03], normal: [0, 0, -1], material: glass}}
 insert:
   - {{type: fill, region: {{box: {{min: [0, 0, 0], max: [0.03, 0.03, 0.03]}}}}, count: 4000,
      material: glass, radius: {{distribution: constant, value: 0.5e-3}}, seed: 3}}

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <ostream>
 #include <sstream>
@@ -168,6 +169,35 @@ void print_coarse_grain_report(const Scene& scene, const Particles& p, MPI_Comm 
   }
 }
 
+// A one-way computed void fraction (centre method) puts a particle's whole volume in the
+// cell of its centre: a particle that fills more than 1 - minimum of a cell clamps it at the
+// minimum even alone, so its drag is a packed bed's (a 0.6 mm bead in 0.3 mm cells settled
+// 23x too slowly, with only the clamp count at the end to say so). Collective (the radius).
+void print_void_fraction_cell_report(const Scene& scene, const Simulation& sim, MPI_Comm comm,
+                                     std::ostream& out) {
+  if (!scene.fluid || !scene.fluid->computed_void_fraction) return;
+  const VoidFractionGridSettings& grid = *scene.fluid->computed_void_fraction;
+  const std::array<double, 3> n = void_fraction_grid_cells(scene.domain, grid);
+  const Vec3 length = scene.domain.hi - scene.domain.lo;
+  const Vec3 h(length[0] / n[0], length[1] / n[1], length[2] / n[2]);
+  const double cell = h.prod();
+  const double r = sim.largest_radius();
+  const double particle = 4.0 / 3.0 * std::numbers::pi * r * r * r;
+  if (!(particle > (1 - grid.minimum) * cell)) return;
+  speaker(comm, out) << scene.fluid->source
+                     << ": warning: fluid.void_fraction: the largest particle (diameter "
+                     << significant(2 * r)
+                     << " m) fills more than 1 - minimum = " << significant(1 - grid.minimum)
+                     << " of a void-fraction cell (" << significant(h[0]) << " x "
+                     << significant(h[1]) << " x " << significant(h[2])
+                     << " m): alone in its cell it leaves eps = "
+                     << significant(1 - particle / cell) << ", so eps is clamped at "
+                     << significant(grid.minimum)
+                     << " there and its drag is a packed bed's (the clamps are counted at the "
+                        "end of the run). Use a cell_size of at least 3 particle diameters ("
+                     << significant(6 * r) << " m)\n";
+}
+
 }  // namespace
 
 std::string continue_command(const std::string& scene_file, const RunOptions& options, int ranks,
@@ -217,6 +247,7 @@ int check_scene(const Scene& scene, std::ostream& out) {
   sim.initialise();  // lists and first forces only: no time step is taken
   print_report(sim, MPI_COMM_WORLD, out);
   print_coarse_grain_report(scene, sim.particles(), MPI_COMM_WORLD, out);
+  print_void_fraction_cell_report(scene, sim, MPI_COMM_WORLD, out);
   const TimeStepReport& rep = sim.time_step_report();
   if (rep.dt > 0 && std::isfinite(rep.dt)) {
     const long steps = steps_to_end(scene.time.end, rep.dt);
@@ -283,6 +314,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   sim.initialise();
   print_report(sim, comm, out, options.allow_large_time_step);
   print_coarse_grain_report(scene, sim.particles(), comm, out);
+  print_void_fraction_cell_report(scene, sim, comm, out);
   if (sim.time_step_report().verdict == TimeStepReport::Verdict::refuse &&
       !options.allow_large_time_step)
     throw SetupError(scene.file + ": error: refusing to run with this time step (see above); " +

@@ -136,6 +136,7 @@ Simulation::Simulation(const Scene& scene, bool insert, MPI_Comm comm,
   sweep_ = select_sweep(scene.contact, scene.parallel.reproducible);
   walls_ = WallSet(scene_);  // reads STL meshes (GeometryError: bad input, exit code 2)
   streams_ = StreamInsertion(scene_);
+  streams_.check_faces(scene_, walls_);
   if (scene_.output.wall_loads) {
     wall_forces_.assign(walls_.walls().size(), Vec3::Zero());
     wall_impulse_ = wall_forces_;

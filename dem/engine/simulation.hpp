@@ -166,6 +166,9 @@ class Simulation {
   double dt() const { return dt_; }
   void set_dt(double dt) { dt_ = dt; }
   double skin() const { return skin_; }
+  // initialise(): the largest radius now, of a stream's particles to come, or of the run a
+  // restart continues (the one that sizes the skin and the cutoff).
+  double largest_radius() const { return largest_radius_; }
   const Counters& counters() const { return counters_; }
   GlobalState global_state() const;  // collective
   const TimeStepReport& time_step_report() const { return report_; }

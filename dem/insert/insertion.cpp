@@ -137,13 +137,16 @@ bool sample_centre(const Region& reg, double r, std::mt19937_64& rng, Vec3& x) {
   if (reg.kind == Region::Kind::box) {
     for (int a = 0; a < 3; ++a) {
       const double lo = reg.lo[a] + r, hi = reg.hi[a] - r;
-      if (hi < lo) return false;
-      x[a] = lo + (hi - lo) * u(rng);
+      // A region as wide as the sphere up to round-off (the scene's check allows 1e-9 of the
+      // diameter) takes it at its middle.
+      if (hi < lo - kRegionFitTolerance * 2 * r) return false;
+      x[a] = hi < lo ? 0.5 * (lo + hi) : lo + (hi - lo) * u(rng);
     }
     return true;
   }
-  const double rad = reg.radius - r, h = reg.height - 2 * r;
-  if (rad < 0 || h < 0) return false;
+  const double slack = kRegionFitTolerance * 2 * r;
+  if (reg.radius - r < -slack || reg.height - 2 * r < -slack) return false;
+  const double rad = std::max(0.0, reg.radius - r), h = std::max(0.0, reg.height - 2 * r);
   // Orthonormal frame (e1, e2, axis).
   const Vec3 a = reg.axis;
   const Vec3 e1 = (std::abs(a[0]) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(a).normalized();

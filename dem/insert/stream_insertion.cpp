@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "dem/core/number_format.hpp"
 #include "dem/insert/insertion.hpp"
 
 namespace grainflow {
@@ -27,6 +28,57 @@ StreamInsertion::StreamInsertion(const Scene& scene) : domain_(scene.domain) {
     s.place_rng.seed(ins.seed ^ 0x5bd1e995u);
     r_max_ = std::max(r_max_, grainflow::max_radius(ins.radius));
     streams_.push_back(std::move(s));
+  }
+}
+
+void StreamInsertion::check_faces(const Scene& scene, const WallSet& walls) const {
+  constexpr int kGrid = 64;  // positions per side of the face
+  for (const Stream& s : streams_) {
+    const Insertion& e = s.entry;
+    const InsertionFace& f = e.face;
+    const double r = grainflow::max_radius(e.radius);
+    // Where sample() may put a centre: the face shrunk by r (a grid over the rectangle, or
+    // rings over the disc), each position wrapped into the domain as the candidates are.
+    const Vec3 e1 = f.kind == InsertionFace::Kind::rectangle
+                        ? f.u
+                        : (std::abs(f.normal[0]) < 0.9 ? Vec3::UnitX() : Vec3::UnitY())
+                              .cross(f.normal)
+                              .normalized();
+    const Vec3 e2 = f.kind == InsertionFace::Kind::rectangle ? s.v_dir : f.normal.cross(e1);
+    bool room = false;
+    int blocking = -1;  // the wall at the face's centre
+    for (int i = 0; i <= kGrid && !room; ++i)
+      for (int j = 0; j <= kGrid && !room; ++j) {
+        const double a = static_cast<double>(i) / kGrid - 0.5,
+                     b = static_cast<double>(j) / kGrid - 0.5;
+        Vec3 x;
+        if (f.kind == InsertionFace::Kind::rectangle) {
+          x = f.centre + a * std::max(0.0, f.length_u - 2 * r) * e1 +
+              b * std::max(0.0, f.length_v - 2 * r) * e2;
+        } else {
+          const double rho = std::max(0.0, f.radius - r) * std::sqrt(a + 0.5);
+          const double phi = 2 * std::numbers::pi * (b + 0.5);
+          x = f.centre + rho * (std::cos(phi) * e1 + std::sin(phi) * e2);
+        }
+        x = wrap(x);
+        room = !walls.touches_any(x, r, /*still_only=*/true);
+        if (i == kGrid / 2 && j == kGrid / 2) blocking = walls.deepest_overlap(x, r).wall;
+      }
+    if (room) continue;
+    std::ostringstream o;
+    o << e.source << ": error: insert: the walls leave no room on the stream's face for its "
+      << "largest particles (radius " << significant(r) << " m): at each of "
+      << (kGrid + 1) * (kGrid + 1) << " positions across the face such a particle touches a wall";
+    if (blocking >= 0)
+      o << " (at the face's centre, wall '" << scene.walls[static_cast<std::size_t>(blocking)].name
+        << "')";
+    o << ", so it would wait for room for ever and the stream deliver nothing. Move the face "
+         "away from the walls or widen the gap between them, or check the walls (a plane's "
+         "normal points to the side the particles live on, a cylinder's `side`)";
+    if (e.coarse_grain != 1)
+      o << "; the particles are parcels, coarse_grain " << significant(e.coarse_grain)
+        << " times the real radius: a lower coarse_grain fits";
+    throw InsertionError(o.str());
   }
 }
 

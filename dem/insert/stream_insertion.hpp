@@ -35,6 +35,12 @@ class StreamInsertion {
   explicit StreamInsertion(const Scene& scene);
 
   bool empty() const { return streams_.empty(); }
+
+  // InsertionError when the walls that do not move leave no room anywhere on a stream's face
+  // for its largest particle: that particle would wait for room for ever, and the stream,
+  // which places its particles in order, would deliver nothing more (the run ended "done"
+  // with the stream's particles "behind"). Tried over a grid of positions across the face.
+  void check_faces(const Scene& scene, const WallSet& walls) const;
   double max_radius() const { return r_max_; }
 
   // Inserts what is due by time t; returns how many particles were inserted over

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "dem/core/number_format.hpp"
 #include "dem/fluid/drag_law.hpp"
 
 namespace grainflow {
@@ -13,7 +14,11 @@ using namespace scene_yaml;
 
 namespace {
 
-void parse_shear(const Field& f, PrescribedFluid& field) {
+// A linear shear varies along its gradient direction; across a periodic side along it the
+// fluid velocity would jump by G times the period (a sheared periodic box needs Lees-Edwards
+// boundaries), and a particle would see the jump only when its centre is next wrapped, at a
+// neighbour rebuild: the answer depended on the skin.
+void parse_shear(const Field& f, PrescribedFluid& field, const Domain& domain) {
   const Map m = f.map({"rate", "flow_direction", "gradient_direction", "origin"});
   field.shear_rate = m.number("rate", kAny);
   field.flow_direction = m.direction("flow_direction");
@@ -23,6 +28,20 @@ void parse_shear(const Field& f, PrescribedFluid& field) {
     m.get("gradient_direction")
         .fail("is not perpendicular to flow_direction; a linear shear u = G ((x − x₀)·n_g) n_u "
               "needs n_g ⟂ n_u (e.g. flow_direction [1, 0, 0], gradient_direction [0, 0, 1])");
+  constexpr const char* axis[3] = {"x", "y", "z"};
+  for (int a = 0; a < 3; ++a) {
+    const double along = field.gradient_direction[a];
+    if (!domain.periodic[a] || std::abs(along) < 1e-12 || field.shear_rate == 0) continue;
+    const double jump = std::abs(field.shear_rate * along) * (domain.hi[a] - domain.lo[a]);
+    m.get("gradient_direction")
+        .fail_at_key(std::string("has the component ") + significant(along) + " along " + axis[a] +
+                     ", and " + axis[a] +
+                     " is periodic (domain.periodic): the sheared fluid velocity would jump by " +
+                     significant(jump) +
+                     " m/s at the periodic sides (a sheared periodic box "
+                     "needs Lees-Edwards boundaries, which grainflow does not have); make " +
+                     axis[a] + " bounded, or choose a gradient_direction along a bounded axis");
+  }
 }
 
 std::vector<FluidForce> parse_forces(const Field& f) {
@@ -72,7 +91,7 @@ std::optional<FluidThermal> parse_thermal(const Map& m, const std::optional<Heat
 
 }  // namespace
 
-FluidSettings parse_fluid_section(const Field& f, const Vec3& gravity,
+FluidSettings parse_fluid_section(const Field& f, const Vec3& gravity, const Domain& domain,
                                   const std::optional<HeatSettings>& heat) {
   const Map m = f.map({"density", "viscosity", "velocity", "shear", "void_fraction", "pressure",
                        "drag", "forces", "model", "virtual_mass_coefficient", "temperature",
@@ -83,7 +102,7 @@ FluidSettings parse_fluid_section(const Field& f, const Vec3& gravity,
   field.density = m.number("density", kPositive);
   field.viscosity = m.number("viscosity", kPositive);
   field.velocity = m.vec3_or("velocity", Vec3::Zero());
-  if (const auto shear = m.find("shear")) parse_shear(*shear, field);
+  if (const auto shear = m.find("shear")) parse_shear(*shear, field, domain);
   if (const auto vf = m.find("void_fraction"); vf && vf->node().IsMap()) {
     // Computed from the particles on a grid: {cell_size: <m>, minimum: <eps_min>}.
     const Map g = vf->map({"cell_size", "minimum"});
@@ -114,7 +133,9 @@ FluidSettings parse_fluid_section(const Field& f, const Vec3& gravity,
     drag.fail("unknown drag law '" + s.drag_law + "'; allowed: " + join(names) +
               suggestion(s.drag_law, names));
 
-  s.model = m.get("model", "add `model: A` or `model: B` (DESIGN.md §4)")
+  s.model = m.get("model",
+                  "add `model: A` or `model: B` (the VANS form; docs/models/fluid-forces.md, "
+                  "\"Model A and model B\")")
                 .choice<VansModel>("VANS model", {{"A", VansModel::A}, {"B", VansModel::B}});
   const Field forces = m.get("forces", "add `forces: [drag, pressure_gradient, viscous]`");
   s.forces = parse_forces(forces);

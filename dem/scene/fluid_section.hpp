@@ -11,8 +11,9 @@
 namespace grainflow {
 
 // `heat`: the scene's heat settings; the fluid's `temperature` (with heat_capacity,
-// conductivity, convection) needs heat on.
+// conductivity, convection) needs heat on. `domain`: a shear may not vary along a periodic
+// axis.
 FluidSettings parse_fluid_section(const scene_yaml::Field& f, const Vec3& gravity,
-                                  const std::optional<HeatSettings>& heat);
+                                  const Domain& domain, const std::optional<HeatSettings>& heat);
 
 }  // namespace grainflow

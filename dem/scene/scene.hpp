@@ -164,6 +164,10 @@ struct Region {
 };
 
 // The planar face a stream insertion feeds particles through.
+// A fill region (a stream face) may be narrower than its particles' diameter by this share of
+// it: round-off of the scene's decimals (0.0115 - 0.0085 < 0.003).
+constexpr double kRegionFitTolerance = 1e-9;
+
 struct InsertionFace {
   enum class Kind { rectangle, disc } kind = Kind::rectangle;
   Vec3 centre = Vec3::Zero();

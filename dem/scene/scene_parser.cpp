@@ -178,6 +178,12 @@ std::vector<Material> parse_materials(const Field& f, Deferred& later,
       name.fail("duplicate material name '" + mat.name + "' (first defined at line " +
                 std::to_string(it->second) + "); give each material a unique name");
     first_line.emplace(mat.name, name.line());
+    // "glass[k=2]" names the parcel class of glass with coarse_grain 2 (add_parcel_classes):
+    // a material of that name would be mistaken for it in every message and report.
+    if (mat.name.find("[k=") != std::string::npos)
+      name.fail("material name '" + mat.name +
+                "' contains \"[k=\", which names parcel "
+                "classes (a material with coarse_grain k, e.g. glass[k=2]); choose another name");
     if (m.find("youngs_modulus"))
       mat.youngs_modulus = m.number("youngs_modulus", kPositive);
     else
@@ -751,7 +757,7 @@ void parse_fill(const Map& m, const Scene& scene, Insertion& ins) {
     const double across =
         g.kind == Region::Kind::box ? (g.hi - g.lo).minCoeff() : std::min(2 * g.radius, g.height);
     const double d = 2 * smallest_radius(ins.radius), k = ins.coarse_grain;
-    if (d > across)
+    if (d - across > kRegionFitTolerance * d)
       m.get("region").fail(
           "the region is " + format_number(across) + " m across at its narrowest, less than " +
           "the smallest particle the fill inserts, " + format_number(d) + " m in diameter" +
@@ -850,7 +856,7 @@ void parse_stream(const Map& m, const Scene& scene, Insertion& ins) {
   const bool rectangle = ins.face.kind == InsertionFace::Kind::rectangle;
   const double across =
       rectangle ? std::min(ins.face.length_u, ins.face.length_v) : 2 * ins.face.radius;
-  if (2 * r_max > across) {
+  if (2 * r_max - across > kRegionFitTolerance * 2 * r_max) {
     const double k = ins.coarse_grain;
     face.fail(std::string(rectangle ? "the rectangle's shorter side is " : "the disc is ") +
               format_number(across) + " m" + (rectangle ? "" : " across") +
@@ -1179,7 +1185,10 @@ void check_coarse_grain_models(Scene& s, const Map& top) {
             "parcels as the energy-conserving scaling asks (k_n in proportion to k), " +
             where +
             "; use `hooke: {characteristic_velocity: <m/s>}`, whose stiffness follows each "
-            "contact's radius and mass (docs/models/coarse-graining.md), or coarse_grain: 1");
+            "contact's radius and mass (docs/models/coarse-graining.md), or " +
+            (first->kind == Insertion::Kind::snapshot
+                 ? std::string("real particles (k = 1) in the snapshot")
+                 : std::string("coarse_grain: 1")));
   if (!s.fluid) return;
   for (FluidForce f : s.fluid->forces)
     if (f == FluidForce::saffman_mei || f == FluidForce::magnus ||
@@ -1268,7 +1277,8 @@ Scene build_scene(const Field& root) {
   else if (s.heat)
     s.output.fields |= snapshot_field_bit("temperature");
   if (const auto p = top.find("parallel")) s.parallel = parse_parallel(*p);
-  if (const auto f = top.find("fluid")) s.fluid = parse_fluid_section(*f, s.gravity, s.heat);
+  if (const auto f = top.find("fluid"))
+    s.fluid = parse_fluid_section(*f, s.gravity, s.domain, s.heat);
   check_coarse_grain_models(s, top);
   // Parcels: the snapshots carry k and the real-particle count unless the scene lists fields.
   const bool fields_listed = top.find("output") && top.get("output").map().find("fields");

@@ -145,10 +145,11 @@ void WallSet::move_to(double t) {
   }
 }
 
-bool WallSet::touches_any(const Vec3& x, double r) const {
+bool WallSet::touches_any(const Vec3& x, double r, bool still_only) const {
   WallTouch t;
   MeshTouch m[TriangleMesh::kMaxTouches];
   for (const Entry& e : walls_) {
+    if (still_only && e.pose.moving()) continue;
     switch (e.kind) {
       case Wall::Kind::plane:
         if (touch_plane(e.plane, x, r, t)) return true;

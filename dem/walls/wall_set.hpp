@@ -67,7 +67,8 @@ class WallSet {
   bool empty() const { return walls_.empty(); }
 
   // True if a sphere at x with radius r touches any wall (insertion).
-  bool touches_any(const Vec3& x, double r) const;
+  // `still_only`: the walls that do not move (a moving one may make room later).
+  bool touches_any(const Vec3& x, double r, bool still_only = false) const;
 
   // The wall a sphere at x with radius r overlaps most (index into walls(); -1: none) and
   // by how much; an overlap above r means its centre is on the wall's far side (planes and

@@ -481,6 +481,36 @@ def saffman_bead():
     }, {"bead.csv": "x,y,z,radius\n0.005,0.005,0.005,5e-4\n"}
 
 
+def bead_in_fine_cells(cell):
+    """A 0.6 mm glass bead settling in water, its void fraction computed on cells of `cell`."""
+    return {
+        "domain": {"min": [0, 0, 0], "max": [0.02, 0.02, 0.02]},
+        "gravity": [0, 0, -9.81],
+        "time": {"step": 1e-4, "end": 0.01},
+        "materials": [{"name": "glass", "youngs_modulus": 6e10, "poisson_ratio": 0.25,
+                       "density": 2500}],
+        "insert": [{"type": "csv", "file": "bead.csv", "material": "glass"}],
+        "fluid": {"density": 1000, "viscosity": 1e-3, "drag": "wen_yu", "model": "B",
+                  "forces": ["drag", "pressure_gradient", "viscous"],
+                  "void_fraction": {"cell_size": cell}},
+        "output": {"progress": False},
+    }, {"bead.csv": "x,y,z,radius\n0.01,0.01,0.015,3e-4\n"}
+
+
+@case("void_fraction_cell", "warning 'the largest particle ... fills more than 1 - minimum of a "
+      "void-fraction cell ...; Use a cell_size of at least 3 particle diameters (X m)' "
+      "(dem/engine/run.cpp)", "check")
+def _(c):
+    s, files = bead_in_fine_cells(3e-4)
+    m = c.expect(c.run("first", s, files=files), 0, r"warning: fluid\.void_fraction: the largest "
+                 r"particle[^\n]*Use a cell_size of at least 3 particle diameters \(" + NUM +
+                 r" m\)")
+    s["fluid"]["void_fraction"]["cell_size"] = float(m.group(1))
+    c.rerun_passes(c.run("rerun", s, files=files), r"warning: fluid\.void_fraction",
+                   "fluid.void_fraction.cell_size")
+    return f"cell_size {m.group(1)}: no warning"
+
+
 FLUID_LIMIT = (r"beyond the stability limit of the fluid force '(\w+)' \([^\n]*\); use dt <= "
                + NUM + r" s, or remove '(\w+)' from fluid\.forces")
 

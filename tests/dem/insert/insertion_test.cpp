@@ -58,6 +58,26 @@ TEST(FillInsertion, CountInBoxWithoutOverlap) {
   EXPECT_NEAR(mean, 7.5e-4, 4 * 5e-4 / std::sqrt(12.0) / std::sqrt(600.0));
 }
 
+// A region as wide as the bead in the scene's decimals, 0.0115 - 0.0085 = 0.003 m for a
+// 3 mm bead, is narrower in doubles (by 4e-19 m): the scene's check refused it ("0.003 m
+// across, less than 0.003 m") and the sampler found no place. Both allow 1e-9 of the
+// diameter: the bead is placed at the region's middle across, within the region to round-off.
+TEST(FillInsertion, ARegionAsWideAsTheParticleUpToRoundOff) {
+  Scene s = test::one_material_scene(1e7, 0.3, 2500, 0.5);
+  Insertion ins = box_fill(Vec3(0.0085, 0.0235, 0), Vec3(0.0115, 0.0265, 0.0030000599999999997));
+  ASSERT_LT(ins.region.hi[0] - ins.region.lo[0], 0.003);
+  ins.count = 1;
+  ins.radius.kind = SizeDistribution::Kind::constant;
+  ins.radius.min = ins.radius.max = ins.radius.value = 0.0015;
+  s.insertions.push_back(ins);
+  Particles p;
+  GlobalId next = 1;
+  insert_particles(s, p, next);
+  ASSERT_EQ(p.size(), 1u);
+  EXPECT_NEAR(p.x[0][0], 0.01, 1e-15);
+  EXPECT_NEAR(p.x[0][1], 0.025, 1e-15);
+}
+
 TEST(FillInsertion, VolumeFractionInCylinder) {
   Scene s = test::one_material_scene(1e7, 0.3, 2500, 0.5);
   Insertion ins;

@@ -155,6 +155,40 @@ TEST(StreamInsertion, AFaceAcrossPeriodicSidesPlacesNoOverlaps) {
   EXPECT_LE(worst, 1e-9);
 }
 
+// Two planes 2 mm apart across a disc face: a particle of radius 1.2 mm fits nowhere
+// between them. It waited for room for ever and the stream delivered nothing, with the run
+// ending "done". Refused when the simulation is built, naming the wall at the face's centre;
+// 3 mm apart (room for the largest particle) it runs, and so it does when one of the planes
+// moves (it may make room later).
+TEST(StreamInsertion, AFaceTheWallsLeaveNoRoomOnIsRefused) {
+  const auto scene = [](double gap, bool moving) {
+    Scene s = falling_stream_scene();
+    s.insertions.push_back(stream(0.05));
+    Wall a = test::plane(Vec3(-0.4 * gap, 0, 0), Vec3::UnitX());  // nearer the face's centre
+    Wall b = test::plane(Vec3(0.6 * gap, 0, 0), -Vec3::UnitX());
+    a.name = "left";
+    b.name = "right";
+    if (moving) b.motion.velocity = Vec3(0, 0, 0.1);
+    s.walls = {a, b};
+    return s;
+  };
+  try {
+    Simulation sim(scene(0.002, false));
+    ADD_FAILURE() << "a face with no room was accepted";
+  } catch (const InsertionError& e) {
+    EXPECT_NE(std::string(e.what()).find(
+                  "<test>: error: insert: the walls leave no room on the stream's face for its "
+                  "largest particles (radius 0.0012 m): at each of 4225 positions across the face "
+                  "such a particle touches a wall (at the face's centre, wall 'left')"),
+              std::string::npos)
+        << e.what();
+  }
+  Simulation wide(scene(0.003, false));
+  wide.advance_to(0.01);
+  EXPECT_GT(wide.particles().size(), 0u);
+  EXPECT_NO_THROW(Simulation(scene(0.002, true)));
+}
+
 // Saving and restoring the stream state continues the same sequence: a fresh
 // inserter restored from the state draws the radii the running simulation draws next.
 TEST(StreamInsertion, StateRoundTripContinuesTheSameSequence) {

@@ -604,9 +604,12 @@ class Draw:
               "velocity": [round(rng.uniform(-2, 2), 4) for _ in range(3)],
               "drag": rng.choice(DRAG_LAWS), "model": rng.choice(["A", "B"]), "forces": forces,
               "pressure": {"hydrostatic": hydro}}
-        if rng.random() < (0.8 if small else 0.5):
+        # A shear varies along a bounded axis (across a periodic one it is refused).
+        gradient = next(([0, a == 1, a == 2] for a in (2, 1) if not per[a]), None)
+        if rng.random() < (0.8 if small else 0.5) and gradient is not None:
             fl["shear"] = {"rate": round(logu(rng, 0.1, 1e4), 4), "flow_direction": [1, 0, 0],
-                           "gradient_direction": [0, 0, 1], "origin": [0, 0, 0]}
+                           "gradient_direction": [int(g) for g in gradient],
+                           "origin": [0, 0, 0]}
         if rng.random() < 0.3:
             fl["pressure"]["gradient"] = [round(rng.uniform(-1e3, 1e3), 3), 0, 0]
         if "virtual_mass" in forces and rng.random() < 0.5:
