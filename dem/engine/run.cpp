@@ -198,6 +198,53 @@ void print_void_fraction_cell_report(const Scene& scene, const Simulation& sim, 
                      << significant(6 * r) << " m)\n";
 }
 
+// A drag law used outside the void fractions it was fitted on (docs/models/fluid-forces.md,
+// "Validity"): for a fixed eps, the range is known before the run. Schiller-Naumann is a
+// single sphere's law and does not use eps at all. (A computed eps spans [minimum, 1] by
+// construction: only Schiller-Naumann's is said.)
+void print_drag_range_report(const Scene& scene, MPI_Comm comm, std::ostream& out) {
+  if (!scene.fluid) return;
+  const FluidSettings& f = *scene.fluid;
+  const std::string law = f.drag_law;
+  std::ostream& o = speaker(comm, out);
+  const std::string where = f.source + ": warning: fluid.drag: ";
+  if (law == "schiller_naumann") {
+    if (f.computed_void_fraction)
+      o << where
+        << "schiller_naumann is a single sphere's law and ignores the computed void "
+           "fraction; a law for beds (di_felice, rong, wen_yu, gidaspow, koch_hill, "
+           "beetstra, tenneti_garg_subramaniam) uses it\n";
+    else if (f.field.void_fraction < 1)
+      o << where << "schiller_naumann is a single sphere's law and ignores void_fraction "
+        << significant(f.field.void_fraction)
+        << "; a law for beds (di_felice, rong, wen_yu, gidaspow, koch_hill, beetstra, "
+           "tenneti_garg_subramaniam) uses it\n";
+    return;
+  }
+  if (f.computed_void_fraction) return;
+  const double eps = f.field.void_fraction;
+  struct Fitted {
+    const char* law;
+    double lo, hi;
+    const char* what;
+  };
+  // Ergun: below Gidaspow's switch at 0.8 (it has no viscous part at eps -> 1); the others
+  // as their papers fitted them.
+  for (const Fitted& r :
+       {Fitted{"ergun", 0, 0.8,
+               "a packed-bed law, used below 0.8 (Gidaspow); without a viscous "
+               "part at eps -> 1; gidaspow or wen_yu cover dilute flow"},
+        Fitted{"koch_hill", 0.4, 1, "fitted for solid fractions up to 0.6"},
+        Fitted{"beetstra", 0.4, 1, "fitted for solid fractions up to 0.6"},
+        Fitted{"tenneti_garg_subramaniam", 0.5, 0.9, "fitted for solid fractions 0.1 to 0.5"},
+        Fitted{"di_felice", 0.4, 1, "fitted on fluidised beds, eps >= ~0.4"},
+        Fitted{"rong", 0.4, 1, "fitted on fluidised beds, eps >= ~0.4"}})
+    if (law == r.law && (eps < r.lo || eps > r.hi))
+      o << where << law << " at void_fraction " << significant(eps) << ", outside "
+        << significant(r.lo) << " to " << significant(r.hi) << ": " << r.what
+        << " (docs/models/fluid-forces.md, \"Validity\")\n";
+}
+
 }  // namespace
 
 std::string continue_command(const std::string& scene_file, const RunOptions& options, int ranks,
@@ -248,6 +295,7 @@ int check_scene(const Scene& scene, std::ostream& out) {
   print_report(sim, MPI_COMM_WORLD, out);
   print_coarse_grain_report(scene, sim.particles(), MPI_COMM_WORLD, out);
   print_void_fraction_cell_report(scene, sim, MPI_COMM_WORLD, out);
+  print_drag_range_report(scene, MPI_COMM_WORLD, out);
   const TimeStepReport& rep = sim.time_step_report();
   if (rep.dt > 0 && std::isfinite(rep.dt)) {
     const long steps = steps_to_end(scene.time.end, rep.dt);
@@ -315,6 +363,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   print_report(sim, comm, out, options.allow_large_time_step);
   print_coarse_grain_report(scene, sim.particles(), comm, out);
   print_void_fraction_cell_report(scene, sim, comm, out);
+  print_drag_range_report(scene, comm, out);
   if (sim.time_step_report().verdict == TimeStepReport::Verdict::refuse &&
       !options.allow_large_time_step)
     throw SetupError(scene.file + ": error: refusing to run with this time step (see above); " +

@@ -144,6 +144,11 @@ FluidSettings parse_fluid_section(const Field& f, const Vec3& gravity, const Dom
     forces.fail(*problem);
   s.virtual_mass_coefficient = m.number_or("virtual_mass_coefficient",
                                            kSphereVirtualMassCoefficient, kNonNegative);
+  if (const auto c = m.find("virtual_mass_coefficient");
+      c && std::find(s.forces.begin(), s.forces.end(), FluidForce::virtual_mass) == s.forces.end())
+    c->fail_at_key(
+        "has no effect without `virtual_mass` in fluid.forces; add virtual_mass to "
+        "the list, or remove this key");
   s.thermal = parse_thermal(m, heat);
   return s;
 }

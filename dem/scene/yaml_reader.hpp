@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <initializer_list>
@@ -173,7 +174,19 @@ class Field {
 
   double number(const Range& range = kAny) const {
     const std::optional<double> x = as_number(node_);
-    if (!x) fail("expected a number, got " + got() + "; write a plain number such as 0.5 or 2e-3");
+    if (!x) {
+      if (looks_numeric())
+        fail("value " + node_.Scalar() +
+             " is beyond the range of a double (magnitudes up to "
+             "1.8e308); write a finite number");
+      fail("expected a number, got " + got() + "; write a plain number such as 0.5 or 2e-3");
+    }
+    // Below the smallest normal double: arithmetic on it loses its digits (a viscosity of
+    // 1e-320 gave NaN drag), and no physical input is that small.
+    if (*x != 0 && std::abs(*x) < std::numeric_limits<double>::min())
+      fail("value " + node_.Scalar() +
+           " is below the smallest normal double (2.2e-308); write "
+           "0 or a number of a physical size");
     check_range(*x, range);
     return *x;
   }
@@ -284,6 +297,25 @@ class Field {
   }
 
  private:
+  // A decimal number in form (digits, a point, an exponent), whatever its size.
+  bool looks_numeric() const {
+    if (!node_.IsScalar()) return false;
+    const std::string& t = node_.Scalar();
+    std::size_t i = (t.size() > 0 && (t[0] == '+' || t[0] == '-')) ? 1 : 0;
+    bool digits = false;
+    while (i < t.size() && (std::isdigit(static_cast<unsigned char>(t[i])) || t[i] == '.'))
+      digits |= t[i++] != '.';
+    if (!digits) return false;
+    if (i < t.size() && (t[i] == 'e' || t[i] == 'E')) {
+      ++i;
+      if (i < t.size() && (t[i] == '+' || t[i] == '-')) ++i;
+      const std::size_t start = i;
+      while (i < t.size() && std::isdigit(static_cast<unsigned char>(t[i]))) ++i;
+      if (i == start) return false;
+    }
+    return i == t.size();
+  }
+
   static std::optional<double> as_number(const YAML::Node& n) {
     double x = 0;
     if (!n.IsScalar() || !YAML::convert<double>::decode(n, x) || !std::isfinite(x))

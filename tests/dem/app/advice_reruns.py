@@ -511,6 +511,41 @@ def _(c):
     return f"cell_size {m.group(1)}: no warning"
 
 
+def bead_in_a_bed(drag, void_fraction):
+    """A 0.6 mm glass bead settling through a fixed bed of void fraction `void_fraction`."""
+    s, files = bead_in_fine_cells(1e-3)
+    s["fluid"]["drag"] = drag
+    s["fluid"]["void_fraction"] = void_fraction
+    return s, files
+
+
+@case("drag_out_of_range", "warning 'fluid.drag: ergun at void_fraction X, outside 0 to 0.8: "
+      "...; gidaspow or wen_yu cover dilute flow' (dem/engine/run.cpp)", "check")
+def _(c):
+    s, files = bead_in_a_bed("ergun", 1)
+    m = c.expect(c.run("first", s, files=files), 0, r"warning: fluid\.drag: ergun at void_fraction "
+                 r"1, outside 0 to 0\.8: [^\n]*; (\w+) or (\w+) cover dilute flow")
+    for law in m.groups():
+        s["fluid"]["drag"] = law
+        c.rerun_passes(c.run("rerun_" + law, s, files=files), r"warning: fluid\.drag",
+                       "fluid.drag")
+    return f"{m.group(1)}, {m.group(2)}: no warning"
+
+
+@case("drag_ignores_void_fraction", "warning 'fluid.drag: schiller_naumann ... ignores "
+      "void_fraction X; a law for beds (...) uses it' (dem/engine/run.cpp)", "check")
+def _(c):
+    s, files = bead_in_a_bed("schiller_naumann", 0.6)
+    m = c.expect(c.run("first", s, files=files), 0, r"warning: fluid\.drag: schiller_naumann is a "
+                 r"single sphere's law and ignores void_fraction 0\.6; a law for beds \(([^)]*)\)")
+    laws = [x.strip() for x in m.group(1).split(",")]
+    for law in laws:
+        s["fluid"]["drag"] = law
+        c.rerun_passes(c.run("rerun_" + law, s, files=files), r"warning: fluid\.drag",
+                       "fluid.drag")
+    return f"{len(laws)} laws: no warning"
+
+
 FLUID_LIMIT = (r"beyond the stability limit of the fluid force '(\w+)' \([^\n]*\); use dt <= "
                + NUM + r" s, or remove '(\w+)' from fluid\.forces")
 

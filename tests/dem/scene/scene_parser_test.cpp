@@ -924,6 +924,30 @@ TEST(SceneErrors, WallsAcrossAPeriodicAxis) {
 // A shear varying along a periodic axis would jump by G L at the periodic sides (the answer
 // depended on the neighbour skin: the jump came when a centre was wrapped): refused at
 // gradient_direction. Along a bounded axis, with the others periodic, it runs.
+// A key with no effect, a number a double cannot hold, and one below the smallest normal
+// double (a viscosity of 1e-320 gave NaN drag): refused at the value, saying why.
+TEST(SceneErrors, FluidValuesThatCannotWork) {
+  const auto fluid = [](const std::string& extra, const std::string& viscosity) {
+    return kBase + "fluid:\n  density: 1000\n  viscosity: " + viscosity +
+           "\n  drag: schiller_naumann\n  model: B\n"
+           "  forces: [drag, pressure_gradient, viscous]\n" +
+           extra;
+  };
+  EXPECT_THAT(error_of(fluid("  virtual_mass_coefficient: 3\n", "1e-3")).what(),
+              HasSubstr("fluid.virtual_mass_coefficient: has no effect without `virtual_mass` in "
+                        "fluid.forces"));
+  EXPECT_THAT(error_of(fluid("", "1e-320")).what(),
+              HasSubstr("fluid.viscosity: value 1e-320 is below the smallest normal double"));
+  EXPECT_THAT(error_of(fluid("", "1e400")).what(),
+              HasSubstr("fluid.viscosity: value 1e400 is beyond the range of a double"));
+  EXPECT_THAT(error_of(fluid("", "abc")).what(),
+              HasSubstr("fluid.viscosity: expected a number, got 'abc'"));
+  EXPECT_NO_THROW(parse_scene(with("forces: [drag, pressure_gradient, viscous]",
+                                   "forces: [drag, pressure_gradient, viscous, virtual_mass]",
+                                   fluid("  virtual_mass_coefficient: 3\n", "1e-3")),
+                              kLabel));
+}
+
 TEST(SceneErrors, ShearAcrossAPeriodicAxis) {
   const auto sheared = [](const std::string& periodic, const std::string& gradient) {
     return with("  max: [1, 1, 1]\n", "  max: [1, 1, 1]\n  periodic: " + periodic + "\n") +
