@@ -1713,16 +1713,21 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
     };
     if (s < kNoStop && s > 1) {
       if (c.hertz) {
+        // A parcel class (glass[k=4]) takes the modulus of its listed material, the key to set.
+        const auto listed = [&](int material) {
+          const int real = scene_.materials[static_cast<std::size_t>(material)].real_material;
+          return real < 0 ? material : real;
+        };
         const auto scaled = [&](int material) {
-          const Material& m = scene_.materials[material];
+          const Material& m = scene_.materials[static_cast<std::size_t>(material)];
           return "material '" + m.name + "': " + significant(round_up(s) * m.youngs_modulus, 6) +
                  " Pa";
         };
-        o << " scale the Young's modulus by at least " << round_up(s) << " (" << scaled(a.material)
-          << (material_b != a.material ? ", " + scaled(material_b) : "")
-          << (driven && driver_material != a.material && driver_material != material_b
-                  ? ", and of particle " + std::to_string(driver_id) + ", " +
-                        scaled(driver_material)
+        const int la = listed(a.material), lb = listed(material_b), ld = listed(driver_material);
+        o << " scale the Young's modulus by at least " << round_up(s) << " (" << scaled(la)
+          << (lb != la ? ", " + scaled(lb) : "")
+          << (driven && ld != la && ld != lb
+                  ? ", and of particle " + std::to_string(driver_id) + ", " + scaled(ld)
                   : "")
           << ")";
         shorter_step(std::pow(round_up(s), -0.4));
@@ -1759,6 +1764,13 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
     if (0.5 * c.m_star * w.speed * w.speed > 0.1 * 0.4 * spring * at_limit)
       o << " a slower impact;";
     if (driven) o << " a lighter or slower particle " << driver_id << ";";
+    // A parcel weighs k^3 real particles: a lower coarse_grain lightens it by that much.
+    double k_max = 1;
+    for (int m : {a.material, material_b, driven ? driver_material : a.material})
+      k_max = std::max(k_max, scene_.materials[static_cast<std::size_t>(m)].coarse_grain);
+    if (k_max > 1)
+      o << " a lower coarse_grain (parcels of k = " << significant(k_max) << " take part, each "
+        << significant(k_max * k_max * k_max) << " real particles' mass);";
   }
   for (const WallSet::Entry* e : moving)
     o << " stop or slow wall '" << e->name << "' before it squeezes the particles this far;";
