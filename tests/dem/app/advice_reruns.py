@@ -519,16 +519,21 @@ def bead_in_a_bed(drag, void_fraction):
     return s, files
 
 
+def rerun_with_each_law(c, s, files, laws):
+    """Reruns the scene with each drag law the warning names: the warning must be gone."""
+    for law in laws:
+        s["fluid"]["drag"] = law
+        c.rerun_passes(c.run("rerun_" + law, s, files=files), r"warning: fluid\.drag",
+                       "fluid.drag")
+
+
 @case("drag_out_of_range", "warning 'fluid.drag: ergun at void_fraction X, outside 0 to 0.8: "
       "...; gidaspow or wen_yu cover dilute flow' (dem/engine/run.cpp)", "check")
 def _(c):
     s, files = bead_in_a_bed("ergun", 1)
     m = c.expect(c.run("first", s, files=files), 0, r"warning: fluid\.drag: ergun at void_fraction "
                  r"1, outside 0 to 0\.8: [^\n]*; (\w+) or (\w+) cover dilute flow")
-    for law in m.groups():
-        s["fluid"]["drag"] = law
-        c.rerun_passes(c.run("rerun_" + law, s, files=files), r"warning: fluid\.drag",
-                       "fluid.drag")
+    rerun_with_each_law(c, s, files, m.groups())
     return f"{m.group(1)}, {m.group(2)}: no warning"
 
 
@@ -539,10 +544,7 @@ def _(c):
     m = c.expect(c.run("first", s, files=files), 0, r"warning: fluid\.drag: schiller_naumann is a "
                  r"single sphere's law and ignores void_fraction 0\.6; a law for beds \(([^)]*)\)")
     laws = [x.strip() for x in m.group(1).split(",")]
-    for law in laws:
-        s["fluid"]["drag"] = law
-        c.rerun_passes(c.run("rerun_" + law, s, files=files), r"warning: fluid\.drag",
-                       "fluid.drag")
+    rerun_with_each_law(c, s, files, laws)
     return f"{len(laws)} laws: no warning"
 
 
