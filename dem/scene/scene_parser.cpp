@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <charconv>
 #include <climits>
 #include <cmath>
@@ -645,9 +646,27 @@ void parse_discrete_distribution(const Map& m, SizeDistribution& s) {
 }
 
 SizeDistribution parse_size_distribution(const Field& f) {
-  const Map m = f.map();
   SizeDistribution s;
   using K = SizeDistribution::Kind;
+  // `radius: 5e-4`, a plain number, is the constant distribution.
+  if (f.node().IsScalar()) {
+    // A word (not a number that is out of range) gets the forms a radius may take.
+    const std::string& text = f.node().Scalar();
+    if (text.empty() || std::isalpha(static_cast<unsigned char>(text[0])))
+      f.fail(
+          "expected a radius in m (such as 5e-4) or a size distribution "
+          "({distribution: constant, uniform, normal or discrete, ...}), got " +
+          f.got());
+    s.kind = K::constant;
+    s.value = f.number(kPositive);
+    return s;
+  }
+  if (!f.node().IsMap())
+    f.fail(
+        "expected a radius in m (such as 5e-4) or a size distribution "
+        "({distribution: constant, uniform, normal or discrete, ...}), got " +
+        f.got());
+  const Map m = f.map();
   s.kind = m.get("distribution", "add `distribution: constant` (or uniform, normal, discrete)")
                .choice<K>("size distribution", {{"constant", K::constant},
                                                 {"uniform", K::uniform},
@@ -747,8 +766,9 @@ void parse_fill(const Map& m, const Scene& scene, Insertion& ins) {
   if (const auto c = m.find("count")) ins.count = static_cast<long>(c->integer(kPositive));
   ins.volume_fraction = m.maybe_number("volume_fraction", Range{0, 0.6, false, true});
   ins.material = material_ref(m, "material", scene.materials);
-  ins.radius = parse_size_distribution(
-      m.get("radius", "add `radius: {distribution: constant, value: <m>}`"));
+  ins.radius = parse_size_distribution(m.get("radius",
+                                             "add `radius: <m>` (or a distribution: `radius: "
+                                             "{distribution: uniform, min: <m>, max: <m>}`)"));
   parse_coarse_grain(m, ins);
   {
     // Every particle lies whole inside the region (sample_centre, dem/insert/insertion.cpp):
@@ -847,8 +867,9 @@ void parse_stream(const Map& m, const Scene& scene, Insertion& ins) {
   if (ins.stop && *ins.stop <= ins.start)
     m.get("stop").fail("stop must be later than start (" + format_number(ins.start) + " s)");
   ins.material = material_ref(m, "material", scene.materials);
-  ins.radius = parse_size_distribution(
-      m.get("radius", "add `radius: {distribution: constant, value: <m>}`"));
+  ins.radius = parse_size_distribution(m.get("radius",
+                                             "add `radius: <m>` (or a distribution: `radius: "
+                                             "{distribution: uniform, min: <m>, max: <m>}`)"));
   parse_coarse_grain(m, ins);
   // Each particle enters whole inside the face's outline (StreamInsertion::sample); a face
   // narrower than the largest one would put it at the centre, sticking out of the outline.

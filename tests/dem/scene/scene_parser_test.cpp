@@ -323,6 +323,31 @@ TEST(SceneParser, HookeCharacteristicVelocityAndConstantRadius) {
   EXPECT_EQ(s.insertions[0].source, kLabel + ":19");
 }
 
+// `radius: 1e-3`, a plain number, is the constant distribution; anything else that is not a
+// distribution map names both forms.
+TEST(SceneParser, APlainNumberIsAConstantRadius) {
+  const auto scene = [](const std::string& radius) {
+    return kBase +
+           "insert:\n"
+           "  - type: fill\n"
+           "    region: {box: {min: [0, 0, 0], max: [1, 1, 1]}}\n"
+           "    count: 10\n"
+           "    material: glass\n"
+           "    radius: " +
+           radius + "\n";
+  };
+  const Scene s = parse_scene(scene("1e-3"), kLabel);
+  EXPECT_EQ(s.insertions.at(0).radius.kind, SizeDistribution::Kind::constant);
+  EXPECT_EQ(s.insertions[0].radius.value, 1e-3);
+  EXPECT_THAT(expect_at(error_of(scene("-1e-3")), 22, 13),
+              HasSubstr("insert[0].radius: value -1e-3 is out of range; it must be > 0"));
+  for (const char* wrong : {"uniform", "[4e-4, 6e-4]", "''"})
+    EXPECT_THAT(expect_at(error_of(scene(wrong)), 22, 13),
+                HasSubstr("insert[0].radius: expected a radius in m (such as 5e-4) or a size "
+                          "distribution ({distribution: constant, uniform, normal or discrete"))
+        << wrong;
+}
+
 TEST(SceneParser, NormalDistributionLowerBoundIsClippedPositive) {
   const Scene s = parse_scene(kBase +
                                   "insert:\n"
