@@ -251,7 +251,8 @@ void DemLink::initialise() {
     if (m.grid)
       for (int a = 0; a < 3; ++a)
         if (dims[a] > 1) m.sim->set_cut_planes(a, m.grid->cuts[a]);
-    m.sim->add_force_term(make_coupled_fluid_forces(*m.scene.fluid, m.scene.gravity, m.fluid));
+    m.sim->add_force_term(
+        make_coupled_fluid_forces(*m.scene.fluid, m.scene.gravity, m.fluid, m.dem_comm));
     // The first force evaluation, before the fluid is sampled, sees fluid at rest, eps = 1.
     Impl* self = &m;
     m.fluid->set_sampler([self](const Vec3&) { return self->to_sample(FluidAtParticle{}); });

@@ -2248,11 +2248,17 @@ void ParticleCoupling::write() {
              << "\n"
              << "grainFoam CPU time split: " << split(times + 4).c_str() << perRank.c_str()
              << wallLoads.c_str() << Foam::endl;
-  if (undisturbed_)
-    for (const std::string& line : dem_->reports())
-      if (line.rfind("undisturbed velocity", 0) == 0)
+  // reports() is collective (the drag's beyond-range count is summed over the ranks).
+  for (const std::string& report : dem_->reports()) {
+    std::istringstream lines(report);
+    for (std::string line; std::getline(lines, line);) {
+      if (undisturbed_ && line.rfind("undisturbed velocity", 0) == 0)
         Foam::Info << "grainFoam " << line.c_str()
                    << (Pstream::parRun() ? " (particles of rank 0)" : "") << Foam::endl;
+      if (line.find(": warning: fluid.drag: ") != std::string::npos)
+        Foam::Info << "grainFoam coupling: " << line.c_str() << Foam::endl;
+    }
+  }
 }
 
 void ParticleCoupling::checkPeriodicSides(const fvMesh& mesh, const fileName& sceneFile) const {

@@ -18,6 +18,12 @@ struct DragLaw {
   DragFunction function;  // K [kg/s] of F = K (u_f - v)
   const char* source;     // paper, for logs and docs
   bool total_force_fit;   // normalised as the total force (mean-pressure part removed by ε)
+  // The largest Reynolds number (the law's own: superficial ρ_f ε d U/μ, or the single
+  // sphere's for schiller_naumann) of the data the law was fitted to or derived for; the run
+  // counts the particle-steps beyond it and warns (docs/models/fluid-forces.md, "Validity").
+  double fitted_reynolds;
+  const char* fitted_range;             // where that bound comes from, for the warning
+  bool single_sphere_reynolds = false;  // Re without ε (schiller_naumann)
 };
 
 // Every law, in the order the docs list them.

@@ -51,11 +51,52 @@ class FluidForcesWith final : public ForceTerm {
       : s_(s), gravity_(gravity), on_(on), comm_(comm), coupled_(std::move(coupled)) {
     if (s.computed_void_fraction) grid_.emplace(domain, *s.computed_void_fraction);
     if (!s_.coarse_grain.empty()) coarse_ = s_.coarse_grain.data();
+    const DragLaw& law = drag_law(s_.drag_law);
+    fitted_reynolds_ = law.fitted_reynolds;
+    reynolds_has_eps_ = !law.single_sphere_reynolds;
   }
 
   std::string name() const override { return "fluid forces (drag: " + s_.drag_law + ")"; }
 
+  // Collective over comm_ (the beyond-range count is summed over the ranks).
   std::string report() const override {
+    const std::string beyond = reynolds_report();
+    std::string out = undisturbed_report();
+    if (!beyond.empty()) out += (out.empty() ? "" : "\n") + beyond;
+    return out;
+  }
+
+  // The drag law evaluated beyond the Reynolds number of its data (DragLaw::fitted_reynolds):
+  // how often, how far, from when, and the laws whose data reach that far.
+  std::string reynolds_report() const {
+    double n[3] = {static_cast<double>(beyond_steps_), static_cast<double>(drag_steps_), 0};
+    double largest = beyond_largest_, first = beyond_first_;
+    if (comm_ != MPI_COMM_NULL) {
+      MPI_Allreduce(MPI_IN_PLACE, n, 2, MPI_DOUBLE, MPI_SUM, comm_);
+      MPI_Allreduce(MPI_IN_PLACE, &largest, 1, MPI_DOUBLE, MPI_MAX, comm_);
+      MPI_Allreduce(MPI_IN_PLACE, &first, 1, MPI_DOUBLE, MPI_MIN, comm_);
+    }
+    if (n[0] == 0) return {};
+    const DragLaw& law = drag_law(s_.drag_law);
+    std::string reaching;
+    // Laws for beds (not the single sphere's) with a known bound that covers the largest Re.
+    for (const DragLaw& other : drag_laws())
+      if (other.fitted_reynolds >= largest && std::isfinite(other.fitted_reynolds) &&
+          !other.single_sphere_reynolds && std::string_view(other.name) != law.name)
+        reaching += (reaching.empty() ? "" : ", ") + std::string(other.name);
+    std::ostringstream o;
+    o << s_.source << ": warning: fluid.drag: " << law.name
+      << " was evaluated beyond the Re = " << significant(law.fitted_reynolds) << " of its data ("
+      << law.fitted_range << ") in " << static_cast<long long>(n[0]) << " of "
+      << static_cast<long long>(n[1]) << " particle-steps, from t = " << significant(first)
+      << " s, up to Re = " << significant(largest) << " (Re = rho_f "
+      << (law.single_sphere_reynolds ? "" : "eps ") << "d |u_f - v| / mu, of the real particles)";
+    if (!reaching.empty()) o << "; laws whose data reach that Re: " << reaching;
+    o << " (docs/models/fluid-forces.md, \"Validity\")";
+    return o.str();
+  }
+
+  std::string undisturbed_report() const {
     if (undisturbed_calls_ > 0) {
       std::string out = "undisturbed velocity: the drag of " + std::to_string(undisturbed_calls_) +
                         " particle-steps raised by a mean factor of " +
@@ -195,7 +236,7 @@ class FluidForcesWith final : public ForceTerm {
     return out;
   }
 
-  void add(Particles& p, double /*time*/, ImplicitDrag& drag) override {
+  void add(Particles& p, double time, ImplicitDrag& drag) override {
     if (grid_) grid_->update(p, comm_);
     CoupledFluid::View samples;
     if (coupled_) {
@@ -219,8 +260,15 @@ class FluidForcesWith final : public ForceTerm {
           d /= cg;
           parcel = cg * cg * cg;
         }
-        double k = Law({d, slip.norm(), f.void_fraction, f.density, f.viscosity});
+        const double u = slip.norm();
+        double k = Law({d, u, f.void_fraction, f.density, f.viscosity});
         if (coarse_) k *= parcel;
+        // Beyond the law's data? (Re > bound, written without a division; never for ergun.)
+        ++drag_steps_;
+        if (f.density * d * u * (reynolds_has_eps_ ? f.void_fraction : 1) >
+            fitted_reynolds_ * f.viscosity)
+          note_beyond_fit(
+              f.density * d * u * (reynolds_has_eps_ ? f.void_fraction : 1) / f.viscosity, time);
         if (samples.disturbance && samples.disturbance[i].cell > 0)
           k *= undisturbed(samples.disturbance[i], d, slip, f);
         const double k_sum = drag.coefficient[i] + k;
@@ -329,6 +377,15 @@ class FluidForcesWith final : public ForceTerm {
   long undisturbed_calls_ = 0, undisturbed_limited_ = 0;
   double undisturbed_sum_ = 0, undisturbed_max_ = 0;
 
+  void note_beyond_fit(double re, double time) {
+    if (beyond_steps_++ == 0) beyond_first_ = time;
+    beyond_largest_ = std::max(beyond_largest_, re);
+  }
+  double fitted_reynolds_ = std::numeric_limits<double>::infinity();
+  bool reynolds_has_eps_ = true;
+  long long drag_steps_ = 0, beyond_steps_ = 0;
+  double beyond_largest_ = 0, beyond_first_ = std::numeric_limits<double>::infinity();
+
   FluidSettings s_;
   // Each material's coarse-graining factor (FluidSettings::coarse_grain); null: all k = 1.
   const double* coarse_ = nullptr;
@@ -389,7 +446,8 @@ std::unique_ptr<ForceTerm> make_fluid_forces(const FluidSettings& s, const Vec3&
 
 std::unique_ptr<ForceTerm> make_coupled_fluid_forces(const FluidSettings& settings,
                                                      const Vec3& gravity,
-                                                     std::shared_ptr<CoupledFluid> coupled) {
+                                                     std::shared_ptr<CoupledFluid> coupled,
+                                                     MPI_Comm comm) {
   if (coupled == nullptr) throw std::invalid_argument("make_coupled_fluid_forces: no CoupledFluid");
   for (FluidForce f : settings.forces)
     if (f == FluidForce::virtual_mass)
@@ -399,7 +457,7 @@ std::unique_ptr<ForceTerm> make_coupled_fluid_forces(const FluidSettings& settin
   FluidSettings s = settings;
   s.computed_void_fraction.reset();        // the coupling computes eps on the mesh
   s.field.hydrostatic_pressure = false;    // the solver's p excludes rho_f g.x
-  return make_term(s, gravity, Domain{}, MPI_COMM_NULL, coupled);
+  return make_term(s, gravity, Domain{}, comm, coupled);
 }
 
 }  // namespace grainflow

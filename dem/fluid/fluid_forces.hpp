@@ -37,8 +37,10 @@ std::unique_ptr<ForceTerm> make_fluid_forces(const FluidSettings& settings, cons
 // fluid step), not from settings.field, and the term writes back coupled->exchange_force.
 // The coupled solver's pressure excludes the hydrostatic part, so the list must have
 // buoyancy. virtual_mass is refused (the coupling does not sample Du/Dt yet).
+// `comm`: the DEM ranks, over which report() sums its counts (collective then).
 std::unique_ptr<ForceTerm> make_coupled_fluid_forces(const FluidSettings& settings,
                                                      const Vec3& gravity,
-                                                     std::shared_ptr<CoupledFluid> coupled);
+                                                     std::shared_ptr<CoupledFluid> coupled,
+                                                     MPI_Comm comm = MPI_COMM_NULL);
 
 }  // namespace grainflow

@@ -519,12 +519,12 @@ def bead_in_a_bed(drag, void_fraction):
     return s, files
 
 
-def rerun_with_each_law(c, s, files, laws):
+def rerun_with_each_law(c, s, files, laws, command="check"):
     """Reruns the scene with each drag law the warning names: the warning must be gone."""
     for law in laws:
         s["fluid"]["drag"] = law
-        c.rerun_passes(c.run("rerun_" + law, s, files=files), r"warning: fluid\.drag",
-                       "fluid.drag")
+        c.rerun_passes(c.run("rerun_" + law, s, command=command, files=files),
+                       r"warning: fluid\.drag", "fluid.drag")
 
 
 @case("drag_out_of_range", "warning 'fluid.drag: ergun at void_fraction X, outside 0 to 0.8: "
@@ -535,6 +535,39 @@ def _(c):
                  r"1, outside 0 to 0\.8: [^\n]*; (\w+) or (\w+) cover dilute flow")
     rerun_with_each_law(c, s, files, m.groups())
     return f"{m.group(1)}, {m.group(2)}: no warning"
+
+
+@case("drag_beyond_reynolds", "warning 'fluid.drag: koch_hill was evaluated beyond the Re = X "
+      "of its data ...; laws whose data reach that Re: ...' (dem/fluid/fluid_forces.cpp)", "run")
+def _(c):
+    # Two 2 mm glass beads at rest in air rising at 12 m/s through a bed of void fraction 0.5:
+    # Re = rho_f eps d U / mu = 1.2 * 0.5 * 2e-3 * 12 / 1.8e-5 = 800 at the start, beyond
+    # Koch-Hill's 200. Both beads on the upper rank of 2: the count is summed over the ranks.
+    s = {
+        "domain": {"min": [0, 0, 0], "max": [0.02, 0.02, 0.04]},
+        "gravity": [0, 0, -9.81],
+        "time": {"rayleigh_fraction": 0.2, "end": 0.002},
+        "materials": [{"name": "glass", "youngs_modulus": 6e10, "poisson_ratio": 0.25,
+                       "density": 2500}],
+        "interactions": [{"materials": ["glass", "glass"], "restitution": 0.5, "friction": 0.5}],
+        "contact": {"normal": "hertz", "tangential": "history"},
+        "insert": [{"type": "csv", "file": "beads.csv", "material": "glass"}],
+        "fluid": {"density": 1.2, "viscosity": 1.8e-5, "velocity": [0, 0, 12],
+                  "void_fraction": 0.5, "drag": "koch_hill", "model": "A",
+                  "forces": ["drag", "pressure_gradient", "viscous"]},
+        "output": {"progress": False},
+    }
+    files = {"beads.csv": "x,y,z,radius\n0.013,0.01,0.01,1e-3\n0.016,0.01,0.01,1e-3\n"}
+    m = c.expect(c.run("first", s, command="run", files=files, ranks=2), 0,
+                 r"warning: fluid\.drag: koch_hill was evaluated beyond the Re = 200 of its data "
+                 r"[^\n]* in (\d+) of (\d+) particle-steps, from t = 0 s, up to Re = 800 "
+                 r"[^\n]*; laws whose data reach that Re: ([\w, ]+) \(docs")
+    if m.group(1) != m.group(2) or int(m.group(2)) < 2:
+        raise Setup(f"expected every particle-step beyond the range, got {m.group(1)} of "
+                    f"{m.group(2)}")
+    laws = [x.strip() for x in m.group(3).split(",")]
+    rerun_with_each_law(c, s, files, laws, command="run")
+    return f"{len(laws)} laws ({', '.join(laws)}): no warning"
 
 
 @case("drag_ignores_void_fraction", "warning 'fluid.drag: schiller_naumann ... ignores "
