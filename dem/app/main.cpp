@@ -65,6 +65,10 @@ int dispatch(const std::string& program, const std::vector<std::string>& args, i
   std::vector<std::string> given;
   for (std::size_t k = 1; k < args.size(); ++k) {
     const std::string& a = args[k];
+    if (a == "--help" || a == "-h") {  // `grain run --help`: the usage, as `grain --help`
+      if (rank == 0) std::cout << kUsage;
+      return 0;
+    }
     if (!a.starts_with("--")) {
       if (!scene_file.empty())
         return usage_error("'" + cmd + "' takes one scene file, got '" + scene_file + "' and '" +
@@ -95,6 +99,10 @@ int dispatch(const std::string& program, const std::vector<std::string>& args, i
     } else if (eq != std::string::npos) {
       return usage_error("option '" + key + "' takes no value, got '" + a + "'");
     }
+    if (value.starts_with("~"))  // --output=~/x: the shell leaves it as it is
+      return usage_error("option '" + key + "': '~' in '" + value +
+                         "' is not expanded (the shell expands it only at the start of a "
+                         "word); write the full path");
     if (key == "--output") options.output_directory = value;
     if (key == "--restart") options.restart = value;
     if (key == "--no-progress") options.progress = false;

@@ -1,8 +1,10 @@
 #include "dem/engine/run.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <filesystem>
 #include <limits>
 #include <numbers>
@@ -247,6 +249,79 @@ void print_drag_range_report(const Scene& scene, MPI_Comm comm, std::ostream& ou
 
 }  // namespace
 
+namespace {
+
+// Whether `name` is a file a run writes into its output folder: log.csv, particles.xdmf,
+// particles_<digits>.h5, checkpoint_<digits>.h5 (and their .part/.tmp while written).
+bool written_by_a_run(std::string name) {
+  for (const char* suffix : {".part", ".tmp"})
+    if (name.ends_with(suffix)) name.resize(name.size() - std::string_view(suffix).size());
+  if (name == "log.csv" || name == "particles.xdmf") return true;
+  for (std::string_view prefix : {"particles_", "checkpoint_"}) {
+    if (!name.starts_with(prefix) || !name.ends_with(".h5")) continue;
+    const std::string_view digits =
+        std::string_view(name).substr(prefix.size(), name.size() - prefix.size() - 3);
+    if (!digits.empty() && std::all_of(digits.begin(), digits.end(), [](char c) {
+          return std::isdigit(static_cast<unsigned char>(c)) != 0;
+        }))
+      return true;
+  }
+  return false;
+}
+
+void refuse_inputs_the_run_overwrites(const Scene& scene, const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path out = fs::weakly_canonical(fs::absolute(dir, ec), ec);
+  if (ec) return;
+  const auto check = [&](const std::string& file, const std::string& where, const char* what) {
+    if (file.empty()) return;
+    std::error_code e;
+    const fs::path in = fs::weakly_canonical(fs::absolute(file, e), e);
+    if (e || in.parent_path() != out || !written_by_a_run(in.filename().string())) return;
+    throw SetupError(where + ": error: the " + what + " '" + file + "' is in the output folder '" +
+                     dir +
+                     "' under a name the run writes there: the run would overwrite it. "
+                     "Move or copy it out of that folder (and point the scene at the copy), or "
+                     "write the output elsewhere (output.directory, or --output)");
+  };
+  for (const Insertion& ins : scene.insertions) {
+    check(ins.csv_file, ins.source, "CSV file");
+    check(ins.snapshot_file, ins.source, "snapshot file");
+  }
+  for (const Wall& w : scene.walls)
+    if (w.kind == Wall::Kind::mesh) check(w.mesh.file, w.mesh.file_source, "STL file");
+}
+
+// The particle files the insertions read, as absolute paths with their modification time
+// (UTC): a scene run from another folder reads the files beside the scene, which may be an
+// earlier stage's (docs/scene-reference.md, "Files").
+void print_input_files(const Scene& scene, MPI_Comm comm, std::ostream& out) {
+  namespace fs = std::filesystem;
+  std::ostream& say = speaker(comm, out);
+  for (const Insertion& ins : scene.insertions) {
+    const std::string& file = ins.csv_file.empty() ? ins.snapshot_file : ins.csv_file;
+    if (file.empty()) continue;
+    std::error_code ec;
+    const fs::path path = fs::absolute(file, ec).lexically_normal();
+    say << "input: " << ins.source << " reads " << path.string();
+    const fs::file_time_type written = fs::last_write_time(path, ec);
+    if (!ec) {
+      const std::time_t t = std::chrono::system_clock::to_time_t(
+          std::chrono::time_point_cast<std::chrono::system_clock::duration>(
+              std::chrono::file_clock::to_sys(written)));
+      std::tm utc{};
+      gmtime_r(&t, &utc);
+      char text[32];
+      std::strftime(text, sizeof text, "%Y-%m-%d %H:%M:%S", &utc);
+      say << " (modified " << text << " UTC)";
+    }
+    say << "\n";
+  }
+}
+
+}  // namespace
+
 std::string continue_command(const std::string& scene_file, const RunOptions& options, int ranks,
                              const std::string& checkpoint) {
   std::string cmd = ranks > 1 ? "mpirun -np " + std::to_string(ranks) + " " : std::string();
@@ -286,6 +361,14 @@ std::string refusal_remedy(const TimeStepReport& rep) {
 
 int check_scene(const Scene& scene, std::ostream& out) {
   check_grids(scene);
+  print_input_files(scene, MPI_COMM_WORLD, out);
+  // The output folder `grain run` would write (without --output): not an input's, not a file.
+  refuse_inputs_the_run_overwrites(scene, scene.output.directory);
+  if (std::error_code ec; std::filesystem::exists(scene.output.directory, ec) &&
+                          !std::filesystem::is_directory(scene.output.directory, ec))
+    throw OutputError("output.directory '" + scene.output.directory +
+                      "' exists but is not a directory: `grain run` could not write there; "
+                      "give another output.directory (or --output to grain run)");
   Simulation sim(scene);
   // The fluid forces too, so that their stability limits are checked as at start-up.
   if (scene.fluid)
@@ -332,9 +415,11 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
                         " (nothing was created or changed); give the path of a "
                         "checkpoint_<step>.h5 that a run wrote (see output.checkpoint_interval)");
   }
+  refuse_inputs_the_run_overwrites(scene, dir);  // before the folder is made or touched
   prepare_output_directory(dir);  // before any work: an unwritable directory fails now
   const OutputLock lock(comm, dir);  // one run per folder: a second is refused, naming this one
   std::ostream& say = speaker(comm, out);
+  if (!options.restart) print_input_files(scene, comm, out);
 
   // A restart takes its particles from the checkpoint instead of inserting them.
   if (options.restart && options.restart->ends_with(".part"))
@@ -381,6 +466,16 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
       << "'): the restart would run no step; raise time.end, or restart from an earlier "
          "checkpoint (nothing was changed or deleted)";
     throw SetupError(m.str());
+  }
+  // At exactly the checkpoint's step: nothing to run, and nothing in the folder is touched
+  // (continuing the series and the log would cut them back to the checkpoint).
+  if (options.restart && end_step == first_step) {
+    say << "restart: the checkpoint is at the scene's time.end already (step " << first_step
+        << "): nothing to run, nothing in " << dir << " changed; to run longer, raise time.end ("
+        << scene.time.end_source << ")\n";
+    RunSummary nothing;
+    nothing.particles_start = nothing.particles_end = sim.global_state().particles;
+    return nothing;
   }
   if (const double last = static_cast<double>(end_step) * sim.dt();
       std::abs(last - scene.time.end) > kEndTolerance * scene.time.end)
@@ -576,9 +671,6 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   long global_particles = sum.particles_start;
   // The run ends at the step nearest to t_end (within half a step).
   const long total_steps = end_step;
-  if (options.restart && total_steps == first_step)
-    say << "restart: the checkpoint is at the scene's time.end already (step " << first_step
-        << "): nothing to run; to run longer, raise time.end (" << scene.time.end_source << ")\n";
   double particle_steps = 0;  // this rank's
   std::ostringstream stop_message;
   const auto snapshot_due = [&](double t, long k) {

@@ -334,6 +334,10 @@ ContactSettings parse_contact(const Field& f) {
 // A file named in the scene, resolved against the scene file's folder; it must exist.
 std::string existing_file(const Field& file, const std::string& what) {
   const fs::path given = file.text();
+  if (file.text().starts_with("~"))
+    file.fail(
+        "'~' is not expanded in a scene file (the shell expands it, not grain); write the "
+        "full path, or a path relative to the scene file's folder");
   const fs::path resolved = given.is_absolute() ? given : file.source().folder / given;
   std::error_code ec;
   if (fs::is_directory(resolved, ec))
@@ -667,7 +671,13 @@ SizeDistribution parse_size_distribution(const Field& f) {
         "({distribution: constant, uniform, normal or discrete, ...}), got " +
         f.got());
   const Map m = f.map();
-  s.kind = m.get("distribution", "add `distribution: constant` (or uniform, normal, discrete)")
+  // Without `distribution`, the form the other keys suggest.
+  const char* suggested = m.find("mean") || m.find("stddev")      ? "normal"
+                          : m.find("min") || m.find("max")        ? "uniform"
+                          : m.find("values") || m.find("weights") ? "discrete"
+                                                                  : "constant";
+  s.kind = m.get("distribution", "add `distribution: " + std::string(suggested) +
+                                     "` (the forms: constant, uniform, normal, discrete)")
                .choice<K>("size distribution", {{"constant", K::constant},
                                                 {"uniform", K::uniform},
                                                 {"normal", K::normal},
@@ -1036,7 +1046,15 @@ OutputSettings parse_output(const Field& f, const TimeSettings& time, bool heat)
                           "checkpoint_interval", "checkpoint_keep"})
     if (const auto v = m.find(key))
       o.given.emplace_back(key, f.source().label + ":" + std::to_string(v->key_mark().line + 1));
-  if (const auto d = m.find("directory")) o.directory = d->text();
+  if (const auto d = m.find("directory")) {
+    o.directory = d->text();
+    if (o.directory.starts_with("~"))
+      d->fail(
+          "'~' is not expanded in a scene file (the shell expands it, not grain); write the "
+          "full path, or a path relative to the working directory");
+    if (o.directory.find_first_not_of(" \t") == std::string::npos)
+      d->fail("the folder name is only spaces; name a folder");
+  }
   o.snapshot_interval = m.maybe_number("snapshot_interval", kPositive);
   o.log_interval = m.maybe_number("log_interval", kPositive);
   if (const auto p = m.find("progress")) o.progress = p->boolean();
@@ -1340,7 +1358,17 @@ void raise_if_tab_indented(const std::string& text, int error_line, const Source
 
 YAML::Node load_yaml(const std::string& text, const Source& src) {
   try {
-    return YAML::Load(text);
+    // Every document is read: a scene is one, and a `---` line that starts a second would
+    // otherwise drop everything after it without a word.
+    const std::vector<YAML::Node> documents = YAML::LoadAll(text);
+    if (documents.size() > 1) {
+      YAML::Mark at = documents[1].Mark();
+      if (at.line < 0) at = start_of_file();
+      raise(src, at,
+            "a second YAML document starts here (after a '---' line): a scene is one document, "
+            "and the keys after '---' would not be read; remove the '---' line");
+    }
+    return documents.empty() ? YAML::Node() : documents.front();
   } catch (const YAML::DeepRecursion& e) {
     // yaml-cpp stops at a fixed depth (500 in 0.7) instead of overflowing the stack,
     // with only "bad file" as its message.

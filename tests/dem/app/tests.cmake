@@ -267,6 +267,12 @@ if(GRAINFLOW_PYTHON3)
                    ${_scenes}/stop_signal.yaml ${_work}/foreign_files)
   set_tests_properties(grain.foreign_files PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}"
                                                       TIMEOUT 300)
+  # What a user's files and folders may not silently do: inputs the run would overwrite,
+  # a second YAML document, '~', the particle files named, a restart at its end (about 5 s).
+  add_test(NAME grain.user_files
+           COMMAND ${GRAINFLOW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/user_files.py ${_grain}
+                   ${_work}/user_files)
+  set_tests_properties(grain.user_files PROPERTIES TIMEOUT 300)
   # log.csv's thermal_J against the energy balance of heat sources in an adiabatic box, on 1
   # and 2 ranks (heat_log.py; about 2 s).
   add_test(NAME grain.heat_log

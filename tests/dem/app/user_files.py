@@ -1,0 +1,189 @@
+#!/usr/bin/env python3
+"""What a user's files and folders may not silently do (docs/scene-reference.md, "Files").
+
+    user_files.py GRAIN WORKDIR
+
+Each case writes a small scene (50 beads dropped on a floor), runs grain and checks its exit
+code, its message and what is on disk afterwards:
+  * overwrite_csv: a CSV insertion named log.csv in the output folder '.': refused (exit 1),
+    naming the file and the output folder, the CSV unchanged (its bytes);
+  * overwrite_snapshot: a snapshot insertion out/particles_000001.h5 with the output in out/:
+    refused, unchanged; with --output elsewhere the same scene runs;
+  * second_document: keys after a '---' line: refused (exit 2) at that line, not dropped;
+  * tilde: '~' in output.directory and in --output=~/x: refused (exit 2), no folder '~' made;
+  * input_named: `grain check` and `grain run` name each particle file they read with its
+    absolute path;
+  * help: `grain run --help` and `grain check --help` print the usage, exit 0;
+  * restart_at_end: a restart whose time.end is the checkpoint's time runs nothing and leaves
+    log.csv, particles.xdmf and every snapshot as they were (bytes), where it had cut the log
+    back to the checkpoint.
+"""
+import hashlib
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+SCENE = """domain: {{min: [0, 0, 0], max: [0.01, 0.01, 0.02], periodic: [true, true, false]}}
+gravity: [0, 0, -9.81]
+time: {{rayleigh_fraction: 0.2, end: {end}}}
+materials: [{{name: glass, youngs_modulus: 5e6, poisson_ratio: 0.25, density: 2500}}]
+interactions: [{{materials: [glass, glass], restitution: 0.5, friction: 0.3}}]
+contact: {{normal: hertz, tangential: history}}
+walls: [{{type: plane, name: floor, point: [0, 0, 0], normal: [0, 0, 1], material: glass}}]
+insert:
+{insert}
+output: {{directory: {directory}, progress: false, snapshot_interval: 0.001{extra}}}
+"""
+FILL = ("  - {type: fill, region: {box: {min: [0, 0, 0.001], max: [0.01, 0.01, 0.019]}}, "
+        "count: 50, material: glass, radius: 4e-4}")
+CSV = "x,y,z,radius\n0.005,0.005,0.005,4e-4\n0.005,0.005,0.006,4e-4\n"
+
+failures = []
+
+
+def fail(case, message):
+    failures.append(f"{case}: {message}")
+    print(f"FAIL {case}: {message}")
+
+
+def scene(folder, name="scene.yaml", insert=FILL, directory="out", end=0.004, extra=""):
+    text = SCENE.format(insert=insert, directory=directory, end=end, extra=extra)
+    with open(os.path.join(folder, name), "w") as out:
+        out.write(text)
+    return text
+
+
+def grain(folder, *args):
+    p = subprocess.run([GRAIN, *args], cwd=folder, capture_output=True, text=True, timeout=120)
+    return p.returncode, p.stdout + p.stderr
+
+
+def digest(path):
+    with open(path, "rb") as f:
+        return hashlib.sha256(f.read()).hexdigest()
+
+
+def fresh(case):
+    folder = os.path.join(WORK, case)
+    shutil.rmtree(folder, ignore_errors=True)
+    os.makedirs(folder)
+    return folder
+
+
+def expect(case, got, code, pattern):
+    rc, out = got
+    if rc != code or not re.search(pattern, out):
+        fail(case, f"exit {rc} (expected {code}), output does not match {pattern!r}:\n{out}")
+
+
+def overwrite_csv():
+    case = "overwrite_csv"
+    d = fresh(case)
+    with open(os.path.join(d, "log.csv"), "w") as out:
+        out.write(CSV)
+    scene(d, insert="  - {type: csv, file: log.csv, material: glass}", directory='"."')
+    before = digest(os.path.join(d, "log.csv"))
+    for command in (["run", "scene.yaml"], ["check", "scene.yaml"]):
+        expect(case, grain(d, *command), 1,
+               r"scene\.yaml:9: error: the CSV file 'log\.csv' is in the output folder '\.' under "
+               r"a name the run writes there: the run would overwrite it")
+    if digest(os.path.join(d, "log.csv")) != before:
+        fail(case, "the CSV was changed")
+
+
+def overwrite_snapshot():
+    case = "overwrite_snapshot"
+    d = fresh(case)
+    scene(d, name="stage1.yaml")
+    expect(case, grain(d, "run", "stage1.yaml"), 0, r"done:")
+    scene(d, insert="  - {type: snapshot, file: out/particles_000001.h5}")
+    before = digest(os.path.join(d, "out", "particles_000001.h5"))
+    expect(case, grain(d, "run", "scene.yaml"), 1,
+           r"scene\.yaml:9: error: the snapshot file 'out/particles_000001\.h5' is in the output "
+           r"folder 'out' under a name the run writes there")
+    if digest(os.path.join(d, "out", "particles_000001.h5")) != before:
+        fail(case, "the snapshot was changed")
+    expect(case, grain(d, "run", "scene.yaml", "--output", "stage2"), 0, r"done:")
+
+
+def second_document():
+    case = "second_document"
+    d = fresh(case)
+    text = scene(d)
+    with open(os.path.join(d, "scene.yaml"), "w") as out:
+        out.write(text.replace("gravity:", "---\ngravity:"))
+    expect(case, grain(d, "check", "scene.yaml"), 2,
+           r"scene\.yaml:3:1: error: a second YAML document starts here \(after a '---' line\)")
+
+
+def tilde():
+    case = "tilde"
+    d = fresh(case)
+    scene(d, directory='"~/results"')
+    expect(case, grain(d, "check", "scene.yaml"), 2,
+           r"scene\.yaml:10:\d+: error: output\.directory: '~' is not expanded in a scene file")
+    scene(d)
+    expect(case, grain(d, "run", "scene.yaml", "--output=~/results"), 2,
+           r"option '--output': '~' in '~/results' is not expanded")
+    if os.path.exists(os.path.join(d, "~")):
+        fail(case, "a folder named '~' was made")
+
+
+def input_named():
+    case = "input_named"
+    d = fresh(case)
+    os.makedirs(os.path.join(d, "case"))
+    with open(os.path.join(d, "case", "beads.csv"), "w") as out:
+        out.write(CSV)
+    scene(os.path.join(d, "case"), insert="  - {type: csv, file: beads.csv, material: glass}")
+    path = re.escape(os.path.join(os.path.realpath(d), "case", "beads.csv"))
+    for command in ("check", "run"):  # from the folder above the scene's
+        expect(case, grain(d, command, "case/scene.yaml"), 0,
+               r"input: case/scene\.yaml:9 reads " + path + r" \(modified \d{4}-\d\d-\d\d ")
+
+
+def help_option():
+    case = "help"
+    d = fresh(case)
+    for command in ("run", "check"):
+        expect(case, grain(d, command, "--help"), 0, r"^usage: grain <command>")
+
+
+def restart_at_end():
+    case = "restart_at_end"
+    d = fresh(case)
+    scene(d, end=0.004, extra=", checkpoint_interval: 0.002")
+    expect(case, grain(d, "run", "scene.yaml"), 0, r"done:")
+    out = os.path.join(d, "out")
+    checkpoints = sorted(n for n in os.listdir(out) if n.startswith("checkpoint_"))
+    if not checkpoints:
+        fail(case, "no checkpoint written")
+        return
+    first = os.path.join("out", checkpoints[0])
+    files = sorted(n for n in os.listdir(out) if not n.startswith("."))
+    before = {n: digest(os.path.join(out, n)) for n in files}
+    # The checkpoint's time as the new end: its step is the nearest whole number of steps.
+    import h5py
+    with h5py.File(os.path.join(d, first), "r") as f:
+        t = float(f.attrs["time"])
+    scene(d, end=repr(t), extra=", checkpoint_interval: 0.002")
+    expect(case, grain(d, "run", "scene.yaml", "--restart", first), 0,
+           r"nothing to run, nothing in out changed")
+    after = {n: digest(os.path.join(out, n)) for n in sorted(os.listdir(out))
+             if not n.startswith(".")}
+    if after != before:
+        changed = sorted(n for n in set(before) | set(after) if before.get(n) != after.get(n))
+        fail(case, f"files changed: {changed}")
+
+
+if __name__ == "__main__":
+    GRAIN, WORK = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
+    os.makedirs(WORK, exist_ok=True)
+    for check in (overwrite_csv, overwrite_snapshot, second_document, tilde, input_named,
+                  help_option, restart_at_end):
+        check()
+    if failures:
+        sys.exit(f"{len(failures)} failure(s)")
+    print("all user-file checks hold")
