@@ -249,7 +249,17 @@ std::vector<std::pair<std::string, std::string>> model_entries(const std::string
 void check_model(const std::string& written, const Scene& scene,
                  const std::string& checkpoint_file) {
   if (written == scene.model_record) return;
-  const auto was = model_entries(written), is = model_entries(scene.model_record);
+  auto was = model_entries(written), is = model_entries(scene.model_record);
+  // A checkpoint from before mesh walls were recorded by content (walls[k].file = <name>):
+  // compared without the mesh files.
+  const auto mesh_line = [](const auto& e, const char* field) {
+    return e.first.starts_with("walls[") && e.first.ends_with(field);
+  };
+  if (std::none_of(was.begin(), was.end(),
+                   [&](const auto& e) { return mesh_line(e, "].file_content"); })) {
+    std::erase_if(was, [&](const auto& e) { return mesh_line(e, "].file"); });
+    std::erase_if(is, [&](const auto& e) { return mesh_line(e, "].file_content"); });
+  }
   const auto value_in = [](const auto& entries, const std::string& path) -> const std::string* {
     for (const auto& [p, v] : entries)
       if (p == path) return &v;
@@ -272,6 +282,17 @@ void check_model(const std::string& written, const Scene& scene,
     }
   if (path.empty()) return;  // the same entries in another order: the same model
   std::ostringstream o;
+  if (path.starts_with("walls[") && path.ends_with("].file_content")) {
+    const std::size_t k = std::stoul(path.substr(6));
+    const std::string file = k < scene.walls.size() ? scene.walls[k].mesh.file : std::string("?");
+    o << where << ": error: the STL file '" << file << "' of walls[" << k << "] is not the one "
+      << "the run that wrote checkpoint '" << checkpoint_file << "' read (" << here << " here, "
+      << there
+      << " then). A restart continues that run with its walls: restore that file (moved or "
+         "renamed is fine, its contents count), or start the changed scene afresh (to keep the "
+         "run's particles, insert its last snapshot with `type: snapshot`)";
+    throw StateError(o.str());
+  }
   o << where << ": error: " << path << " is " << here << " here, " << there
     << " in the run that wrote checkpoint '" << checkpoint_file
     << "'. A restart continues that run as it was, with its model (domain, gravity, materials, "

@@ -18,6 +18,8 @@
 #include <charconv>
 #include <climits>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
@@ -1276,6 +1278,38 @@ void add_model_lines(const YAML::Node& node, const std::string& path, const Sour
   s.model_sources.push_back(where.str());
 }
 
+// A mesh wall's STL file enters the model by its contents, not its name: the line
+// "walls[k].file = <name>" becomes "walls[k].file_content = <FNV-1a 64 digest>, <bytes> bytes"
+// (same position, same source line), so that a restart refuses a changed mesh and accepts the
+// same file moved or renamed (check_model).
+void record_mesh_contents(Scene& s) {
+  std::string record;
+  std::istringstream lines(s.model_record);
+  for (std::string line; std::getline(lines, line);) {
+    for (std::size_t k = 0; k < s.walls.size(); ++k) {
+      const std::string key = "walls[" + std::to_string(k) + "].file = ";
+      if (s.walls[k].kind != Wall::Kind::mesh || !line.starts_with(key)) continue;
+      std::ifstream in(s.walls[k].mesh.file, std::ios::binary);
+      std::uint64_t digest = 14695981039346656037ull;  // FNV-1a, 64 bit
+      std::uint64_t bytes = 0;
+      char buffer[1 << 16];
+      while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
+        for (std::streamsize i = 0; i < in.gcount(); ++i) {
+          digest ^= static_cast<unsigned char>(buffer[i]);
+          digest *= 1099511628211ull;
+        }
+        bytes += static_cast<std::uint64_t>(in.gcount());
+      }
+      char hex[17];
+      std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(digest));
+      line = "walls[" + std::to_string(k) + "].file_content = fnv1a64 " + hex + ", " +
+             std::to_string(bytes) + " bytes";
+    }
+    record += line + "\n";
+  }
+  s.model_record = record;
+}
+
 Scene build_scene(const Field& root) {
   if (!root.node().IsDefined() || root.node().IsNull())
     root.fail("the scene is empty; it needs at least domain, time, materials and contact");
@@ -1328,6 +1362,7 @@ Scene build_scene(const Field& root) {
   for (const char* section : {"domain", "gravity", "materials", "interactions",
                               "interaction_defaults", "contact", "walls", "heat", "fluid"})
     if (const auto f = top.find(section)) add_model_lines(f->node(), section, root.source(), s);
+  record_mesh_contents(s);
   // The Rayleigh time needs the elastic constants of every material a particle uses.
   if (s.time.rayleigh_fraction)
     for (const Material& mat : s.materials)

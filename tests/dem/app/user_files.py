@@ -14,6 +14,8 @@ code, its message and what is on disk afterwards:
   * input_named: `grain check` and `grain run` name each particle file they read with its
     absolute path;
   * help: `grain run --help` and `grain check --help` print the usage, exit 0;
+  * restart_mesh: a mesh wall's STL file moved to another folder restarts; its contents
+    changed, the restart is refused naming the file (it had run on with the new mesh);
   * restart_at_end: a restart whose time.end is the checkpoint's time runs nothing and leaves
     log.csv, particles.xdmf and every snapshot as they were (bytes), where it had cut the log
     back to the checkpoint.
@@ -178,11 +180,60 @@ def restart_at_end():
         fail(case, f"files changed: {changed}")
 
 
+PLATE = """solid plate
+facet normal 0 0 1
+ outer loop
+  vertex -1 -1 0
+  vertex 1 -1 0
+  vertex 1 1 0
+ endloop
+endfacet
+facet normal 0 0 1
+ outer loop
+  vertex -1 -1 0
+  vertex 1 1 0
+  vertex -1 1 0
+ endloop
+endfacet
+endsolid plate
+"""
+
+
+def restart_mesh():
+    """A mesh wall is in the model by its file's contents: the same file moved restarts, a
+    changed one is refused naming it."""
+    case = "restart_mesh"
+    d = fresh(case)
+    with open(os.path.join(d, "plate.stl"), "w") as out:
+        out.write(PLATE)
+    text = scene(d, extra=", checkpoint_interval: 0.002")
+    wall = "walls: [{type: plane, name: floor, point: [0, 0, 0], normal: [0, 0, 1], material: glass}]"
+    mesh = ("walls: [{type: mesh, name: floor, file: %s, scale: 0.01, translate: [0.005, 0.005, 0], "
+            "material: glass}]")
+    with open(os.path.join(d, "scene.yaml"), "w") as out:
+        out.write(text.replace(wall, mesh % "plate.stl"))
+    expect(case, grain(d, "run", "scene.yaml"), 0, r"done:")
+    checkpoint = os.path.join("out", sorted(n for n in os.listdir(os.path.join(d, "out"))
+                                            if n.startswith("checkpoint_"))[0])
+    os.makedirs(os.path.join(d, "meshes"))
+    shutil.move(os.path.join(d, "plate.stl"), os.path.join(d, "meshes", "floor.stl"))
+    with open(os.path.join(d, "scene.yaml"), "w") as out:
+        out.write(text.replace(wall, mesh % "meshes/floor.stl"))
+    expect(case, grain(d, "run", "scene.yaml", "--output", "moved", "--restart", checkpoint), 0,
+           r"done:")
+    with open(os.path.join(d, "meshes", "floor.stl"), "w") as out:
+        out.write(PLATE.replace("1 1 0", "0.6 0.6 0"))
+    expect(case, grain(d, "run", "scene.yaml", "--output", "changed", "--restart", checkpoint), 1,
+           r"scene\.yaml:7: error: the STL file '[^']*meshes/floor\.stl' of walls\[0\] is not the "
+           r"one the run that wrote checkpoint '[^']*' read \(fnv1a64 [0-9a-f]{16}, \d+ bytes here, "
+           r"fnv1a64 [0-9a-f]{16}, \d+ bytes then\)\. A restart continues that run with its walls")
+
+
 if __name__ == "__main__":
     GRAIN, WORK = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
     os.makedirs(WORK, exist_ok=True)
     for check in (overwrite_csv, overwrite_snapshot, second_document, tilde, input_named,
-                  help_option, restart_at_end):
+                  help_option, restart_at_end, restart_mesh):
         check()
     if failures:
         sys.exit(f"{len(failures)} failure(s)")
