@@ -37,11 +37,42 @@ long step_of(const std::string& name, const std::string& suffix) {
   return step;
 }
 
+// The lines of a model record, sorted: the same model in another order compares equal.
+std::vector<std::string> sorted_lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    lines.push_back(text.substr(start, end - start));
+    start = end + 1;
+  }
+  std::sort(lines.begin(), lines.end());
+  return lines;
+}
+
 }  // namespace
 
+bool CheckpointSeries::is_foreign(const std::string& path) const {
+  if (!record_.empty()) {
+    const std::optional<std::string> theirs = read_checkpoint_insertions(path);
+    if (theirs && *theirs != record_) return true;
+  }
+  if (!model_.empty()) {
+    const std::optional<std::string> theirs = read_checkpoint_model(path);
+    if (theirs && sorted_lines(*theirs) != sorted_lines(model_)) return true;
+  }
+  return false;
+}
+
 CheckpointSeries::CheckpointSeries(MPI_Comm comm, std::string directory, int keep,
-                                   long adopt_up_to_step, const std::string& record)
-    : comm_(comm), directory_(std::move(directory)), keep_(std::max(1, keep)) {
+                                   long adopt_up_to_step, const std::string& record,
+                                   const std::string& model)
+    : comm_(comm),
+      directory_(std::move(directory)),
+      keep_(std::max(1, keep)),
+      record_(record),
+      model_(model) {
   MPI_Comm_rank(comm_, &rank_);
   std::vector<std::string> found;
   std::error_code ec;
@@ -49,9 +80,7 @@ CheckpointSeries::CheckpointSeries(MPI_Comm comm, std::string directory, int kee
     const std::string name = e.path().filename().string();
     const long step = step_of(name, "");
     if (adopt_up_to_step >= 0 && step >= 0 && step <= adopt_up_to_step) {
-      const std::optional<std::string> theirs =
-          record.empty() ? std::nullopt : read_checkpoint_insertions(e.path().string());
-      if (theirs && *theirs != record)
+      if (is_foreign(e.path().string()))
         foreign_.push_back(e.path().string());
       else
         found.push_back(e.path().string());
@@ -75,9 +104,19 @@ CheckpointSeries::CheckpointSeries(MPI_Comm comm, std::string directory, int kee
 
 std::string CheckpointSeries::write(Simulation& sim) {
   const std::string path = (fs::path(directory_) / file_name(sim.counters().steps)).string();
+  // Another scene's checkpoint under this name (beyond the adopted step): written over, said.
+  std::string over;
+  if (rank_ == 0 && std::find(files_.begin(), files_.end(), path) == files_.end()) {
+    std::error_code ec;
+    if (fs::exists(path, ec) && is_foreign(path)) over = path;
+  }
   sim.write_checkpoint(path);  // <path>.part, then renamed: complete before anything is deleted
   newest_ = path;
   warning_.clear();
+  if (!over.empty())
+    warning_ = "note: wrote this run's checkpoint over " + over +
+               ", which another scene's run had written (its record of insertions or model "
+               "differs): give each run its own --output";
   if (rank_ == 0) {
     if (files_.empty() || files_.back() != path) files_.push_back(path);
     while (static_cast<int>(files_.size()) > keep_) {

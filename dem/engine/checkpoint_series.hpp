@@ -18,11 +18,13 @@ class CheckpointSeries {
   // step <= it count as the series' oldest members. Files of other runs are left alone.
   // Partial checkpoints (checkpoint_<step>.h5.part) that a killed run left behind are
   // deleted: they are never complete checkpoints (see removed_partial()).
-  // With `record` (the scene's insertion_record, dem/engine/insertion_record.hpp), a checkpoint
-  // whose own record differs was written by another scene's run: it is not adopted, so never
-  // deleted (see foreign()); a checkpoint without a record predates it and is adopted.
+  // With `record` (the scene's insertion_record, dem/engine/insertion_record.hpp) and `model`
+  // (Scene::model_record), a checkpoint whose own record or model (its lines in any order)
+  // differs was written by another scene's run: it is not adopted, so never deleted (see
+  // foreign()); a checkpoint without a record predates it and is adopted. A later write over
+  // such a file under the same name says so in warning().
   CheckpointSeries(MPI_Comm comm, std::string directory, int keep, long adopt_up_to_step = -1,
-                   const std::string& record = {});
+                   const std::string& record = {}, const std::string& model = {});
 
   // Collective: writes the checkpoint of the simulation's current step (which also rebuilds
   // its neighbour lists, see Simulation::write_checkpoint), then deletes the
@@ -53,6 +55,9 @@ class CheckpointSeries {
   std::string warning_;
   std::vector<std::string> removed_partial_;
   std::vector<std::string> foreign_;
+  std::string record_, model_;
+  // Whether the checkpoint at `path` was written by another scene's run (see the constructor).
+  bool is_foreign(const std::string& path) const;
 };
 
 }  // namespace grainflow

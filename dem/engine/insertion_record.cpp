@@ -173,6 +173,13 @@ std::uint64_t scene_fingerprint(const Scene& scene) {
   std::string text = insertion_record(scene);
   for (const Material& m : scene.materials)
     text += m.name + " " + number(m.density) + " " + number(m.coarse_grain) + "\n";
+  // The model (gravity, walls, contact, ...), its lines sorted: a run with other physics is
+  // another run, whose snapshots a restart must not take over.
+  std::vector<std::string> model;
+  std::istringstream lines(scene.model_record);
+  for (std::string line; std::getline(lines, line);) model.push_back(line);
+  std::sort(model.begin(), model.end());
+  for (const std::string& line : model) text += line + "\n";
   std::uint64_t h = 14695981039346656037ull;  // FNV-1a, 64 bits
   for (const unsigned char c : text) {
     h ^= c;

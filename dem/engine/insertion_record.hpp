@@ -21,10 +21,11 @@ namespace grainflow {
 // run and its restart, and those insertions have been read into the state already.
 std::string insertion_record(const Scene& scene);
 
-// A 64-bit hash (FNV-1a) of insertion_record(scene) and each material's name, density and
-// coarse-graining factor: the same for every run of the same scene (whatever its output, time
-// or parallel settings), different for another scene's run. Each snapshot carries it (root
-// attribute `scene_fingerprint`), so that a restart continues only its own run's snapshot series.
+// A 64-bit hash (FNV-1a) of insertion_record(scene), each material's name, density and
+// coarse-graining factor, and the model record's lines (sorted): the same for every run of the same
+// scene (whatever its output, time or parallel settings), different for another scene's run. Each
+// snapshot carries it (root attribute `scene_fingerprint`), so that a restart continues only its
+// own run's snapshot series.
 std::uint64_t scene_fingerprint(const Scene& scene);
 
 // Throws StateError (restored_state.hpp) when `written`, the record of the checkpoint

@@ -226,8 +226,14 @@ void check_checkpoint(const CheckpointData& d, const Scene& scene, std::size_t w
   if (d.removed < 0)
     attribute("removed",
               "the count of removed particles " + std::to_string(d.removed) + " is negative");
-  // The skin Simulation::initialise will choose, from the same radii.
-  const double drift = 0.5 * scene.neighbour.skin.value_or(0.4 * r_max);
+  // The skin Simulation::initialise will choose, from the same radii, or the run's when larger:
+  // its centres drifted by up to half of it (a restart with a smaller skin had refused them).
+  if (d.skin && !(std::isfinite(*d.skin) && *d.skin > 0 &&
+                  *d.skin <= (scene.domain.hi - scene.domain.lo).maxCoeff()))
+    attribute("skin", "the neighbour skin " + number(*d.skin) +
+                          " m is not a positive finite length within the domain's longest side");
+  const double drift =
+      0.5 * std::max(scene.neighbour.skin.value_or(0.4 * r_max), d.skin.value_or(0.0));
   const Domain& dom = scene.domain;
   for (std::size_t i = 0; i < p.size(); ++i) {
     const double slack = std::max(p.radius[i], drift);

@@ -542,10 +542,12 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   sim.set_log_record(&log.record());  // each checkpoint keeps the log up to its step
   ProgressLine progress(comm, scene.time.end, options.progress && scene.output.progress, out);
   CheckpointSeries checkpoints(comm, dir, scene.output.checkpoint_keep,
-                               options.restart ? first_step : -1, insertion_record(scene));
+                               options.restart ? first_step : -1, insertion_record(scene),
+                               scene.model_record);
   for (const std::string& other : checkpoints.foreign())
     say << "note: " << other
-        << " was written by another scene's run (its record of insertions differs): not part "
+        << " was written by another scene's run (its record of insertions or model differs): "
+           "not part "
            "of this run's checkpoints, never deleted by it\n";
   for (const std::string& partial : checkpoints.removed_partial())
     say << "note: deleted the partial checkpoint " << partial

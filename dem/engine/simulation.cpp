@@ -822,7 +822,7 @@ void Simulation::restore(const CheckpointData& checkpoint) {
     throw StateError(checkpoint.file +
                      ": error: the root group's attributes (time, dt, step, next_id, rebuilds, "
                      "material_coarse_grain, material_real, wall_impulse, largest_radius, "
-                     "removed) do not match their "
+                     "removed, skin) do not match their "
                      "checksum, attribute 'attributes_checksum' (" +
                      sums +
                      "): the checkpoint was changed or damaged after it was written; restart "
@@ -838,7 +838,10 @@ void Simulation::write_checkpoint(const std::string& path) {
   d.dt = dt_;
   d.step = counters_.steps;
   d.rebuilds = counters_.rebuilds;
-  if (initialised_) d.largest_radius = largest_radius_;
+  if (initialised_) {
+    d.largest_radius = largest_radius_;
+    d.skin = skin_;
+  }
   d.removed = counters_.removed;
   MPI_Allreduce(MPI_IN_PLACE, &d.removed, 1, MPI_LONG, MPI_SUM, comm_);
   d.next_id = next_id_;

@@ -233,6 +233,9 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
             write_attribute(fail, f.id(), "removed", H5T_NATIVE_LLONG, removed),
         "writing the attributes largest_radius, removed");
   }
+  if (fail.ok() && d.skin)
+    fail.check(write_attribute(fail, f.id(), "skin", H5T_NATIVE_DOUBLE, *d.skin),
+               "writing the attribute skin");
   if (fail.ok()) {
     const std::uint32_t sum = attributes_checksum(d);
     fail.check(write_attribute(fail, f.id(), "attributes_checksum", H5T_NATIVE_UINT32, sum),
@@ -397,6 +400,7 @@ void write_checkpoint(MPI_Comm comm, const std::string& path, const CheckpointDa
     d.next_id = local.next_id;
     d.rebuilds = local.rebuilds;
     d.largest_radius = local.largest_radius;
+    d.skin = local.skin;
     d.removed = local.removed;
     d.streams = local.streams;
     d.insertions = local.insertions;
@@ -431,14 +435,18 @@ void write_checkpoint(MPI_Comm comm, const std::string& path, const CheckpointDa
                       "; its partial file was deleted and no earlier checkpoint was touched");
 }
 
-std::optional<std::string> read_checkpoint_insertions(const std::string& path) {
+namespace {
+
+// The text dataset `name` ("/group/set") of the checkpoint at `path`; empty when the file
+// cannot be read or holds no such dataset.
+std::optional<std::string> read_checkpoint_text(const std::string& path, const char* group,
+                                                const char* name) {
   const QuietHdf5Errors quiet;
   const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   if (f < 0) return std::nullopt;
   std::optional<std::string> out;
-  if (H5Lexists(f, "streams", H5P_DEFAULT) > 0 &&
-      H5Lexists(f, "/streams/insertions", H5P_DEFAULT) > 0) {
-    const hid_t set = H5Dopen2(f, "/streams/insertions", H5P_DEFAULT);
+  if (H5Lexists(f, group, H5P_DEFAULT) > 0 && H5Lexists(f, name, H5P_DEFAULT) > 0) {
+    const hid_t set = H5Dopen2(f, name, H5P_DEFAULT);
     const hid_t space = set >= 0 ? H5Dget_space(set) : -1;
     const hssize_t n = space >= 0 ? H5Sget_simple_extent_npoints(space) : -1;
     if (n >= 0) {
@@ -451,6 +459,16 @@ std::optional<std::string> read_checkpoint_insertions(const std::string& path) {
   }
   H5Fclose(f);
   return out;
+}
+
+}  // namespace
+
+std::optional<std::string> read_checkpoint_insertions(const std::string& path) {
+  return read_checkpoint_text(path, "streams", "/streams/insertions");
+}
+
+std::optional<std::string> read_checkpoint_model(const std::string& path) {
+  return read_checkpoint_text(path, "scene", "/scene/model");
 }
 
 std::uint32_t attributes_checksum(const CheckpointData& d) {
@@ -473,6 +491,7 @@ std::uint32_t attributes_checksum(const CheckpointData& d) {
     put(*d.largest_radius);
     put(static_cast<std::int64_t>(d.removed));
   }
+  if (d.skin) put(*d.skin);
   return fletcher32(bytes.data(), bytes.size());
 }
 
@@ -518,6 +537,11 @@ CheckpointData read_checkpoint(const std::string& path) {
       attr("removed", H5T_NATIVE_LLONG, &removed);
       d.largest_radius = r;
       d.removed = static_cast<long>(removed);
+    }
+    if (error.empty() && H5Aexists(f, "skin") > 0) {  // optional: files written before it
+      double skin = 0;
+      attr("skin", H5T_NATIVE_DOUBLE, &skin);
+      d.skin = skin;
     }
     // Optional (written since the parcel classes are checked on restart).
     if (error.empty() && !read_array_attribute(f, "material_coarse_grain", H5T_NATIVE_DOUBLE,

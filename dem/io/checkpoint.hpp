@@ -75,6 +75,11 @@ struct CheckpointData {
   // left the domain continues with the lists of the uninterrupted run. Root attribute
   // `largest_radius`, optional (absent: files written before it, or before the first step).
   std::optional<double> largest_radius;
+  // The Verlet skin the run used (neighbour.skin, or its default), by which a centre may have
+  // drifted past the domain's sides since the last rebuild: a restart with a smaller skin
+  // accepts the run's positions. Root attribute `skin`, optional (absent: files written before
+  // it; written with largest_radius).
+  std::optional<double> skin;
   // Particles that left through a bounded side before this checkpoint, over all ranks: the
   // restart's log and summary count on from it. Root attribute `removed`, optional (0).
   long removed = 0;
@@ -139,5 +144,7 @@ CheckpointData read_checkpoint(const std::string& path);
 // The record of the run's insertions (/streams/insertions) of the checkpoint at `path`, without
 // reading the rest; empty when the file cannot be read or holds no record.
 std::optional<std::string> read_checkpoint_insertions(const std::string& path);
+// The same for the run's model record (/scene/model, Scene::model_record).
+std::optional<std::string> read_checkpoint_model(const std::string& path);
 
 }  // namespace grainflow

@@ -16,6 +16,10 @@ code, its message and what is on disk afterwards:
   * help: `grain run --help` and `grain check --help` print the usage, exit 0;
   * restart_mesh: a mesh wall's STL file moved to another folder restarts; its contents
     changed, the restart is refused naming the file (it had run on with the new mesh);
+  * restart_other_physics: a restart into a folder of a run with another gravity (same
+    insertions) takes over none of its snapshots and keeps its checkpoints;
+  * restart_smaller_skin: a restart with a tenth of the run's neighbour skin ends where the
+    uninterrupted run does (positions to 1e-12 m across the periodic sides);
   * restart_at_end: a restart whose time.end is the checkpoint's time runs nothing and leaves
     log.csv, particles.xdmf and every snapshot as they were (bytes), where it had cut the log
     back to the checkpoint.
@@ -229,11 +233,82 @@ def restart_mesh():
            r"fnv1a64 [0-9a-f]{16}, \d+ bytes then\)\. A restart continues that run with its walls")
 
 
+def restart_other_physics():
+    """A restart into a folder holding a run of the same insertions but another gravity takes
+    over none of its snapshots and neither adopts nor deletes its checkpoints (it had mixed
+    them into its series and deleted them)."""
+    case = "restart_other_physics"
+    d = fresh(case)
+    text = scene(d, extra=", checkpoint_interval: 0.001, checkpoint_keep: 1")
+    expect(case, grain(d, "run", "scene.yaml", "--output", "full"), 0, r"done:")
+    with open(os.path.join(d, "heavy.yaml"), "w") as out:
+        out.write(text.replace("gravity: [0, 0, -9.81]", "gravity: [0, 0, -50]"))
+    expect(case, grain(d, "run", "heavy.yaml", "--output", "heavy"), 0, r"done:")
+    theirs = sorted(n for n in os.listdir(os.path.join(d, "heavy")) if n.startswith("checkpoint_"))
+    first = os.path.join("full", sorted(n for n in os.listdir(os.path.join(d, "full"))
+                                        if n.startswith("checkpoint_"))[0])
+    before = {n: digest(os.path.join(d, "heavy", n)) for n in theirs}
+    expect(case, grain(d, "run", "scene.yaml", "--output", "heavy", "--restart", first), 0,
+           r"heavy/particles_000000\.h5 was written by another scene's run[^\n]*\n"
+           r"(.|\n)*heavy/checkpoint_\d+\.h5 was written by another scene's run \(its record of "
+           r"insertions or model differs\)")
+    left = [n for n in theirs if not os.path.exists(os.path.join(d, "heavy", n))]
+    if left:
+        fail(case, f"the other run's checkpoints {left} were deleted")
+
+
+GAS = """domain: {min: [0, 0, 0], max: [0.01, 0.01, 0.01], periodic: [true, true, true]}
+gravity: [0, 0, 0]
+time: {rayleigh_fraction: 0.15, end: 0.004}
+materials: [{name: glass, youngs_modulus: 5e6, poisson_ratio: 0.3, density: 2500}]
+interactions: [{materials: [glass, glass], restitution: 0.9, friction: 0.3}]
+contact: {normal: hertz, tangential: history}
+neighbour: {skin: SKIN}
+insert:
+  - {type: fill, region: {box: {min: [0, 0, 0], max: [0.01, 0.01, 0.01]}}, count: 100,
+     material: glass, radius: 3e-4, velocity: [3, 2, 1]}
+output: {snapshot_interval: 0.001, checkpoint_interval: 0.001, checkpoint_keep: 10, progress: false}
+"""
+
+
+def restart_smaller_skin():
+    """neighbour may change at a restart: a gas of beads crossing a periodic box restarted
+    with a tenth of the run's skin ends where the uninterrupted run ends (its centres, up to
+    half the run's skin past the sides, had been refused as a damaged checkpoint)."""
+    case = "restart_smaller_skin"
+    d = fresh(case)
+    with open(os.path.join(d, "gas.yaml"), "w") as out:
+        out.write(GAS.replace("SKIN", "0.002"))
+    with open(os.path.join(d, "small.yaml"), "w") as out:
+        out.write(GAS.replace("SKIN", "0.0002"))
+    expect(case, grain(d, "run", "gas.yaml", "--output", "full"), 0, r"done:")
+    import h5py
+    import numpy as np
+    with h5py.File(os.path.join(d, "full", "particles_000004.h5"), "r") as f:
+        order = np.argsort(f["id"][()])
+        x_full, v_full = f["position"][()][order], f["velocity"][()][order]
+    for checkpoint in sorted(n for n in os.listdir(os.path.join(d, "full"))
+                             if n.startswith("checkpoint_")):
+        out = "r" + checkpoint[11:20]
+        expect(case, grain(d, "run", "small.yaml", "--output", out, "--restart",
+                           os.path.join("full", checkpoint)), 0, r"done:")
+        last = sorted(n for n in os.listdir(os.path.join(d, out)) if n.startswith("particles_"))
+        with h5py.File(os.path.join(d, out, last[-1]), "r") as f:
+            order = np.argsort(f["id"][()])
+            dx = f["position"][()][order] - x_full
+            dx -= 0.01 * np.round(dx / 0.01)  # the same point, wrapped at another rebuild
+            dv = f["velocity"][()][order] - v_full
+        if np.abs(dx).max() > 1e-12 or np.abs(dv).max() > 1e-9:
+            fail(case, f"{checkpoint}: ends {np.abs(dx).max():.3g} m, {np.abs(dv).max():.3g} "
+                       "m/s from the uninterrupted run")
+
+
 if __name__ == "__main__":
     GRAIN, WORK = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
     os.makedirs(WORK, exist_ok=True)
     for check in (overwrite_csv, overwrite_snapshot, second_document, tilde, input_named,
-                  help_option, restart_at_end, restart_mesh):
+                  help_option, restart_at_end, restart_mesh,
+                  restart_other_physics, restart_smaller_skin):
         check()
     if failures:
         sys.exit(f"{len(failures)} failure(s)")
