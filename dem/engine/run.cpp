@@ -4,6 +4,7 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <ctime>
 #include <filesystem>
 #include <limits>
@@ -427,10 +428,26 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
                       "': a .part file is a checkpoint that was being written when its run "
                       "was killed, possibly incomplete; restart from a complete "
                       "checkpoint_<step>.h5");
+  if (options.restart &&
+      std::filesystem::path(*options.restart).filename().string().starts_with("particles_"))
+    throw OutputError("cannot restart from '" + *options.restart +
+                      "': it is a snapshot, not a checkpoint (nothing was created or changed); a "
+                      "restart needs a checkpoint_<step>.h5 (output.checkpoint_interval), and a "
+                      "new run starts from a snapshot with the insertion `type: snapshot`");
   Simulation sim(scene, !options.restart, comm);
   std::optional<std::string> checkpoint_log;  // the log table the checkpoint keeps
   if (options.restart) {
     const CheckpointData checkpoint = read_checkpoint(*options.restart);
+    // A checkpoint renamed to another step: said, as "restart from the newest name" would
+    // then go back in time.
+    long named = -1;
+    int used = 0;
+    const std::string name = std::filesystem::path(*options.restart).filename().string();
+    if (std::sscanf(name.c_str(), "checkpoint_%ld.h5%n", &named, &used) == 1 &&
+        used == static_cast<int>(name.size()) && named != checkpoint.step)
+      speaker(comm, out) << "note: " << *options.restart << " holds step " << checkpoint.step
+                         << " (t = " << checkpoint.time << " s), not the step " << named
+                         << " its name says: it was renamed or copied over\n";
     check_restart_step(scene, checkpoint);
     sim.restore(checkpoint);
     checkpoint_log = checkpoint.log;
@@ -504,6 +521,18 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     say << "restart: from " << *options.restart << " at step " << first_step
         << " (t = " << sim.time() << " s); continuing " << dir
         << "/log.csv and the snapshot series after " << kept << " earlier snapshot(s)\n";
+    // Into a folder other than the checkpoint's (its run's): said, with where the run is.
+    std::error_code ec;
+    const auto here = std::filesystem::weakly_canonical(std::filesystem::absolute(dir, ec), ec);
+    const auto there = std::filesystem::weakly_canonical(
+        std::filesystem::absolute(*options.restart, ec).parent_path(), ec);
+    std::string folder = std::filesystem::path(*options.restart).parent_path().string();
+    if (folder.empty()) folder = ".";
+    if (kept == 0 && here != there)
+      say << "note: the checkpoint is in " << folder << ", this restart writes into " << dir
+          << ", which holds none of its run's snapshots: the series here starts at t = "
+          << sim.time() << " s with particles_000000.h5 (to continue the run's own series, "
+          << "restart with --output " << folder << ")\n";
     for (const std::string& gap : snapshots.missing())
       say << "note: " << dir << "/" << gap
           << " is a gap in the snapshot series (deleted or damaged since it was written): "
@@ -748,6 +777,11 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
       << " neighbour rebuilds, " << sum.wall_seconds << " s wall, " << sum.particle_steps_per_second
       << " particle-steps/s\n"
       << "output: " << dir << "/particles.xdmf (open in ParaView), " << dir << "/log.csv\n";
+  // None is written at the end: the newest, and how to extend the run exactly from it.
+  if (sum.stop_checkpoint.empty() && !checkpoints.newest().empty())
+    say << "checkpoint: the newest is " << checkpoints.newest()
+        << " (none is written at time.end); to run longer, raise time.end and continue with: "
+        << continue_command(scene.file, options, ranks, checkpoints.newest()) << "\n";
   if (!scene.coarse_grain_table().empty()) {
     const ParticleTotals end = particle_totals(scene, sim.particles(), comm);
     say << "coarse graining: the " << end.computed << " particles stand for " << end.real

@@ -409,6 +409,8 @@ void read_csv(const Scene& scene, const WallSet* walls, const Insertion& ins, Pa
   std::vector<std::string> header;
   while (header.empty() && std::getline(in, line)) {
     ++lineno;
+    // A UTF-8 byte-order mark (Excel's "CSV UTF-8") before the header: not part of a name.
+    if (lineno == 1 && line.starts_with("\xEF\xBB\xBF")) line.erase(0, 3);
     if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
     header = split_csv(line);
     header_line = lineno;

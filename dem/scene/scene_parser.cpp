@@ -345,6 +345,9 @@ std::string existing_file(const Field& file, const std::string& what) {
   if (fs::is_directory(resolved, ec))
     file.fail(what + " '" + given.string() + "' is a directory ('" + resolved.string() +
               "'), not a file; name the file inside it");
+  if (fs::exists(resolved, ec) && !fs::is_regular_file(resolved, ec))
+    file.fail(what + " '" + given.string() + "' ('" + resolved.string() +
+              "') is not a regular file (a device, a pipe or a socket); name a file");
   if (!fs::is_regular_file(resolved, ec))
     file.fail(what + " '" + given.string() + "' not found (looked for '" + resolved.string() +
               "'); file names are relative to the scene file's folder");
@@ -1392,18 +1395,31 @@ void raise_if_tab_indented(const std::string& text, int error_line, const Source
 }
 
 YAML::Node load_yaml(const std::string& text, const Source& src) {
-  try {
-    // Every document is read: a scene is one, and a `---` line that starts a second would
-    // otherwise drop everything after it without a word.
-    const std::vector<YAML::Node> documents = YAML::LoadAll(text);
-    if (documents.size() > 1) {
-      YAML::Mark at = documents[1].Mark();
-      if (at.line < 0) at = start_of_file();
-      raise(src, at,
-            "a second YAML document starts here (after a '---' line): a scene is one document, "
-            "and the keys after '---' would not be read; remove the '---' line");
+  // A scene is one document: a `---` line after content starts a second one, whose keys
+  // YAML::Load would drop without a word. Found in the text (yaml-cpp's LoadAll loops for
+  // ever on some inputs, such as a lone ',').
+  {
+    std::istringstream lines(text);
+    bool content = false;
+    int n = 0;
+    for (std::string line; std::getline(lines, line); ++n) {
+      const bool marker = line.starts_with("---") && (line.size() == 3 || line[3] == ' ' ||
+                                                      line[3] == '\t' || line[3] == '\r');
+      if (marker && content) {
+        YAML::Mark at = start_of_file();
+        at.line = n;
+        raise(src, at,
+              "a second YAML document starts here (a '---' line after the first one's keys): a "
+              "scene is one document, and the keys after '---' would not be read; remove the "
+              "'---' line");
+      }
+      const std::size_t first = line.find_first_not_of(" \t\r");
+      if (!marker && first != std::string::npos && line[first] != '#' && line[first] != '%')
+        content = true;
     }
-    return documents.empty() ? YAML::Node() : documents.front();
+  }
+  try {
+    return YAML::Load(text);
   } catch (const YAML::DeepRecursion& e) {
     // yaml-cpp stops at a fixed depth (500 in 0.7) instead of overflowing the stack,
     // with only "bad file" as its message.
@@ -1431,7 +1447,9 @@ Scene parse_scene(const std::string& yaml_text, const std::string& file_label) {
 
 Scene load_scene(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in || fs::is_directory(path))
+  if (std::error_code ec; fs::is_directory(path, ec))
+    throw SceneError(path, 0, 0, "is a directory, not a scene file; name the .yaml file in it");
+  if (!in)
     throw SceneError(path, 0, 0,
                      "cannot open the scene file; check the path (relative paths are taken from "
                      "the working directory " +

@@ -10,6 +10,7 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <initializer_list>
 #include <iomanip>
@@ -61,6 +62,29 @@ inline std::size_t edit_distance(std::string_view a, std::string_view b) {
     }
   }
   return row[b.size()];
+}
+
+// " (it holds the character U+200B, at character 5: retype it)" when `name` holds a character
+// outside printable ASCII (a zero-width or non-breaking space pasted in shows as nothing), else "".
+inline std::string hidden_character(std::string_view name) {
+  std::size_t position = 0;
+  for (std::size_t i = 0; i < name.size(); ++position) {
+    const auto c = static_cast<unsigned char>(name[i]);
+    if (c >= 0x20 && c < 0x7f) {
+      ++i;
+      continue;
+    }
+    // One UTF-8 sequence: its code point (a malformed byte is shown as itself).
+    const int extra = c >= 0xf0 ? 3 : c >= 0xe0 ? 2 : c >= 0xc0 ? 1 : 0;
+    unsigned long code = extra == 0 ? c : c & (0x3fu >> extra);
+    for (int k = 1; k <= extra && i + k < name.size(); ++k)
+      code = (code << 6) | (static_cast<unsigned char>(name[i + k]) & 0x3fu);
+    char hex[16];
+    std::snprintf(hex, sizeof hex, "U+%04lX", code);
+    return " (it holds the character " + std::string(hex) + ", at character " +
+           std::to_string(position + 1) + ", which may not show: retype it)";
+  }
+  return "";
 }
 
 // " (did you mean 'hertz'?)" when exactly one candidate is close to `given`, else "".
@@ -193,6 +217,8 @@ class Field {
 
   long long integer(const Range& range) const {
     const std::optional<double> x = as_number(node_);
+    if (x && std::floor(*x) == *x && std::abs(*x) > 9e15)
+      fail("value " + node_.Scalar() + " is too large for a whole number here (at most 9e15)");
     if (!x || std::floor(*x) != *x || std::abs(*x) > 9e15)
       fail("expected a whole number, got " + got() + "; write an integer such as 1000");
     check_range(*x, range);
@@ -293,7 +319,11 @@ class Field {
     if (!node_.IsDefined() || node_.IsNull()) return "nothing";
     if (node_.IsSequence()) return "a list of " + std::to_string(node_.size());
     if (node_.IsMap()) return "a map";
-    return "'" + node_.Scalar() + "'";
+    // A long value (a file pasted in, the wrong file given) is shown by its start.
+    const std::string& text = node_.Scalar();
+    if (text.size() > 80)
+      return "'" + text.substr(0, 60) + "...' (" + std::to_string(text.size()) + " characters)";
+    return "'" + text + "'";
   }
 
  private:
@@ -370,8 +400,8 @@ class Map {
     for (const Entry& e : entries_) {
       if (std::find(allowed.begin(), allowed.end(), e.key) != allowed.end()) continue;
       raise(self_.source(), e.key_mark,
-            "unknown key '" + e.key + "' in " + where() + what +
-                "; allowed keys: " + join(allowed) + suggestion(e.key, allowed));
+            "unknown key '" + e.key + "' in " + where() + what + "; allowed keys: " +
+                join(allowed) + suggestion(e.key, allowed) + hidden_character(e.key));
     }
   }
 
@@ -465,6 +495,10 @@ inline Map Field::map() const {
   for (const auto& key_value : node_) {
     const YAML::Node key = key_value.first;  // copies: the iterator yields temporaries
     if (!key.IsScalar()) raise(*src_, key.Mark(), "a key in " + path_ + " is not a plain name");
+    if (key.Scalar() == "<<" && key.Tag() != "!")
+      raise(*src_, key.Mark(),
+            "YAML merge keys ('<<: *anchor') are not supported in a scene; write the keys out "
+            "(an alias of a whole value, `key: *anchor`, works)");
     if (const auto it = seen.find(key.Scalar()); it != seen.end())
       raise(*src_, key.Mark(),
             "key '" + key.Scalar() + "' is given twice in " +

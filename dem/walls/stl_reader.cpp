@@ -290,6 +290,9 @@ Vec3 MeshTransform::apply(const Vec3& x) const {
 TriangleMesh parse_stl(const std::string& bytes, const std::string& label,
                        const MeshTransform& transform, StlReport* report, double weld_tolerance) {
   std::uint32_t count = 0;
+  // An ASCII STL saved with a UTF-8 byte-order mark (some editors on Windows): read past it.
+  if (bytes.starts_with("\xEF\xBB\xBF") && !looks_binary(bytes, count))
+    return parse_stl(bytes.substr(3), label, transform, report, weld_tolerance);
   const std::size_t first = bytes.find_first_not_of(" \t\r\n");
   std::vector<RawTriangle> raw;
   StlReport rep;

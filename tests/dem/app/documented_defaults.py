@@ -170,6 +170,8 @@ def normalised_report(text):
             continue
         progress = False
         line = re.sub(r", [0-9.e+-]+ s wall, [0-9.e+-]+ particle-steps/s", ", <wall>", line)
+        # The particle files read, by their folder (each run has its own) and time written.
+        line = re.sub(r"^(input: \S+ reads ).*/([^/]+) \(modified [^)]*\)$", r"\1\2", line)
         out.append(line)
     return "\n".join(out)
 

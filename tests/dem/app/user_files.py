@@ -20,6 +20,12 @@ code, its message and what is on disk afterwards:
     insertions) takes over none of its snapshots and keeps its checkpoints;
   * restart_smaller_skin: a restart with a tenth of the run's neighbour skin ends where the
     uninterrupted run does (positions to 1e-12 m across the periodic sides);
+  * hostile_text: a CSV and an ASCII STL with a UTF-8 byte-order mark are read; an invisible
+    character in a key is named by its code point; merge keys, a 200 000-character value, a
+    count of 1e20, a device as the particle file and a folder as the scene get clear errors;
+  * restart_advice: the summary's "continue with" command, time.end raised, ends bit for bit
+    where one longer run ends; a restart into another folder says so; a snapshot given to
+    --restart is named as one;
   * restart_at_end: a restart whose time.end is the checkpoint's time runs nothing and leaves
     log.csv, particles.xdmf and every snapshot as they were (bytes), where it had cut the log
     back to the checkpoint.
@@ -121,7 +127,7 @@ def second_document():
     with open(os.path.join(d, "scene.yaml"), "w") as out:
         out.write(text.replace("gravity:", "---\ngravity:"))
     expect(case, grain(d, "check", "scene.yaml"), 2,
-           r"scene\.yaml:3:1: error: a second YAML document starts here \(after a '---' line\)")
+           r"scene\.yaml:2:1: error: a second YAML document starts here \(a '---' line after")
 
 
 def tilde():
@@ -303,12 +309,96 @@ def restart_smaller_skin():
                        "m/s from the uninterrupted run")
 
 
+def hostile_text():
+    """Text a user's tools leave in files: a byte-order mark (CSV and ASCII STL, read past),
+    an invisible character in a key (named by its code point), a merge key, a value pasted
+    whole (shown by its start), a number too large to count, odd paths."""
+    case = "hostile_text"
+    d = fresh(case)
+    with open(os.path.join(d, "beads.csv"), "w", encoding="utf-8-sig") as out:
+        out.write(CSV)
+    with open(os.path.join(d, "plate.stl"), "w", encoding="utf-8-sig") as out:
+        out.write(PLATE)
+    csv = "  - {type: csv, file: beads.csv, material: glass}"
+    text = scene(d, insert=csv)
+    wall = "walls: [{type: plane, name: floor, point: [0, 0, 0], normal: [0, 0, 1], material: glass}]"
+    with open(os.path.join(d, "scene.yaml"), "w") as out:
+        out.write(text.replace(wall, "walls: [{type: mesh, name: floor, file: plate.stl, scale: "
+                                     "0.01, translate: [0.005, 0.005, 0], material: glass}]"))
+    expect(case, grain(d, "check", "scene.yaml"), 0, r"particles: 2\b")
+
+    def refused(name, new_text, pattern, code=2, command="check"):
+        with open(os.path.join(d, name), "w") as out:
+            out.write(new_text)
+        got = grain(d, command, name)
+        expect(case + ":" + name, got, code, pattern)
+        if len(got[1]) > 5000:
+            fail(case + ":" + name, f"the message is {len(got[1])} characters long")
+
+    refused("hidden.yaml", text.replace("density: 2500", "dens\u200bity: 2500"),
+            r"unknown key 'dens.*ity' in materials\[0\].*it holds the character U\+200B, at "
+            r"character 5, which may not show: retype it")
+    refused("merge.yaml", text.replace("materials: [{name: glass,",
+                                       "base: &b {poisson_ratio: 0.25}\nmaterials: [{<<: *b, "
+                                       "name: glass,"),
+            r"error: (unknown key 'base'|YAML merge keys)")
+    refused("merge2.yaml", text.replace("materials: [{name: glass,", "materials: [{<<: {x: 1}, "
+                                        "name: glass,"),
+            r"YAML merge keys \('<<: \*anchor'\) are not supported in a scene")
+    refused("long.yaml", text.replace("restitution: 0.5", "restitution: " + "7" * 200000 + "x"),
+            r"got '7{60}\.\.\.' \(200001 characters\)")
+    refused("huge.yaml", text.replace(csv, FILL).replace("count: 50", "count: 1e20"),
+            r"value 1e20 is too large for a whole number here")
+    refused("device.yaml", text.replace("file: beads.csv", "file: /dev/null"),
+            r"'/dev/null' \('/dev/null'\) is not a regular file")
+    os.makedirs(os.path.join(d, "folder.yaml"), exist_ok=True)
+    expect(case, grain(d, "check", "folder.yaml"), 2, r"folder\.yaml: error: is a directory")
+
+
+def restart_advice():
+    """The summary names the newest checkpoint and the command that continues from it; that
+    command, with time.end raised, ends where one longer run ends (bit for bit). A restart
+    into another folder says so; a snapshot given as the checkpoint is named as one."""
+    case = "restart_advice"
+    d = fresh(case)
+    scene(d, name="long.yaml", end=0.006, extra=", checkpoint_interval: 0.0015")
+    expect(case, grain(d, "run", "long.yaml", "--output", "long", "--no-progress"), 0, r"done:")
+    scene(d, end=0.004, extra=", checkpoint_interval: 0.0015")
+    rc, out = grain(d, "run", "scene.yaml", "--no-progress")
+    m = re.search(r"checkpoint: the newest is (out/checkpoint_\d+\.h5) \(none is written at "
+                  r"time\.end\); to run longer, raise time\.end and continue with: (.*)", out)
+    if rc != 0 or not m:
+        fail(case, f"exit {rc}, no checkpoint line:\n{out}")
+        return
+    command = m.group(2).split()
+    if command[0] != GRAIN or command[-2:] != ["--restart", m.group(1)]:
+        fail(case, f"the command is {m.group(2)!r}")
+        return
+    scene(d, end=0.006, extra=", checkpoint_interval: 0.0015")
+    expect(case, grain(d, *command[1:]), 0, r"done:")
+    import h5py
+    import numpy as np
+    last = sorted(n for n in os.listdir(os.path.join(d, "long")) if n.startswith("particles_"))[-1]
+    with h5py.File(os.path.join(d, "long", last), "r") as a, \
+            h5py.File(os.path.join(d, "out", last), "r") as b:
+        if a.attrs["time"] != b.attrs["time"] or not all(
+                np.array_equal(a[k][()], b[k][()]) for k in ("id", "position", "velocity")):
+            fail(case, f"{last}: the extended run is not the longer run bit for bit")
+    expect(case, grain(d, "run", "scene.yaml", "--output", "elsewhere", "--restart", m.group(1)),
+           0, r"note: the checkpoint is in out, this restart writes into elsewhere, which holds "
+              r"none of its run's snapshots")
+    expect(case, grain(d, "run", "scene.yaml", "--output", "x", "--restart",
+                       "out/particles_000002.h5"), 1,
+           r"cannot restart from 'out/particles_000002\.h5': it is a snapshot, not a checkpoint")
+
+
 if __name__ == "__main__":
     GRAIN, WORK = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
     os.makedirs(WORK, exist_ok=True)
     for check in (overwrite_csv, overwrite_snapshot, second_document, tilde, input_named,
                   help_option, restart_at_end, restart_mesh,
-                  restart_other_physics, restart_smaller_skin):
+                  restart_other_physics, restart_smaller_skin, hostile_text,
+                  restart_advice):
         check()
     if failures:
         sys.exit(f"{len(failures)} failure(s)")
