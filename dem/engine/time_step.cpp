@@ -37,7 +37,51 @@ namespace {
 struct PairImpact {
   std::string pair;
   double contact_time, restitution;
+  double r_star = 0, m_star = 0, r_small = 0;  // the pair's, and the radius max_overlap is of
+  const PairCoefficients* coefficients = nullptr;
 };
+
+// The peak overlap of a head-on impact at `v` over the elastic one's, by RK4 of the
+// dimensionless contact (overlap in units of the elastic peak, time of that peak / v):
+//   Hertz: x'' = -(5/4) x^(3/2) - 2.5 b x^(1/4) x'  (b: the dashpot factor hertz_beta),
+//   Hooke: x'' = -x - 2 z x'  (z = g_n / (2 sqrt(k_n m*)), time in sqrt(m*/k_n)),
+// from x = 0, x' = 1 to the turn (x' = 0). 1 without damping; independent of v.
+double peak_overlap_ratio(bool hertz, double damping) {
+  const auto accel = [&](double x, double u) {
+    const double xp = std::max(x, 0.0);
+    return hertz ? -1.25 * xp * std::sqrt(xp) - 2.5 * damping * std::sqrt(std::sqrt(xp)) * u
+                 : -xp - 2 * damping * u;
+  };
+  double x = 0, u = 1;
+  const double h = 1e-3;
+  for (int k = 0; k < 100000 && u > 0; ++k) {
+    const double k1x = u, k1u = accel(x, u);
+    const double k2x = u + 0.5 * h * k1u, k2u = accel(x + 0.5 * h * k1x, u + 0.5 * h * k1u);
+    const double k3x = u + 0.5 * h * k2u, k3u = accel(x + 0.5 * h * k2x, u + 0.5 * h * k2u);
+    const double k4x = u + h * k3u, k4u = accel(x + h * k3x, u + h * k3u);
+    const double x1 = x + h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x);
+    const double u1 = u + h / 6 * (k1u + 2 * k2u + 2 * k3u + k4u);
+    if (u1 <= 0) return x + (x1 - x) * u / (u - u1);  // the turn, between the two steps
+    x = x1;
+    u = u1;
+  }
+  return x;
+}
+
+// The head-on impact speed above which the pair's peak overlap exceeds time.max_overlap of
+// the smaller radius (the overlap guard's stop), with the pair's damping.
+double overlap_guard_speed(const Scene& scene, const ContactConstants& cc, const PairImpact& im) {
+  const double limit = scene.time.max_overlap * im.r_small;
+  const PairCoefficients& pc = *im.coefficients;
+  if (scene.contact.normal == NormalModel::hertz) {
+    // Elastic peak d0 = (15 m* v^2 / (16 Y* sqrt(R*)))^(2/5), the damped one rho d0.
+    const double d0 = limit / peak_overlap_ratio(true, pc.hertz_beta);
+    return std::sqrt(16 * pc.y_star * std::sqrt(im.r_star) * std::pow(d0, 2.5) / (15 * im.m_star));
+  }
+  const SpringDashpot s = HookeNormal::coefficients(pc, cc, im.r_star, im.m_star, 0);
+  const double zeta = s.gn / (2 * std::sqrt(s.kn * im.m_star));
+  return limit / peak_overlap_ratio(false, zeta) * std::sqrt(s.kn / im.m_star);
+}
 
 // Where dt sits on the measured curve (time_step_accuracy.hpp), for the pair whose
 // restitution suffers most (fewest steps per impact, lowest e).
@@ -67,7 +111,7 @@ void accuracy_note(const Scene& scene, TimeStepReport& rep,
   o.precision(3);
   o << "dt = ";
   if (std::isfinite(rep.rayleigh_time)) o << rep.dt / rep.rayleigh_time << " t_R, ";
-  const char* about = acc.coarser_than_measured ? " > " : " ≈ ";
+  const char* about = acc.coarser_than_measured || acc.below_restitution > 0 ? " > " : " ≈ ";
   o << worst->contact_time / rep.dt << " steps per impact: restitution error" << about
     << percent(acc.restitution_rms) << " % (worst" << about << percent(acc.restitution_max)
     << " %), contact-time error" << about << percent(acc.contact_time_rms) << " % (" << worst->pair
@@ -75,7 +119,10 @@ void accuracy_note(const Scene& scene, TimeStepReport& rep,
   const auto [lo, hi] = measured_steps_per_impact(scene.contact.normal);
   if (acc.coarser_than_measured)
     o << "; fewer steps per impact than the measured minimum of " << lo;
-  else if (acc.extrapolated)
+  if (acc.below_restitution > 0)
+    o << "; e is below the lowest measured restitution, " << acc.below_restitution
+      << ": these are its errors, and a lower e has larger ones";
+  else if (acc.extrapolated && !acc.coarser_than_measured)
     o << "; extrapolated beyond the measured " << lo << "-" << hi << " steps per impact";
   o << "; measured, docs/accuracy-vs-cost.md)";
   rep.notes.push_back(o.str());
@@ -141,7 +188,8 @@ TimeStepReport check_time_step(const Scene& scene, const Particles& p, const Pai
       const double ms = mass(a) * mass(b) / (mass(a) + mass(b));
       const double t = pair_contact_time(scene.contact, table(a, b), constants, rs, ms, v);
       const std::string name = scene.materials[a].name + "-" + scene.materials[b].name;
-      impacts.push_back({name, t, table(a, b).restitution});
+      impacts.push_back(
+          {name, t, table(a, b).restitution, rs, ms, std::min(r_min[a], r_min[b]), &table(a, b)});
       if (t < rep.contact_time) {
         rep.contact_time = t;
         contact_pair = name;
@@ -151,7 +199,8 @@ TimeStepReport check_time_step(const Scene& scene, const Particles& p, const Pai
       const double t =
           pair_contact_time(scene.contact, table(a, w.material), constants, r_min[a], mass(a), v);
       const std::string name = scene.materials[a].name + "-wall '" + w.name + "'";
-      impacts.push_back({name, t, table(a, w.material).restitution});
+      impacts.push_back({name, t, table(a, w.material).restitution, r_min[a], mass(a), r_min[a],
+                         &table(a, w.material)});
       if (t < rep.contact_time) {
         rep.contact_time = t;
         contact_pair = name;
@@ -215,6 +264,30 @@ TimeStepReport check_time_step(const Scene& scene, const Particles& p, const Pai
       rep.notes.push_back(o.str());
       o.str("");
       if (v >= v_stop && rep.verdict == TimeStepReport::Verdict::ok)
+        rep.verdict = TimeStepReport::Verdict::warn;
+    }
+    // The overlap guard (time.max_overlap): the slowest head-on impact that stops the run.
+    const PairImpact* first_stop = nullptr;
+    double v_overlap = inf;
+    for (const PairImpact& im : impacts) {
+      if (im.coefficients == nullptr || !std::isfinite(im.contact_time)) continue;
+      const double s = overlap_guard_speed(scene, constants, im);
+      if (s < v_overlap) {
+        v_overlap = s;
+        first_stop = &im;
+      }
+    }
+    if (first_stop != nullptr) {
+      o << "overlap guard: a head-on impact faster than " << v_overlap << " m/s ("
+        << first_stop->pair << ", e = " << first_stop->restitution
+        << ") overlaps by more than time.max_overlap = " << scene.time.max_overlap
+        << " of the smaller radius and stops the run";
+      if (v >= v_overlap)
+        o << "; warning: that is below time.expected_max_speed = " << v
+          << " m/s: raise time.max_overlap, or use a stiffer material (docs/stability.md)";
+      rep.notes.push_back(o.str());
+      o.str("");
+      if (v >= v_overlap && rep.verdict == TimeStepReport::Verdict::ok)
         rep.verdict = TimeStepReport::Verdict::warn;
     }
     const double fr = rep.dt / rep.rayleigh_time;

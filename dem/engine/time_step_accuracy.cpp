@@ -69,7 +69,8 @@ ImpactAccuracy impact_accuracy(NormalModel model, double restitution, double ste
   if (curves.empty()) throw std::logic_error("no measured impact curve for this normal model");
   if (restitution <= curves.front()->restitution) {
     ImpactAccuracy a = on_curve(*curves.front(), steps_per_impact);
-    a.extrapolated = a.extrapolated || restitution < curves.front()->restitution;
+    if (restitution < curves.front()->restitution)
+      a.below_restitution = curves.front()->restitution;
     return a;
   }
   if (restitution >= curves.back()->restitution) return on_curve(*curves.back(), steps_per_impact);

@@ -29,6 +29,9 @@ struct ImpactAccuracy {
   // segment extended, an extrapolation.
   bool coarser_than_measured = false;
   bool extrapolated = false;
+  // e below the lowest measured restitution: the values are that curve's, a lower bound (the
+  // errors grow as e falls).
+  double below_restitution = 0;  // the lowest measured e when below it, else 0
 };
 
 // Errors of an impact of the given model and restitution resolved by `steps_per_impact` steps,

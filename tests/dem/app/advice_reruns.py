@@ -570,6 +570,52 @@ def _(c):
     return f"{len(laws)} laws ({', '.join(laws)}): no warning"
 
 
+def head_on(speed, restitution=0.5, step=1.9e-6, max_overlap=None):
+    """Two 1 mm beads (Y = 50 MPa) meeting head-on at `speed`, no gravity."""
+    time = {"step": step, "end": 3e-4, "expected_max_speed": speed}
+    if max_overlap is not None:
+        time["max_overlap"] = max_overlap
+    gap = 1.02e-3
+    return {
+        "domain": {"min": [-0.02, -0.02, -0.02], "max": [0.02, 0.02, 0.02]},
+        "time": time,
+        "materials": [{"name": "g", "youngs_modulus": 5e7, "poisson_ratio": 0.25,
+                       "density": 2500}],
+        "interactions": [{"materials": ["g", "g"], "restitution": restitution}],
+        "contact": {"normal": "hertz"},
+        "insert": [{"type": "csv", "file": "p.csv", "material": "g"}],
+        "output": {"progress": False},
+    }, {"p.csv": f"x,y,z,radius,vx,vy,vz\n{-gap},0,0,1e-3,{speed},0,0\n{gap},0,0,1e-3,0,0,0\n"}
+
+
+@case("overlap_guard_speed", "warning 'overlap guard: a head-on impact faster than X m/s ... "
+      "stops the run; warning: that is below time.expected_max_speed ...: raise "
+      "time.max_overlap, or use a stiffer material' (dem/engine/time_step.cpp)", "check")
+def _(c):
+    s, files = head_on(20)
+    m = c.expect(c.run("first", s, files=files), 0,
+                 r"overlap guard: a head-on impact faster than " + NUM + r" m/s \(g-g, e = 0\.5\) "
+                 r"overlaps by more than time\.max_overlap = 0\.25 of the smaller radius and stops "
+                 r"the run; warning: that is below time\.expected_max_speed = 20 m/s: raise "
+                 r"time\.max_overlap")
+    v = float(m.group(1))
+    # The speed is the run's: 3 % below it the impact passes, 3 % above it stops the run.
+    for factor, code in ((0.97, 0), (1.03, 1)):
+        s, files = head_on(factor * v)
+        r = c.run(f"run_{factor}", s, command="run", files=files)
+        if r.rc != code or (code == 1 and "overlap" not in r.out):
+            raise Broken(f"an impact at {factor} x {v} m/s exits {r.rc}, expected {code}: "
+                         f"{first_error(r.out)}")
+    # The advice: a larger max_overlap lets the 20 m/s impact through, without the warning.
+    s, files = head_on(20, max_overlap=0.35)
+    c.rerun_passes(c.run("rerun", s, files=files), r"overlap guard:[^\n]*warning", "max_overlap")
+    s, files = head_on(20, max_overlap=0.35)
+    r = c.run("rerun_run", s, command="run", files=files)
+    if r.rc != 0:
+        raise Broken(f"max_overlap 0.35 at 20 m/s: exit {r.rc}: {first_error(r.out)}")
+    return f"{v} m/s: 0.97x passes, 1.03x stops; max_overlap 0.35 runs 20 m/s"
+
+
 @case("drag_ignores_void_fraction", "warning 'fluid.drag: schiller_naumann ... ignores "
       "void_fraction X; a law for beds (...) uses it' (dem/engine/run.cpp)", "check")
 def _(c):
