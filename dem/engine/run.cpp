@@ -721,6 +721,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
       log_step = k;
       log_index = static_cast<long>(std::floor(t / log_every + 0.5));
       global_particles = write_log().particles;
+      sim.recheck_force_limits();  // the fluid forces' limits at the flow reached (collective)
     }
     if (snapshot_due(t, k)) {
       snap_step = k;

@@ -341,32 +341,57 @@ void Simulation::check_mesh_tunnelling(const WallTravelReport& walls, double r_m
   throw SetupError(o.str());
 }
 
-void Simulation::check_force_limits() {
-  force_limits_.clear();
-  force_limit_notes_.clear();
+std::vector<TermLimit> Simulation::gather_force_limits() const {
+  std::vector<TermLimit> limits;
   for (const auto& term : terms_)
-    for (TermLimit& l : term->limits(p_, time_)) force_limits_.push_back(std::move(l));
+    for (TermLimit& l : term->limits(p_, time_)) limits.push_back(std::move(l));
   // The smallest time scale and limit over the ranks, with the particle of the time scale
   // (the same list of terms on every rank).
-  const std::size_t n = force_limits_.size();
+  const std::size_t n = limits.size();
   if (n > 0 && decomp_->size() > 1) {
     std::vector<double> least(2 * n);
     for (std::size_t k = 0; k < n; ++k) {
-      least[2 * k] = force_limits_[k].tau;
-      least[2 * k + 1] = force_limits_[k].dt_max;
+      least[2 * k] = limits[k].tau;
+      least[2 * k + 1] = limits[k].dt_max;
     }
     MPI_Allreduce(MPI_IN_PLACE, least.data(), static_cast<int>(2 * n), MPI_DOUBLE, MPI_MIN, comm_);
     std::vector<std::int64_t> who(n);
     for (std::size_t k = 0; k < n; ++k)
-      who[k] = force_limits_[k].tau == least[2 * k] ? force_limits_[k].particle
-                                                    : std::numeric_limits<std::int64_t>::max();
+      who[k] = limits[k].tau == least[2 * k] ? limits[k].particle
+                                             : std::numeric_limits<std::int64_t>::max();
     MPI_Allreduce(MPI_IN_PLACE, who.data(), static_cast<int>(n), MPI_INT64_T, MPI_MIN, comm_);
     for (std::size_t k = 0; k < n; ++k) {
-      force_limits_[k].tau = least[2 * k];
-      force_limits_[k].dt_max = least[2 * k + 1];
-      force_limits_[k].particle = who[k];
+      limits[k].tau = least[2 * k];
+      limits[k].dt_max = least[2 * k + 1];
+      limits[k].particle = who[k];
     }
   }
+  return limits;
+}
+
+void Simulation::recheck_force_limits() {
+  if (terms_.empty()) return;
+  const std::vector<TermLimit> now = gather_force_limits();  // collective
+  for (const TermLimit& l : now) {
+    if (!(dt_ > l.dt_max)) continue;
+    double at_start = std::numeric_limits<double>::infinity();
+    for (const TermLimit& s : force_limits_)
+      if (s.term == l.term) at_start = s.dt_max;
+    std::ostringstream o;
+    o.precision(4);
+    o << scene_.file << ": error: at t = " << time_ << " s, dt = " << dt_
+      << " s is beyond the stability limit of the fluid force '" << l.term
+      << "' (dt <= " << l.dt_max << " s; " << l.rule << "), set by particle " << l.particle
+      << ": the flow has grown past what the start-up allowed (dt <= " << at_start
+      << " s then); the run stops before the force makes it unstable. Use dt <= " << 0.9 * l.dt_max
+      << " s, or remove '" << l.term << "' from fluid.forces";
+    throw SetupError(o.str());
+  }
+}
+
+void Simulation::check_force_limits() {
+  force_limits_ = gather_force_limits();
+  force_limit_notes_.clear();
   for (const TermLimit& l : force_limits_) {
     std::ostringstream o;
     o.precision(4);

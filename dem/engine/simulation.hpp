@@ -101,6 +101,10 @@ class Simulation {
   std::string force_limits_summary() const;
   // The lines check_force_limits() added to the time-step report (also for runs that do not
   // print the report, the coupled DEM).
+  // Collective: the fluid forces' stability limits at the present state; throws SetupError when
+  // dt is beyond one of them (the slip or spin grew since start-up, where check_force_limits
+  // looked). Called by the run at each log row.
+  void recheck_force_limits();
   const std::vector<std::string>& force_limit_notes() const { return force_limit_notes_; }
   std::vector<std::string> force_term_reports() const {
     std::vector<std::string> out;
@@ -261,6 +265,7 @@ class Simulation {
   // Each force term's stability limit at the present state, over every rank; notes in the
   // time-step report, and a refusal there for a step beyond an explicit term's limit.
   void check_force_limits();
+  std::vector<TermLimit> gather_force_limits() const;  // collective
   // Stops the run (ParallelError on every rank) when a contact overlaps beyond
   // time.max_overlap, or when a Hertz contact gets fewer than time.min_steps_per_contact
   // steps at its own approach speed; the message names the contact and a time step that
