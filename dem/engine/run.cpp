@@ -721,7 +721,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
       log_step = k;
       log_index = static_cast<long>(std::floor(t / log_every + 0.5));
       global_particles = write_log().particles;
-      sim.recheck_force_limits();  // the fluid forces' limits at the flow reached (collective)
+      // The fluid forces' limits at the flow reached (collective; --allow-large-dt: not held).
+      if (!options.allow_large_time_step) sim.recheck_force_limits();
     }
     if (snapshot_due(t, k)) {
       snap_step = k;
