@@ -17,6 +17,11 @@ function(grain_cli_test name code regex)
   set_tests_properties(grain.${name} PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}")
 endfunction()
 
+# The contact-time error of the pair whose contact time suffers most, named when it is not
+# the pair of the worst restitution error.
+grain_cli_test(check_names_the_contact_time_pair 0
+               "restitution error ≈ 3.3 % \\(worst ≈ 3.9 %\\), contact-time error ≈ 0.43 % \\(s-wall 'floor', 17.7 steps, e = 0.9\\) \\(s-L at 1 m/s, e = 0.1"
+               CMD ${_grain} check ${_scenes}/mixed_pairs_accuracy.yaml)
 grain_cli_test(version 0 "grain \\(grainflow\\) [0-9]+\\.[0-9]+\\.[0-9]+" CMD ${_grain} --version)
 grain_cli_test(help 0 "usage: grain" CMD ${_grain} --help)
 grain_cli_test(no_command 2 "no command given" CMD ${_grain})
