@@ -27,6 +27,12 @@ StreamInsertion::StreamInsertion(const Scene& scene) : domain_(scene.domain) {
     s.radius_rng.seed(ins.seed);
     s.place_rng.seed(ins.seed ^ 0x5bd1e995u);
     r_max_ = std::max(r_max_, grainflow::max_radius(ins.radius));
+    const double area = ins.face.kind == InsertionFace::Kind::rectangle
+                            ? ins.face.length_u * ins.face.length_v
+                            : std::numbers::pi * ins.face.radius * ins.face.radius;
+    const double r_min = grainflow::min_radius(ins.radius);
+    const double most = std::floor(area / (std::numbers::pi * r_min * r_min)) + 1;
+    s.capacity = most < 1e9 ? static_cast<long>(most) : 1000000000L;
     streams_.push_back(std::move(s));
   }
 }
@@ -148,9 +154,11 @@ long StreamInsertion::insert(double t, Particles& p, const Ghosts& ghosts, const
   constexpr int kAttempts = 12;  // placement tries per particle and step
   long total = 0;
   for (Stream& s : streams_) {
-    const long need = due(s, t);
-    s.lag = need;
-    if (need == 0) continue;
+    const long due_now = due(s, t);
+    s.lag = due_now;
+    if (due_now == 0) continue;
+    // No more than the face holds can be placed in one step: the rest of a backlog waits.
+    const long need = std::min(due_now, s.capacity);
     // Existing bodies near the face: local particles and ghosts within reach.
     const InsertionFace& f = s.entry.face;
     std::vector<Vec3> near_x;
@@ -213,7 +221,7 @@ long StreamInsertion::insert(double t, Particles& p, const Ghosts& ghosts, const
       ++placed;
     }
     s.pending.erase(s.pending.begin(), s.pending.begin() + placed);
-    s.lag = need - placed;
+    s.lag = due_now - placed;
     total += placed;
   }
   return total;

@@ -74,6 +74,10 @@ class StreamInsertion {
     double mass = 0;
     long count = 0;
     long lag = 0;
+    // The most particles the face can hold at once: their discs on the face lie inside it
+    // and do not overlap, so at most its area over the smallest disc's. A blocked stream's
+    // backlog is tried only up to it per step (its cost had grown with the backlog).
+    long capacity = 1;
   };
   static Vec3 sample(Stream& s, double r);
   // A face that reaches across a periodic side: candidates are wrapped into the domain and

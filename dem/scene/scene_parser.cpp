@@ -161,6 +161,27 @@ void read_material_heat(const Map& m, const std::optional<HeatSettings>& heat, M
           .number(kPositive);
 }
 
+// A name that becomes a column of log.csv (walls) or a cell of a particle CSV (materials):
+// no comma, quote, line break or other control character, which would break the file's
+// columns for every reader (a wall "floor, main" shifted the log's columns).
+void check_csv_safe_name(const Field& name, const std::string& what) {
+  const std::string& text = name.text();
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c == ',' || c == '"' || c < 0x20 || c == 0x7f) {
+      const std::string shown = c == ','    ? "a comma"
+                                : c == '"'  ? "a double quote"
+                                : c == '\n' ? "a line break"
+                                : c == '\t' ? "a tab"
+                                            : "a control character";
+      name.fail(what + " name '" + text + "' holds " + shown + " (at character " +
+                std::to_string(i + 1) +
+                "), which would break the columns of log.csv and of particle CSV files; "
+                "use letters, digits, '_', '-' or '.'");
+    }
+  }
+}
+
 std::vector<Material> parse_materials(const Field& f, Deferred& later,
                                       const std::optional<HeatSettings>& heat) {
   std::vector<Material> out;
@@ -177,6 +198,7 @@ std::vector<Material> parse_materials(const Field& f, Deferred& later,
     const Field name = m.get("name", "add `name: <material name>`");
     Material mat;
     mat.name = name.text();
+    check_csv_safe_name(name, "material");
     if (const auto it = first_line.find(mat.name); it != first_line.end())
       name.fail("duplicate material name '" + mat.name + "' (first defined at line " +
                 std::to_string(it->second) + "); give each material a unique name");
@@ -549,6 +571,7 @@ Wall parse_wall(const Field& item, const std::unordered_set<std::string>& names,
   }
   const std::optional<Field> name = m.find("name");
   w.name = name ? name->text() : "wall" + std::to_string(names.size());
+  if (name) check_csv_safe_name(*name, "wall");
   check_periodic_wall(m, w, domain);
   if (names.count(w.name) > 0)
     (name ? *name : item).fail("duplicate wall name '" + w.name + "'; give each wall a unique name");

@@ -348,6 +348,27 @@ TEST(SceneParser, APlainNumberIsAConstantRadius) {
         << wrong;
 }
 
+// A wall's name becomes log.csv's column names (<name>_load_x_N) and a material's a cell of
+// particle CSV files: a comma, quote or line break in either would shift every column after
+// it for every CSV reader, so they are refused naming the character.
+TEST(SceneParser, NamesThatWouldBreakCsvColumnsAreRefused) {
+  const std::string wall =
+      kBase +
+      "walls:\n  - {type: plane, name: \"floor, main\", point: [0, 0, 0], normal: [0, "
+      "0, 1], material: glass}\n";
+  EXPECT_THAT(error_of(wall).what(),
+              HasSubstr("walls[0].name: wall name 'floor, main' holds a comma (at character 6), "
+                        "which would break the columns of log.csv"));
+  EXPECT_THAT(error_of(with("name: glass", "name: \"gl\\nass\"")).what(),
+              HasSubstr("holds a line break (at character 3)"));
+  EXPECT_THAT(error_of(with("name: glass", "name: 'gl\"ass'")).what(),
+              HasSubstr("holds a double quote (at character 3)"));
+  // Spaces and other punctuation stay allowed.
+  std::string spaced = wall;
+  spaced.replace(spaced.find("floor, main"), 11, "floor main-1.5");
+  EXPECT_EQ(parse_scene(spaced, kLabel).walls.at(0).name, "floor main-1.5");
+}
+
 TEST(SceneParser, NormalDistributionLowerBoundIsClippedPositive) {
   const Scene s = parse_scene(kBase +
                                   "insert:\n"
