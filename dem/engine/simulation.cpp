@@ -1646,6 +1646,9 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
                                   : std::string("is no evidence"))
         << "; if a finer step stops again, the message will say what carries the contact)";
     o << ". A step of at most " << tc / kResolvingSteps << remedy;
+    if (restored_)
+      o << " (this run is a restart, which keeps its run's step: start the scene afresh from "
+           "the last snapshot, with `type: snapshot`, to use another)";
     return;
   }
   std::vector<const WallSet::Entry*> moving;
@@ -1802,6 +1805,11 @@ void Simulation::describe_overlap(std::ostream& o, const WorstContact& w, double
   }
   for (const WallSet::Entry* e : moving)
     o << " stop or slow wall '" << e->name << "' before it squeezes the particles this far;";
+  // A restart keeps its run's model (materials, contact, walls): those changes need a new run.
+  if (restored_)
+    o << " (this run is a restart, which keeps its run's model and insertions: a changed "
+         "material, contact or wall needs the changed scene started afresh, from the last "
+         "snapshot with `type: snapshot`; time.max_overlap may change at a restart)";
   o << " (docs/stability.md, the overlap guard)";
 }
 
