@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "dem/core/fnv1a.hpp"
 #include "dem/engine/restored_state.hpp"
 
 namespace grainflow {
@@ -180,12 +181,7 @@ std::uint64_t scene_fingerprint(const Scene& scene) {
   for (std::string line; std::getline(lines, line);) model.push_back(line);
   std::sort(model.begin(), model.end());
   for (const std::string& line : model) text += line + "\n";
-  std::uint64_t h = 14695981039346656037ull;  // FNV-1a, 64 bits
-  for (const unsigned char c : text) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  return h;
+  return fnv1a64(text);
 }
 
 void check_insertions(const std::string& written, const Scene& scene,

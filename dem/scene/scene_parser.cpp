@@ -36,6 +36,7 @@
 #include <utility>
 #include <vector>
 
+#include "dem/core/fnv1a.hpp"
 #include "dem/core/number_format.hpp"
 #include "dem/io/snapshot_reader.hpp"
 #include "dem/io/xdmf_index.hpp"
@@ -1316,15 +1317,13 @@ void record_mesh_contents(Scene& s) {
       const std::string key = "walls[" + std::to_string(k) + "].file = ";
       if (s.walls[k].kind != Wall::Kind::mesh || !line.starts_with(key)) continue;
       std::ifstream in(s.walls[k].mesh.file, std::ios::binary);
-      std::uint64_t digest = 14695981039346656037ull;  // FNV-1a, 64 bit
+      std::uint64_t digest = kFnv1a64Start;
       std::uint64_t bytes = 0;
       char buffer[1 << 16];
       while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
-        for (std::streamsize i = 0; i < in.gcount(); ++i) {
-          digest ^= static_cast<unsigned char>(buffer[i]);
-          digest *= 1099511628211ull;
-        }
-        bytes += static_cast<std::uint64_t>(in.gcount());
+        const auto n = static_cast<std::size_t>(in.gcount());
+        digest = fnv1a64(std::string_view(buffer, n), digest);
+        bytes += n;
       }
       char hex[17];
       std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(digest));

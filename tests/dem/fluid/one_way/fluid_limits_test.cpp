@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <numbers>
 
 #include "dem/engine/finite_guard.hpp"
@@ -192,21 +193,34 @@ TEST(FluidLimits, ExplicitLiftBeyondItsLimitIsRefused) {
 // shear's, 2 sqrt(tau_M / G) = 0.017 s. Reference: the linearised motion, stable below it;
 // run 6 s at 0.9 of it, the bead stays within 1 mm of its height (the fine-step run's); at 1.2
 // of it, it leaves its height by more than 10 mm.
+// A 1 mm bead (1100 kg/m^3) in a box of 0.1 m, periodic across, in a shear of G = 300/s
+// through its centre with the Magnus lift; the bead is added by add_magnus_bead.
+constexpr double kMagnusD = 1e-3, kMagnusG = 300;
+void add_magnus_bead(Simulation& sim) {
+  sim.particles().add(1, Vec3(0.05, 0.05, 0.05), Vec3(-0.01, 0, 0), Vec3::Zero(), kMagnusD / 2, 0,
+                      1100);
+}
+std::unique_ptr<Simulation> magnus_in_shear(double dt, bool with_bead) {
+  Scene s = scene_with(dt);
+  s.materials[0].density = 1100;
+  s.domain.lo = Vec3(0, 0, 0);
+  s.domain.hi = Vec3(0.1, 0.1, 0.1);
+  s.domain.periodic = {true, true, false};
+  s.time.max_step_travel = 1000;
+  auto sim = std::make_unique<Simulation>(s, false);
+  if (with_bead) add_magnus_bead(*sim);
+  FluidSettings f = shear_flow(kMagnusG, {FluidForce::magnus});
+  f.field.origin = Vec3(0.05, 0.05, 0.05);
+  sim->add_force_term(make_fluid_forces(f, Vec3::Zero()));
+  sim->initialise();
+  return sim;
+}
+
 TEST(FluidLimits, LiftAcrossTheShearHoldsAtTheProposedStep) {
-  const double d = 1e-3, g = 300;
+  const double d = kMagnusD, g = kMagnusG;
   const auto height_change = [&](double dt, double* limit) {
-    Scene s = scene_with(dt);
-    s.materials[0].density = 1100;
-    s.domain.lo = Vec3(0, 0, 0);
-    s.domain.hi = Vec3(0.1, 0.1, 0.1);
-    s.domain.periodic = {true, true, false};
-    s.time.max_step_travel = 1000;
-    Simulation sim(s, false);
-    sim.particles().add(1, Vec3(0.05, 0.05, 0.05), Vec3(-0.01, 0, 0), Vec3::Zero(), d / 2, 0, 1100);
-    FluidSettings f = shear_flow(g, {FluidForce::magnus});
-    f.field.origin = Vec3(0.05, 0.05, 0.05);
-    sim.add_force_term(make_fluid_forces(f, Vec3::Zero()));
-    sim.initialise();
+    const std::unique_ptr<Simulation> owned = magnus_in_shear(dt, true);
+    Simulation& sim = *owned;
     for (const TermLimit& l : sim.force_limits())
       if (l.term == "magnus" && limit != nullptr) {
         EXPECT_LT(l.tau, kRhoP * d * d / (18 * kMu));
@@ -237,23 +251,17 @@ TEST(FluidLimits, LiftAcrossTheShearHoldsAtTheProposedStep) {
 // bead leaves its height by > 1 cm in 6 s) and the recheck stops the run naming the force and
 // the step; at 0.9 times it passes.
 TEST(FluidLimits, ALiftLimitReachedAfterStartUpStopsTheRun) {
-  const double d = 1e-3, g = 300;
-  const auto arrive_after_start = [&](double dt) {
-    Scene s = scene_with(dt);
-    s.materials[0].density = 1100;
-    s.domain.lo = Vec3(0, 0, 0);
-    s.domain.hi = Vec3(0.1, 0.1, 0.1);
-    s.domain.periodic = {true, true, false};
-    s.time.max_step_travel = 1000;
-    Simulation sim(s, false);
-    FluidSettings f = shear_flow(g, {FluidForce::magnus});
-    f.field.origin = Vec3(0.05, 0.05, 0.05);
-    sim.add_force_term(make_fluid_forces(f, Vec3::Zero()));
-    sim.initialise();  // no particle: no finite limit at start-up
-    sim.particles().add(1, Vec3(0.05, 0.05, 0.05), Vec3(-0.01, 0, 0), Vec3::Zero(), d / 2, 0, 1100);
-    sim.recheck_force_limits();
+  const auto arrive_after_start = [](double dt) {
+    const auto sim = magnus_in_shear(dt, false);  // no particle: no finite limit at start-up
+    add_magnus_bead(*sim);
+    sim->recheck_force_limits();
   };
-  const double limit = 0.01706;  // the Magnus limit of that bead (the test above: 0.01706 s)
+  // The bead's limit had it been there at start-up, 2 sqrt(tau_M / G) (the test above).
+  double limit = 0;
+  const auto with_bead = magnus_in_shear(1e-3, true);
+  for (const TermLimit& l : with_bead->force_limits())
+    if (l.term == "magnus") limit = l.dt_max;
+  ASSERT_NEAR(limit, 0.01706, 5e-6);
   EXPECT_NO_THROW(arrive_after_start(0.9 * limit));
   try {
     arrive_after_start(1.2 * limit);
