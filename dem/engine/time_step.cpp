@@ -5,6 +5,7 @@
 #include <limits>
 #include <numbers>
 #include <sstream>
+#include <vector>
 
 #include "dem/contact/normal_hooke.hpp"
 #include "dem/core/number_format.hpp"
@@ -46,12 +47,16 @@ struct PairImpact {
 //   Hertz: x'' = -(5/4) x^(3/2) - 2.5 b x^(1/4) x'  (b: the dashpot factor hertz_beta),
 //   Hooke: x'' = -x - 2 z x'  (z = g_n / (2 sqrt(k_n m*)), time in sqrt(m*/k_n)),
 // from x = 0, x' = 1 to the turn (x' = 0). 1 without damping; independent of v.
-double peak_overlap_ratio(bool hertz, double damping) {
+struct ApproachPath {
+  std::vector<double> x, u;  // from (0, 1); the last point is the turn (u = 0)
+};
+ApproachPath approach_path(bool hertz, double damping) {
   const auto accel = [&](double x, double u) {
     const double xp = std::max(x, 0.0);
     return hertz ? -1.25 * xp * std::sqrt(xp) - 2.5 * damping * std::sqrt(std::sqrt(xp)) * u
                  : -xp - 2 * damping * u;
   };
+  ApproachPath path{{0}, {1}};
   double x = 0, u = 1;
   const double h = 1e-3;
   for (int k = 0; k < 100000 && u > 0; ++k) {
@@ -61,12 +66,68 @@ double peak_overlap_ratio(bool hertz, double damping) {
     const double k4x = u + h * k3u, k4u = accel(x + h * k3x, u + h * k3u);
     const double x1 = x + h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x);
     const double u1 = u + h / 6 * (k1u + 2 * k2u + 2 * k3u + k4u);
-    if (u1 <= 0) return x + (x1 - x) * u / (u - u1);  // the turn, between the two steps
+    if (u1 <= 0) {
+      path.x.push_back(x + (x1 - x) * u / (u - u1));  // the turn, between the two steps
+      path.u.push_back(0);
+      break;
+    }
     x = x1;
     u = u1;
+    path.x.push_back(x);
+    path.u.push_back(u);
   }
-  return x;
+  return path;
 }
+
+double peak_overlap_ratio(bool hertz, double damping) {
+  return approach_path(hertz, damping).x.back();
+}
+
+}  // namespace
+
+double damped_impact_speed(const ContactSettings& cs, const PairCoefficients& pc,
+                           const ContactConstants& cc, double r_star, double m_star, double overlap,
+                           double speed) {
+  // The overlap unit: the elastic peak of an impact at V, A V^p (Hertz: A = (15 m* /
+  // (16 Y* sqrt(R*)))^(2/5), p = 4/5; Hooke: A = sqrt(m*/k_n), p = 1).
+  const bool hertz = cs.normal == NormalModel::hertz;
+  double damping = pc.hertz_beta, a = 0, p = 1;
+  if (hertz) {
+    a = std::pow(15 * m_star / (16 * pc.y_star * std::sqrt(r_star)), 0.4);
+    p = 0.8;
+  } else {
+    const SpringDashpot s = HookeNormal::coefficients(pc, cc, r_star, m_star, 0);
+    a = std::sqrt(m_star / s.kn);
+    damping = s.gn / (2 * std::sqrt(s.kn * m_star));
+  }
+  if (!(overlap > 0) || !(a > 0)) return std::max(speed, 0.0);
+  // The dimensionless approach, u against x, from (0, 1) to the turn.
+  const ApproachPath path = approach_path(hertz, damping);
+  const std::vector<double>&xs = path.x, &us = path.u;
+  const double x_peak = xs.back();
+  // u on the approach at x (x rises monotonically until the turn).
+  const auto u_at = [&](double x) {
+    if (x >= x_peak) return 0.0;
+    const std::size_t k =
+        static_cast<std::size_t>(std::upper_bound(xs.begin(), xs.end(), x) - xs.begin());
+    const double t = (x - xs[k - 1]) / (xs[k] - xs[k - 1]);
+    return us[k - 1] + t * (us[k] - us[k - 1]);
+  };
+  // The state (overlap, speed) lies on the path of the impact at V: u(overlap / (A V^p)) =
+  // speed / V, rising in V from the impact whose damped peak is the overlap now.
+  const double v0 = std::max(speed, 0.0);
+  const auto miss = [&](double v) { return u_at(overlap / (a * std::pow(v, p))) - v0 / v; };
+  double lo = std::pow(overlap / (a * x_peak), 1 / p), hi = 2 * lo;
+  if (!(miss(lo) < 0)) return lo;
+  for (int k = 0; k < 200 && miss(hi) < 0; ++k) hi *= 2;
+  for (int k = 0; k < 100; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (miss(mid) < 0 ? lo : hi) = mid;
+  }
+  return hi;
+}
+
+namespace {
 
 // The head-on impact speed above which the pair's peak overlap exceeds time.max_overlap of
 // the smaller radius (the overlap guard's stop), with the pair's damping.

@@ -54,6 +54,13 @@ double hertz_contact_time(double y_star, double r_star, double m_star, double sp
 // damped, independent of v; infinity for an overdamped Hooke contact).
 double pair_contact_time(const ContactSettings& cs, const PairCoefficients& pc,
                          const ContactConstants& cc, double r_star, double m_star, double v);
+// The speed at first touch of a free head-on impact (no load, no cohesion) that passes
+// `overlap` [m] approaching at `speed` [m/s], under the pair's damped normal law: the
+// dimensionless damped approach (RK4, as for the overlap guard's speed in grain check) is one
+// curve for every impact speed, scaled by the elastic peak overlap.
+double damped_impact_speed(const ContactSettings& cs, const PairCoefficients& pc,
+                           const ContactConstants& cc, double r_star, double m_star, double overlap,
+                           double speed);
 
 // `restart_step`: the step of the checkpoint a restart continues with (Simulation::restore),
 // which the report then judges and prints instead of the scene's, and says so: its smallest
