@@ -29,9 +29,12 @@ commands:
                       from a checkpoint. SIGTERM/SIGINT write a checkpoint and stop.
                       Options go before or after the scene, as --key value or
                       --key=value, each at most once. One run per output folder
-  check SCENE.yaml    parse and validate the scene, insert its particles, and print
+  check SCENE.yaml [--restart CHECKPOINT.h5]
+                      parse and validate the scene, insert its particles, and print
                       the Rayleigh time, the contact time at the expected impact
-                      speed and the time step as a fraction of both
+                      speed and the time step as a fraction of both; --restart
+                      verifies the checkpoint against the scene, as run --restart
+                      would, and judges its particles instead; writes nothing
   --version           print the version
   --help              print this help
 
@@ -81,8 +84,9 @@ int dispatch(const std::string& program, const std::vector<std::string>& args, i
     const bool takes_value = key == "--output" || key == "--restart";
     const bool known = takes_value || key == "--no-progress" || key == "--allow-large-dt";
     if (!known) return usage_error("unknown option '" + a + "' for '" + cmd + "'");
-    if (cmd != "run")
-      return usage_error("option '" + key + "' is for 'run'; 'check' takes only the scene file");
+    if (cmd != "run" && key != "--restart")
+      return usage_error("option '" + key +
+                         "' is for 'run'; 'check' takes the scene file and --restart");
     if (std::find(given.begin(), given.end(), key) != given.end())
       return usage_error("option '" + key + "' is given twice; give it once");
     given.push_back(key);
@@ -111,7 +115,7 @@ int dispatch(const std::string& program, const std::vector<std::string>& args, i
   if (scene_file.empty()) return usage_error("'" + cmd + "' needs a scene file");
   try {
     const Scene scene = load_scene(scene_file);
-    if (cmd == "check") return check_scene(scene, std::cout);
+    if (cmd == "check") return check_scene(scene, std::cout, options.restart);
     run_scene(scene, options, MPI_COMM_WORLD, std::cout);
     return 0;
   } catch (const SceneError& e) {

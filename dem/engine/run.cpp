@@ -360,9 +360,70 @@ std::string refusal_remedy(const TimeStepReport& rep) {
 
 }  // namespace
 
-int check_scene(const Scene& scene, std::ostream& out) {
+namespace {
+// What a --restart path must not be, told from its name and kind alone: before anything is
+// read, made or changed.
+void refuse_unusable_restart(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw OutputError(
+        "cannot restart from '" + path +
+        "': " + (std::filesystem::exists(path, ec) ? "it is not a regular file" : "no such file") +
+        " (nothing was created or changed); give the path of a "
+        "checkpoint_<step>.h5 that a run wrote (see output.checkpoint_interval)");
+  if (path.ends_with(".part"))
+    throw OutputError("cannot restart from '" + path +
+                      "': a .part file is a checkpoint that was being written when its run "
+                      "was killed, possibly incomplete; restart from a complete "
+                      "checkpoint_<step>.h5");
+  if (std::filesystem::path(path).filename().string().starts_with("particles_"))
+    throw OutputError("cannot restart from '" + path +
+                      "': it is a snapshot, not a checkpoint (nothing was created or changed); a "
+                      "restart needs a checkpoint_<step>.h5 (output.checkpoint_interval), and a "
+                      "new run starts from a snapshot with the insertion `type: snapshot`");
+}
+
+// Reads the checkpoint at `path` (its checksums), checks it against the scene (step,
+// insertions, model: check_restart_step, Simulation::restore) and restores it into `sim`.
+// Returns the log table it keeps.
+std::optional<std::string> restore_checkpoint(Simulation& sim, const Scene& scene,
+                                              const std::string& path, MPI_Comm comm,
+                                              std::ostream& out) {
+  const CheckpointData checkpoint = read_checkpoint(path);
+  // A checkpoint renamed to another step: said, as "restart from the newest name" would
+  // then go back in time.
+  long named = -1;
+  int used = 0;
+  const std::string name = std::filesystem::path(path).filename().string();
+  if (std::sscanf(name.c_str(), "checkpoint_%ld.h5%n", &named, &used) == 1 &&
+      used == static_cast<int>(name.size()) && named != checkpoint.step)
+    speaker(comm, out) << "note: " << path << " holds step " << checkpoint.step
+                       << " (t = " << checkpoint.time << " s), not the step " << named
+                       << " its name says: it was renamed or copied over\n";
+  check_restart_step(scene, checkpoint);
+  sim.restore(checkpoint);
+  return checkpoint.log;
+}
+
+// A restart's scene must end after its checkpoint: the error, for `run` and `check`.
+std::string ends_before_checkpoint(const Scene& scene, const Simulation& sim,
+                                   const std::string& checkpoint) {
+  std::ostringstream m;
+  m << scene.time.end_source << ": error: time.end = " << scene.time.end
+    << " s is before the checkpoint's time, t = " << sim.time() << " s (step "
+    << sim.counters().steps << ", '" << checkpoint
+    << "'): the restart would run no step; raise time.end, or restart from an earlier "
+       "checkpoint (nothing was changed or deleted)";
+  return m.str();
+}
+}  // namespace
+
+int check_scene(const Scene& scene, std::ostream& out, const std::optional<std::string>& restart) {
   check_grids(scene);
-  print_input_files(scene, MPI_COMM_WORLD, out);
+  if (restart)
+    refuse_unusable_restart(*restart);
+  else
+    print_input_files(scene, MPI_COMM_WORLD, out);
   // The output folder `grain run` would write (without --output): not an input's, not a file.
   refuse_inputs_the_run_overwrites(scene, scene.output.directory);
   if (std::error_code ec; std::filesystem::exists(scene.output.directory, ec) &&
@@ -370,7 +431,10 @@ int check_scene(const Scene& scene, std::ostream& out) {
     throw OutputError("output.directory '" + scene.output.directory +
                       "' exists but is not a directory: `grain run` could not write there; "
                       "give another output.directory (or --output to grain run)");
-  Simulation sim(scene);
+  // A restart: the checkpoint is read, verified and checked against the scene as `grain run
+  // --restart` does, and its state is what the report below judges; nothing is written.
+  Simulation sim(scene, !restart);
+  if (restart) restore_checkpoint(sim, scene, *restart, MPI_COMM_WORLD, out);
   // The fluid forces too, so that their stability limits are checked as at start-up.
   if (scene.fluid)
     sim.add_force_term(
@@ -381,7 +445,22 @@ int check_scene(const Scene& scene, std::ostream& out) {
   print_void_fraction_cell_report(scene, sim, MPI_COMM_WORLD, out);
   print_drag_range_report(scene, MPI_COMM_WORLD, out);
   const TimeStepReport& rep = sim.time_step_report();
-  if (rep.dt > 0 && std::isfinite(rep.dt)) {
+  if (restart) {
+    const long first = sim.counters().steps, end = steps_to_end(scene.time.end, sim.dt());
+    if (end < first) {
+      speaker(MPI_COMM_WORLD, out) << ends_before_checkpoint(scene, sim, *restart) << "\n";
+      return 1;
+    }
+    std::ostream& say = speaker(MPI_COMM_WORLD, out);
+    say << "restart: " << *restart << " holds step " << first << " (t = " << sim.time() << " s), "
+        << sim.global_state().particles << " particles, and matches the scene; ";
+    if (end == first)
+      say << "it is at time.end already: nothing to run; to run longer, raise time.end ("
+          << scene.time.end_source << ")\n";
+    else
+      say << "the restart runs " << end - first << " steps of dt = " << sim.dt()
+          << " s to t = " << significant(static_cast<double>(end) * sim.dt(), 9) << " s\n";
+  } else if (rep.dt > 0 && std::isfinite(rep.dt)) {
     const long steps = steps_to_end(scene.time.end, rep.dt);
     const double last = static_cast<double>(steps) * rep.dt;
     std::ostream& say = speaker(MPI_COMM_WORLD, out);
@@ -407,15 +486,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   };
   check_grids(scene);
   const std::string dir = options.output_directory.value_or(scene.output.directory);
-  if (options.restart) {  // before the output folder is made: a mistyped name changes nothing
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(*options.restart, ec))
-      throw OutputError("cannot restart from '" + *options.restart + "': " +
-                        (std::filesystem::exists(*options.restart, ec) ? "it is not a regular file"
-                                                                       : "no such file") +
-                        " (nothing was created or changed); give the path of a "
-                        "checkpoint_<step>.h5 that a run wrote (see output.checkpoint_interval)");
-  }
+  // Before the output folder is made: a mistyped name changes nothing.
+  if (options.restart) refuse_unusable_restart(*options.restart);
   refuse_inputs_the_run_overwrites(scene, dir);  // before the folder is made or touched
   prepare_output_directory(dir);  // before any work: an unwritable directory fails now
   const OutputLock lock(comm, dir);  // one run per folder: a second is refused, naming this one
@@ -423,35 +495,9 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   if (!options.restart) print_input_files(scene, comm, out);
 
   // A restart takes its particles from the checkpoint instead of inserting them.
-  if (options.restart && options.restart->ends_with(".part"))
-    throw OutputError("cannot restart from '" + *options.restart +
-                      "': a .part file is a checkpoint that was being written when its run "
-                      "was killed, possibly incomplete; restart from a complete "
-                      "checkpoint_<step>.h5");
-  if (options.restart &&
-      std::filesystem::path(*options.restart).filename().string().starts_with("particles_"))
-    throw OutputError("cannot restart from '" + *options.restart +
-                      "': it is a snapshot, not a checkpoint (nothing was created or changed); a "
-                      "restart needs a checkpoint_<step>.h5 (output.checkpoint_interval), and a "
-                      "new run starts from a snapshot with the insertion `type: snapshot`");
   Simulation sim(scene, !options.restart, comm);
   std::optional<std::string> checkpoint_log;  // the log table the checkpoint keeps
-  if (options.restart) {
-    const CheckpointData checkpoint = read_checkpoint(*options.restart);
-    // A checkpoint renamed to another step: said, as "restart from the newest name" would
-    // then go back in time.
-    long named = -1;
-    int used = 0;
-    const std::string name = std::filesystem::path(*options.restart).filename().string();
-    if (std::sscanf(name.c_str(), "checkpoint_%ld.h5%n", &named, &used) == 1 &&
-        used == static_cast<int>(name.size()) && named != checkpoint.step)
-      speaker(comm, out) << "note: " << *options.restart << " holds step " << checkpoint.step
-                         << " (t = " << checkpoint.time << " s), not the step " << named
-                         << " its name says: it was renamed or copied over\n";
-    check_restart_step(scene, checkpoint);
-    sim.restore(checkpoint);
-    checkpoint_log = checkpoint.log;
-  }
+  if (options.restart) checkpoint_log = restore_checkpoint(sim, scene, *options.restart, comm, out);
   // fluid_force needs the force terms' share kept, at the steps that write a snapshot.
   const bool wants_fluid_force = (scene.output.fields & snapshot_field_bit("fluid_force")) != 0;
   sim.record_fluid_force(wants_fluid_force);  // the first forces (snapshot of step 0)
@@ -475,15 +521,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   // A restart whose scene ends before the checkpoint would run no step, and would first cut
   // the snapshot series and log back to the checkpoint: refused before anything is touched.
   const long end_step = steps_to_end(scene.time.end, sim.dt());
-  if (options.restart && end_step < first_step) {
-    std::ostringstream m;
-    m << scene.time.end_source << ": error: time.end = " << scene.time.end
-      << " s is before the checkpoint's time, t = " << sim.time() << " s (step " << first_step
-      << ", '" << *options.restart
-      << "'): the restart would run no step; raise time.end, or restart from an earlier "
-         "checkpoint (nothing was changed or deleted)";
-    throw SetupError(m.str());
-  }
+  if (options.restart && end_step < first_step)
+    throw SetupError(ends_before_checkpoint(scene, sim, *options.restart));
   // At exactly the checkpoint's step: nothing to run, and nothing in the folder is touched
   // (continuing the series and the log would cut them back to the checkpoint).
   if (options.restart && end_step == first_step) {

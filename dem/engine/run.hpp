@@ -52,8 +52,10 @@ struct RunSummary {
 };
 
 // Prints the time-step report (`grain check`); returns the process exit code:
-// 0 fine, 1 refused.
-int check_scene(const Scene& scene, std::ostream& out);
+// 0 fine, 1 refused. With `restart`, the checkpoint is read, verified and checked against the
+// scene as `grain run --restart` would, and the report judges its state; nothing is written.
+int check_scene(const Scene& scene, std::ostream& out,
+                const std::optional<std::string>& restart = std::nullopt);
 
 // Throws SceneError / SetupError / InsertionError / OutputError with a message for the user.
 RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm comm,

@@ -241,11 +241,6 @@ void fill_region(const Scene& scene, const WallSet* walls, const Insertion& ins,
   const long target_count = ins.count ? *ins.count : 0;
   long placed = 0, attempts = 0;
   double volume = 0;
-  // Random sequential addition saturates near 38 % solids for equal spheres; the
-  // attempt budget turns an impossible request into a clear error, not a hang.
-  // (In double: a count near the parser's limit of 9e15 would overflow a long here.)
-  const long budget = static_cast<long>(
-      std::min(2000.0 * std::max(1000.0, static_cast<double>(target_count)) + 2e6, 9e18));
   // Why attempts failed, for the message: a wall (counted per wall), the domain, an earlier
   // particle.
   std::vector<long> by_wall(scene.walls.size(), 0);
@@ -278,6 +273,12 @@ void fill_region(const Scene& scene, const WallSet* walls, const Insertion& ins,
     }
   }
   std::stable_sort(radii.begin(), radii.end(), std::greater<>());
+  // Random sequential addition saturates near 38 % solids for equal spheres; the
+  // attempt budget (2000 per particle drawn, for a count and a volume fraction alike) turns
+  // an impossible request into a clear error, not a hang. (In double: a count near the
+  // parser's limit of 9e15 would overflow a long here.)
+  const long budget = static_cast<long>(
+      std::min(2000.0 * std::max(1000.0, static_cast<double>(radii.size())) + 2e6, 9e18));
   while (static_cast<std::size_t>(placed) < radii.size()) {
     if (++attempts > budget) {
       std::ostringstream msg;

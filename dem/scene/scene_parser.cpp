@@ -162,11 +162,18 @@ void read_material_heat(const Map& m, const std::optional<HeatSettings>& heat, M
           .number(kPositive);
 }
 
+constexpr std::size_t kMaxNameLength = 100;
+
 // A name that becomes a column of log.csv (walls) or a cell of a particle CSV (materials):
 // no comma, quote, line break or other control character, which would break the file's
 // columns for every reader (a wall "floor, main" shifted the log's columns).
 void check_csv_safe_name(const Field& name, const std::string& what) {
   const std::string& text = name.text();
+  // A name is a column header and a word in every message: 100 characters at most.
+  if (text.size() > kMaxNameLength)
+    name.fail(what + " name '" + text.substr(0, 60) + "...' is " + std::to_string(text.size()) +
+              " characters long; a name is at most " + std::to_string(kMaxNameLength) +
+              " characters (it heads log.csv columns and appears in messages)");
   for (std::size_t i = 0; i < text.size(); ++i) {
     const auto c = static_cast<unsigned char>(text[i]);
     if (c == ',' || c == '"' || c < 0x20 || c == 0x7f) {

@@ -149,9 +149,32 @@ struct Source {
   std::filesystem::path folder;    // relative file names inside the scene are resolved against it
 };
 
+// A message with every word (a run without spaces) longer than 200 characters shown by its
+// first 60 and its length: a value pasted in or the wrong file given, quoted into a message
+// (an unknown model's name, a number beyond a double, a list of names), stays readable.
+inline std::string shorten_long_words(const std::string& message) {
+  std::string out;
+  std::size_t i = 0;
+  while (i < message.size()) {
+    const std::size_t end = std::min(message.find(' ', i), message.size());
+    if (end - i > 200) {
+      // Its closing quote and punctuation stay ("'...(200003 characters)';").
+      std::size_t tail = 0;
+      while (tail < 3 && std::string("';,.)").find(message[end - 1 - tail]) != std::string::npos)
+        ++tail;
+      out += message.substr(i, 60) + "...(" + std::to_string(end - i) + " characters)" +
+             message.substr(end - tail, tail);
+    } else
+      out.append(message, i, end - i);
+    if (end < message.size()) out += ' ';
+    i = end + 1;
+  }
+  return out;
+}
+
 [[noreturn]] inline void raise(const Source& src, const YAML::Mark& mark, const std::string& message) {
   // yaml-cpp marks are 0-based; ours are 1-based.
-  throw SceneError(src.label, mark.line + 1, mark.column + 1, message);
+  throw SceneError(src.label, mark.line + 1, mark.column + 1, shorten_long_words(message));
 }
 
 inline YAML::Mark start_of_file() {

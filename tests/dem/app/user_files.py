@@ -23,12 +23,17 @@ code, its message and what is on disk afterwards:
   * hostile_text: a CSV and an ASCII STL with a UTF-8 byte-order mark are read; an invisible
     character in a key is named by its code point; merge keys, a 200 000-character value, a
     count of 1e20, a device as the particle file and a folder as the scene get clear errors;
+    a 200 000-character model name, number or wall name is shown by its first 60 characters;
   * restart_advice: the summary's "continue with" command, time.end raised, ends bit for bit
     where one longer run ends; a restart into another folder says so; a snapshot given to
     --restart is named as one;
   * restart_at_end: a restart whose time.end is the checkpoint's time runs nothing and leaves
     log.csv, particles.xdmf and every snapshot as they were (bytes), where it had cut the log
-    back to the checkpoint.
+    back to the checkpoint;
+  * check_restart: `grain check --restart` verifies a checkpoint against the scene as the
+    restart would: a good one passes with the steps the restart then runs (it runs exactly
+    those), a changed gravity and a flipped byte are refused as `run --restart` refuses them,
+    and the output folder keeps its bytes (check writes nothing).
 """
 import hashlib
 import os
@@ -190,6 +195,55 @@ def restart_at_end():
         fail(case, f"files changed: {changed}")
 
 
+def check_restart():
+    case = "check_restart"
+    d = fresh(case)
+    scene(d, end=0.004, extra=", checkpoint_interval: 0.002")
+    expect(case, grain(d, "run", "scene.yaml"), 0, r"done:")
+    out = os.path.join(d, "out")
+    checkpoint = os.path.join("out", sorted(n for n in os.listdir(out)
+                                            if n.startswith("checkpoint_"))[0])
+    before = {n: digest(os.path.join(out, n)) for n in sorted(os.listdir(out))}
+    text = scene(d, end=0.006, extra=", checkpoint_interval: 0.002")
+    rc, said = grain(d, "check", "scene.yaml", "--restart", checkpoint)
+    m = re.search(r"restart: out/checkpoint_\d+\.h5 holds step (\d+) \(t = [^)]*\), 50 particles, "
+                  r"and matches the scene; the restart runs (\d+) steps of dt", said)
+    if rc != 0 or not m:
+        fail(case, f"check --restart: exit {rc}, no 'matches the scene' line:\n{said}")
+        return
+    steps = int(m.group(1)) + int(m.group(2))
+    # A changed model and a damaged checkpoint: refused by check as by run, same message.
+    with open(os.path.join(d, "scene.yaml"), "w") as f:
+        f.write(text.replace("-9.81", "-5"))
+    for command in ("check", "run"):
+        expect(case, grain(d, command, "scene.yaml", "--restart", checkpoint), 1,
+               r"gravity\[2\] is -5 here, -9\.81 in the run that wrote checkpoint")
+    with open(os.path.join(d, "scene.yaml"), "w") as f:
+        f.write(text)
+    damaged = os.path.join(d, "damaged.h5")
+    shutil.copy(os.path.join(d, checkpoint), damaged)
+    import h5py
+    with h5py.File(damaged, "r") as f:  # one bit of the first position's bytes, on disk
+        at = f["particles/position"].id.get_chunk_info(0).byte_offset + 3
+    with open(damaged, "r+b") as f:
+        f.seek(at)
+        byte = f.read(1)[0]
+        f.seek(at)
+        f.write(bytes([byte ^ 0x10]))
+    for command in ("check", "run"):
+        args = ["--output", "x"] if command == "run" else []
+        expect(case, grain(d, command, "scene.yaml", *args, "--restart", "damaged.h5"), 1,
+               r"damaged\.h5[^\n]*(checksum|changed or damaged)")
+    after = {n: digest(os.path.join(out, n)) for n in sorted(os.listdir(out))}
+    if after != before:
+        fail(case, "check --restart changed the output folder: " +
+             str(sorted(n for n in set(before) | set(after) if before.get(n) != after.get(n))))
+    # The restart it checked runs the steps it said.
+    rc, said = grain(d, "run", "scene.yaml", "--restart", checkpoint)
+    if rc != 0 or f"done: {steps} steps" not in said:  # done: counts from t = 0
+        fail(case, f"the restart after check: exit {rc}, not ending at step {steps}:\n{said}")
+
+
 PLATE = """solid plate
 facet normal 0 0 1
  outer loop
@@ -347,6 +401,14 @@ def hostile_text():
             r"YAML merge keys \('<<: \*anchor'\) are not supported in a scene")
     refused("long.yaml", text.replace("restitution: 0.5", "restitution: " + "7" * 200000 + "x"),
             r"got '7{60}\.\.\.' \(200001 characters\)")
+    # Every message shortens a long value, not only "got ...": a model's name, a number's
+    # digits; and a name (a log.csv column) is at most 100 characters.
+    refused("long_model.yaml", text.replace("normal: hertz", "normal: " + "h" * 200000),
+            r"unknown normal contact model 'h{59}\.\.\.\(200003 characters\)'; allowed: hertz")
+    refused("long_digits.yaml", text.replace("density: 2500", "density: " + "1" * 200000),
+            r"value 1{60}\.\.\.\(200000 characters\) is beyond the range of a double")
+    refused("long_name.yaml", text.replace("name: floor", "name: " + "f" * 200000),
+            r"wall name 'f{60}\.\.\.' is 200000 characters long; a name is at most 100 characters")
     refused("huge.yaml", text.replace(csv, FILL).replace("count: 50", "count: 1e20"),
             r"value 1e20 is too large for a whole number here")
     refused("device.yaml", text.replace("file: beads.csv", "file: /dev/null"),
@@ -396,7 +458,7 @@ if __name__ == "__main__":
     GRAIN, WORK = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
     os.makedirs(WORK, exist_ok=True)
     for check in (overwrite_csv, overwrite_snapshot, second_document, tilde, input_named,
-                  help_option, restart_at_end, restart_mesh,
+                  help_option, restart_at_end, check_restart, restart_mesh,
                   restart_other_physics, restart_smaller_skin, hostile_text,
                   restart_advice):
         check()
