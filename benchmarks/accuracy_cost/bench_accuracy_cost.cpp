@@ -493,7 +493,9 @@ void sweep_dt(const Settings& st, Checks& checks) {
     ImpactSpec spec;
   };
   std::vector<Case> cases;
-  for (double e : {1.0, 0.9, 0.7, 0.5, 0.3, 0.1})
+  // e = 0.2 and 0.15: the contact-time error peaks between 0.3 and 0.1 (1.7 and 0.7 % at 22
+  // steps), where interpolating the two curves quoted 0.82 % and an impact measured 1.28 %.
+  for (double e : {1.0, 0.9, 0.7, 0.5, 0.3, 0.2, 0.15, 0.1})
     cases.push_back({"reference", hertz_impact(e, kV, kY)});
   if (!st.short_run) {
     for (double e : {1.0, 0.5}) {
@@ -503,13 +505,13 @@ void sweep_dt(const Settings& st, Checks& checks) {
     }
   }
   // contact.dashpot_velocity: predicted (the reference cases use the default, half_step).
-  for (double e : {0.9, 0.7, 0.5, 0.3, 0.1}) {
+  for (double e : {0.9, 0.7, 0.5, 0.3, 0.2, 0.15, 0.1}) {
     if (st.short_run && e != 0.5) continue;
     ImpactSpec p = hertz_impact(e, kV, kY);
     p.dashpot = DashpotVelocity::predicted;
     cases.push_back({"predicted", p});
   }
-  for (double e : {1.0, 0.9, 0.7, 0.5, 0.3, 0.1}) {
+  for (double e : {1.0, 0.9, 0.7, 0.5, 0.3, 0.2, 0.15, 0.1}) {
     if (st.short_run && e != 1.0 && e != 0.5) continue;
     ImpactSpec h;
     h.restitution = e;
