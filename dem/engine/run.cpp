@@ -23,6 +23,7 @@
 #include "dem/engine/stop_signals.hpp"
 #include "dem/fluid/fluid_forces.hpp"
 #include "dem/fluid/void_fraction_grid.hpp"
+#include "dem/insert/insertion.hpp"
 #include "dem/io/log_table.hpp"
 #include "dem/io/output_directory.hpp"
 #include "dem/io/progress_line.hpp"
@@ -299,6 +300,9 @@ void refuse_inputs_the_run_overwrites(const Scene& scene, const std::string& dir
 // earlier stage's (docs/scene-reference.md, "Files").
 void print_input_files(const Scene& scene, MPI_Comm comm, std::ostream& out) {
   namespace fs = std::filesystem;
+  // A missing CSV file (the parser leaves it to the insertion, which a restart skips).
+  for (const Insertion& ins : scene.insertions)
+    if (!ins.csv_missing.empty()) throw InsertionError(ins.csv_missing);
   std::ostream& say = speaker(comm, out);
   for (const Insertion& ins : scene.insertions) {
     const std::string& file = ins.csv_file.empty() ? ins.snapshot_file : ins.csv_file;
@@ -389,6 +393,11 @@ void refuse_unusable_restart(const std::string& path) {
 std::optional<std::string> restore_checkpoint(Simulation& sim, const Scene& scene,
                                               const std::string& path, MPI_Comm comm,
                                               std::ostream& out) {
+  for (const Insertion& ins : scene.insertions)
+    if (!ins.csv_missing.empty())
+      speaker(comm, out) << "note: " << ins.source << ": the particle file '" << ins.csv_file
+                         << "' is missing; a restart takes its particles from the checkpoint "
+                            "and does not read it\n";
   const CheckpointData checkpoint = read_checkpoint(path);
   // A checkpoint renamed to another step: said, as "restart from the newest name" would
   // then go back in time.

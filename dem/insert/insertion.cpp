@@ -732,7 +732,10 @@ void insert_particles(const Scene& scene, Particles& p, GlobalId& next_id, const
         [](const Insertion& later) { return later.kind != Insertion::Kind::stream; });
     switch (ins.kind) {
       case Insertion::Kind::fill: fill_region(scene, walls, ins, p, next_id, grid); break;
-      case Insertion::Kind::csv: read_csv(scene, walls, ins, p, next_id, grid); break;
+      case Insertion::Kind::csv:
+        if (!ins.csv_missing.empty()) throw InsertionError(ins.csv_missing);
+        read_csv(scene, walls, ins, p, next_id, grid);
+        break;
       case Insertion::Kind::snapshot:
         read_snapshot_entry(scene, walls, ins, p, next_id, grid, later_checks);
         break;

@@ -206,6 +206,9 @@ struct Insertion {
   unsigned seed = 1;
   // csv: columns x,y,z,radius and optionally vx,vy,vz, wx,wy,wz, material (material by name)
   std::string csv_file;  // resolved relative to the scene file's folder
+  // A csv file that does not exist: the error (file:line:column) its insertion reports. A
+  // restart, which inserts nothing, runs without it (the parser cannot tell the two apart).
+  std::string csv_missing;
   std::string source;    // "file:line" of this entry, for messages
   // fill, stream: coarse-graining factor k >= 1 (`coarse_grain`); with k != 1 the parser has
   // already set `material` to the parcel class (Material::coarse_grain) and multiplied

@@ -363,8 +363,10 @@ ContactSettings parse_contact(const Field& f) {
   return c;
 }
 
-// A file named in the scene, resolved against the scene file's folder; it must exist.
-std::string existing_file(const Field& file, const std::string& what) {
+// A file named in the scene, resolved against the scene file's folder; it must exist. With
+// `missing`, a file that does not exist is no error here: `*missing` gets the error.
+std::string existing_file(const Field& file, const std::string& what,
+                          std::string* missing = nullptr) {
   const fs::path given = file.text();
   if (file.text().starts_with("~"))
     file.fail(
@@ -378,9 +380,17 @@ std::string existing_file(const Field& file, const std::string& what) {
   if (fs::exists(resolved, ec) && !fs::is_regular_file(resolved, ec))
     file.fail(what + " '" + given.string() + "' ('" + resolved.string() +
               "') is not a regular file (a device, a pipe or a socket); name a file");
-  if (!fs::is_regular_file(resolved, ec))
-    file.fail(what + " '" + given.string() + "' not found (looked for '" + resolved.string() +
-              "'); file names are relative to the scene file's folder");
+  if (!fs::is_regular_file(resolved, ec)) {
+    const std::string error = what + " '" + given.string() + "' not found (looked for '" +
+                              resolved.string() +
+                              "'); file names are relative to the scene file's folder";
+    if (!missing) file.fail(error);
+    try {
+      file.fail(error);
+    } catch (const SceneError& e) {
+      *missing = e.what();
+    }
+  }
   return resolved.string();
 }
 
@@ -859,7 +869,8 @@ void parse_fill(const Map& m, const Scene& scene, Insertion& ins) {
 void parse_csv(const Map& m, const Scene& scene, Insertion& ins) {
   refuse_coarse_grain(m, "csv");
   m.allow_only({"type", "file", "material", "temperature"}, " (a csv insertion)");
-  ins.csv_file = existing_file(m.get("file", "add `file: <particles.csv>`"), "particle file");
+  ins.csv_file = existing_file(m.get("file", "add `file: <particles.csv>`"), "particle file",
+                               &ins.csv_missing);
   ins.material = material_ref(m, "material", scene.materials);
 }
 

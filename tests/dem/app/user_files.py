@@ -33,7 +33,9 @@ code, its message and what is on disk afterwards:
   * check_restart: `grain check --restart` verifies a checkpoint against the scene as the
     restart would: a good one passes with the steps the restart then runs (it runs exactly
     those), a changed gravity and a flipped byte are refused as `run --restart` refuses them,
-    and the output folder keeps its bytes (check writes nothing).
+    and the output folder keeps its bytes (check writes nothing);
+  * restart_missing_csv: a CSV insertion's file deleted after the run: a restart runs (with a
+    note), a new run and `check` are refused naming the file.
 """
 import hashlib
 import os
@@ -242,6 +244,29 @@ def check_restart():
     rc, said = grain(d, "run", "scene.yaml", "--restart", checkpoint)
     if rc != 0 or f"done: {steps} steps" not in said:  # done: counts from t = 0
         fail(case, f"the restart after check: exit {rc}, not ending at step {steps}:\n{said}")
+
+
+def restart_missing_csv():
+    """A restart reads no insertion file: the CSV of a `type: csv` insertion, deleted after the
+    run, no longer blocks it (a note says so); a new run still needs it."""
+    case = "restart_missing_csv"
+    d = fresh(case)
+    with open(os.path.join(d, "beads.csv"), "w") as out:
+        out.write(CSV)
+    scene(d, insert="  - {type: csv, file: beads.csv, material: glass}", end=0.004,
+          extra=", checkpoint_interval: 0.002")
+    expect(case, grain(d, "run", "scene.yaml"), 0, r"done:")
+    checkpoint = os.path.join("out", sorted(n for n in os.listdir(os.path.join(d, "out"))
+                                            if n.startswith("checkpoint_"))[0])
+    os.remove(os.path.join(d, "beads.csv"))
+    scene(d, insert="  - {type: csv, file: beads.csv, material: glass}", end=0.006,
+          extra=", checkpoint_interval: 0.002")
+    missing = r"particle file 'beads\.csv' not found"
+    expect(case, grain(d, "check", "scene.yaml"), 2, missing)
+    expect(case, grain(d, "run", "scene.yaml", "--output", "fresh"), 2, missing)
+    note = r"note: scene\.yaml:\d+: the particle file '[^']*beads\.csv' is missing; a restart"
+    expect(case, grain(d, "check", "scene.yaml", "--restart", checkpoint), 0, note)
+    expect(case, grain(d, "run", "scene.yaml", "--restart", checkpoint), 0, note + r"(.|\n)*done:")
 
 
 PLATE = """solid plate
@@ -458,7 +483,7 @@ if __name__ == "__main__":
     GRAIN, WORK = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
     os.makedirs(WORK, exist_ok=True)
     for check in (overwrite_csv, overwrite_snapshot, second_document, tilde, input_named,
-                  help_option, restart_at_end, check_restart, restart_mesh,
+                  help_option, restart_at_end, check_restart, restart_missing_csv, restart_mesh,
                   restart_other_physics, restart_smaller_skin, hostile_text,
                   restart_advice):
         check()
