@@ -1935,8 +1935,8 @@ void Simulation::step() {
   // Velocity Verlet: half kick, drift, new forces, half kick.
   kick_and_drift();
   // Stream insertion (dem/insert/stream_insertion.hpp); new particles force a rebuild.
-  const bool inserted = !streams_.empty() && streams_.insert(time_ + dt_, p_, ghosts_, walls_,
-                                                             *decomp_, next_id_, comm_) > 0;
+  const bool inserted =
+      !streams_.empty() && streams_.insert(time_ + dt_, p_, walls_, *decomp_, next_id_, comm_) > 0;
   if (sweep_.has_history)  // inserted particles: a spring in the columns of every particle
     for (std::size_t col = 0; col < wall_history_.size(); ++col)
       if (wall_neighbours_.list_of_column(col).all) wall_history_[col].resize(p_.size());

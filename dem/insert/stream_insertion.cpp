@@ -149,7 +149,7 @@ Vec3 StreamInsertion::nearest_offset(const Vec3& a, const Vec3& b) const {
   return d;
 }
 
-long StreamInsertion::insert(double t, Particles& p, const Ghosts& ghosts, const WallSet& walls,
+long StreamInsertion::insert(double t, Particles& p, const WallSet& walls,
                              const Decomposition& decomp, GlobalId& next_id, MPI_Comm comm) {
   constexpr int kAttempts = 12;  // placement tries per particle and step
   long total = 0;
@@ -159,7 +159,12 @@ long StreamInsertion::insert(double t, Particles& p, const Ghosts& ghosts, const
     if (due_now == 0) continue;
     // No more than the face holds can be placed in one step: the rest of a backlog waits.
     const long need = std::min(due_now, s.capacity);
-    // Existing bodies near the face: local particles and ghosts within reach.
+    // Existing bodies near the face: this rank's particles within reach (periodic images by
+    // the nearest offset). Every particle is some rank's own, so the OR over the ranks below
+    // sees each once, at its position now. Not the ghosts: insertion runs after the drift and
+    // before the ghosts are refreshed, so their positions are a step old, and a candidate
+    // they blocked on some rank counts but not on another (a stream particle landed 3 mm
+    // elsewhere on 3 ranks than on 1, with `reproducible: true`).
     const InsertionFace& f = s.entry.face;
     std::vector<Vec3> near_x;
     std::vector<double> near_r;
@@ -170,7 +175,6 @@ long StreamInsertion::insert(double t, Particles& p, const Ghosts& ghosts, const
       }
     };
     for (std::size_t i = 0; i < p.size(); ++i) consider(p.x[i], p.radius[i]);
-    for (std::size_t g = 0; g < ghosts.size(); ++g) consider(ghosts.position(g), ghosts.radius[g]);
     // Candidates for each due particle; `blocked` = overlaps an existing body here.
     std::vector<Vec3> cand(static_cast<std::size_t>(need) * kAttempts);
     std::vector<int> blocked(cand.size(), 0);

@@ -45,8 +45,8 @@ class StreamInsertion {
 
   // Inserts what is due by time t; returns how many particles were inserted over
   // all ranks (the same number on every rank). Collective when comm has > 1 rank.
-  long insert(double t, Particles& p, const Ghosts& ghosts, const WallSet& walls,
-              const Decomposition& decomp, GlobalId& next_id, MPI_Comm comm);
+  long insert(double t, Particles& p, const WallSet& walls, const Decomposition& decomp,
+              GlobalId& next_id, MPI_Comm comm);
 
   // Totals of stream k over all ranks (the same on every rank).
   double mass_inserted(std::size_t k) const { return streams_[k].mass; }

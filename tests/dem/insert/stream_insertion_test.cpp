@@ -204,11 +204,10 @@ TEST(StreamInsertion, StateRoundTripContinuesTheSameSequence) {
   // same time into an empty set (the stream is sparse: nothing blocks either).
   a.advance_to(0.05 + 10 * 2e-5);
   Particles pb;
-  Ghosts none;
   const WallSet walls(s);
   const Decomposition d(MPI_COMM_SELF, s.domain, {1, 1, 1});
   GlobalId ib = first_new;
-  copy.insert(a.time(), pb, none, walls, d, ib, MPI_COMM_SELF);
+  copy.insert(a.time(), pb, walls, d, ib, MPI_COMM_SELF);
   std::vector<double> ra;
   const Particles& p = a.particles();
   for (GlobalId id = first_new; id < a.next_id(); ++id)
