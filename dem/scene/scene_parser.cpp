@@ -828,15 +828,19 @@ void parse_fill(const Map& m, const Scene& scene, Insertion& ins) {
   parse_coarse_grain(m, ins);
   {
     // Every particle lies whole inside the region (sample_centre, dem/insert/insertion.cpp):
-    // a region thinner than the smallest sphere would place none, whatever the count.
+    // a region thinner than the largest sphere the distribution draws places none of those,
+    // and the fill, which places the largest first, none at all, whatever the count.
     const Region& g = ins.region;
     const double across =
         g.kind == Region::Kind::box ? (g.hi - g.lo).minCoeff() : std::min(2 * g.radius, g.height);
-    const double d = 2 * smallest_radius(ins.radius), k = ins.coarse_grain;
+    const double d = 2 * largest_radius(ins.radius), k = ins.coarse_grain;
+    const bool one_size = largest_radius(ins.radius) == smallest_radius(ins.radius);
     if (d - across > kRegionFitTolerance * d)
       m.get("region").fail(
           "the region is " + format_number(across) + " m across at its narrowest, less than " +
-          "the smallest particle the fill inserts, " + format_number(d) + " m in diameter" +
+          (one_size ? "the particles the fill inserts, "
+                    : "the largest particle the fill's radius distribution draws, ") +
+          format_number(d) + " m in diameter" +
           (k != 1 ? " (a parcel: the real diameter " + format_number(d / k) +
                         " m times coarse_grain " + format_number(k) + ")"
                   : std::string()) +

@@ -695,6 +695,52 @@ def _(c):
     return "; ".join(done)
 
 
+DATA = os.path.join(os.path.dirname(os.path.realpath(__file__)), "..", "..", "data")
+
+
+@case("overlap_guard_chain_light_backing", "overlap guard, a heavy group pressing a particle "
+      "into a light one: 'set time.max_overlap to at least X' (dem/engine/simulation.cpp, "
+      "describe_overlap)", "run")
+def _(c):
+    # A random scene of the invariants probe: 87 soft spheres, radius ratio up to 3.2, an
+    # elastic frictionless Hooke gas periodic on every side (tests/data/scenes/
+    # soft_gas_light_backing.csv). Its stop names a chain whose backing particle is 34 times
+    # lighter than the driver: the group's approach speed had been its kinetic energy over
+    # the chain's m* (about the light particle's mass), 19.9 m/s in a box whose fastest sphere
+    # moves at 3.3 m/s, and no max_overlap "carried it". Now the printed speed is at most the
+    # largest relative speed in the box, and the max_overlap it proposes runs to the end.
+    with open(os.path.join(DATA, "scenes", "soft_gas_light_backing.csv")) as f:
+        csv = f.read()
+    s = {
+        "domain": {"min": [-0.02141986199118584, -0.04460692976183436, -0.011663111921448178],
+                   "max": [-0.004149821058750516, -0.02729575870552345, 0.0015514459331418089],
+                   "periodic": [True, True, True]},
+        "time": {"rayleigh_fraction": 0.17600691304490668, "end": 0.03242430391813477,
+                 "expected_max_speed": 1.3274650356881497},
+        "materials": [{"name": "m0", "youngs_modulus": 9518174.604642797,
+                       "poisson_ratio": 0.258627550417456, "density": 4044.6328655759944}],
+        "interaction_defaults": {"restitution": 1, "friction": 0},
+        "contact": {"normal": "hooke", "tangential": "none",
+                    "hooke": {"characteristic_velocity": 1.3274650356881497}},
+        "insert": [{"type": "csv", "file": "p.csv", "material": "m0"}],
+        "output": {"snapshot_interval": 0.006484860783626954, "progress": False},
+        "parallel": {"reproducible": True},
+    }
+    files = {"p.csv": csv}
+    m = c.expect(c.run("first", s, "run", files=files), 1,
+                 r"is pressed against particle \d+ by particle \d+ \([^\n]*approaching at " +
+                 NUM + r" m/s[^\n]*set time\.max_overlap to at least " + NUM)
+    speeds = [sum(float(x) ** 2 for x in row.split(",")[4:7]) ** 0.5
+              for row in csv.splitlines()[1:]]
+    if float(m.group(1)) > 2 * max(speeds) * 1.5:
+        raise Broken(f"the chain approaches at {m.group(1)} m/s, beyond any relative speed in the "
+                     f"box (fastest sphere at the start {max(speeds):.3g} m/s)")
+    s["time"]["max_overlap"] = float(m.group(2))
+    r = c.run("rerun", s, "run", files=files)
+    c.rerun_passes(r, r"key time\.max_overlap", "time.max_overlap")
+    return f"chain at {m.group(1)} m/s; max_overlap {m.group(2)}: " + r.lines("done:")[0].split(",")[0]
+
+
 @case("overlap_guard_step", "overlap guard, the step is to blame: 'A step of at most X s "
       "would resolve it' (dem/engine/simulation.cpp, describe_overlap)", "run")
 def _(c):
@@ -1090,12 +1136,31 @@ def _(c):
     s["insert"][0]["coarse_grain"] = 3  # parcels 3 mm across, in a layer 2.5 mm thick
     s["insert"][0]["region"]["box"] = {"min": [0, 0, 0.001], "max": [0.01, 0.01, 0.0035]}
     m = c.expect(c.run("first", s), 2, r"insert\[0\]\.region: the region is 0\.0025 m across "
-                 r"at its narrowest, less than the smallest particle the fill inserts, " + NUM +
+                 r"at its narrowest, less than the particles the fill inserts, " + NUM +
                  r" m in diameter \(a parcel[^\n]*make it at least " + NUM + r" m across, or "
                  r"lower coarse_grain")
     s["insert"][0]["region"]["box"]["max"][2] = 0.001 + float(m.group(2))
     c.rerun_passes(c.run("rerun", s), r"across at its narrowest", "the region's height")
     return f"height {m.group(2)}: 5 parcels placed"
+
+
+@case("fill_region_largest", "a fill region that fits the smallest radius of the distribution "
+      "but not the largest, 'make it at least X m across' (dem/scene/scene_parser.cpp)", "check")
+def _(c):
+    # Radii 0.305 and 0.611 mm in a layer 0.74 mm thick: the small beads fit, the large ones
+    # never; the fill, largest first, had placed none after its attempts and advised a lower
+    # count, which cannot help.
+    s = bed(count=20)
+    s["insert"][0]["radius"] = {"distribution": "discrete", "values": [3.05e-4, 6.11e-4],
+                                "weights": [1, 1]}
+    s["insert"][0]["region"]["box"] = {"min": [0, 0, 0.001], "max": [0.01, 0.01, 0.00174]}
+    m = c.expect(c.run("first", s), 2, r"insert\[0\]\.region: the region is 0\.00074 m across "
+                 r"at its narrowest, less than the largest particle the fill's radius "
+                 r"distribution draws, " + NUM + r" m in diameter; [^\n]*make it at least " + NUM +
+                 r" m across")
+    s["insert"][0]["region"]["box"]["max"][2] = 0.001 + float(m.group(2))
+    c.rerun_passes(c.run("rerun", s), r"across at its narrowest", "the region's height")
+    return f"height {m.group(2)}: 20 beads placed"
 
 
 @case("output_in_use", "a second run into the folder of a running one, 'give this one another "
