@@ -262,6 +262,7 @@ def run_case(case, build, name, ranks):
         if rc != 0:
             sys.exit(f"bed_surface: {name}: {cmd[0]} failed, see {case}/{log}")
     text = open(os.path.join(case, "log.grainFoam")).read()
+    cs.finished(text, case, name)
     split = re.findall(r"grainFoam time split: DEM (\S+) s .*?coupling (\S+) s .*?fluid (\S+) s", text)
     cpu = re.findall(r"ExecutionTime = (\S+) s", text)
     dem, coupling, fluid = (float(x) for x in split[-1])

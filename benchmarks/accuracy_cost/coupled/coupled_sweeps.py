@@ -49,6 +49,15 @@ def sub(path, pattern, replacement, count=1):
         f.write(new)
 
 
+def finished(text, case, what):
+    """A grainFoam stopped by SIGTERM or SIGINT writes a checkpoint and exits 0 (a batch
+    system's time limit): its log then lacks OpenFOAM's closing "End", and its numbers are
+    not the full run's."""
+    if not re.search(r"^End\s*$", text, re.M):
+        sys.exit(f"coupled_sweeps: {what}: grainFoam did not reach its end time (stopped by a "
+                 f"signal, or failed), see {case}/log.grainFoam")
+
+
 def run(case, build, what):
     env = dict(os.environ, LD_LIBRARY_PATH=os.path.join(build, "lib"))
     for cmd, log in ((["blockMesh"], "log.blockMesh"),
@@ -58,6 +67,7 @@ def run(case, build, what):
         if rc != 0:
             sys.exit(f"coupled_sweeps: {what}: {cmd[0]} failed, see {case}/{log}")
     text = open(os.path.join(case, "log.grainFoam")).read()
+    finished(text, case, what)
     split = re.findall(r"grainFoam time split: DEM (\S+) s .*?coupling (\S+) s .*?fluid (\S+) s", text)
     cpu = re.findall(r"ExecutionTime = (\S+) s", text)
     dem, coupling, fluid = (float(x) for x in split[-1])
