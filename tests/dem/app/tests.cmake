@@ -33,8 +33,8 @@ grain_cli_test(option_without_value 2 "option '--restart' needs a value: --resta
                CMD ${_grain} run x.yaml --restart)
 grain_cli_test(option_given_twice 2 "option '--output' is given twice; give it once"
                CMD ${_grain} run x.yaml --output a --output b)
-grain_cli_test(run_option_to_check 2 "option '--restart' is for 'run'"
-               CMD ${_grain} check x.yaml --restart c.h5)
+grain_cli_test(run_option_to_check 2 "option '--output' is for 'run'; 'check' takes the scene file and --restart"
+               CMD ${_grain} check x.yaml --output o)
 grain_cli_test(two_scene_files 2 "'run' takes one scene file, got 'a.yaml' and 'b.yaml'"
                CMD ${_grain} run a.yaml b.yaml)
 grain_cli_test(options_before_scene 0 "done: 2000 steps, 1 particles \\(0 removed\\)"

@@ -686,13 +686,19 @@ TEST(SceneErrors, ModelSettingsMustMatchTheModel) {
                               "contact.hooke"));
 }
 
+// A missing CSV file is reported by its insertion, at the `file` key (file:line:column):
+// the parser keeps the error, as a restart, which inserts nothing, runs without the file.
 TEST(SceneErrors, CsvFileMustExist) {
-  const std::string msg = expect_at(
-      error_of(kBase + "insert:\n  - {type: csv, file: no_such_file.csv, material: glass}\n"), 18,
-      23);
+  const Scene s = parse_scene(
+      kBase + "insert:\n  - {type: csv, file: no_such_file.csv, material: glass}\n", kLabel);
+  ASSERT_EQ(s.insertions.size(), 1u);
+  const std::string& msg = s.insertions[0].csv_missing;
+  EXPECT_EQ(msg.rfind(kLabel + ":18:23: error: ", 0), 0u) << msg;
   EXPECT_THAT(msg, AllOf(HasSubstr("insert[0].file: particle file 'no_such_file.csv' not found"),
                          HasSubstr(kScenes + "/no_such_file.csv"),
                          HasSubstr("relative to the scene file's folder")));
+  // The insertion throws it (`grain check` and `grain run` exit 2 with it): user_files.py,
+  // restart_missing_csv.
 }
 
 TEST(SceneErrors, FillRegionMustLieInsideDomain) {
