@@ -84,6 +84,12 @@ def digest(path):
         return hashlib.sha256(f.read()).hexdigest()
 
 
+def first_checkpoint(d, out="out"):
+    """The first checkpoint the run in folder d wrote into `out`, as a path relative to d."""
+    return os.path.join(out, sorted(n for n in os.listdir(os.path.join(d, out))
+                                    if n.startswith("checkpoint_"))[0])
+
+
 def fresh(case):
     folder = os.path.join(WORK, case)
     shutil.rmtree(folder, ignore_errors=True)
@@ -203,8 +209,7 @@ def check_restart():
     scene(d, end=0.004, extra=", checkpoint_interval: 0.002")
     expect(case, grain(d, "run", "scene.yaml"), 0, r"done:")
     out = os.path.join(d, "out")
-    checkpoint = os.path.join("out", sorted(n for n in os.listdir(out)
-                                            if n.startswith("checkpoint_"))[0])
+    checkpoint = first_checkpoint(d)
     before = {n: digest(os.path.join(out, n)) for n in sorted(os.listdir(out))}
     text = scene(d, end=0.006, extra=", checkpoint_interval: 0.002")
     rc, said = grain(d, "check", "scene.yaml", "--restart", checkpoint)
@@ -256,8 +261,7 @@ def restart_missing_csv():
     scene(d, insert="  - {type: csv, file: beads.csv, material: glass}", end=0.004,
           extra=", checkpoint_interval: 0.002")
     expect(case, grain(d, "run", "scene.yaml"), 0, r"done:")
-    checkpoint = os.path.join("out", sorted(n for n in os.listdir(os.path.join(d, "out"))
-                                            if n.startswith("checkpoint_"))[0])
+    checkpoint = first_checkpoint(d)
     os.remove(os.path.join(d, "beads.csv"))
     scene(d, insert="  - {type: csv, file: beads.csv, material: glass}", end=0.006,
           extra=", checkpoint_interval: 0.002")
@@ -302,8 +306,7 @@ def restart_mesh():
     with open(os.path.join(d, "scene.yaml"), "w") as out:
         out.write(text.replace(wall, mesh % "plate.stl"))
     expect(case, grain(d, "run", "scene.yaml"), 0, r"done:")
-    checkpoint = os.path.join("out", sorted(n for n in os.listdir(os.path.join(d, "out"))
-                                            if n.startswith("checkpoint_"))[0])
+    checkpoint = first_checkpoint(d)
     os.makedirs(os.path.join(d, "meshes"))
     shutil.move(os.path.join(d, "plate.stl"), os.path.join(d, "meshes", "floor.stl"))
     with open(os.path.join(d, "scene.yaml"), "w") as out:
