@@ -158,42 +158,38 @@ std::string render_xdmf_entry(const XdmfEntry& e) {
   std::string out;
   out.reserve(2048);
   const std::string stem = std::filesystem::path(e.file).stem().string();
-  const std::string time = "<Time Value=\"" + exact(e.time) + "\"/>\n";
-  // With a contact network, the entry is a Spatial collection of the particles' grid and
-  // the network's grids, at one time.
-  const bool network = e.contacts >= 0;
-  const std::string in = network ? "          " : "        ";  // the grid's children
-  if (network) {
-    out += "      <Grid Name=\"" + xml_escape(stem) +
-           "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n";
-    out += "        " + time;
+  // Every time step is a Spatial collection: the particles' grid (none when the snapshot holds
+  // no particle) and, with a contact network, the network's grids. ParaView's XDMF 2 reader
+  // fails on a geometry of no points, and it expects every time step to be of the first one's
+  // type, so an empty snapshot (a stream-filled scene at t = 0, a run its particles have all
+  // left) can only be an empty collection among collections.
+  out += "      <Grid Name=\"" + xml_escape(stem) +
+         "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n";
+  out += "        <Time Value=\"" + exact(e.time) + "\"/>\n";
+  if (e.count > 0) {
+    const std::string in = "          ";  // the grid's children
+    const std::string item_indent = in + "  ";
     out += "        <Grid Name=\"particles\" GridType=\"Uniform\">\n";
-  } else {
-    out += "      <Grid Name=\"" + xml_escape(stem) + "\" GridType=\"Uniform\">\n";
-    out += in + time;
-  }
-  out += in + "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" +
-         std::to_string(e.count) + "\" NodesPerElement=\"1\"/>\n";
-  const std::string item_indent = in + "  ";
-  for (const SnapshotField& f : snapshot_fields) {
-    if (std::string_view(f.name) != snapshot_geometry_field) continue;
-    out += in + "<Geometry GeometryType=\"XYZ\">\n";
-    data_item(out, e.file, e.count, f, item_indent.c_str());
-    out += in + "</Geometry>\n";
-  }
-  for (std::size_t k = 0; k < snapshot_fields.size(); ++k) {
-    const SnapshotField& f = snapshot_fields[k];
-    if (std::string_view(f.name) == snapshot_geometry_field) continue;
-    if (!(e.fields & (SnapshotFieldSet{1} << k))) continue;
-    out += in + "<Attribute Name=\"" + std::string(f.name) + "\" AttributeType=\"" +
-           (f.components == 1 ? "Scalar" : "Vector") + "\" Center=\"Node\">\n";
-    data_item(out, e.file, e.count, f, item_indent.c_str());
-    out += in + "</Attribute>\n";
-  }
-  if (network) {
+    out += in + "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" +
+           std::to_string(e.count) + "\" NodesPerElement=\"1\"/>\n";
+    for (const SnapshotField& f : snapshot_fields) {
+      if (std::string_view(f.name) != snapshot_geometry_field) continue;
+      out += in + "<Geometry GeometryType=\"XYZ\">\n";
+      data_item(out, e.file, e.count, f, item_indent.c_str());
+      out += in + "</Geometry>\n";
+    }
+    for (std::size_t k = 0; k < snapshot_fields.size(); ++k) {
+      const SnapshotField& f = snapshot_fields[k];
+      if (std::string_view(f.name) == snapshot_geometry_field) continue;
+      if (!(e.fields & (SnapshotFieldSet{1} << k))) continue;
+      out += in + "<Attribute Name=\"" + std::string(f.name) + "\" AttributeType=\"" +
+             (f.components == 1 ? "Scalar" : "Vector") + "\" Center=\"Node\">\n";
+      data_item(out, e.file, e.count, f, item_indent.c_str());
+      out += in + "</Attribute>\n";
+    }
     out += "        </Grid>\n";
-    out += render_contact_grids(e, "        ");
   }
+  out += render_contact_grids(e, "        ");
   out += "      </Grid>\n";
   return out;
 }

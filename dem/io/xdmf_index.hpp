@@ -3,9 +3,10 @@
 // time series of particle point clouds, while the per-particle arrays stay in the HDF5 files.
 // Format: XDMF 2 (https://www.xdmf.org/index.php/Xdmf2_Model_and_Format_Archive). A
 // Polyvertex topology without a connectivity DataItem gets the default connectivity 0..N-1
-// (Xdmf2 XdmfTopology::Update), i.e. one vertex cell per particle. A snapshot with a contact
-// network (output.contacts) is a Spatial collection of that grid and the network's Polyline
-// grids (render_contact_grids).
+// (Xdmf2 XdmfTopology::Update), i.e. one vertex cell per particle. Each time step is a
+// Spatial collection of that grid named "particles" (absent when the snapshot holds no
+// particle) and, with a contact network (output.contacts), the network's Polyline grids
+// (render_contact_grids).
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -88,7 +89,8 @@ struct XdmfEntry {
 std::string render_contact_grids(const XdmfEntry& entry, const std::string& indent);
 
 // The complete index for `entries` (in the order given), as one Temporal Collection named
-// `series_name` of Uniform Polyvertex grids; each grid lists the fields its file holds.
+// `series_name` of Spatial collections, one per time step (render_xdmf_entry); each
+// particles grid lists the fields its file holds.
 // It is render_xdmf_head + render_xdmf_entry of each entry + render_xdmf_tail; the index file
 // (xdmf_index_file.hpp) appends one rendered entry at a time between the grids and the tail.
 std::string render_xdmf(const std::vector<XdmfEntry>& entries, const std::string& series_name);

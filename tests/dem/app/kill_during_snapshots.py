@@ -52,17 +52,19 @@ def check_index(out, when):
         fail(f"{when}: {path}: the series is not a Temporal Collection")
     grids = series.findall("Grid")
     last_time = None
-    for k, grid in enumerate(grids):
+    for k, step in enumerate(grids):  # one Spatial collection per time
         name = f"particles_{k:06d}"
-        if grid.get("Name") != name:
-            fail(f"{when}: {path}: grid {k} is {grid.get('Name')}, expected {name}")
-        t = float(grid.find("Time").get("Value"))
+        if step.get("Name") != name or step.get("CollectionType") != "Spatial":
+            fail(f"{when}: {path}: time step {k} is {step.get('Name')} "
+                 f"({step.get('CollectionType')}), expected the Spatial collection {name}")
+        t = float(step.find("Time").get("Value"))
         if last_time is not None and t <= last_time:
             fail(f"{when}: {path}: {name} at t = {t} after t = {last_time}")
         last_time = t
-        count = int(grid.find("Topology").get("NumberOfElements"))
-        items = [grid.find("Geometry/DataItem")] + [a.find("DataItem")
-                                                    for a in grid.findall("Attribute")]
+        grid = step.find("Grid[@Name='particles']")  # none when the snapshot is empty
+        count = 0 if grid is None else int(grid.find("Topology").get("NumberOfElements"))
+        items = [] if grid is None else [grid.find("Geometry/DataItem")] + [
+            a.find("DataItem") for a in grid.findall("Attribute")]
         with h5py.File(os.path.join(out, name + ".h5"), "r") as f:
             if float(f.attrs["time"]) != t or int(f.attrs["count"]) != count:
                 fail(f"{when}: {name}.h5 holds t = {f.attrs['time']}, {f.attrs['count']} "

@@ -4,10 +4,11 @@
 
 Opens INDEX with ParaView's "XDMF Reader" (XDMFReader, the XDMF 2 reader: the Xdmf3 readers
 give the Polyvertex grids no cells), writes for every time step the points and every point
-array with its components and values into JSON, and renders the last step (beads as spheres
-of their radius, coloured by speed) into PNG; the JSON also holds the share of the picture's
-pixels that differ from the background. tests/dem/app/paraview_reads_snapshots.py compares
-it all with the HDF5 files.
+array of its "particles" block (each time step is a multiblock; a snapshot of no particle has
+no such block: 0 points) with its components and values into JSON, and renders the last step
+(beads as spheres of their radius, coloured by speed) into PNG (PNG "-": no picture); the
+JSON also holds the share of the picture's pixels that differ from the background.
+tests/dem/app/paraview_reads_snapshots.py compares it all with the HDF5 files.
 """
 import json
 import sys
@@ -18,6 +19,20 @@ from paraview.simple import (ColorBy, GetActiveViewOrCreate, GetColorTransferFun
 from paraview.vtk.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkIOImage import vtkPNGReader
 
+
+
+def particles_block(multiblock):
+    """The block the reader made of the time step's "particles" grid (None: no such grid)."""
+    found = None
+    it = multiblock.NewIterator()
+    it.InitTraversal()
+    while not it.IsDoneWithTraversal():
+        if it.GetCurrentMetaData().Get(multiblock.NAME()).split("[")[0] == "particles":
+            found = it.GetCurrentDataObject()
+        it.GoToNextItem()
+    return found
+
+
 index, png, out = sys.argv[1:4]
 reader = XDMFReader(FileNames=[index])
 reader.PointArrayStatus = reader.GetProperty("PointArrayInfo")[::2]  # every array
@@ -25,7 +40,10 @@ reader.UpdatePipelineInformation()
 steps = []
 for t in reader.TimestepValues:
     reader.UpdatePipeline(t)
-    data = sm.Fetch(reader)
+    data = particles_block(sm.Fetch(reader))
+    if data is None:
+        steps.append({"time": t, "points": 0, "cells": 0, "positions": [], "arrays": {}})
+        continue
     arrays = {}
     pd = data.GetPointData()
     for i in range(pd.GetNumberOfArrays()):
@@ -37,6 +55,9 @@ for t in reader.TimestepValues:
                   "positions": vtk_to_numpy(data.GetPoints().GetData()).tolist(),
                   "arrays": arrays})
 
+if png == "-":
+    json.dump({"steps": steps}, open(out, "w"))
+    sys.exit(0)
 view = GetActiveViewOrCreate("RenderView")
 view.ViewSize = [800, 600]
 view.ViewTime = reader.TimestepValues[-1]

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """ParaView's own XDMF reader opens what `grain run` writes (docs/scene-reference.md).
 
-    paraview_reads_snapshots.py GRAIN SCENE WORKDIR PVBATCH_SH
+    paraview_reads_snapshots.py GRAIN SCENE WORKDIR PVBATCH_SH EMPTY_TIMES_SCENE
 
 Runs `grain run SCENE` (tests/data/scenes/paraview_snapshots.yaml: 300 beads falling onto a
 floor, five snapshots with force, torque, coordination, fluid_force and overlap_max), then
@@ -15,6 +15,9 @@ what ParaView read with the HDF5 files read by h5py:
   - at least one bead touches the floor in the last step (coordination > 0, force not just
     gravity), so the compared values are not all trivial;
   - the picture (800 x 600 PNG) has beads drawn on at least 2 % of its pixels.
+Then runs EMPTY_TIMES_SCENE (tests/data/scenes/paraview_empty_times.yaml: a stream falling
+through an open floor, so the first and the last snapshots hold no particle) and asks the
+same of every time, the empty ones read as 0 points, with no error from the reader.
 """
 import json
 import os
@@ -33,38 +36,43 @@ def fail(message):
     sys.exit(1)
 
 
-def main():
-    grain, scene, work, pvbatch = sys.argv[1:5]
-    subprocess.run(["rm", "-rf", work], check=True)
-    os.makedirs(work)
-    os.chdir(work)
-    run = subprocess.run([grain, "run", scene, "--output", "out", "--no-progress"],
+def run_and_read(grain, scene, out, pvbatch, picture):
+    """Runs `grain run scene` into `out` and dumps what ParaView reads of it; returns the
+    dump and pvbatch's output."""
+    run = subprocess.run([grain, "run", scene, "--output", out, "--no-progress"],
                          capture_output=True, text=True)
     if run.returncode != 0:
-        fail(f"grain run exited {run.returncode}:\n{run.stdout}{run.stderr}")
+        fail(f"grain run {scene} exited {run.returncode}:\n{run.stdout}{run.stderr}")
     dump = os.path.join(os.path.dirname(os.path.abspath(__file__)), "paraview_dump.py")
-    pv = subprocess.run(["bash", pvbatch, dump, "out/particles.xdmf", "out/particles.png",
-                         "paraview.json"], capture_output=True, text=True)
-    if pv.returncode != 0 or not os.path.exists("paraview.json"):
+    json_file = out + ".json"
+    pv = subprocess.run(["bash", pvbatch, dump, f"{out}/particles.xdmf", picture, json_file],
+                        capture_output=True, text=True)
+    if pv.returncode != 0 or not os.path.exists(json_file):
         fail(f"pvbatch exited {pv.returncode}:\n{pv.stdout}{pv.stderr}")
-    seen = json.load(open("paraview.json"))
+    return json.load(open(json_file)), pv.stdout + pv.stderr
 
-    files = sorted(n for n in os.listdir("out") if n.startswith("particles_") and n.endswith(".h5"))
-    steps = seen["steps"]
-    if len(steps) != len(files) or len(files) != 5:
-        fail(f"ParaView sees {len(steps)} time steps, the run wrote {len(files)} (expected 5)")
+
+def compare(out, steps, fields):
+    """Every time step ParaView read against the HDF5 file of its snapshot; returns the files
+    and the datasets compared."""
+    files = sorted(n for n in os.listdir(out) if n.startswith("particles_") and n.endswith(".h5"))
+    if len(steps) != len(files):
+        fail(f"{out}: ParaView sees {len(steps)} time steps, the run wrote {len(files)}")
+    held = []
     for name, step in zip(files, steps):
-        with h5py.File(os.path.join("out", name), "r") as f:
+        with h5py.File(os.path.join(out, name), "r") as f:
             t, n = float(f.attrs["time"]), int(f.attrs["count"])
             if step["time"] != t:
                 fail(f"{name}: ParaView's time {step['time']!r}, the file's {t!r}")
             if step["points"] != n or step["cells"] != n:
                 fail(f"{name}: ParaView has {step['points']} points and {step['cells']} cells, "
                      f"the file {n} particles")
+            if n == 0:
+                continue
             if not np.array_equal(np.array(step["positions"]), f["position"][()]):
                 fail(f"{name}: ParaView's points are not /position")
             held = sorted(k for k in f.keys() if k != "position")
-            if sorted(step["arrays"]) != held or sorted(held) != sorted(FIELDS + ["id"]):
+            if sorted(step["arrays"]) != held or sorted(held) != sorted(fields + ["id"]):
                 fail(f"{name}: ParaView's arrays {sorted(step['arrays'])}, the file's {held}")
             for key in held:
                 data = f[key][()]
@@ -74,6 +82,19 @@ def main():
                 if array["components"] != components or not np.array_equal(values, data):
                     fail(f"{name}:{key}: ParaView's {array['components']} component(s) / values "
                          f"differ from the file's {components}")
+    return files, held
+
+
+def main():
+    grain, scene, work, pvbatch, empty_scene = sys.argv[1:6]
+    subprocess.run(["rm", "-rf", work], check=True)
+    os.makedirs(work)
+    os.chdir(work)
+    seen, _ = run_and_read(grain, scene, "out", pvbatch, "out/particles.png")
+    steps = seen["steps"]
+    if len(steps) != 5:
+        fail(f"ParaView sees {len(steps)} time steps (expected 5)")
+    files, held = compare("out", steps, FIELDS)
     with h5py.File(os.path.join("out", files[-1]), "r") as f:
         touching = int((f["coordination"][()] > 0).sum())
         if touching == 0 or float(f["overlap_max"][()].max()) <= 0:
@@ -85,6 +106,20 @@ def main():
     print(f"ParaView (XDMFReader) read {len(steps)} time steps of {steps[-1]['points']} points "
           f"with {len(held)} arrays equal to the HDF5 files; {touching} beads in contact at "
           f"the end; out/particles.png has beads on {image['drawn']:.1%} of its pixels")
+
+    seen, said = run_and_read(grain, empty_scene, "empty_times", pvbatch, "-")
+    steps = seen["steps"]
+    compare("empty_times", steps, ["velocity", "radius"])
+    counts = [s["points"] for s in steps]
+    if counts[0] != 0 or counts[-1] != 0 or max(counts) == 0:
+        fail(f"empty_times: the snapshots hold {counts} particles; the scene should give none "
+             f"at the first and the last time and some between")
+    errors = [line for line in said.splitlines() if "ERR|" in line or "Error" in line]
+    if errors:
+        fail("ParaView's reader reported errors on the run with empty times:\n" +
+             "\n".join(errors[:10]))
+    print(f"ParaView read the {len(steps)} times of a stream through an open floor, "
+          f"{counts} points, the empty ones without an error")
     print("PASS")
 
 

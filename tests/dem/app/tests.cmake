@@ -177,14 +177,16 @@ if(GRAINFLOW_PYTHON3)
   set_tests_properties(grain.kill_during_snapshots
                        PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}" TIMEOUT 120)
   # ParaView's own XDMF reader (pvbatch, Debian's paraview package) reads a run's snapshots
-  # with the extra fields, value for value, and renders them (about 15 s).
+  # with the extra fields, value for value, and renders them, and reads a run whose first
+  # and last snapshots hold no particle without an error (about 20 s).
   execute_process(COMMAND bash ${PROJECT_SOURCE_DIR}/scripts/pvbatch.sh --check
                   RESULT_VARIABLE _no_paraview)
   if(_no_paraview EQUAL 0)
     add_test(NAME grain.paraview_reads_snapshots
              COMMAND ${GRAINFLOW_PYTHON3} ${CMAKE_CURRENT_LIST_DIR}/paraview_reads_snapshots.py
                      ${_grain} ${_scenes}/paraview_snapshots.yaml
-                     ${_work}/paraview_reads_snapshots ${PROJECT_SOURCE_DIR}/scripts/pvbatch.sh)
+                     ${_work}/paraview_reads_snapshots ${PROJECT_SOURCE_DIR}/scripts/pvbatch.sh
+                     ${_scenes}/paraview_empty_times.yaml)
     set_tests_properties(grain.paraview_reads_snapshots
                          PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}" TIMEOUT 120)
   else()

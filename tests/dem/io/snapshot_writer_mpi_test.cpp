@@ -276,8 +276,9 @@ TEST(SnapshotWriter, MissingExtraFieldIsALogicError) {
   MPI_Barrier(MPI_COMM_WORLD);
 }
 
-// Runs python's strict XML parser on the index and prints one line per grid:
-//   <grid name> <time> <topology type> <elements> then "<tag>:<name> <dims> <type> <prec> <ref>"
+// Runs python's strict XML parser on the index and prints one line per time step (a Spatial
+// collection holding one grid, "particles"):
+//   <step name> <time> <topology type> <elements> then "<tag>:<name> <dims> <type> <prec> <ref>"
 // for the geometry and every attribute.
 const char* xdmf_dump_script = R"PY(
 import sys, xml.etree.ElementTree as ET
@@ -286,9 +287,12 @@ assert root.tag == "Xdmf", root.tag
 (domain,) = root.findall("Domain")
 (series,) = domain.findall("Grid")
 print("series", series.get("Name"), series.get("GridType"), series.get("CollectionType"))
-for g in series.findall("Grid"):
+for step in series.findall("Grid"):
+    assert (step.get("GridType"), step.get("CollectionType")) == ("Collection", "Spatial")
+    (g,) = step.findall("Grid")
+    assert g.get("Name") == "particles", g.get("Name")
     topo = g.find("Topology")
-    print("grid", g.get("Name"), repr(float(g.find("Time").get("Value"))),
+    print("grid", step.get("Name"), repr(float(step.find("Time").get("Value"))),
           topo.get("TopologyType"), topo.get("NumberOfElements"), topo.get("NodesPerElement"))
     items = [("Geometry:" + g.find("Geometry").get("GeometryType"), g.find("Geometry/DataItem"))]
     items += [("Attribute:" + a.get("Name") + ":" + a.get("AttributeType") + ":" + a.get("Center"),

@@ -26,11 +26,12 @@ XdmfEntry with_network(long pairs, long walls) {
   return e;
 }
 
-TEST(XdmfContacts, EntryWithoutNetworkIsAPlainGrid) {
+TEST(XdmfContacts, EntryWithoutNetworkHoldsTheParticlesAlone) {
   const XdmfEntry plain{"p_000000.h5", 0, 0, 30};
   EXPECT_EQ(render_contact_grids(plain, "  "), "");
   const std::string xml = render_xdmf({plain}, "p");
-  EXPECT_EQ(count(xml, "Spatial"), 0u);
+  EXPECT_EQ(count(xml, "Spatial"), 1u);
+  EXPECT_EQ(count(xml, "<Grid "), 1u + 1u + 1u);  // series, the time's collection, particles
   EXPECT_EQ(count(xml, "Polyline"), 0u);
 }
 

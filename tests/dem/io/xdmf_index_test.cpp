@@ -46,6 +46,19 @@ TEST(XdmfIndex, EmptySeriesIsACompleteDocument) {
   EXPECT_EQ(xml.substr(xml.size() - 8), "</Xdmf>\n");
 }
 
+// Each time step is a Spatial collection; a snapshot of no particle is one without a particles
+// grid (ParaView's XDMF 2 reader fails on a geometry of no points), not a grid of zero points.
+TEST(XdmfIndex, ASnapshotOfNoParticleIsAnEmptyCollection) {
+  const std::string xml =
+      render_xdmf({{"p_000000.h5", 0.0, 0, 0}, {"p_000001.h5", 0.1, 10, 4}}, "p");
+  EXPECT_EQ(count(xml, "CollectionType=\"Spatial\""), 2u);
+  EXPECT_EQ(count(xml, "<Grid Name=\"particles\""), 1u);
+  EXPECT_EQ(count(xml, "<Time "), 2u);
+  EXPECT_EQ(count(xml, "p_000000.h5"), 0u);  // nothing of the empty file is read
+  EXPECT_EQ(count(xml, "NumberOfElements=\"0\""), 0u);
+  EXPECT_EQ(count(xml, "Dimensions=\"4 3\">p_000001.h5:/position<"), 1u);
+}
+
 TEST(XdmfIndex, TimeIsPrintedToFullPrecision) {
   const double t = 1.0 / 3.0;
   const std::string xml = render_xdmf({{"p_000000.h5", t, 3, 2}}, "p");
