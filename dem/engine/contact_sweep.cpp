@@ -1006,10 +1006,11 @@ void report_contacts(const ContactSweep& s, ContactNetwork& out) {
       MeshTouch touch[TriangleMesh::kMaxTouches];
       for (std::size_t i = 0; i < p.size(); ++i) {
         const double r = p.radius[i];
-        const int n = mesh.touches(moving ? wall.pose.to_body(p.x[i]) : p.x[i], r, touch);
+        const Vec3 x = s.walls.in_period(p.x[i]);
+        const int n = mesh.touches(WallSet::mesh_query(wall, x), r, touch);
         bool used[kSlots] = {};
         for (int k = 0; k < n; ++k) {
-          const WallTouch t = mesh_wall_touch(wall, touch[k], p.x[i], r, moving, conveyor, belt);
+          const WallTouch t = mesh_wall_touch(wall, touch[k], x, r, moving, conveyor, belt);
           ContactHistory h;
           if constexpr (Law::has_history) {
             const int best = mesh_slot(s.wall_history, wall.column, i, t.n, used);
@@ -1134,13 +1135,14 @@ void steps_per_contact_sweep(ContactSweep& s) {
       MeshTouch touch[TriangleMesh::kMaxTouches];
       for (std::size_t i = 0; i < p.size(); ++i) {
         const double r = p.radius[i];
-        const int n = mesh.touches(moving ? wall.pose.to_body(p.x[i]) : p.x[i], r, touch);
+        const Vec3 x = s.walls.in_period(p.x[i]);
+        const int n = mesh.touches(WallSet::mesh_query(wall, x), r, touch);
         for (int k = 0; k < n; ++k) {
           WallTouch t;
           t.n = moving ? wall.pose.direction_to_world(touch[k].n) : touch[k].n;
           t.overlap = touch[k].overlap;
           t.surface_velocity = belt - belt.dot(t.n) * t.n;
-          if (moving) t.surface_velocity += wall.pose.velocity_at(p.x[i] - (r - t.overlap) * t.n);
+          if (moving) t.surface_velocity += wall.pose.velocity_at(x - (r - t.overlap) * t.n);
           wall_contact(i, t, wall.material);
         }
       }
@@ -1197,10 +1199,10 @@ void tally_contacts(const Particles& p, const Ghosts& g, const NeighbourList& lo
     const WallSet::Entry& wall = walls.walls()[w];
     if (wall.kind == Wall::Kind::mesh) {
       const TriangleMesh& mesh = walls.mesh(wall);
-      const bool moving = wall.pose.moving();
       MeshTouch touch[TriangleMesh::kMaxTouches];
       for (std::size_t i = 0; i < p.size(); ++i) {
-        const int n = mesh.touches(moving ? wall.pose.to_body(p.x[i]) : p.x[i], p.radius[i], touch);
+        const int n =
+            mesh.touches(WallSet::mesh_query(wall, walls.in_period(p.x[i])), p.radius[i], touch);
         for (int k = 0; k < n; ++k) add(i, touch[k].overlap / p.radius[i]);
       }
       continue;

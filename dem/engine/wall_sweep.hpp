@@ -165,10 +165,11 @@ void mesh_sweep(ContactSweep& s, const WallSet::Entry& wall, const TriangleMesh&
   ContactHistory scratch;
   for (std::size_t i = 0; i < p.size(); ++i) {
     const double r = p.radius[i];
-    const int n = mesh.touches(moving ? wall.pose.to_body(p.x[i]) : p.x[i], r, touch);
+    const Vec3 x = s.walls.in_period(p.x[i]);
+    const int n = mesh.touches(WallSet::mesh_query(wall, x), r, touch);
     bool used[kSlots] = {};
     for (int k = 0; k < n; ++k) {
-      const WallTouch t = mesh_wall_touch(wall, touch[k], p.x[i], r, moving, conveyor, belt);
+      const WallTouch t = mesh_wall_touch(wall, touch[k], x, r, moving, conveyor, belt);
       ContactHistory* h = &scratch;
       if constexpr (Law::has_history) {
         const int best = mesh_slot(s.wall_history, wall.column, i, t.n, used);

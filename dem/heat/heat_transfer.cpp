@@ -81,10 +81,10 @@ void HeatTransfer::walls_pass(const Particles& p, const WallSet& walls, const Wa
     };
     if (wall.kind == Wall::Kind::mesh) {
       const TriangleMesh& mesh = walls.mesh(wall);
-      const bool moving = wall.pose.moving();
       MeshTouch touch[TriangleMesh::kMaxTouches];
       for (std::size_t i = 0; i < p.size(); ++i) {
-        const int n = mesh.touches(moving ? wall.pose.to_body(p.x[i]) : p.x[i], p.radius[i], touch);
+        const int n =
+            mesh.touches(WallSet::mesh_query(wall, walls.in_period(p.x[i])), p.radius[i], touch);
         for (int k = 0; k < n; ++k) conduct(i, touch[k].overlap);
       }
       continue;

@@ -10,7 +10,9 @@
 
 namespace grainflow {
 
-WallSet::WallSet(const Scene& scene) {
+WallSet::WallSet(const Scene& scene)
+    : lo_(scene.domain.lo), hi_(scene.domain.hi), periodic_(scene.domain.periodic) {
+  any_periodic_ = periodic_[0] || periodic_[1] || periodic_[2];
   double r_hint = 0;
   for (const Insertion& ins : scene.insertions)
     if (ins.kind == Insertion::Kind::fill || ins.kind == Insertion::Kind::stream)
@@ -158,7 +160,7 @@ bool WallSet::touches_any(const Vec3& x, double r, bool still_only) const {
         if (touch_cylinder(e.cylinder, x, r, t)) return true;
         break;
       case Wall::Kind::mesh:
-        if (meshes_[e.mesh].touches(e.pose.to_body(x), r, m) > 0) return true;
+        if (meshes_[e.mesh].touches(e.pose.to_body(in_period(x)), r, m) > 0) return true;
         break;
     }
   }
@@ -182,7 +184,7 @@ WallSet::Overlap WallSet::deepest_overlap(const Vec3& x, double r) const {
         if (touch_cylinder(e.cylinder, x, r, t)) take(k, t.overlap);
         break;
       case Wall::Kind::mesh: {
-        const int n = meshes_[e.mesh].touches(e.pose.to_body(x), r, m);
+        const int n = meshes_[e.mesh].touches(e.pose.to_body(in_period(x)), r, m);
         for (int c = 0; c < n; ++c) take(k, m[c].overlap);
         break;
       }

@@ -10,6 +10,7 @@
 // of the last step (kept in the key column's `tangential`). A mesh contact takes the slot
 // whose key is closest to its normal (within ~37 degrees), so a spring follows a particle
 // that slides or rolls across triangle boundaries of a flat or gently curved mesh.
+#include <array>
 #include <string>
 #include <vector>
 
@@ -82,11 +83,36 @@ class WallSet {
   // One line per mesh: triangles, vertices, repairs (for the run report).
   const std::vector<std::string>& notes() const { return notes_; }
 
+  // x moved into the domain along its periodic axes. Between the neighbour rebuilds that wrap
+  // them, centres drift up to half a skin past a periodic side; a mesh is not repeated across
+  // the sides, so asked at such a centre it would miss the part of itself where the particle
+  // already is (a floor ending at the side: the bead rolls onto its rim and falls through).
+  // Planes and cylinders look alike from both sides (scene_parser.cpp) and need no wrap.
+  Vec3 in_period(const Vec3& x) const {
+    if (!any_periodic_) return x;
+    Vec3 y = x;
+    for (int a = 0; a < 3; ++a) {
+      if (!periodic_[a]) continue;
+      if (y[a] < lo_[a])
+        y[a] += hi_[a] - lo_[a];
+      else if (y[a] >= hi_[a])
+        y[a] -= hi_[a] - lo_[a];
+    }
+    return y;
+  }
+  // Where mesh e is asked about a particle at x, already in_period: in the mesh's body frame.
+  static Vec3 mesh_query(const Entry& e, const Vec3& x) {
+    return e.pose.moving() ? e.pose.to_body(x) : x;
+  }
+
  private:
   std::vector<Entry> walls_;
   std::vector<TriangleMesh> meshes_;
   std::size_t columns_ = 0;
   std::vector<std::string> notes_;
+  Vec3 lo_ = Vec3::Zero(), hi_ = Vec3::Zero();  // the domain
+  std::array<bool, 3> periodic_{false, false, false};
+  bool any_periodic_ = false;
 };
 
 }  // namespace grainflow
