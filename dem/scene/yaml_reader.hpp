@@ -198,8 +198,10 @@ class Field {
  public:
   Field(const Source& src, YAML::Node node, std::string path, YAML::Mark key_mark)
       : src_(&src), node_(std::move(node)), path_(std::move(path)), key_mark_(key_mark) {
-    // A missing value (`key:` alone) has no useful mark of its own; use the key's.
-    const bool has_own_mark = node_.IsDefined() && !node_.IsNull() && node_.Mark().line >= 0;
+    // A missing value (`key:` alone) has no useful mark of its own; use the key's. An alias
+    // (`end: *g`) has its anchor's mark, before its key: the key is where it is used.
+    const bool has_own_mark = node_.IsDefined() && !node_.IsNull() && node_.Mark().line >= 0 &&
+                              node_.Mark().pos >= key_mark_.pos;
     mark_ = has_own_mark ? node_.Mark() : key_mark_;
   }
 
@@ -280,7 +282,9 @@ class Field {
     std::vector<Field> out;
     for (std::size_t i = 0; i < node_.size(); ++i) {
       const YAML::Node item = node_[i];
-      const YAML::Mark m = item.IsNull() || item.Mark().line < 0 ? mark_ : item.Mark();
+      // An alias among the items has its anchor's mark, before the list: use the list's.
+      const bool own = !item.IsNull() && item.Mark().line >= 0 && item.Mark().pos >= mark_.pos;
+      const YAML::Mark m = own ? item.Mark() : mark_;
       out.emplace_back(*src_, item, path_ + "[" + std::to_string(i) + "]", m);
     }
     return out;

@@ -455,6 +455,25 @@ TEST(SceneErrors, WrongTypeVector) {
   EXPECT_THAT(scalar, HasSubstr("gravity: expected a list of 3 numbers, got '-9.81'"));
 }
 
+// A YAML alias carries its anchor's position; the error points where the alias is used (the
+// key, or the list holding it), where the wrong value entered, not at the anchor.
+TEST(SceneErrors, AnAliasOfTheWrongTypeIsReportedWhereItIsUsed) {
+  const std::string base = with("  max: [1, 1, 1]\n", "  max: &top [1, 1, 1]\n");
+  const std::string end = expect_at(error_of(with("  end: 0.5\n", "  end: *top\n", base)), 6, 3);
+  EXPECT_THAT(end, HasSubstr("time.end: expected a number, got a list of 3"));
+
+  const std::string item = expect_at(
+      error_of(with("density: 2500", "density: &rho 2500",
+                    with("materials: [glass, glass]", "materials: [glass, *rho]", kBase))),
+      13, 16);
+  EXPECT_THAT(item, HasSubstr("interactions[0].materials"));
+
+  // An alias of the right type is read as its anchor's value.
+  const Scene s = parse_scene(
+      with("  step: 1e-6\n", "  step: &dt 1e-6\n", with("  end: 0.5\n", "  end: *dt\n")), kLabel);
+  EXPECT_EQ(s.time.end, 1e-6);
+}
+
 TEST(SceneErrors, WrongTypeSectionAndList) {
   const std::string map =
       expect_at(error_of(with("time:\n  step: 1e-6\n  end: 0.5\n", "time: 0.5\n")), 4, 7);
