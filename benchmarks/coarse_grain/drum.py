@@ -106,6 +106,10 @@ def run(grain, case, text):
                    check=True, stdout=open(os.path.join(case, "log.txt"), "w"),
                    stderr=subprocess.STDOUT)
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    with open(os.path.join(case, "log.txt")) as log:
+        if not any(line.startswith("done: ") for line in log):
+            sys.exit(f"drum: grain run {path} did not reach its end (a SIGTERM or SIGINT stops "
+                     f"it with exit 0 after a checkpoint: 'stopped:'); see {case}/log.txt")
     return after.ru_utime - before.ru_utime, time.time() - t0
 
 

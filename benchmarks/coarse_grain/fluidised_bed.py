@@ -492,6 +492,9 @@ def main():
                         sys.exit(f"fluidised_bed: k = {k}: {cmd[0]} failed, see {case}/{log}")
             wall = time.monotonic() - started
         text = open(os.path.join(case, "log.grainFoam")).read()
+        if not re.search(r"^End\s*$", text, re.M):
+            sys.exit(f"fluidised_bed: k = {k}: grainFoam did not reach its end time (a SIGTERM or SIGINT stops it with exit 0 after a checkpoint); "
+                     f"see {case}/log.grainFoam")
         cpu = float(re.findall(r"ExecutionTime = (\S+) s", text)[-1])
         simulated = float(re.findall(r"^Time = (\S+)$", text, re.MULTILINE)[-1])  # the run's own end
         imbalance = max(float(x) for x in re.findall(r"relative imbalance (\S+)", text))

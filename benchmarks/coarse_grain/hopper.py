@@ -169,6 +169,10 @@ def run(grain, case, scene):
         rc = subprocess.call([grain, "run", scene], cwd=case, stdout=log, stderr=subprocess.STDOUT)
     if rc != 0:
         sys.exit(f"hopper: {grain} run {scene} failed in {case} (exit {rc}); see its .log")
+    with open(os.path.join(case, scene.replace(".yaml", ".log"))) as log:
+        if not any(line.startswith("done: ") for line in log):
+            sys.exit(f"hopper: {grain} run {scene} in {case} did not reach its end "
+                     f"(a SIGTERM or SIGINT stops it with exit 0 after a checkpoint: 'stopped:'); see its .log")
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     return after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime, time.time() - wall
 

@@ -201,6 +201,9 @@ def main():
             r = subprocess.run(cmd, cwd=case, stdout=f, stderr=subprocess.STDOUT, env=env)
         if r.returncode != 0:
             sys.exit(f"run.py: {' '.join(cmd)} failed:\n" + (case / log).read_text()[-3000:])
+        if log == "log.grainFoam" and not re.search(r"^End\s*$", (case / log).read_text(), re.M):
+            sys.exit(f"run.py: grainFoam did not reach its end time (a SIGTERM or SIGINT stops it with exit 0 after a checkpoint); "
+                     f"see {case / log}")
 
     if args.report_only:
         n = len(x_tile) * TILES[0] * TILES[1]

@@ -59,6 +59,9 @@ def sh(cmd, cwd, log):
     if r.returncode != 0:
         sys.exit(f"settled_bed.py: {' '.join(map(str, cmd))} failed, see {cwd / log}:\n"
                  + (cwd / log).read_text()[-3000:])
+    if log == "log.grainFoam" and not re.search(r"^End\s*$", (cwd / log).read_text(), re.M):
+        sys.exit(f"settled_bed.py: grainFoam did not reach its end time (a SIGTERM or SIGINT stops it with exit 0 after a checkpoint); "
+                 f"see {cwd / log}")
 
 
 def fresh(name, end, beads):

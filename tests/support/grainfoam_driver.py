@@ -90,6 +90,11 @@ class Runner:
         elif r.returncode != 0:
             raise RuntimeError(f"{log} failed (exit {r.returncode}); {case}/log.{log}:\n"
                                + r.stdout[-3000:])
+        elif command[0] == self.solver and not re.search(r"^End\s*$", r.stdout, re.M):
+            # A SIGTERM or SIGINT stops grainFoam with exit 0 after a checkpoint (a batch
+            # system's time limit); its numbers are then not the full run's.
+            raise RuntimeError(f"{log} exited 0 without OpenFOAM's closing 'End' (stopped by a "
+                               f"signal before its end time); see {case}/log.{log}")
         return r.stdout
 
     def solve(self, case, ranks=1):

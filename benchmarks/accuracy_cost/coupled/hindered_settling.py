@@ -317,6 +317,9 @@ def run(case, a):
             rc = subprocess.call([FOAM] + cmd, cwd=case, stdout=out, stderr=subprocess.STDOUT, env=env)
         if rc != 0:
             sys.exit(f"hindered_settling: {cmd[0]} failed, see {case}/{log}")
+    if not re.search(r"^End\s*$", open(os.path.join(case, "log.grainFoam")).read(), re.M):
+        sys.exit(f"hindered_settling: grainFoam did not reach its end time (a SIGTERM or SIGINT stops it with exit 0 after a checkpoint); "
+                 f"see {case}/log.grainFoam")
 
 
 def measure(case, info, a):

@@ -26,6 +26,7 @@ import csv
 import glob
 import math
 import os
+import re
 import subprocess
 import sys
 
@@ -161,6 +162,9 @@ def run(case, build):
             rc = subprocess.call([FOAM] + cmd, cwd=case, stdout=out, stderr=subprocess.STDOUT, env=env)
         if rc != 0:
             sys.exit(f"settling_cells: {cmd[0]} failed, see {case}/{log}")
+    if not re.search(r"^End\s*$", open(os.path.join(case, "log.grainFoam")).read(), re.M):
+        sys.exit(f"settling_cells: grainFoam did not reach its end time (a SIGTERM or SIGINT stops it with exit 0 after a checkpoint); "
+                 f"see {case}/log.grainFoam")
     cpu, imbalance, fluid_z = 0.0, 0.0, float("nan")
     for line in open(os.path.join(case, "log.grainFoam")):
         if line.startswith("ExecutionTime"):
