@@ -750,6 +750,7 @@ void DemLink::write_snapshot(const std::string& directory, long step, long conti
                                                      m.scene.output.fields);
       // Each material's k, for the coarse_grain and real_count fields (empty: no parcels).
       m.snapshots->set_coarse_grain(m.scene.coarse_grain_table(), m.scene.real_material_table());
+      m.snapshots->set_material_names(m.scene.material_names());
       m.snapshot_directory = directory;
       if (continue_after >= 0) m.snapshots->continue_series(continue_after);
     }

@@ -100,6 +100,7 @@ void guard_finite(const Simulation& sim, bool local_bad, const std::string& dire
   try {
     prepare_output_directory(directory);  // a coupled run may not have written any yet
     SnapshotWriter diagnostic(comm, directory, "diagnostic");
+    diagnostic.set_material_names(sim.scene().material_names());
     where = "; every particle of this step is in " +
             diagnostic.write(sim.particles(), sim.time(), sim.counters().steps);
   } catch (const OutputError& e) {

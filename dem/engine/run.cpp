@@ -550,6 +550,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
 
   SnapshotWriter snapshots(comm, dir, "particles", scene.output.fields);
   snapshots.set_coarse_grain(scene.coarse_grain_table(), scene.real_material_table());
+  snapshots.set_material_names(scene.material_names());
   snapshots.set_scene_fingerprint(scene_fingerprint(scene));
   const std::string log_path = (std::filesystem::path(dir) / "log.csv").string();
   // output.wall_loads: each wall's mean load since the previous row, and that time span; with

@@ -601,8 +601,9 @@ void read_snapshot_entry(const Scene& scene, const WallSet* walls, const Inserti
   // up to half a skin outside that range: such a centre is the same sphere as its image
   // inside, and is moved there. Farther out (a snapshot of another domain) is an error.
   Particles& q = snap.particles;
-  // A snapshot of parcels: its material indices are those of the scene that wrote it; the
-  // parser gave this scene the same parcel classes (Insertion::material_map).
+  // Its material indices are those of the scene that wrote it. The parser mapped them to this
+  // scene's materials by name (root attribute material_names) and gave this scene the same
+  // parcel classes (Insertion::material_map).
   if (!ins.material_map.empty())
     for (std::size_t i = 0; i < q.size(); ++i) {
       const int m = q.material[i];
@@ -611,10 +612,22 @@ void read_snapshot_entry(const Scene& scene, const WallSet* walls, const Inserti
                          std::to_string(i) + " (particle id " + std::to_string(q.id[i]) +
                          "): the material index " + std::to_string(m) + " is not one of the " +
                          std::to_string(ins.material_map.size()) +
-                         " materials of the scene that wrote it (root attribute "
-                         "material_coarse_grain); the snapshot (insertion at " +
+                         " materials of the scene that wrote it (root attributes "
+                         "material_names, material_coarse_grain); the snapshot (insertion at " +
                          ins.source + ") was changed or damaged after it was written");
-      q.material[i] = ins.material_map[static_cast<std::size_t>(m)];
+      const int here = ins.material_map[static_cast<std::size_t>(m)];
+      if (here < 0) {
+        std::string listed;
+        for (std::size_t k = 0; k < scene.materials.size(); ++k)
+          if (scene.materials[k].real_material < 0)
+            listed += (listed.empty() ? "" : ", ") + scene.materials[k].name;
+        throw InsertionError(
+            ins.source + ": error: snapshot '" + ins.snapshot_file + "' holds particles of " +
+            "material '" + ins.snapshot_material_names[static_cast<std::size_t>(m)] +
+            "' (particle id " + std::to_string(q.id[i]) + "), and this scene lists no material " +
+            "of that name (it lists " + listed + "); add it to `materials`");
+      }
+      q.material[i] = here;
     }
   // Masses the writing scene left out (output.fields) follow from the radius and the
   // material, as they would be checked: rho (4/3) pi r^3.

@@ -2,6 +2,7 @@
 
 #include <hdf5.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <type_traits>
@@ -90,6 +91,38 @@ File open_snapshot(const std::string& path) {
 
 }  // namespace
 
+namespace {
+// The root attribute material_names (a fixed-length string, the names joined by commas:
+// snapshot_writer.hpp), split; empty when the file has none.
+std::vector<std::string> read_material_names(hid_t file, const std::string& path) {
+  std::vector<std::string> names;
+  if (H5Aexists(file, "material_names") <= 0) return names;
+  std::string joined;
+  bool read_ok = false;
+  const hid_t a = H5Aopen(file, "material_names", H5P_DEFAULT);
+  if (a >= 0) {
+    const hid_t type = H5Aget_type(a);
+    if (type >= 0 && H5Tget_class(type) == H5T_STRING && H5Tis_variable_str(type) == 0) {
+      std::vector<char> text(H5Tget_size(type) + 1, '\0');
+      read_ok = H5Aread(a, type, text.data()) >= 0;
+      joined = text.data();
+    }
+    if (type >= 0) H5Tclose(type);
+    H5Aclose(a);
+  }
+  if (!read_ok)
+    throw SnapshotDamagedError(path +
+                               ": error: cannot read the root attribute 'material_names' "
+                               "(a fixed-length string)");
+  for (std::size_t start = 0; start <= joined.size();) {
+    const std::size_t comma = std::min(joined.find(',', start), joined.size());
+    names.push_back(joined.substr(start, comma - start));
+    start = comma + 1;
+  }
+  return names;
+}
+}  // namespace
+
 Snapshot read_snapshot(const std::string& path) {
   Quiet quiet;
   const File f = open_snapshot(path);
@@ -143,6 +176,7 @@ Snapshot read_snapshot(const std::string& path) {
     H5Aread(a, H5T_NATIVE_DOUBLE, &s.time);
     H5Aclose(a);
   }
+  s.material_names = read_material_names(f.id, path);
   p.inertia.resize(n);
   for (std::size_t i = 0; i < n; ++i) p.inertia[i] = 0.4 * p.mass[i] * p.radius[i] * p.radius[i];
   p.v_pred = p.v;
@@ -183,6 +217,7 @@ SnapshotClasses read_snapshot_classes(const std::string& path) {
   SnapshotClasses c;
   c.k = array_attribute<double>(f.id, path, "material_coarse_grain", H5T_NATIVE_DOUBLE);
   c.real = array_attribute<int>(f.id, path, "material_real", H5T_NATIVE_INT);
+  c.names = read_material_names(f.id, path);
   if (c.k.size() != c.real.size())
     throw SnapshotReadError(path + ": error: the root attributes material_coarse_grain (" +
                             std::to_string(c.k.size()) + " values) and material_real (" +

@@ -37,6 +37,9 @@ struct Snapshot {
   bool has_mass = true;
   bool has_temperature = false;  // the file holds temperatures (else particles' are 0)
   std::vector<double> coarse_grain;  // each particle's k, when the file has the dataset
+  // The writing scene's material names by index (root attribute material_names); empty for
+  // a file written before snapshots carried them.
+  std::vector<std::string> material_names;
 };
 
 Snapshot read_snapshot(const std::string& path);
@@ -50,6 +53,9 @@ Snapshot read_snapshot(const std::string& path);
 struct SnapshotClasses {
   std::vector<double> k;
   std::vector<int> real;
+  // Every material's name by index (root attribute material_names; empty for a file written
+  // before snapshots carried them).
+  std::vector<std::string> names;
   bool parcels_without_classes = false;
 };
 SnapshotClasses read_snapshot_classes(const std::string& path);

@@ -602,6 +602,10 @@ std::string SnapshotWriter::write(const Particles& p, double time, long step,
       ok = !opens || write_scalar_attribute(file.get(), "scene_fingerprint", i64, &fingerprint);
       agreement.check(ok, "writing the root attribute scene_fingerprint");
     }
+    if (!material_names_.empty()) {
+      ok = !opens || write_string_attribute(file.get(), "material_names", material_names_);
+      agreement.check(ok, "writing the root attribute material_names");
+    }
     if (!coarse_grain_.empty()) {
       const std::vector<std::int64_t> real(real_material_.begin(), real_material_.end());
       ok = !opens ||

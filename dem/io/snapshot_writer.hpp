@@ -85,6 +85,15 @@ class SnapshotWriter {
     coarse_grain_ = std::move(per_material);
     real_material_ = std::move(real_material);
   }
+  // The scene's material names (parcel classes included), in material-index order, written as
+  // the root attribute `material_names` (the names joined by commas, which a name never
+  // holds): a snapshot insertion maps the stored indices onto its own scene's materials by
+  // name, so a scene that lists them in another order keeps each particle's material.
+  void set_material_names(const std::vector<std::string>& names) {
+    material_names_.clear();
+    for (const std::string& name : names)
+      material_names_ += (material_names_.empty() ? "" : ",") + name;
+  }
   // The scene's fingerprint (scene_fingerprint, dem/engine/insertion_record.hpp), written as
   // the root attribute `scene_fingerprint` of each snapshot (0: none). continue_series stops at
   // a file that carries another fingerprint: another scene's run wrote it.
@@ -103,6 +112,7 @@ class SnapshotWriter {
   std::vector<double> coarse_grain_;
   std::vector<int> real_material_;
   std::uint64_t fingerprint_ = 0;
+  std::string material_names_;
   std::string foreign_file_;
   std::vector<std::string> missing_;
   long next_number_ = 0;  // the number of the next file write() makes

@@ -40,6 +40,12 @@ std::vector<int> Scene::real_material_table() const {
   return real;
 }
 
+std::vector<std::string> Scene::material_names() const {
+  std::vector<std::string> names;
+  for (const Material& m : materials) names.push_back(m.name);
+  return names;
+}
+
 const MaterialPair& Scene::pair(int a, int b) const {
   if (a > b) std::swap(a, b);
   const int n = static_cast<int>(materials.size());

@@ -192,10 +192,14 @@ struct Insertion {
   // A snapshot of parcels: the writing scene's parcel classes (its root attributes
   // material_coarse_grain and material_real, one entry per material index), and for each of
   // its material indices this scene's (the parser adds a class per (real material, k) the
-  // snapshot holds). Empty: a snapshot of real particles, read with its material indices.
+  // snapshot holds). When the snapshot names its materials (root attribute material_names),
+  // each listed material is this scene's material of that name, in whatever order this scene
+  // lists them (-1: this scene has no material of that name; an error if a particle has it).
+  // Empty: a snapshot of real particles without names, read with its material indices.
   std::vector<double> snapshot_class_k;
   std::vector<int> snapshot_class_real;
   std::vector<int> material_map;
+  std::vector<std::string> snapshot_material_names;  // the writer's, by its material index
   // fill
   Region region;
   std::optional<long> count;              // number of particles, or
@@ -307,6 +311,8 @@ struct Scene {
   // Every material's listed material (its own index for a listed one, Material::real_material
   // for a parcel class), indexed by material; empty like coarse_grain_table().
   std::vector<int> real_material_table() const;
+  // The materials' names in index order (parcel classes included).
+  std::vector<std::string> material_names() const;
   const MaterialPair& pair(int a, int b) const;       // precondition: complete table
 };
 

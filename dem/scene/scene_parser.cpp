@@ -1012,9 +1012,33 @@ void parse_snapshot_classes(const Field& file, const Scene& scene, Insertion& in
               "Continue that run from one of its checkpoints (grain run --restart), or rerun "
               "its scene with this grainflow and insert from the new snapshot");
   const std::size_t listed = scene.materials.size();
+  ins.snapshot_material_names = c.names;
+  if (!c.names.empty() && c.k.empty()) {  // real particles: one class per named material
+    c.k.assign(c.names.size(), 1.0);
+    for (std::size_t m = 0; m < c.names.size(); ++m) c.real.push_back(static_cast<int>(m));
+  }
+  if (!c.names.empty() && c.names.size() != c.k.size())
+    file.fail("the snapshot '" + ins.snapshot_file + "' names " + std::to_string(c.names.size()) +
+              " materials (root attribute material_names) "
+              "but has classes for " +
+              std::to_string(c.k.size()) +
+              " (material_coarse_grain); the file was changed or damaged after it was written");
+  // This scene's index of the writer's listed material m, by name when the file names it.
+  const auto here = [&](int m) {
+    if (c.names.empty()) return m;
+    for (std::size_t i = 0; i < listed; ++i)
+      if (scene.materials[i].name == c.names[static_cast<std::size_t>(m)])
+        return static_cast<int>(i);
+    return -1;
+  };
   for (std::size_t m = 0; m < c.k.size(); ++m) {
-    const bool listed_here = c.real[m] >= 0 && static_cast<std::size_t>(c.real[m]) < listed;
-    if (!(c.k[m] >= 1 && c.k[m] <= 1e3) || c.real[m] < 0 || (c.k[m] == 1 && c.real[m] != int(m)))
+    const std::size_t known = c.names.empty() ? listed : c.names.size();
+    const bool listed_here = c.real[m] >= 0 && static_cast<std::size_t>(c.real[m]) < known;
+    // With names, a class's listed material is one of the writer's own (k = 1) materials.
+    const bool real_is_listed =
+        c.names.empty() || !listed_here || c.k[static_cast<std::size_t>(c.real[m])] == 1;
+    if (!(c.k[m] >= 1 && c.k[m] <= 1e3) || c.real[m] < 0 || (c.k[m] == 1 && c.real[m] != int(m)) ||
+        !real_is_listed)
       file.fail("the snapshot '" + ins.snapshot_file + "' has a broken parcel class: material " +
                 std::to_string(m) + " with k = " + format_number(c.k[m]) + " and listed material " +
                 std::to_string(c.real[m]) +
@@ -1029,8 +1053,19 @@ void parse_snapshot_classes(const Field& file, const Scene& scene, Insertion& in
                 ", but this scene lists " + std::to_string(listed) +
                 " material(s) (allowed: 0 to " + std::to_string(listed - 1) +
                 "); list the materials in the order of the scene that wrote it");
+    if (c.k[m] != 1 && here(c.real[m]) < 0) {
+      std::string names;
+      for (std::size_t i = 0; i < listed; ++i)
+        names += (names.empty() ? "" : ", ") + scene.materials[i].name;
+      file.fail("the snapshot '" + ins.snapshot_file +
+                "' holds parcels of k = " + format_number(c.k[m]) + " of material '" +
+                c.names[static_cast<std::size_t>(c.real[m])] +
+                "', and this scene lists no material of that name (it lists " + names +
+                "); add it to `materials`");
+    }
     ins.coarse_grain = std::max(ins.coarse_grain, c.k[m]);
   }
+  for (int& real : c.real) real = here(real);
   ins.snapshot_class_k = std::move(c.k);
   ins.snapshot_class_real = std::move(c.real);
 }
@@ -1223,9 +1258,10 @@ void add_parcel_classes(Scene& s) {
       // The writer's material indices, in its order of classes, to this scene's.
       const std::vector<double>& k = ins.snapshot_class_k;
       ins.material_map.clear();
-      for (std::size_t m = 0; m < k.size(); ++m)
-        ins.material_map.push_back(k[m] == 1 ? static_cast<int>(m)
-                                             : parcel_class(ins.snapshot_class_real[m], k[m]));
+      for (std::size_t m = 0; m < k.size(); ++m) {
+        const int real = ins.snapshot_class_real[m];  // -1: no material of its name here
+        ins.material_map.push_back(k[m] == 1 || real < 0 ? real : parcel_class(real, k[m]));
+      }
       continue;
     }
     if (ins.coarse_grain == 1) continue;

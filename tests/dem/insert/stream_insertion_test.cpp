@@ -10,6 +10,7 @@
 #include "dem/insert/insertion.hpp"
 #include "dem/io/output_directory.hpp"
 #include "dem/io/snapshot_writer.hpp"
+#include "dem/scene/scene_parser.hpp"
 #include "tests/dem/support/test_scene.hpp"
 
 namespace grainflow {
@@ -254,6 +255,57 @@ TEST(SnapshotInsertion, ContinuesABedFromASnapshot) {
   EXPECT_EQ(r.v[0], Vec3::Zero());
   s.insertions[0].snapshot_file = (dir / "particles.xdmf").string();
   EXPECT_THROW(insert_particles(s, r, next), InsertionError);
+}
+
+// A snapshot names its scene's materials (root attribute material_names), and a scene that
+// lists them in another order keeps each particle's material: the glass bead stays glass, the
+// rubber one rubber (by index they had been swapped, silently when the densities agree). A
+// scene without one of the names is refused, naming it.
+TEST(SnapshotInsertion, MaterialsAreMatchedByNameNotByIndex) {
+  const std::filesystem::path dir =
+      std::filesystem::path(GRAINFLOW_BINARY_DIR) / "test_output" / "snapshot_material_names";
+  std::filesystem::remove_all(dir);
+  prepare_output_directory(dir.string());
+  Particles p;
+  p.add(10, Vec3(0.002, 0.002, 0.002), Vec3::Zero(), Vec3::Zero(), 5e-4, 0, kRho);  // glass
+  p.add(11, Vec3(0.006, 0.006, 0.006), Vec3::Zero(), Vec3::Zero(), 5e-4, 1, kRho);  // rubber
+  SnapshotWriter w(MPI_COMM_WORLD, dir.string());
+  w.set_material_names({"glass", "rubber"});
+  const std::string file = w.write(p, 0.5, 10);
+  const auto scene = [&](const std::string& materials) {
+    return parse_scene(
+        "domain: {min: [0, 0, 0], max: [0.01, 0.01, 0.01]}\n"
+        "time: {step: 1e-6, end: 1e-5}\n"
+        "materials:\n" +
+            materials +
+            "interaction_defaults: {restitution: 0.5}\n"
+            "contact: {normal: hertz}\n"
+            "insert:\n  - {type: snapshot, file: '" +
+            file + "'}\n",
+        "<test>");
+  };
+  const Scene s = scene(
+      "  - {name: rubber, youngs_modulus: 1e6, poisson_ratio: 0.45, density: 2500}\n"
+      "  - {name: glass, youngs_modulus: 5e7, poisson_ratio: 0.3, density: 2500}\n");
+  Particles q;
+  GlobalId next = 1;
+  insert_particles(s, q, next);
+  ASSERT_EQ(q.size(), 2u);
+  EXPECT_EQ(s.materials[static_cast<std::size_t>(q.material[0])].name, "glass");
+  EXPECT_EQ(s.materials[static_cast<std::size_t>(q.material[1])].name, "rubber");
+
+  const Scene missing = scene(
+      "  - {name: glass, youngs_modulus: 5e7, poisson_ratio: 0.3, density: 2500}\n"
+      "  - {name: gum, youngs_modulus: 1e6, poisson_ratio: 0.45, density: 2500}\n");
+  Particles r;
+  next = 1;
+  try {
+    insert_particles(missing, r, next);
+    ADD_FAILURE() << "a snapshot of rubber beads was taken into a scene without rubber";
+  } catch (const InsertionError& e) {
+    EXPECT_NE(std::string(e.what()).find("material 'rubber'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("it lists glass, gum"), std::string::npos) << e.what();
+  }
 }
 
 // A periodic run moves centres back into [lo, hi) only at neighbour-list rebuilds, so its

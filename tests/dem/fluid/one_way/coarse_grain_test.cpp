@@ -524,6 +524,20 @@ TEST(CoarseGrain, SnapshotOfParcelsContinuesAsParcels) {
         v, ut, terminal_velocity(2 * d));
     EXPECT_NEAR(v / ut, 1, 0.005);
   }
+  // A reader that lists another material first: the stored classes are matched by name
+  // (root attribute material_names), so the parcel is still a glass parcel, not a steel one.
+  {
+    std::string text = reader(file, "");
+    const std::string glass = "  - {name: glass,";
+    text.insert(text.find(glass),
+                "  - {name: steel, youngs_modulus: 2e11, poisson_ratio: 0.3, density: 7800}\n");
+    const Scene s = parse_scene(text, "reader.yaml");
+    Simulation sim(s, true, MPI_COMM_SELF);
+    ASSERT_EQ(sim.particles().size(), 1u);
+    const Material& m = s.materials[static_cast<std::size_t>(sim.particles().material[0])];
+    EXPECT_EQ(m.name, "glass[k=2]");
+    EXPECT_EQ(m.density, 2500);
+  }
   // With a fill of the same k the class is shared; with another k, both exist.
   EXPECT_EQ(parse_scene(reader(file, "2"), "reader.yaml").materials.size(), 2u);
   const Scene two = parse_scene(reader(file, "3"), "reader.yaml");
@@ -552,8 +566,8 @@ TEST(CoarseGrain, SnapshotOfParcelsContinuesAsParcels) {
   EXPECT_NE(e.find(tampered + ": error: dataset '/coarse_grain', index 0"), std::string::npos) << e;
   EXPECT_NE(e.find("k = 3, but its material 'glass[k=2]' has k = 2"), std::string::npos) << e;
 
-  // A copy whose parcel class copies a material this scene does not list (the writer's
-  // second listed material, say).
+  // A copy whose parcel class copies another parcel class (its listed material changed to 1,
+  // the writer's glass[k=2]): a broken class.
   const std::string other = (dir / "other_material.h5").string();
   fs::copy_file(file, other);
   {
@@ -567,9 +581,7 @@ TEST(CoarseGrain, SnapshotOfParcelsContinuesAsParcels) {
   e = error_of(reader(other, ""));
   std::printf("%s\n", e.c_str());
   EXPECT_NE(e.find("cg.yaml:16:"), std::string::npos) << e;
-  EXPECT_NE(e.find("holds material 1 (parcels of k = 2 of material 1), but this scene lists 1 "
-                   "material(s) (allowed: 0 to 0); list the materials in the order of the scene "
-                   "that wrote it"),
+  EXPECT_NE(e.find("has a broken parcel class: material 1 with k = 2 and listed material 1"),
             std::string::npos)
       << e;
 
