@@ -200,6 +200,51 @@ TEST(FillInsertion, TruncatedNormalStaysInBounds) {
   EXPECT_NEAR(mean, expected, 4 * 2e-4 / std::sqrt(n));
 }
 
+// A window narrow against the standard deviation: a normal draw falls in [0.97, 1.01] mm with
+// probability 0.02 % for sigma = 0.1 m, and after 1000 misses the sampler had returned the
+// mean (in the probe's [0.9, 1.1] mm with sigma 0.1 m, 46 % of the radii were exactly 1 mm).
+// The truncated normal's mean and standard deviation, closed forms (Johnson, Kotz &
+// Balakrishnan 1994, Continuous Univariate Distributions 1, sec. 10.1), must come out for
+// every sigma, and no radius may repeat.
+TEST(FillInsertion, TruncatedNormalInANarrowWindowIsExact) {
+  auto phi = [](double z) { return std::exp(-z * z / 2) / std::sqrt(2 * std::numbers::pi); };
+  auto Phi = [](double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); };
+  for (const double sigma : {1e-1, 1e-3, 1e-4, 3e-5, 1e-5}) {
+    SizeDistribution d;
+    d.kind = SizeDistribution::Kind::normal;
+    d.mean = 1e-3;
+    d.stddev = sigma;
+    d.min = 9.7e-4;
+    d.max = 1.01e-3;
+    const double a = (d.min - d.mean) / sigma, b = (d.max - d.mean) / sigma;
+    const double z = Phi(b) - Phi(a);
+    const double mean = d.mean + sigma * (phi(a) - phi(b)) / z;
+    const double sd =
+        sigma * std::sqrt(1 + (a * phi(a) - b * phi(b)) / z - std::pow((phi(a) - phi(b)) / z, 2));
+    std::mt19937_64 rng(11);
+    const int n = 40000;
+    std::vector<double> r(n);
+    double sum = 0, sum2 = 0;
+    for (double& x : r) {
+      x = sample_radius(d, rng);
+      ASSERT_GE(x, d.min);
+      ASSERT_LE(x, d.max);
+      sum += x;
+      sum2 += x * x;
+    }
+    const double m = sum / n, s = std::sqrt(sum2 / n - m * m);
+    std::sort(r.begin(), r.end());
+    const long repeats = std::adjacent_find(r.begin(), r.end()) == r.end() ? 0 : 1;
+    std::printf(
+        "[ measured ] sigma %.0e: P(window) %.4f, mean %.6e (closed form %.6e), sd %.4e "
+        "(%.4e)\n",
+        sigma, z, m, mean, s, sd);
+    EXPECT_NEAR(m, mean, 4 * sd / std::sqrt(n));
+    EXPECT_NEAR(s, sd, 0.02 * sd);
+    EXPECT_EQ(repeats, 0);
+  }
+}
+
 // A fill by volume fraction has the attempt budget of the particles it draws, 2000 each, as a
 // fill by count: a 2 cm box at 0.335 solids of 0.5 mm spheres (5119 of them, below random
 // sequential addition's saturation near 0.38) had a flat 4e6 attempts and was refused at
