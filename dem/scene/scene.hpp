@@ -207,7 +207,7 @@ struct Insertion {
   SizeDistribution radius;
   int material = 0;
   Vec3 velocity = Vec3::Zero();
-  unsigned seed = 1;
+  unsigned seed = 1;  // the parser's default: 1 + the entry's index in `insert`
   // csv: columns x,y,z,radius and optionally vx,vy,vz, wx,wy,wz, material (material by name)
   std::string csv_file;  // resolved relative to the scene file's folder
   // A csv file that does not exist: the error (file:line:column) its insertion reports. A

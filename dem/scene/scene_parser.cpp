@@ -1103,6 +1103,10 @@ std::vector<Insertion> parse_insertions(const Field& f, const Scene& scene) {
     const Map m = item.map();
     Insertion ins;
     ins.source = item.source().label + ":" + std::to_string(item.line());
+    // Without a `seed`, insert[i] draws from seed 1 + i: two fills of equal regions (or a
+    // stream after a fill) with one default seed drew the same numbers, the second bed an
+    // exact copy of the first shifted, the stream's radii the fill's.
+    ins.seed = static_cast<unsigned>(1 + out.size());
     ins.kind = m.get("type", "add `type: fill`, `csv`, `stream` or `snapshot`")
                    .choice<Insertion::Kind>("insertion type",
                                             {{"fill", Insertion::Kind::fill},

@@ -3,6 +3,8 @@
 // containment and pairwise non-overlap checked by brute force, and the moments of
 // the size distributions (sample mean within 4 standard errors of the exact mean:
 // a false failure rate below 1e-4).
+#include "dem/insert/insertion.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -11,7 +13,7 @@
 #include <fstream>
 #include <numbers>
 
-#include "dem/insert/insertion.hpp"
+#include "dem/scene/scene_parser.hpp"
 #include "tests/dem/support/test_scene.hpp"
 
 namespace grainflow {
@@ -458,6 +460,49 @@ TEST_F(BrokenCsv, OutsideTheDomainAndOverlapping) {
   EXPECT_THAT(error_of("x,y,z,radius\n0,0,0,0.01\n0.5,0.5,0.5,4e4\n", true),
               HasSubstr(at(3) + "the particle at (0.5, 0.5, 0.5) with radius 40000 overlaps an "
                                 "earlier particle at (0, 0, 0) with radius 0.01"));
+}
+
+// Two fills of equal regions without a `seed`: each entry's default seed is its own (1 + its
+// index), so the second bed is not the first one shifted, as it was when both drew from seed
+// 1 (largest difference 8.7e-19 m, the probe). With one seed given to both, it is, which shows
+// what the comparison sees.
+TEST(FillInsertion, FillsWithoutASeedDrawIndependentLayouts) {
+  const auto layouts = [](const std::string& seed) {
+    const std::string fill =
+        "    count: 30\n    material: glass\n    radius: {distribution: uniform, min: 3e-4, "
+        "max: 5e-4}\n" +
+        seed;
+    const Scene s = parse_scene(
+        "domain: {min: [0, 0, 0], max: [0.01, 0.01, 0.02]}\n"
+        "time: {step: 1e-6, end: 1e-5}\n"
+        "materials: [{name: glass, youngs_modulus: 5e6, poisson_ratio: 0.3, density: 2500}]\n"
+        "interaction_defaults: {restitution: 0.5}\n"
+        "contact: {normal: hertz}\n"
+        "insert:\n"
+        "  - type: fill\n    region: {box: {min: [0, 0, 0], max: [0.01, 0.01, 0.01]}}\n" +
+            fill +
+            "  - type: fill\n    region: {box: {min: [0, 0, 0.01], max: [0.01, 0.01, 0.02]}}\n" +
+            fill,
+        "<test>");
+    Particles p;
+    GlobalId next = 1;
+    insert_particles(s, p, next);
+    EXPECT_EQ(p.size(), 60u);
+    double largest = 0;  // between bead k of the first bed and bead k of the second, shifted
+    for (std::size_t k = 0; k < 30; ++k)
+      largest = std::max({largest, (p.x[k + 30] - Vec3(0, 0, 0.01) - p.x[k]).norm(),
+                          std::abs(p.radius[k + 30] - p.radius[k])});
+    return std::make_pair(largest, s.insertions[1].seed);
+  };
+  const auto [by_default, second_seed] = layouts("");
+  const auto [same_seed, given] = layouts("    seed: 5\n");
+  std::printf(
+      "[ measured ] largest difference between the beds: default seeds (1, %u) %.3g m, "
+      "both seed %u %.3g m\n",
+      second_seed, by_default, given, same_seed);
+  EXPECT_EQ(second_seed, 2u);
+  EXPECT_GT(by_default, 1e-4);
+  EXPECT_LT(same_seed, 1e-15);
 }
 
 }  // namespace
