@@ -99,6 +99,7 @@ void print_report(const Simulation& sim, MPI_Comm comm, std::ostream& out,
       o << note << "\n";
   }
   for (const std::string& note : sim.walls().notes()) o << note << "\n";  // meshes read
+  for (const std::string& note : sim.insertion_notes()) o << note << "\n";
 }
 
 // `word` as one word of a POSIX shell command: as it is when it holds only characters no

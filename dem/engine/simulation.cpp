@@ -143,7 +143,7 @@ Simulation::Simulation(const Scene& scene, bool insert, MPI_Comm comm,
   }
   if (scene_.heat) heat_ = std::make_unique<HeatTransfer>(scene_);
   if (insert) {
-    insert_particles(scene_, p_, next_id_, &walls_);
+    insert_particles(scene_, p_, next_id_, &walls_, &insertion_notes_);
     walls_.check_closed_meshes(p_.x);  // every rank holds every inserted particle here
   }
 }

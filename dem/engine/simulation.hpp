@@ -106,6 +106,8 @@ class Simulation {
   // looked). Called by the run at each log row.
   void recheck_force_limits();
   const std::vector<std::string>& force_limit_notes() const { return force_limit_notes_; }
+  // Lines on fills whose outcome differs from what they asked (insert_particles).
+  const std::vector<std::string>& insertion_notes() const { return insertion_notes_; }
   std::vector<std::string> force_term_reports() const {
     std::vector<std::string> out;
     for (const auto& t : terms_) out.push_back(t->report());
@@ -344,6 +346,7 @@ class Simulation {
   ImplicitDrag drag_;
   std::vector<TermLimit> force_limits_;
   std::vector<std::string> force_limit_notes_;
+  std::vector<std::string> insertion_notes_;
   Counters counters_;
   // record_fluid_force(): the force terms' explicit force on each particle, as of the last
   // force evaluation that recorded it.

@@ -255,7 +255,7 @@ std::string inside_a_wall(const Scene& s, const WallSet* walls, const Vec3& x, d
 }
 
 void fill_region(const Scene& scene, const WallSet* walls, const Insertion& ins, Particles& p,
-                 GlobalId& next_id, OverlapGrid& grid) {
+                 GlobalId& next_id, OverlapGrid& grid, std::vector<std::string>* notes) {
   std::mt19937_64 rng(ins.seed);
   const double density = scene.materials[ins.material].density;
   const double target_volume =
@@ -354,6 +354,21 @@ void fill_region(const Scene& scene, const WallSet* walls, const Insertion& ins,
     p.temperature.back() = ins.temperature.value_or(0.0);
     ++placed;
     volume += sphere_volume(r);
+  }
+  // Radii are drawn until their volume reaches the fraction, so the last one overshoots it:
+  // by little in a large region, by much where one particle is a sizeable part of it.
+  const double reached = volume / region_volume(ins.region);
+  if (ins.volume_fraction && notes && reached > 1.05 * *ins.volume_fraction) {
+    std::ostringstream o;
+    o.precision(4);
+    o << "note: " << ins.source << ": the fill placed " << placed << " particle"
+      << (placed == 1 ? "" : "s") << ", a volume fraction of " << reached
+      << " of its region, where "
+      << "volume_fraction asks " << *ins.volume_fraction
+      << ": radii are drawn until their volume reaches the fraction, and the last one, up to "
+      << sphere_volume(max_radius(ins.radius)) / region_volume(ins.region)
+      << " of the region, overshoots it; a larger region or a `count` comes closer";
+    notes->push_back(o.str());
   }
 }
 
@@ -751,7 +766,8 @@ void read_snapshot_entry(const Scene& scene, const WallSet* walls, const Inserti
 
 }  // namespace
 
-void insert_particles(const Scene& scene, Particles& p, GlobalId& next_id, const WallSet* walls) {
+void insert_particles(const Scene& scene, Particles& p, GlobalId& next_id, const WallSet* walls,
+                      std::vector<std::string>* notes) {
   double r_max = 0;
   for (std::size_t i = 0; i < p.size(); ++i) r_max = std::max(r_max, p.radius[i]);
   for (const Insertion& ins : scene.insertions)
@@ -766,7 +782,9 @@ void insert_particles(const Scene& scene, Particles& p, GlobalId& next_id, const
         scene.insertions.begin() + static_cast<std::ptrdiff_t>(e) + 1, scene.insertions.end(),
         [](const Insertion& later) { return later.kind != Insertion::Kind::stream; });
     switch (ins.kind) {
-      case Insertion::Kind::fill: fill_region(scene, walls, ins, p, next_id, grid); break;
+      case Insertion::Kind::fill:
+        fill_region(scene, walls, ins, p, next_id, grid, notes);
+        break;
       case Insertion::Kind::csv:
         if (!ins.csv_missing.empty()) throw InsertionError(ins.csv_missing);
         read_csv(scene, walls, ins, p, next_id, grid);

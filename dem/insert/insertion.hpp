@@ -4,6 +4,7 @@
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "dem/core/particles.hpp"
 #include "dem/scene/scene.hpp"
@@ -29,8 +30,10 @@ double min_radius(const SizeDistribution& d);  // the smallest radius d can give
 // nor walls, and lie inside the domain.
 // Stream entries are left to StreamInsertion; snapshot entries add the particles of
 // a grainflow HDF5 snapshot (new ids, same order). `walls`, when given, adds mesh
-// walls (and moving walls at t = 0) to the walls new particles must not touch.
+// walls (and moving walls at t = 0) to the walls new particles must not touch. `notes`, when
+// given, receives a line per fill whose outcome differs from what it asked (a volume fraction
+// overshot by its last particle).
 void insert_particles(const Scene& scene, Particles& p, GlobalId& next_id,
-                      const WallSet* walls = nullptr);
+                      const WallSet* walls = nullptr, std::vector<std::string>* notes = nullptr);
 
 }  // namespace grainflow

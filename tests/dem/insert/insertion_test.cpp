@@ -505,5 +505,36 @@ TEST(FillInsertion, FillsWithoutASeedDrawIndependentLayouts) {
   EXPECT_LT(same_seed, 1e-15);
 }
 
+// A volume fraction is reached by the last particle drawn, which overshoots it: one 4 mm bead
+// is 0.268 of a 1 cm box, where 0.01 was asked. The fill reports what it placed; a large fill,
+// within 5 % of what it asked, says nothing.
+TEST(FillInsertion, AVolumeFractionOvershotByItsLastParticleIsReported) {
+  const auto notes_of = [](double box, double fraction, double radius) {
+    Scene s = test::one_material_scene(1e7, 0.3, 2000, 0.5);
+    Insertion ins = box_fill(Vec3(0, 0, 0), Vec3(box, box, box));
+    ins.volume_fraction = fraction;
+    ins.radius.kind = SizeDistribution::Kind::constant;
+    ins.radius.value = radius;
+    ins.source = "tiny.yaml:8";
+    s.insertions.push_back(ins);
+    Particles p;
+    GlobalId next = 1;
+    std::vector<std::string> notes;
+    insert_particles(s, p, next, nullptr, &notes);
+    double volume = 0;
+    for (double r : p.radius) volume += sphere_volume(r);
+    std::printf("[ measured ] %.3g asked, %.4f placed (%zu particles)\n", fraction,
+                volume / (box * box * box), p.size());
+    return notes;
+  };
+  const std::vector<std::string> tiny = notes_of(0.01, 0.01, 4e-3);
+  ASSERT_EQ(tiny.size(), 1u);
+  const double one = sphere_volume(4e-3) / 1e-6;  // 0.26808
+  EXPECT_THAT(tiny[0], HasSubstr("tiny.yaml:8: the fill placed 1 particle, a volume fraction of "
+                                 "0.2681 of its region, where volume_fraction asks 0.01"));
+  EXPECT_NEAR(one, 0.2681, 5e-5);
+  EXPECT_TRUE(notes_of(0.02, 0.2, 5e-4).empty());
+}
+
 }  // namespace
 }  // namespace grainflow
