@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <limits>
@@ -526,7 +527,11 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
       !options.allow_large_time_step)
     throw SetupError(scene.file + ": error: refusing to run with this time step (see above); " +
                      refusal_remedy(sim.time_step_report()) +
-                     ", or pass --allow-large-dt to run anyway");
+                     ", or pass --allow-large-dt to start anyway (the run-time guards still "
+                     "stop it at the first contact this step does not resolve, keys "
+                     "time.min_steps_per_contact and time.max_overlap, or the first particle "
+                     "that moves too far in a step, time.max_step_travel; 0 turns "
+                     "min_steps_per_contact or max_step_travel off)");
   guard_finite(sim, has_non_finite(sim.particles(), sim.heat() != nullptr), dir, comm);
   // A restart whose scene ends before the checkpoint would run no step, and would first cut
   // the snapshot series and log back to the checkpoint: refused before anything is touched.
@@ -587,6 +592,32 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
       say << "note: " << dir << "/" << gap
           << " is a gap in the snapshot series (deleted or damaged since it was written): "
              "particles.xdmf lists the snapshots around it\n";
+    // Intervals left to their defaults follow time.end: a restart that extends the run (as
+    // the summary advises) would space its snapshots and log rows otherwise than the run it
+    // continues, unsaid. The earlier spacing is read off the snapshots and rows taken over.
+    const auto spacing_note = [&](const char* key, const char* rule, double now, double before) {
+      if (before > 0 && std::abs(now - before) > 1e-6 * before)
+        say << "note: output." << key << " is left to its default, " << rule << " = " << now
+            << " s, and the run this restart continues wrote every " << before
+            << " s (another time.end); set output." << key << ": " << significant(before, 9)
+            << " to keep its spacing\n";
+    };
+    if (!scene.output.snapshot_interval && kept >= 2) {
+      const std::vector<XdmfEntry>& e = snapshots.entries();
+      spacing_note("snapshot_interval", "time.end / 20", scene.time.end / 20,
+                   e[kept - 1].time - e[kept - 2].time);
+    }
+    if (!scene.output.log_interval && checkpoint_log) {
+      // The last two rows' times (first column) of the log the checkpoint keeps.
+      std::vector<double> times;
+      std::istringstream rows(*checkpoint_log);
+      for (std::string row; std::getline(rows, row);)
+        if (!row.empty() && (std::isdigit(static_cast<unsigned char>(row[0])) || row[0] == '-'))
+          times.push_back(std::strtod(row.c_str(), nullptr));
+      if (times.size() >= 2)
+        spacing_note("log_interval", "time.end / 200", scene.time.end / 200,
+                     times[times.size() - 1] - times[times.size() - 2]);
+    }
     if (!snapshots.foreign_file().empty())
       say << "note: " << dir << "/" << snapshots.foreign_file()
           << " was written by another scene's run (its scene_fingerprint differs): the series "

@@ -1086,7 +1086,9 @@ FastParticle Simulation::fastest_particle(double v2_max) const {
   // gate needs no division: nobody can exceed the limit while v_max dt <= limit r_min.
   FastParticle fast;
   const double limit = scene_.time.max_step_travel;
-  if (limit <= 0 || v2_max * dt_ * dt_ <= limit * limit * smallest_radius_ * smallest_radius_)
+  // Nothing to pass through where nothing can touch (one particle, no walls).
+  if (limit <= 0 || !scene_.contacts_possible ||
+      v2_max * dt_ * dt_ <= limit * limit * smallest_radius_ * smallest_radius_)
     return fast;
   for (std::size_t i = 0; i < p_.size(); ++i) {
     const double speed = std::sqrt(p_.v[i].squaredNorm());
@@ -1180,12 +1182,35 @@ bool Simulation::check_contacts(const ContactGuards& s, bool finite_here) const 
       o << "; the fluid reaches " << fluid_max << " m/s in the domain and drags the particle "
         << "towards it: a step of at most " << round_down_3(travel_limit * r / fluid_max)
         << " s keeps it within the limit at that speed";
+    // Gravity goes on accelerating a falling particle: a step that fits today's speed is
+    // refused again a few steps later. The speed gravity alone gives it by the end of the run,
+    // or by a fall across the domain's bounded extent along gravity, whichever is less.
+    const double g = scene_.gravity.norm();
+    if (g > 0 && scene_.time.end > time_) {
+      double fall = 0;
+      bool bounded = true;
+      for (int a = 0; a < 3; ++a) {
+        const double along = std::abs(scene_.gravity[a]) / g;
+        if (along <= 1e-12) continue;
+        if (scene_.domain.periodic[a]) bounded = false;
+        fall += along * (scene_.domain.hi[a] - scene_.domain.lo[a]);
+      }
+      const double by_end = speed + g * (scene_.time.end - time_);
+      const double v_g =
+          bounded ? std::min(by_end, std::sqrt(speed * speed + 2 * g * fall)) : by_end;
+      if (v_g > 1.01 * std::max(speed, fluid_max))
+        o << "; gravity alone takes it to " << v_g << " m/s by "
+          << (bounded && v_g < by_end ? "a fall across the domain" : "the end of the run")
+          << ": a step of at most " << round_down_3(travel_limit * r / v_g)
+          << " s keeps it within the limit then";
+    }
     if (scene_.contact.normal == NormalModel::hertz) {
       // An impact at that speed on a wall of its own material: R* = r, m* = m.
       const double tc =
           hertz_contact_time(table_(p_.material[i], p_.material[i]).y_star, r, p_.mass[i], speed);
-      o << "; resolving an impact at that speed needs at most " << tc / 20
-        << " s (1/20 of the Hertz contact time against a wall of its own material)";
+      if (std::isfinite(tc))
+        o << "; resolving an impact at that speed needs at most " << tc / 20
+          << " s (1/20 of the Hertz contact time against a wall of its own material)";
     }
     o << ". If the speed itself is unphysical, look for what caused it (an initial velocity, a "
          "fluid force, a contact in the steps before)";
@@ -1244,7 +1269,8 @@ bool Simulation::check_contacts(const ContactGuards& s, bool finite_here) const 
     else
       o << tc / 20 << " s would (1/20 of the Hertz contact time at that speed)";
     o << "; lower time.step or time.rayleigh_fraction, or raise time.expected_max_speed so that "
-         "grain check warns about it";
+         "grain check warns about it; or set time.min_steps_per_contact: 0 to let such contacts "
+         "through (to measure under-resolved impacts on purpose)";
   } else {
     o << " overlap by " << 100 * worst[0] << " % of the smaller radius (limit " << 100 * limit
       << " %, key time.max_overlap)";

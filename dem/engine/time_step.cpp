@@ -333,7 +333,7 @@ TimeStepReport check_time_step(const Scene& scene, const Particles& p, const Pai
     double r_smallest = inf;
     for (int m = 0; m < nm; ++m) r_smallest = std::min(r_smallest, r_min[m]);
     const double travel = scene.time.max_step_travel;
-    if (travel > 0 && r_smallest < inf) {
+    if (travel > 0 && r_smallest < inf && scene.contacts_possible) {
       const double v_stop = travel * r_smallest / rep.dt;
       o << "travel guard: a particle that moves more than " << travel
         << " x its radius in one step stops the run (key time.max_step_travel): above " << v_stop

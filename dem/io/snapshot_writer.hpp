@@ -74,6 +74,8 @@ class SnapshotWriter {
   const std::vector<std::string>& missing() const { return missing_; }
 
   std::size_t snapshots_written() const { return entries_.size(); }
+  // The series' entries so far (after continue_series: the snapshots it took over).
+  const std::vector<XdmfEntry>& entries() const { return entries_; }
   std::string index_path() const;
   SnapshotFieldSet fields() const { return fields_; }
 

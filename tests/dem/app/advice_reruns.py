@@ -43,6 +43,8 @@ import subprocess
 import sys
 import time
 
+import h5py
+
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.realpath(__file__)), "..", "..",
                                 "support"))
 from singleton import isolated_singleton  # noqa: E402  (tests/support/singleton.py)
@@ -679,6 +681,47 @@ def _(c):
     return f"step {m.group(1)}: " + r.lines("done:")[0].split(",")[0]
 
 
+@case("travel_guard_gravity", "travel guard on a falling particle, 'gravity alone takes it to "
+      "X m/s by the end of the run: a step of at most Y s keeps it within the limit then' "
+      "(dem/engine/simulation.cpp)", "run")
+def _(c):
+    # A 1 mm bead falling 78 m in 4 s (a floor 100 m down makes contacts possible): at
+    # dt = 0.3 t_R it passes a radius per step at 27 m/s, and the step that fits that speed
+    # was refused again a few steps later as gravity went on (the probe: a lone bead).
+    s, files = dropped_on_floor("x,y,z,radius\n0,0,99.9,0.001\n", end=4.0, youngs=5e6)
+    s["domain"] = {"min": [-0.05, -0.05, 0], "max": [0.05, 0.05, 100]}
+    s["time"] = {"rayleigh_fraction": 0.3, "end": 4.0}
+    s["output"] = {"snapshot_interval": 1.0}
+    m = c.expect(c.run("first", s, "run", files=files), 1,
+                 r"key time\.max_step_travel\)[^\n]*gravity alone takes it to " + NUM +
+                 r" m/s by the end of the run: a step of at most " + NUM +
+                 r" s keeps it within the limit then")
+    s["time"] = {"step": float(m.group(2)), "end": 4.0}
+    r = c.run("rerun", s, "run", files=files)
+    c.rerun_passes(r, r"of its radii per step", "time.step (gravity)")
+    return f"{m.group(1)} m/s, step {m.group(2)} s: " + r.lines("done:")[0].split(",")[0]
+
+
+@case("allow_large_dt", "start-up refusal of dt, 'pass --allow-large-dt to start anyway (... "
+      "0 turns min_steps_per_contact ... off)', then the steps-per-contact guard's 'set "
+      "time.min_steps_per_contact: 0' (dem/engine/run.cpp, dem/engine/simulation.cpp)", "run")
+def _(c):
+    # The probe's scene: a 1 mm bead 0.5 mm above the floor at 1 m/s, dt = 1.06 t_R (2.5
+    # steps per impact). "--allow-large-dt to run anyway" had been refuted by the guard.
+    s, files = dropped_on_floor("x,y,z,radius,vx,vy,vz\n0,0,0.0015,0.001,0,0,-1.0\n",
+                                end=1.369107e-3, step=4.10119e-5, youngs=5e7, restitution=0.5)
+    s["time"]["expected_max_speed"] = 1.2
+    c.expect(c.run("first", s, "run", files=files), 1,
+             r"or pass --allow-large-dt to start anyway \(the run-time guards still stop it")
+    r = c.run("flag", s, "run", ["--allow-large-dt"], files=files)
+    c.expect(r, 1, r"key time\.min_steps_per_contact\)[^\n]*or set "
+             r"time\.min_steps_per_contact: 0 to let such contacts through")
+    s["time"]["min_steps_per_contact"] = 0
+    r = c.run("rerun", s, "run", ["--allow-large-dt"], files=files)
+    c.rerun_passes(r, r"key time\.min_steps_per_contact\)", "time.min_steps_per_contact: 0")
+    return "--allow-large-dt with min_steps_per_contact 0: " + r.lines("done:")[0].split(",")[0]
+
+
 @case("travel_guard", "travel guard, 'A step of at most X s keeps it within the limit ...; "
       "resolving an impact at that speed needs at most Y s' (dem/engine/simulation.cpp)", "run")
 def _(c):
@@ -1041,6 +1084,38 @@ def checkpointed(c, s, every):
     return r, os.path.relpath(checkpoints[0], r.folder)
 
 
+@case("restart_extended_spacing", "restart of a longer run with the default intervals, "
+      "'set output.snapshot_interval: X to keep its spacing' (dem/engine/run.cpp)", "run --restart")
+def _(c):
+    # The probe's extension: end raised from 0.004 to 0.008 s on restart, intervals left to
+    # their defaults (end/20, end/200), which then doubled, unsaid.
+    s = bed(step=2e-5, end=0.004)
+    del s["output"]["snapshot_interval"]
+    s["output"]["checkpoint_keep"] = 10  # the restarts' own checkpoints leave the first one
+    r, checkpoint = checkpointed(c, s, 0.002)
+    s["time"]["end"] = 0.008
+    r = c.run("", s, "run", ["--restart", checkpoint], folder=r.folder, scene_name="longer.yaml")
+    snap = c.expect(r, 0, r"note: output\.snapshot_interval is left to its default, time\.end / "
+                    r"20 = " + NUM + r" s, and the run this restart continues wrote every " + NUM
+                    + r" s \(another time\.end\); set output\.snapshot_interval: " + NUM)
+    log = c.expect(r, 0, r"note: output\.log_interval is left to its default[^\n]*set "
+                   r"output\.log_interval: " + NUM)
+    s["output"]["snapshot_interval"] = float(snap.group(3))
+    s["output"]["log_interval"] = float(log.group(1))
+    r = c.run("", s, "run", ["--restart", checkpoint], folder=r.folder, scene_name="longer.yaml")
+    c.rerun_passes(r, r"is left to its default", "output.snapshot_interval, output.log_interval")
+    # The restarted series keeps the spacing: every snapshot 0.0002 s after the one before.
+    times = []
+    for f in sorted(glob.glob(os.path.join(r.folder, "out", "particles_*.h5"))):
+        with h5py.File(f, "r") as h:
+            times.append(float(h.attrs["time"]))
+    gaps = {round(b - a, 9) for a, b in zip(times, times[1:])}
+    if gaps != {round(float(snap.group(3)), 9)}:
+        raise Broken(f"the restarted series has the gaps {sorted(gaps)}, not {snap.group(3)} s")
+    return (f"snapshot_interval {snap.group(3)}, log_interval {log.group(1)}: {len(times)} "
+            f"snapshots evenly spaced; " + r.lines("done:")[0].split(",")[0])
+
+
 def stream_bed(mass_rate=0.01):
     """0.1 g of glass beads (radius 0.4-0.6 mm) streamed at `mass_rate` kg/s over 10 ms onto
     the floor of a 10 x 10 x 20 mm box."""
@@ -1330,6 +1405,26 @@ def _(c):
     s["insert"][0]["count"] = int(m.group(1))
     c.rerun_passes(c.run("rerun", s), r"could place only", "count")
     return f"count {m.group(1)}: accepted"
+
+
+@case("fill_fraction_walls", "volume-fraction fill among walls, 'this fill reached X ...: a "
+      "`volume_fraction` of at most Y fits' (dem/insert/insertion.cpp)", "check")
+def _(c):
+    # The probe's drum: 1.5 mm beads in a cylinder of radius 10 mm. The estimate from the
+    # walls' share (0.2749) was refused again when followed (0.2403 reached).
+    s = bed(radius=1.5e-3)
+    s["domain"] = {"min": [0, 0, 0], "max": [0.02, 0.02, 0.02]}
+    s["walls"] = [{"type": "cylinder", "name": "drum", "axis_point": [0.01, 0.01, 0],
+                   "axis": [0, 0, 1], "radius": 0.01, "material": "glass"}]
+    fill = s["insert"][0]
+    fill.pop("count", None)
+    fill["volume_fraction"] = 0.3
+    fill["region"] = {"box": {"min": [0, 0, 0], "max": [0.02, 0.02, 0.02]}}
+    m = c.expect(c.run("first", s), 2, r"this fill reached " + NUM + r" before its attempts ran "
+                 r"out: a `volume_fraction` of at most " + NUM + r" fits")
+    fill["volume_fraction"] = float(m.group(2))
+    c.rerun_passes(c.run("rerun", s), r"could place only", "volume_fraction")
+    return f"reached {m.group(1)}; volume_fraction {m.group(2)}: accepted"
 
 
 # ---------------------------------------------------------------- driver

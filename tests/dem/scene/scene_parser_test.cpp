@@ -229,7 +229,7 @@ TEST(SceneParser, CompleteSceneFillsEveryField) {
   EXPECT_DOUBLE_EQ(cyl.radius.min, 7e-4) << "default truncation mean - 3 stddev";
   EXPECT_DOUBLE_EQ(cyl.radius.max, 1.3e-3) << "default truncation mean + 3 stddev";
   EXPECT_EQ(cyl.velocity, Vec3::Zero());
-  EXPECT_EQ(cyl.seed, 1u);
+  EXPECT_EQ(cyl.seed, 2u) << "default seed 1 + its index in insert";
 
   const Insertion& csv = s.insertions[2];
   EXPECT_EQ(csv.kind, Insertion::Kind::csv);
