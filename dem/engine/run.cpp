@@ -103,6 +103,29 @@ void print_report(const Simulation& sim, MPI_Comm comm, std::ostream& out,
   for (const std::string& note : sim.insertion_notes()) o << note << "\n";
 }
 
+// The interval of a series written at the steps (of dt) nearest to the multiples of it after
+// times[0]: the value with the fewest significant digits within dt / k of (t_k - t_0) / k for
+// every k, i.e. the one the scene wrote (0.002, where one gap of the series was 272 steps of
+// 7.345e-6 s = 0.00199794 s). 0 for fewer than two times.
+double series_interval(const std::vector<double>& times, double dt) {
+  if (times.size() < 2) return 0;
+  double lo = 0, hi = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 1; k < times.size(); ++k) {
+    const double n = static_cast<double>(k), span = times[k] - times[0];
+    lo = std::max(lo, (span - dt) / n);
+    hi = std::min(hi, (span + dt) / n);
+  }
+  const double mean = (times.back() - times.front()) / static_cast<double>(times.size() - 1);
+  if (!(lo <= hi)) return mean;  // not a series of one interval
+  for (int digits = 1; digits <= 17; ++digits) {
+    char text[40];
+    std::snprintf(text, sizeof text, "%.*g", digits, 0.5 * (lo + hi));
+    const double v = std::strtod(text, nullptr);
+    if (v >= lo && v <= hi) return v;
+  }
+  return mean;
+}
+
 // `word` as one word of a POSIX shell command: as it is when it holds only characters no
 // shell treats specially, otherwise in single quotes.
 std::string shell_word(const std::string& word) {
@@ -595,17 +618,19 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     // Intervals left to their defaults follow time.end: a restart that extends the run (as
     // the summary advises) would space its snapshots and log rows otherwise than the run it
     // continues, unsaid. The earlier spacing is read off the snapshots and rows taken over.
-    const auto spacing_note = [&](const char* key, const char* rule, double now, double before) {
+    const auto spacing_note = [&](const char* key, const char* rule, double now,
+                                  const std::vector<double>& times) {
+      const double before = series_interval(times, sim.dt());
       if (before > 0 && std::abs(now - before) > 1e-6 * before)
         say << "note: output." << key << " is left to its default, " << rule << " = " << now
             << " s, and the run this restart continues wrote every " << before
-            << " s (another time.end); set output." << key << ": " << significant(before, 9)
+            << " s (another time.end); set output." << key << ": " << before
             << " to keep its spacing\n";
     };
     if (!scene.output.snapshot_interval && kept >= 2) {
-      const std::vector<XdmfEntry>& e = snapshots.entries();
-      spacing_note("snapshot_interval", "time.end / 20", scene.time.end / 20,
-                   e[kept - 1].time - e[kept - 2].time);
+      std::vector<double> times;
+      for (std::size_t k = 0; k < kept; ++k) times.push_back(snapshots.entries()[k].time);
+      spacing_note("snapshot_interval", "time.end / 20", scene.time.end / 20, times);
     }
     if (!scene.output.log_interval && checkpoint_log) {
       // The last two rows' times (first column) of the log the checkpoint keeps.
@@ -615,8 +640,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
         if (!row.empty() && (std::isdigit(static_cast<unsigned char>(row[0])) || row[0] == '-'))
           times.push_back(std::strtod(row.c_str(), nullptr));
       if (times.size() >= 2)
-        spacing_note("log_interval", "time.end / 200", scene.time.end / 200,
-                     times[times.size() - 1] - times[times.size() - 2]);
+        spacing_note("log_interval", "time.end / 200", scene.time.end / 200, times);
     }
     if (!snapshots.foreign_file().empty())
       say << "note: " << dir << "/" << snapshots.foreign_file()

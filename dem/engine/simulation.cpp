@@ -556,13 +556,54 @@ void Simulation::kick_and_drift() {
 }
 
 bool Simulation::needs_rebuild() const {
+  // 2: a leaving particle is behind a wall (rare: looked at only when one leaves).
   int local = !leaving_.empty() || moved_beyond_half_skin_;
-  if (decomp_->size() == 1) return local;
-  int any = 0;
-  const double start = MPI_Wtime();
-  MPI_Allreduce(&local, &any, 1, MPI_INT, MPI_LOR, comm_);
-  collective_wait_seconds_ += MPI_Wtime() - start;
-  return any;
+  if (!leaving_.empty() && !left_through_wall_message().empty()) local = 2;
+  int any = local;
+  if (decomp_->size() > 1) {
+    const double start = MPI_Wtime();
+    MPI_Allreduce(&local, &any, 1, MPI_INT, MPI_MAX, comm_);
+    collective_wait_seconds_ += MPI_Wtime() - start;
+  }
+  left_through_wall_ = any == 2;
+  return any > 0;
+}
+
+std::string Simulation::left_through_wall_message() const {
+  // A plane or a cylinder is one-sided: a centre behind it crossed it within a step, between
+  // two looks of the overlap guard (with time.max_overlap near 1, or the other guards off),
+  // and a wall on a domain side then let the particle out as if through an open side. A mesh
+  // has no far side; its crossing is kept in view by the check of max_overlap against
+  // max_step_travel (docs/scene-reference.md).
+  for (std::size_t i = 0; i < leaving_.size(); ++i) {
+    if (!leaving_[i]) continue;
+    const double r = p_.radius[i];
+    for (const WallSet::Entry& w : walls_.walls()) {
+      if (w.kind == Wall::Kind::mesh) continue;
+      WallTouch t;
+      const bool touching = w.kind == Wall::Kind::plane ? touch_plane(w.plane, p_.x[i], r, t)
+                                                        : touch_cylinder(w.cylinder, p_.x[i], r, t);
+      if (!touching || t.overlap <= r) continue;
+      std::ostringstream o;
+      o.precision(4);
+      const double speed = p_.v[i].norm();
+      o << scene_.file << ": error: t = " << time_ << " s (step " << counters_.steps
+        << "): particle " << p_.id[i] << " left the domain behind wall '" << w.name
+        << "', its centre " << (t.overlap - r) / r << " of its radius past it (speed " << speed
+        << " m/s, radius " << r << " m, dt = " << dt_ << " s): it crossed the wall within a "
+        << "step, between two looks of the overlap guard (time.max_overlap = "
+        << scene_.time.max_overlap << "), and would have been counted as leaving through an "
+        << "open side. A step of at most "
+        << round_down_3((1 - scene_.time.max_overlap) * r / speed)
+        << " s keeps a crossing at that speed in view (it moves the particle less than "
+        << "1 - max_overlap of its radius per step); or lower time.max_overlap";
+      if (scene_.time.min_steps_per_contact <= 0 || scene_.time.max_step_travel <= 0)
+        o << ", and turn time.min_steps_per_contact or time.max_step_travel back on (0 turned "
+             "them off)";
+      return o.str();
+    }
+  }
+  return "";
 }
 
 CarriedState Simulation::take_histories() {
@@ -958,6 +999,7 @@ void Simulation::rebuild(bool keep_drag) {
   if (scene_.parallel.balance && decomp_->size() > 1 && counters_.rebuilds % 10 == 0 &&
       load_imbalance() > 1.1)
     balance_cuts();
+  if (left_through_wall_) agree_on_error(comm_, left_through_wall_message());  // throws
   if (!leaving_.empty()) {
     const long before = static_cast<long>(p_.size());
     p_.remove_if(leaving_);  // their springs stay behind in `carried`, never looked up

@@ -337,6 +337,11 @@ class Simulation {
   StreamInsertion streams_;
   std::vector<Vec3> x_at_build_;
   std::vector<char> leaving_;
+  // Set by needs_rebuild (agreed over the ranks): a particle leaving the domain has its
+  // centre behind a plane or cylinder wall, i.e. crossed it within a step; rebuild() stops
+  // the run instead of counting it as removed.
+  mutable bool left_through_wall_ = false;
+  std::string left_through_wall_message() const;
   std::vector<std::unique_ptr<ForceTerm>> terms_;
   std::unique_ptr<HeatTransfer> heat_;       // scene.heat; null: no thermal code runs
   std::vector<double> ghost_temperature_;    // each ghost's, at the step's start (heat on)
