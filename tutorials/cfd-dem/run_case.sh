@@ -28,6 +28,23 @@ run_case() {
   # is being written while Allrun runs) stay, and so do the tracked inputs.
   rm -rf processor* particles postProcessing log.blockMesh log.decomposePar log.grainFoam \
     [1-9]* 0.[0-9]* constant/polyMesh system/decomposeParDict.np*
+  case "$np" in
+    '' | *[!0-9]* | 0) echo "Allrun: -np $np: give a whole number of ranks, 1 or more" >&2; return 2 ;;
+  esac
+  if [ "$np" -gt 1 ]; then
+    # The N slabs along x must split the mesh's cells along x equally (grainFoam's shared
+    # decomposition refuses unequal slabs): check before meshing, naming the counts that do.
+    local nx
+    nx=$(sed -n 's/.*hex ([0-9 ]*) (\([0-9]*\) [0-9]* [0-9]*).*/\1/p' system/blockMeshDict | head -1)
+    if [ -n "$nx" ] && [ $((nx % np)) -ne 0 ]; then
+      local fits="" k
+      for ((k = 2; k <= nx; k++)); do [ $((nx % k)) -eq 0 ] && fits="$fits${fits:+, }$k"; done
+      echo "Allrun: -np $np: this case's mesh has $nx cells along x (system/blockMeshDict), and" \
+        "the $np slabs of the shared decomposition must split them equally; use -np 1 or one" \
+        "of $fits" >&2
+      return 2
+    fi
+  fi
   "$foam" blockMesh > log.blockMesh 2>&1 || { tail -20 log.blockMesh; return 1; }
   if [ "$np" -gt 1 ]; then
     # N slabs along x for method simple. The case's own file is set up for 2 ranks; another
