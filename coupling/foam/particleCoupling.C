@@ -15,6 +15,7 @@
 #include "coupling/foam/particleCoupling.H"
 #include "coupling/shared_decomposition.hpp"
 #include "coupling/written_files.hpp"
+#include "dem/core/suggestion.hpp"
 #include "dem/io/output_directory.hpp"
 #include "extrapolatedCalculatedFvPatchField.H"
 #include "processorFvPatch.H"
@@ -152,10 +153,20 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
                            "sampling", "minVoidFraction", "ddtVoidFraction",
                            "undisturbedVelocity", "meanPressureGradient", "dragVoidFraction",
                            "facePressure", "diffusionBandwidth"};
+    std::vector<std::string> names;
+    for (const word& a : allowed) names.push_back(a);
     for (const word& key : dict.toc())
-      if (!allowed.found(key))
-        FatalIOErrorInFunction(dict) << "unknown key '" << key << "'; allowed: " << allowed
-                                     << exit(FatalIOError);
+      if (!allowed.found(key)) {
+        std::string list;
+        for (const std::string& a : names) list += (list.empty() ? "" : ", ") + a;
+        const entry* e = dict.findEntry(key, keyType::LITERAL);
+        // Plain text (an OpenFOAM stream quotes a std::string).
+        const std::string text =
+            "unknown key '" + std::string(key) + "'" +
+            (e ? " at line " + std::to_string(e->startLineNumber()) : std::string()) +
+            grainflow::suggestion(key, names) + "; allowed: " + list;
+        FatalIOErrorInFunction(dict) << text.c_str() << exit(FatalIOError);
+      }
   }
   // The scene, relative to the case folder (not processorN/).
   const fileName scene = dict.get<fileName>("scene");
@@ -311,6 +322,16 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
 
   // --- the DEM ----------------------------------------------------------------------
   if (!sceneFile.isAbsolute()) sceneFile = cwd() / sceneFile;
+  if (!isFile(sceneFile)) {
+    const entry* e = dict.findEntry("scene", keyType::LITERAL);
+    const std::string text =
+        "scene \"" + std::string(scene) + "\"" +
+        (e ? " (line " + std::to_string(e->startLineNumber()) + ")" : std::string()) +
+        ": no such file " + std::string(sceneFile) +
+        "; the scene's path is taken from the case folder (" +
+        std::string(mesh.time().rootPath() / mesh.time().globalCaseName()) + ")";
+    FatalIOErrorInFunction(dict) << text.c_str() << exit(FatalIOError);
+  }
   try {
     dem_ = std::make_unique<coupling::DemLink>(sceneFile, rho_, rho_ * nu_, MPI_COMM_WORLD);
     dem_->correct_self_disturbance(undisturbed_);

@@ -23,12 +23,16 @@
 #include <utility>
 #include <vector>
 
+#include "dem/core/suggestion.hpp"
 #include "dem/core/types.hpp"
 #include "dem/scene/scene_error.hpp"
 
 namespace grainflow::scene_yaml {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+
+using grainflow::edit_distance;
+using grainflow::suggestion;
 
 // ---------------------------------------------------------------------------
 // Message helpers
@@ -46,22 +50,6 @@ inline std::string join(const std::vector<std::string>& items, std::string_view 
     out += items[i];
   }
   return out;
-}
-
-inline std::size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t above = row[j];
-      const std::size_t substitute = diagonal + (a[i - 1] == b[j - 1] ? 0 : 1);
-      row[j] = std::min({above + 1, row[j - 1] + 1, substitute});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
 }
 
 // " (it holds the character U+200B, at character 5: retype it)" when `name` holds a character
@@ -85,26 +73,6 @@ inline std::string hidden_character(std::string_view name) {
            std::to_string(position + 1) + ", which may not show: retype it)";
   }
   return "";
-}
-
-// " (did you mean 'hertz'?)" when exactly one candidate is close to `given`, else "".
-inline std::string suggestion(std::string_view given, const std::vector<std::string>& candidates) {
-  const std::size_t limit = std::clamp<std::size_t>((given.size() + 1) / 3, 1, 3);
-  std::size_t best = limit + 1;
-  const std::string* match = nullptr;
-  bool tie = false;
-  for (const std::string& c : candidates) {
-    const std::size_t d = edit_distance(given, c);
-    if (d < best) {
-      best = d;
-      match = &c;
-      tie = false;
-    } else if (d == best) {
-      tie = true;
-    }
-  }
-  if (match == nullptr || tie) return "";
-  return " (did you mean '" + *match + "'?)";
 }
 
 // ---------------------------------------------------------------------------

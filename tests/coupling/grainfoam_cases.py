@@ -411,6 +411,26 @@ def refuses_bad_setup(runner, checks):
         runner.run(again, "blockMesh", "blockMesh")
         runner.run(again, "grainFoam", runner.solver)  # raises unless it runs to the end
 
+    # 2a. A misspelt couplingProperties key: refused at its line, with the key it resembles
+    #     and the allowed keys as a plain list (it had printed OpenFOAM's "12 ( ... )" list
+    #     and the dictionary's line range). The advice, followed, is the original case.
+    case = runner.fresh_case("periodic_box", "misspelt_key", [
+        ("constant/couplingProperties", "voidFraction    divided;", "voidfraction    divided;")])
+    runner.run(case, "blockMesh", "blockMesh")
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    checks.expect("unknown key 'voidfraction' at line 11 (did you mean 'voidFraction'?); "
+                  "allowed: scene, voidFraction, dividedResolution" in log,
+                  "voidfraction: refused at line 11, 'did you mean voidFraction', a plain list")
+
+    # A misspelt scene path: refused naming the key, its line and where the path is taken from
+    # (it had said only "particle.yaml: cannot open the scene file").
+    case = runner.fresh_case("periodic_box", "misspelt_scene", [
+        ("constant/couplingProperties", '"particles.yaml"', '"particle.yaml"')])
+    runner.run(case, "blockMesh", "blockMesh")
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    checks.expect('scene "particle.yaml" (line 10): no such file' in log and "couplingProperties"
+                  in log, "scene particle.yaml: refused naming the key, line 10 and the file")
+
     # 2b. deltaT 0 and an endTime before the start: refused, saying why.
     case = runner.fresh_case("periodic_box", "deltaT_zero", [
         ("system/controlDict", "deltaT          1e-4;", "deltaT          0;")])
