@@ -1,6 +1,6 @@
 """Run by pvbatch: what ParaView's own XDMF reader makes of a grainflow particles.xdmf.
 
-    pvbatch --force-offscreen-rendering paraview_dump.py INDEX PNG JSON
+    pvbatch --force-offscreen-rendering paraview_dump.py INDEX PNG JSON [INDEX PNG JSON ...]
 
 Opens INDEX with ParaView's "XDMF Reader" (XDMFReader, the XDMF 2 reader: the Xdmf3 readers
 give the Polyvertex grids no cells), writes for every time step the points and every point
@@ -33,57 +33,69 @@ def particles_block(multiblock):
     return found
 
 
-index, png, out = sys.argv[1:4]
-reader = XDMFReader(FileNames=[index])
-reader.PointArrayStatus = reader.GetProperty("PointArrayInfo")[::2]  # every array
-reader.UpdatePipelineInformation()
-steps = []
-for t in reader.TimestepValues:
-    reader.UpdatePipeline(t)
-    data = particles_block(sm.Fetch(reader))
-    if data is None:
-        steps.append({"time": t, "points": 0, "cells": 0, "positions": [], "arrays": {}})
-        continue
-    arrays = {}
-    pd = data.GetPointData()
-    for i in range(pd.GetNumberOfArrays()):
-        a = pd.GetArray(i)
-        arrays[a.GetName()] = {"components": a.GetNumberOfComponents(),
-                               "type": a.GetDataTypeAsString(),
-                               "values": vtk_to_numpy(a).tolist()}
-    steps.append({"time": t, "points": data.GetNumberOfPoints(), "cells": data.GetNumberOfCells(),
-                  "positions": vtk_to_numpy(data.GetPoints().GetData()).tolist(),
-                  "arrays": arrays})
+def read_steps(index):
+    """The reader of INDEX and, for every time step, its particles' points and arrays."""
+    reader = XDMFReader(FileNames=[index])
+    reader.PointArrayStatus = reader.GetProperty("PointArrayInfo")[::2]  # every array
+    reader.UpdatePipelineInformation()
+    steps = []
+    for t in reader.TimestepValues:
+        reader.UpdatePipeline(t)
+        data = particles_block(sm.Fetch(reader))
+        if data is None:
+            steps.append({"time": t, "points": 0, "cells": 0, "positions": [], "arrays": {}})
+            continue
+        arrays = {}
+        pd = data.GetPointData()
+        for i in range(pd.GetNumberOfArrays()):
+            a = pd.GetArray(i)
+            arrays[a.GetName()] = {"components": a.GetNumberOfComponents(),
+                                   "type": a.GetDataTypeAsString(),
+                                   "values": vtk_to_numpy(a).tolist()}
+        steps.append({"time": t, "points": data.GetNumberOfPoints(),
+                      "cells": data.GetNumberOfCells(),
+                      "positions": vtk_to_numpy(data.GetPoints().GetData()).tolist(),
+                      "arrays": arrays})
+    return reader, steps
 
-if png == "-":
-    json.dump({"steps": steps}, open(out, "w"))
-    sys.exit(0)
-view = GetActiveViewOrCreate("RenderView")
-view.ViewSize = [800, 600]
-view.ViewTime = reader.TimestepValues[-1]
-view.OrientationAxesVisibility = 0
-shown = Show(reader, view)
-shown.SetRepresentationType("Point Gaussian")
-shown.ScaleByArray = 1
-shown.SetScaleArray = ["POINTS", "radius"]
-shown.UseScaleFunction = 0
-shown.GaussianRadius = 1.0
-shown.ShaderPreset = "Sphere"
-ColorBy(shown, ("POINTS", "velocity", "Magnitude"))
-shown.RescaleTransferFunctionToDataRange(True, False)
-shown.SetScalarBarVisibility(view, True)
-GetColorTransferFunction("velocity").ApplyPreset("Viridis (matplotlib)", True)
-view.CameraPosition = [0.06, -0.05, 0.04]
-view.CameraViewUp = [0, 0, 1]
-ResetCamera(view)
-SaveScreenshot(png, view, ImageResolution=[800, 600])
 
-image = vtkPNGReader()
-image.SetFileName(png)
-image.Update()
-pixels = vtk_to_numpy(image.GetOutput().GetPointData().GetScalars())[:, :3].astype(int)
-background = pixels[0]  # a corner
-drawn = float((abs(pixels - background).sum(axis=1) > 30).mean())
-dims = image.GetOutput().GetDimensions()
-json.dump({"steps": steps, "image": {"width": dims[0], "height": dims[1], "drawn": drawn}},
-          open(out, "w"))
+def render(reader, png):
+    """The last step drawn into PNG; its size and the share of pixels off the background."""
+    view = GetActiveViewOrCreate("RenderView")
+    view.ViewSize = [800, 600]
+    view.ViewTime = reader.TimestepValues[-1]
+    view.OrientationAxesVisibility = 0
+    shown = Show(reader, view)
+    shown.SetRepresentationType("Point Gaussian")
+    shown.ScaleByArray = 1
+    shown.SetScaleArray = ["POINTS", "radius"]
+    shown.UseScaleFunction = 0
+    shown.GaussianRadius = 1.0
+    shown.ShaderPreset = "Sphere"
+    ColorBy(shown, ("POINTS", "velocity", "Magnitude"))
+    shown.RescaleTransferFunctionToDataRange(True, False)
+    shown.SetScalarBarVisibility(view, True)
+    GetColorTransferFunction("velocity").ApplyPreset("Viridis (matplotlib)", True)
+    view.CameraPosition = [0.06, -0.05, 0.04]
+    view.CameraViewUp = [0, 0, 1]
+    ResetCamera(view)
+    SaveScreenshot(png, view, ImageResolution=[800, 600])
+    image = vtkPNGReader()
+    image.SetFileName(png)
+    image.Update()
+    pixels = vtk_to_numpy(image.GetOutput().GetPointData().GetScalars())[:, :3].astype(int)
+    background = pixels[0]  # a corner
+    drawn = float((abs(pixels - background).sum(axis=1) > 30).mean())
+    dims = image.GetOutput().GetDimensions()
+    return {"width": dims[0], "height": dims[1], "drawn": drawn}
+
+
+# One pvbatch (one X connection, the flaky part under Xvfb) for every INDEX PNG JSON triple.
+args = sys.argv[1:]
+for k in range(0, len(args) - 2, 3):
+    index, png, out = args[k:k + 3]
+    reader, steps = read_steps(index)
+    result = {"steps": steps}
+    if png != "-":
+        result["image"] = render(reader, png)
+    json.dump(result, open(out, "w"))
