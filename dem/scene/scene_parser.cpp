@@ -1045,6 +1045,23 @@ void parse_snapshot_classes(const Field& file, const Scene& scene, Insertion& in
                 " (root attributes material_coarse_grain, material_real; allowed: k in [1, "
                 "1000], a listed material's own index for k = 1); the file was changed or "
                 "damaged after it was written");
+    // A parcel class is named after its listed material and k (add_parcel_classes: glass[k=2]);
+    // a name that says otherwise was edited, and which of the two is meant cannot be told.
+    if (!c.names.empty() && listed_here) {
+      const std::string& name = c.names[m];
+      const std::string expected = c.k[m] == 1 ? name
+                                               : c.names[static_cast<std::size_t>(c.real[m])] +
+                                                     "[k=" + format_number(c.k[m]) + "]";
+      if (name != expected || (c.k[m] == 1 && name.find("[k=") != std::string::npos))
+        file.fail("the snapshot '" + ins.snapshot_file + "' names its material " +
+                  std::to_string(m) + " '" + name + "' (root attribute material_names), but " +
+                  (c.k[m] == 1
+                       ? std::string("its class is a listed material (k = 1)")
+                       : "its class is parcels of k = " + format_number(c.k[m]) + " of material '" +
+                             c.names[static_cast<std::size_t>(c.real[m])] +
+                             "' (material_coarse_grain, material_real), named '" + expected + "'") +
+                  "; the file was changed or damaged after it was written");
+    }
     if (!listed_here)
       file.fail("the snapshot '" + ins.snapshot_file + "' holds material " + std::to_string(m) +
                 (c.k[m] == 1 ? std::string()

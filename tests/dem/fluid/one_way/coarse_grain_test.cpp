@@ -585,6 +585,42 @@ TEST(CoarseGrain, SnapshotOfParcelsContinuesAsParcels) {
             std::string::npos)
       << e;
 
+  // Copies whose material_names were edited: the parcel class's name says k = 5 (its
+  // numbers say 2), or a listed material's name carries a parcel suffix. Which is meant
+  // cannot be told: refused as damaged.
+  const auto renamed = [&](const std::string& name, const std::string& names) {
+    const std::string path = (dir / name).string();
+    fs::copy_file(file, path);
+    const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    H5Adelete(f, "material_names");
+    const hid_t type = H5Tcopy(H5T_C_S1);
+    H5Tset_size(type, names.size());
+    const hid_t space = H5Screate(H5S_SCALAR);
+    const hid_t a = H5Acreate2(f, "material_names", type, space, H5P_DEFAULT, H5P_DEFAULT);
+    H5Awrite(a, type, names.c_str());
+    H5Aclose(a);
+    H5Sclose(space);
+    H5Tclose(type);
+    H5Fclose(f);
+    return path;
+  };
+  e = error_of(reader(renamed("renamed_class.h5", "glass,glass[k=5]"), ""));
+  std::printf("%s\n", e.c_str());
+  EXPECT_NE(e.find("cg.yaml:16:"), std::string::npos) << e;
+  EXPECT_NE(e.find("names its material 1 'glass[k=5]' (root attribute material_names), but its "
+                   "class is parcels of k = 2 of material 'glass' (material_coarse_grain, "
+                   "material_real), named 'glass[k=2]'"),
+            std::string::npos)
+      << e;
+  e = error_of(reader(renamed("renamed_listed.h5", "glass[k=2],glass[k=2]"), ""));
+  std::printf("%s\n", e.c_str());
+  EXPECT_NE(e.find("names its material 0 'glass[k=2]' (root attribute material_names), but its "
+                   "class is a listed material (k = 1)"),
+            std::string::npos)
+      << e;
+  // The file as written reads (the check is not a false alarm).
+  EXPECT_EQ(error_of(reader(renamed("renamed_same.h5", "glass,glass[k=2]"), "")), "no error");
+
   // A copy without the classes, as an older grainflow wrote them.
   const std::string old = (dir / "old.h5").string();
   fs::copy_file(file, old);
