@@ -803,7 +803,12 @@ std::vector<std::string> DemLink::parcel_domain_warnings() const {
   const std::vector<ParcelClass> classes =
       parcel_classes(impl_->scene, impl_->simulation().particles(), impl_->dem_comm);
   const Vec3 extent = impl_->scene.domain.hi - impl_->scene.domain.lo;
-  return grainflow::parcel_domain_warnings(classes, extent, impl_->scene.domain.periodic);
+  std::vector<std::string> out =
+      grainflow::parcel_domain_warnings(classes, extent, impl_->scene.domain.periodic);
+  for (std::string& w : grainflow::parcel_opening_warnings(classes, impl_->simulation().walls(),
+                                                           impl_->scene.domain))
+    out.push_back(std::move(w));
+  return out;
 }
 
 }  // namespace grainflow::coupling

@@ -298,7 +298,8 @@ class DemLink {
   // The rule `grain check` and `grain run` apply to the domain (dem/engine/parcel_limits.hpp):
   // one "warning: ..." line when the domain's narrowest side is less than 10 diameters of the
   // widest parcels (in the fluidisedBed column, 9 mm deep, the k = 2 parcels layer against the
-  // front and back walls and the gas runs along them; docs/models/coarse-graining.md).
+  // front and back walls and the gas runs along them; docs/models/coarse-graining.md); and one
+  // per mesh wall whose narrowest opening (a hopper's orifice) is under 10 of their diameters.
   // Empty without parcels or when the domain is wide enough. Collective (after initialise()).
   std::vector<std::string> parcel_domain_warnings() const;
 

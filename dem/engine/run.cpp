@@ -172,8 +172,8 @@ ParticleTotals particle_totals(const Scene& scene, const Particles& p, MPI_Comm 
 // particles they stand for and their mass, and warnings where the literature says parcels
 // stop standing for the real particles (dem/engine/parcel_limits.hpp, the rules grainFoam
 // applies to its mesh too). Collective over comm; nothing without parcels.
-void print_coarse_grain_report(const Scene& scene, const Particles& p, MPI_Comm comm,
-                               std::ostream& out) {
+void print_coarse_grain_report(const Scene& scene, const Particles& p, const WallSet& walls,
+                               MPI_Comm comm, std::ostream& out) {
   if (scene.coarse_grain_table().empty()) return;
   const std::vector<ParcelClass> classes = parcel_classes(scene, p, comm);
   const ParticleTotals totals = particle_totals(scene, p, comm);
@@ -190,6 +190,8 @@ void print_coarse_grain_report(const Scene& scene, const Particles& p, MPI_Comm 
     << " kg\n";
   const Vec3 extent = scene.domain.hi - scene.domain.lo;
   for (const std::string& w : parcel_domain_warnings(classes, extent, scene.domain.periodic))
+    o << "  " << w << "\n";
+  for (const std::string& w : parcel_opening_warnings(classes, walls, scene.domain))
     o << "  " << w << "\n";
   if (scene.fluid && scene.fluid->computed_void_fraction) {
     const double h = scene.fluid->computed_void_fraction->cell_size;
@@ -475,7 +477,7 @@ int check_scene(const Scene& scene, std::ostream& out, const std::optional<std::
         make_fluid_forces(*scene.fluid, scene.gravity, scene.domain, MPI_COMM_WORLD));
   sim.initialise();  // lists and first forces only: no time step is taken
   print_report(sim, MPI_COMM_WORLD, out);
-  print_coarse_grain_report(scene, sim.particles(), MPI_COMM_WORLD, out);
+  print_coarse_grain_report(scene, sim.particles(), sim.walls(), MPI_COMM_WORLD, out);
   print_void_fraction_cell_report(scene, sim, MPI_COMM_WORLD, out);
   print_drag_range_report(scene, MPI_COMM_WORLD, out);
   const TimeStepReport& rep = sim.time_step_report();
@@ -543,7 +545,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     sim.add_force_term(make_fluid_forces(*scene.fluid, scene.gravity, scene.domain, comm));
   sim.initialise();
   print_report(sim, comm, out, options.allow_large_time_step);
-  print_coarse_grain_report(scene, sim.particles(), comm, out);
+  print_coarse_grain_report(scene, sim.particles(), sim.walls(), comm, out);
   print_void_fraction_cell_report(scene, sim, comm, out);
   print_drag_range_report(scene, comm, out);
   if (sim.time_step_report().verdict == TimeStepReport::Verdict::refuse &&

@@ -42,3 +42,8 @@ grain_cli_test(coarse_grain_run_stream 0
                "done: [0-9]+ steps, 20 particles \\(0 removed\\);coarse graining: the 20 particles stand for 160 real particles \\(4.5238[0-9]*e-05 kg\\); each parcel counts as one particle;stream .*parcel_stream.yaml:18: 20 particles \\(parcels of k = 2: 160 real particles\\)"
                CMD ${_grain} run ${_scenes}/fluid/parcel_stream.yaml --output out --no-progress
                WORKDIR ${_work}/coarse_grain_run_stream)
+# A mesh wall's opening under 10 parcel diameters: the hopper tutorial's 12 mm orifice under
+# parcels of k = 2 (4.4 mm) is 2.7 of them (docs/models/coarse-graining.md, "Limits").
+grain_cli_test(coarse_grain_check_orifice 0
+               "warning: wall 'hopper' has an opening 0.01199 m wide around \\(0, 0, 0\\) m: 2.72 diameters of parcels 'glass\\[k=2\\]' \\(0.004399 m\\), fewer than 10"
+               CMD ${_grain} check ${_scenes}/coarse_grain_hopper.yaml)
