@@ -66,17 +66,27 @@ std::vector<MeshOpening> mesh_openings(const TriangleMesh& mesh) {
     return static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32 |
            static_cast<std::uint32_t>(b);
   };
-  // Undirected uses of each edge; the open ones keep their triangle's direction.
+  // Uses of each edge; the open ones (one use) are walked as loops, in either direction (an
+  // STL's triangles need not all turn the same way).
   std::unordered_map<std::uint64_t, int> uses;
   for (const auto& t : mesh.triangles())
     for (int e = 0; e < 3; ++e)
       ++uses[key(std::min(t[e], t[(e + 1) % 3]), std::max(t[e], t[(e + 1) % 3]))];
-  std::unordered_multimap<int, int> next;  // open edge a -> b, by a
-  for (const auto& t : mesh.triangles())
-    for (int e = 0; e < 3; ++e) {
-      const int a = t[e], b = t[(e + 1) % 3];
-      if (uses[key(std::min(a, b), std::max(a, b))] == 1) next.emplace(a, b);
+  std::unordered_multimap<int, int> next;  // each open edge a - b, as a -> b and b -> a
+  for (const auto& [k, n] : uses)
+    if (n == 1) {
+      const int a = static_cast<int>(k >> 32), b = static_cast<int>(k & 0xffffffffu);
+      next.emplace(a, b);
+      next.emplace(b, a);
     }
+  const auto take = [&](int a, int b) {  // removes the edge's reverse entry b -> a
+    const auto range = next.equal_range(b);
+    for (auto it = range.first; it != range.second; ++it)
+      if (it->second == a) {
+        next.erase(it);
+        return;
+      }
+  };
   const std::vector<Vec3>& x = mesh.vertices();
   std::vector<MeshOpening> loops;
   while (!next.empty()) {
@@ -88,6 +98,7 @@ std::vector<MeshOpening> mesh_openings(const TriangleMesh& mesh) {
       if (it == next.end()) break;  // an open chain (a non-manifold rim): ends here
       const int to = it->second;
       next.erase(it);
+      take(at, to);
       loop.vertices.push_back(x[static_cast<std::size_t>(at)]);
       loop.perimeter += (x[static_cast<std::size_t>(to)] - x[static_cast<std::size_t>(at)]).norm();
       at = to;

@@ -65,6 +65,12 @@ TEST(MeshOpenings, AnAnnulusHasItsHoleNotItsRim) {
   EXPECT_NEAR(o[0].width / exact, 1, 1e-12) << o[0].width;
   EXPECT_NEAR(o[0].perimeter, 2 * n * r0 * std::sin(std::numbers::pi / n), 1e-12);
   EXPECT_LT(o[0].centre.norm(), 1e-12);
+  // Every other triangle turned the other way (an STL need not be oriented): the same hole.
+  test::MeshData flipped = m;
+  for (std::size_t t = 0; t < flipped.t.size(); t += 2) std::swap(flipped.t[t][1], flipped.t[t][2]);
+  const std::vector<MeshOpening> f = mesh_openings(TriangleMesh(flipped.v, flipped.t));
+  ASSERT_EQ(f.size(), 1u);
+  EXPECT_NEAR(f[0].width / exact, 1, 1e-12);
 }
 
 TEST(MeshOpenings, ASlotIsAsWideAsItsShorterSide) {
