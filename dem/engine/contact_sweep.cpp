@@ -433,15 +433,17 @@ void apply_wall_contacts(ContactSweep& s, int material, const WallHit* hits, int
         const V3<V> wi = gather3<V>([&](int l) -> const Vec3& { return w[h[l]->i]; });
         const V3<V> v_rel = vi - wall_v - g.arm_i * cross(wi, g.n);  // as in pair_geometry
         g.v_rel = v_rel;
-        g.w_rel = wi;
+        // The rolling models see the spin relative to the wall's (wall_geometry).
+        const V3<V> wall_w = gather3<V>([&](int l) -> const Vec3& { return h[l]->t.spin; });
+        g.w_rel = wi - wall_w;
         if constexpr (Law::predicted_dashpot) {
           const V3<V> wpi = gather3<V>([&](int l) -> const Vec3& { return wp[h[l]->i]; });
           g.v_pred = gather3<V>([&](int l) -> const Vec3& { return vp[h[l]->i]; }) - wall_v -
                      g.arm_i * cross(wpi, g.n);
-          g.w_pred = wpi;
+          g.w_pred = wpi - wall_w;
         } else {
           g.v_pred = v_rel;
-          g.w_pred = wi;
+          g.w_pred = g.w_rel;
         }
       } else if constexpr (Law::predicted_dashpot) {
         g.v_rel = vi - wall_v;
@@ -1034,8 +1036,10 @@ void report_contacts(const ContactSweep& s, ContactNetwork& out) {
                                 ? touch_plane(wall.plane, p.x[i], p.radius[i], t)
                                 : touch_cylinder(wall.cylinder, p.x[i], p.radius[i], t);
       if (!touching) continue;
-      if (wall.pose.moving())
+      if (wall.pose.moving()) {
         t.surface_velocity += wall.pose.velocity_at(p.x[i] - (p.radius[i] - t.overlap) * t.n);
+        t.spin += wall.pose.spin();
+      }
       add_wall(i, index, t, wall.material, Law::has_history ? history[k] : ContactHistory{});
     }
   }

@@ -33,10 +33,10 @@ inline ContactGeometry wall_geometry(const Particles& p, std::size_t i, const Wa
   // that of the step's end, exact for prescribed motion).
   if constexpr (Law::needs_spin) {
     g.v_rel = p.v[i] - t.surface_velocity - g.arm_i * p.omega[i].cross(g.n);
-    g.w_rel = p.omega[i];
+    g.w_rel = p.omega[i] - t.spin;
     if constexpr (Law::predicted_dashpot) {
       g.v_pred = p.v_pred[i] - t.surface_velocity - g.arm_i * p.omega_pred[i].cross(g.n);
-      g.w_pred = p.omega_pred[i];
+      g.w_pred = p.omega_pred[i] - t.spin;
     } else {
       g.v_pred = g.v_rel;
       g.w_pred = g.w_rel;
@@ -104,9 +104,11 @@ void wall_sweep_one(ContactSweep& s, const WallSet::Entry& wall, const WallNeigh
       if constexpr (Law::has_history) history[k] = ContactHistory{};
       continue;
     }
-    if (wall.pose.moving())
+    if (wall.pose.moving()) {
       hit.t.surface_velocity +=
           wall.pose.velocity_at(p.x[i] - (p.radius[i] - hit.t.overlap) * hit.t.n);
+      hit.t.spin += wall.pose.spin();
+    }
     hit.i = static_cast<int>(i);
     hit.k = static_cast<int>(k);
     if (++m == kWallBatch) {
@@ -125,7 +127,11 @@ inline WallTouch mesh_wall_touch(const WallSet::Entry& wall, const MeshTouch& to
   t.n = moving ? wall.pose.direction_to_world(touch.n) : touch.n;
   t.overlap = touch.overlap;
   t.surface_velocity.setZero();
-  if (moving) t.surface_velocity = wall.pose.velocity_at(x - (r - t.overlap) * t.n);
+  t.spin.setZero();
+  if (moving) {
+    t.surface_velocity = wall.pose.velocity_at(x - (r - t.overlap) * t.n);
+    t.spin = wall.pose.spin();
+  }
   if (conveyor) t.surface_velocity += belt - belt.dot(t.n) * t.n;
   return t;
 }

@@ -14,6 +14,10 @@ struct WallTouch {
   Vec3 n;
   double overlap;
   Vec3 surface_velocity;
+  // The wall's angular velocity [rad/s]: a cylinder's own turning and a rotating motion. The
+  // rolling models act on the particle's spin relative to it (a sphere carried round by a
+  // drum at the drum's own spin does not roll on it).
+  Vec3 spin = Vec3::Zero();
 };
 
 inline bool touch_plane(const PlaneWall& w, const Vec3& x, double r, WallTouch& t) {
@@ -23,6 +27,7 @@ inline bool touch_plane(const PlaneWall& w, const Vec3& x, double r, WallTouch& 
   t.n = w.normal;
   t.overlap = overlap;
   t.surface_velocity.setZero();
+  t.spin.setZero();
   return true;
 }
 
@@ -45,6 +50,7 @@ inline bool touch_cylinder(const CylinderWall& w, const Vec3& x, double r, WallT
   // Contact point on the cylinder surface; the surface turns about the axis.
   const Vec3 surface_point = w.axis_point + rel.dot(w.axis) * w.axis + w.radius * out;
   t.surface_velocity = w.angular_velocity * w.axis.cross(surface_point - w.axis_point);
+  t.spin = w.angular_velocity * w.axis;
   return true;
 }
 

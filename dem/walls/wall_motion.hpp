@@ -29,6 +29,7 @@ class WallPose {
     return m_.axis_point + rotation_.transpose() * (x - centre_);
   }
   Vec3 direction_to_world(const Vec3& d0) const { return rotation_ * d0; }
+  Vec3 spin() const { return m_.angular_velocity * m_.axis; }  // angular velocity [rad/s]
   Vec3 velocity_at(const Vec3& y) const {
     return m_.velocity + m_.angular_velocity * m_.axis.cross(y - centre_);
   }
