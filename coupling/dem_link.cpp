@@ -13,6 +13,7 @@
 #include "dem/engine/finite_guard.hpp"
 #include "dem/engine/parcel_limits.hpp"
 #include "dem/engine/restored_state.hpp"
+#include "dem/engine/run.hpp"
 #include "dem/engine/simulation.hpp"
 #include "dem/fluid/coupled_fluid.hpp"
 #include "dem/fluid/fluid_forces.hpp"
@@ -788,6 +789,42 @@ std::vector<std::string> DemLink::reports() const { return impl_->simulation().f
 
 std::vector<std::string> DemLink::force_limit_notes() const {
   return impl_->simulation().force_limit_notes();
+}
+
+std::vector<std::string> DemLink::startup_notes() const {
+  const Simulation& sim = impl_->simulation();
+  const std::vector<std::string>& fluid = sim.force_limit_notes();
+  std::vector<std::string> out;
+  for (const std::string& note : sim.time_step_report().notes)
+    if (std::find(fluid.begin(), fluid.end(), note) == fluid.end() &&
+        !note.starts_with("steps to reach"))
+      out.push_back(note);
+  using Lines = const std::vector<std::string>*;
+  for (Lines notes :
+       {Lines{&sim.walls().notes()}, Lines{&sim.insertion_notes()}, Lines{&impl_->scene.notes}})
+    out.insert(out.end(), notes->begin(), notes->end());
+  return out;
+}
+
+std::string DemLink::time_step_refusal(double fluid_dt) const {
+  const TimeStepReport& rep = impl_->simulation().time_step_report();
+  if (rep.verdict != TimeStepReport::Verdict::refuse) return {};
+  std::ostringstream o;
+  o.precision(4);
+  o << impl_->scene.file << ": error: refusing to run with this DEM time step (see the lines "
+    << "above); " << refusal_remedy(rep);
+  // time.step must divide the fluid step: the largest such step the limits allow.
+  if (std::isfinite(rep.refusal_step) && rep.refusal_step > 0 && fluid_dt > 0) {
+    const double n = std::ceil(fluid_dt / rep.refusal_step * (1 - 1e-12));
+    o << "; for this fluid step (deltaT " << fluid_dt << " s) time.step " << fluid_dt / n
+      << " s (deltaT / " << n << ")";
+  }
+  o << "; or set `allowLargeTimeStep yes;` in constant/couplingProperties to start anyway (the "
+       "run-time guards still stop it at the first contact this step does not resolve, keys "
+       "time.min_steps_per_contact and time.max_overlap, or the first particle that moves too "
+       "far in a step, time.max_step_travel; 0 turns min_steps_per_contact or max_step_travel "
+       "off)";
+  return o.str();
 }
 
 std::vector<std::string> DemLink::parcel_cell_warnings(double smallest_cell,

@@ -287,6 +287,16 @@ class DemLink {
   // fluid sample: fluid at rest), one line each, and an "error: ..." line for a step beyond
   // an explicit force's limit (docs/models/fluid-forces.md).
   std::vector<std::string> force_limit_notes() const;
+  // The DEM's start-up findings that `grain check` prints, besides the fluid forces' lines
+  // (force_limit_notes) and the step count to the scene's time.end: the time-step check's
+  // lines (Rayleigh and contact times, steps per impact and their errors, the guards, an
+  // "error: ..." line for a step it refuses), the meshes read (with their warnings), the
+  // insertions' notes and the scene's settings without effect (Scene::notes). After
+  // initialise(); the same on every rank.
+  std::vector<std::string> startup_notes() const;
+  // When the time-step check refuses the DEM step, as `grain run` would: what to do, with a
+  // step that also divides the fluid step `fluid_dt` [s]; empty when the step is accepted.
+  std::string time_step_refusal(double fluid_dt) const;
   // Coarse-grained parcels against the fluid cells, the rule `grain check` applies to its
   // void-fraction cells (dem/engine/parcel_limits.hpp; Radl et al. 2011): one "warning: ..."
   // line per parcel class whose largest parcel is wider than a third of the smallest cell

@@ -149,10 +149,19 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
   // --- settings -------------------------------------------------------------------
   // A misspelt key would silently fall back to its default: refuse unknown keys.
   {
-    const wordList allowed{"scene", "voidFraction", "dividedResolution", "smoothingFactor",
-                           "sampling", "minVoidFraction", "ddtVoidFraction",
-                           "undisturbedVelocity", "meanPressureGradient", "dragVoidFraction",
-                           "facePressure", "diffusionBandwidth"};
+    const wordList allowed{"scene",
+                           "voidFraction",
+                           "dividedResolution",
+                           "smoothingFactor",
+                           "sampling",
+                           "minVoidFraction",
+                           "ddtVoidFraction",
+                           "undisturbedVelocity",
+                           "meanPressureGradient",
+                           "dragVoidFraction",
+                           "facePressure",
+                           "diffusionBandwidth",
+                           "allowLargeTimeStep"};
     std::vector<std::string> names;
     for (const word& a : allowed) names.push_back(a);
     for (const word& key : dict.toc())
@@ -253,6 +262,10 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
                                     "gradient carries the particles' buoyant weight, for a "
                                     "domain periodic along gravity; docs/coupling.md)"
                                  << exit(FatalIOError);
+
+  // A DEM step the time-step check refuses stops grainFoam at start-up, as `grain run`
+  // without --allow-large-dt; `allowLargeTimeStep yes` starts it anyway.
+  allowLargeTimeStep_ = dict.lookupOrDefault<Switch>("allowLargeTimeStep", false);
 
   const word dragEps = dict.lookupOrDefault<word>("dragVoidFraction", "cell");
   if (dragEps == "sharpInterface")
@@ -505,6 +518,18 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
     if (note.rfind("error:", 0) == 0) FatalErrorInFunction << "\n" << note << exit(FatalError);
     Info << "grainFoam coupling: " << note.c_str() << endl;
   }
+  // The DEM's own start-up findings, as `grain check` prints them (time step and contacts,
+  // meshes, insertions, settings without effect); a DEM step the check refuses stops here.
+  const std::string refusal = dem_->time_step_refusal(mesh.time().deltaTValue());
+  for (const std::string& note : dem_->startup_notes()) {
+    if (!refusal.empty() && allowLargeTimeStep_ && note.rfind("error: ", 0) == 0)
+      Info << "grainFoam DEM: warning: " << note.substr(7).c_str()
+           << " (running anyway: allowLargeTimeStep yes)" << endl;
+    else
+      Info << "grainFoam DEM: " << note.c_str() << endl;
+  }
+  if (!refusal.empty() && !allowLargeTimeStep_)
+    FatalErrorInFunction << "\n" << refusal.c_str() << exit(FatalError);
 
   if (meanGradPOn_) {
     updateMeanPressureGradient();

@@ -101,6 +101,7 @@ void print_report(const Simulation& sim, MPI_Comm comm, std::ostream& out,
   }
   for (const std::string& note : sim.walls().notes()) o << note << "\n";  // meshes read
   for (const std::string& note : sim.insertion_notes()) o << note << "\n";
+  for (const std::string& note : sim.scene().notes) o << note << "\n";  // settings unused
 }
 
 // The interval of a series written at the steps (of dt) nearest to the multiples of it after
@@ -366,8 +367,6 @@ std::string continue_command(const std::string& scene_file, const RunOptions& op
 
 namespace {
 
-// The advice of a refused step: the smallest step the refusing checks propose, which every
-// one of them allows (following the first error alone may meet the next one).
 // The steps a run takes: the whole number nearest to end / dt, at least one, so that it ends
 // within half a step of time.end (`grain check` prints the same count).
 // When the last step's time misses time.end by more than this share of it, `grain check` and
@@ -377,6 +376,10 @@ long steps_to_end(double end, double dt) {
   return std::max(1L, static_cast<long>(std::ceil(end / dt - 0.5 - 1e-9)));
 }
 
+}  // namespace
+
+// The advice of a refused step: the smallest step the refusing checks propose, which every
+// one of them allows (following the first error alone may meet the next one).
 std::string refusal_remedy(const TimeStepReport& rep) {
   if (!std::isfinite(rep.refusal_step) || !(rep.refusal_step > 0))
     return "lower time.step / time.rayleigh_fraction";
@@ -388,8 +391,6 @@ std::string refusal_remedy(const TimeStepReport& rep) {
   o << "), the smallest step proposed above, which every limit above allows";
   return o.str();
 }
-
-}  // namespace
 
 namespace {
 // What a --restart path must not be, told from its name and kind alone: before anything is

@@ -51,6 +51,12 @@ struct RunSummary {
   std::vector<StreamTotal> streams;  // one per stream insertion, in scene order
 };
 
+// What to do about a time step the check refuses: "use dt <= <s> s (time.step, or
+// time.rayleigh_fraction <= <f>), the smallest step proposed above, which every limit above
+// allows", or to lower the step when no limit proposes one.
+struct TimeStepReport;
+std::string refusal_remedy(const TimeStepReport& rep);
+
 // Prints the time-step report (`grain check`); returns the process exit code:
 // 0 fine, 1 refused. With `restart`, the checkpoint is read, verified and checked against the
 // scene as `grain run --restart` would, and the report judges its state; nothing is written.

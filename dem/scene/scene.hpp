@@ -303,6 +303,10 @@ struct Scene {
   // count 1 or a CSV file of one row; no stream or snapshot). Then `contact`, `interactions`
   // and the materials' elastic constants may be left out.
   bool contacts_possible = true;
+  // Settings the scene gives that have no effect in it (a pair's rolling_friction with
+  // contact.rolling none, ...): one "<file>:<line>:<column>: note: ..." line each, printed at
+  // start-up by grain check, grain run and grainFoam.
+  std::vector<std::string> notes;
 
   int material_index(const std::string& name) const;  // -1 if absent
   // Every material's coarse-graining factor k (Material::coarse_grain), indexed by material;

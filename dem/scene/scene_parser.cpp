@@ -1414,6 +1414,59 @@ void record_mesh_contents(Scene& s) {
   s.model_record = record;
 }
 
+// Settings that are accepted (a scene may keep them while a model is switched off) but have no
+// effect in this scene: each named in Scene::notes, with what would use it.
+void note_unused_settings(const Map& top, Scene& s) {
+  if (s.contacts_possible) {
+    std::vector<Field> pairs;
+    if (const auto list = top.find("interactions")) pairs = list->items();
+    if (const auto d = top.find("interaction_defaults")) pairs.push_back(*d);
+    for (const Field& item : pairs) {
+      const Map m = item.map();
+      const auto unused = [&](const char* key, bool off, bool only_if_positive,
+                              const std::string& why) {
+        const auto v = m.find(key);
+        if (!v || !off || (only_if_positive && !(v->number() > 0))) return;
+        s.notes.push_back(v->note_at_key(format_number(v->number()) + " has no effect: " + why));
+      };
+      unused("rolling_friction", s.contact.rolling == RollingModel::none, true,
+             "contact.rolling is none, so contacts resist no rolling; name `rolling: cdt` or "
+             "`rolling: epsd` in contact to use it");
+      unused("cohesion_energy_density", s.contact.cohesion == CohesionModel::none, true,
+             "contact.cohesion is none, so contacts do not attract; name `cohesion: sjkr` in "
+             "contact to use it");
+      unused("friction", s.contact.tangential == TangentialModel::none, false,
+             "contact.tangential is none, so contacts are frictionless; name `tangential: "
+             "history` in contact (the default) to use it");
+    }
+  }
+  if (const auto o = top.find("output")) {
+    const Map m = o->map();
+    if (const auto k = m.find("checkpoint_keep"); k && !s.output.checkpoint_interval)
+      s.notes.push_back(k->note_at_key(
+          k->node().Scalar() +
+          " has no effect: no checkpoint_interval is given, so the run writes no periodic "
+          "checkpoints to keep; add `checkpoint_interval: <s>`"));
+    if (const auto w = m.find("wall_loads"); w && s.output.wall_loads && s.walls.empty())
+      s.notes.push_back(w->note_at_key("true has no effect: the scene has no walls"));
+  }
+  if (const auto walls = top.find("walls"))
+    for (const Field& wall : walls->items()) {
+      const auto motion = wall.map().find("motion");
+      if (!motion || !motion->node().IsMap()) continue;
+      const Map m = motion->map();
+      const auto w = m.find("angular_velocity");
+      if (w && w->number() != 0) continue;
+      for (const char* key : {"axis", "axis_point"})
+        if (const auto a = m.find(key))
+          s.notes.push_back(a->note_at_key(
+              "is given but has no effect: the wall does not rotate (motion.angular_velocity is " +
+              std::string(w ? "0" : "not given") +
+              "); give `angular_velocity: <rad/s>` to "
+              "turn it about this axis"));
+    }
+}
+
 Scene build_scene(const Field& root) {
   if (!root.node().IsDefined() || root.node().IsNull())
     root.fail("the scene is empty; it needs at least domain, time, materials and contact");
@@ -1467,6 +1520,7 @@ Scene build_scene(const Field& root) {
                               "interaction_defaults", "contact", "walls", "heat", "fluid"})
     if (const auto f = top.find(section)) add_model_lines(f->node(), section, root.source(), s);
   record_mesh_contents(s);
+  note_unused_settings(top, s);
   // The Rayleigh time needs the elastic constants of every material a particle uses.
   if (s.time.rayleigh_fraction)
     for (const Material& mat : s.materials)

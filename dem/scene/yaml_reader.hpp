@@ -188,6 +188,12 @@ class Field {
   [[noreturn]] void fail_at_key(const std::string& message) const {
     raise(*src_, key_mark_, prefixed(message));
   }
+  // A note at the key that names this value, as an error would name it but not thrown:
+  // "<file>:<line>:<column>: note: <path>: <message>" (a setting that has no effect).
+  std::string note_at_key(const std::string& message) const {
+    return src_->label + ":" + std::to_string(key_mark_.line + 1) + ":" +
+           std::to_string(key_mark_.column + 1) + ": note: " + prefixed(message);
+  }
 
   double number(const Range& range = kAny) const {
     const std::optional<double> x = as_number(node_);

@@ -411,6 +411,42 @@ def refuses_bad_setup(runner, checks):
         runner.run(again, "blockMesh", "blockMesh")
         runner.run(again, "grainFoam", runner.solver)  # raises unless it runs to the end
 
+    # 2c. A DEM step the time-step check refuses (1e-4 s, 1.6 Rayleigh times): stopped at
+    #     start-up as `grain run` stops it, after the DEM's own start-up lines (it had started,
+    #     without them, until a run-time guard stopped it). The message's advice, rerun: the
+    #     step it names for this deltaT runs; `allowLargeTimeStep yes` starts anyway, printing
+    #     the refusal as a warning and a setting without effect as a note.
+    case = runner.fresh_case("periodic_box", "dem_step_refused", [
+        ("particles.yaml", "step: 1e-5 ", "step: 1e-4 ")])
+    runner.run(case, "blockMesh", "blockMesh")
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    advised = re.search(r"refusing to run with this DEM time step \(see the lines above\); use dt "
+                        r"<= \S+ s .*; for this fluid step \(deltaT 0\.0001 s\) time\.step (\S+) s "
+                        r"\(deltaT / (\d+)\); or set `allowLargeTimeStep yes;`", log)
+    checks.expect(advised is not None and "grainFoam DEM: error: dt is too large to resolve "
+                  "contacts" in log and "grainFoam DEM: Rayleigh time t_R = " in log,
+                  "DEM step 1e-4 s: refused at start-up after the DEM's lines, advising a step "
+                  f"that divides deltaT ({advised.groups() if advised else None})")
+    if advised:
+        again = runner.fresh_case("periodic_box", "dem_step_advised", [
+            ("particles.yaml", "step: 1e-5 ", f"step: {advised.group(1)} ")])
+        runner.run(again, "blockMesh", "blockMesh")
+        runner.run(again, "grainFoam", runner.solver)  # raises unless it runs to the end
+    anyway = runner.fresh_case("periodic_box", "dem_step_anyway", [
+        ("particles.yaml", "step: 1e-5 ", "step: 1e-4 "),
+        ("particles.yaml", "friction: 0.5}", "friction: 0.5, rolling_friction: 0.1}"),
+        ("constant/couplingProperties", "sampling        cell;",
+         "allowLargeTimeStep yes;\nsampling        cell;")])
+    runner.run(anyway, "blockMesh", "blockMesh")
+    log = runner.run(anyway, "grainFoam", runner.solver)
+    checks.expect("grainFoam DEM: warning: dt is too large to resolve contacts" in log
+                  and "(running anyway: allowLargeTimeStep yes)" in log
+                  and re.search(r"grainFoam DEM: \S*particles\.yaml:\d+:\d+: note: "
+                                r"interaction_defaults\.rolling_friction: 0\.1 has no effect", log)
+                  is not None,
+                  "allowLargeTimeStep yes: starts, the refusal a warning; rolling_friction with "
+                  "rolling none named as a note")
+
     # 2a. A misspelt couplingProperties key: refused at its line, with the key it resembles
     #     and the allowed keys as a plain list (it had printed OpenFOAM's "12 ( ... )" list
     #     and the dictionary's line range). The advice, followed, is the original case.

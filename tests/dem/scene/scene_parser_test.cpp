@@ -686,6 +686,49 @@ TEST(SceneErrors, ZeroDirection) {
   EXPECT_THAT(msg, HasSubstr("walls[0].normal: the direction [0, 0, 0] has no length"));
 }
 
+// Settings accepted but without effect in the scene are named at start-up (Scene::notes, one
+// "<file>:<line>:<column>: note: ..." each): a pair's rolling_friction with rolling none,
+// cohesion_energy_density with cohesion none, friction with tangential none; checkpoint_keep
+// without checkpoint_interval; wall_loads without walls; a wall motion's axis that turns nothing.
+// They ran without a word, bit for bit as without them. Used, none is named.
+TEST(SceneNotes, SettingsWithoutEffectAreNamed) {
+  const std::string unused =
+      with("    restitution: 0.9\n",
+           "    restitution: 0.9\n    friction: 0.9\n    rolling_friction: 0.3\n"
+           "    cohesion_energy_density: 1e5\n") +
+      "  tangential: none\n"                                                       // 20
+      "walls:\n"                                                                   // 21
+      "  - {type: plane, point: [0, 0, 0], normal: [0, 0, 1], material: glass,\n"  // 22
+      "     motion: {velocity: [0.1, 0, 0], axis: [0, 0, 1]}}\n"                   // 23
+      "output: {checkpoint_keep: 3}\n";                                            // 24
+  const Scene s = parse_scene(unused, kLabel);
+  ASSERT_EQ(s.notes.size(), 5u);
+  const std::string at = kLabel + ":";
+  EXPECT_EQ(s.notes[0], at + "16:5: note: interactions[0].rolling_friction: 0.3 has no effect: "
+                             "contact.rolling is none, so contacts resist no rolling; name "
+                             "`rolling: cdt` or `rolling: epsd` in contact to use it");
+  EXPECT_THAT(s.notes[1], HasSubstr(at + "17:5: note: interactions[0].cohesion_energy_density: "
+                                         "100000 has no effect: contact.cohesion is none"));
+  EXPECT_THAT(s.notes[2], HasSubstr(at + "15:5: note: interactions[0].friction: 0.9 has no "
+                                         "effect: contact.tangential is none"));
+  EXPECT_THAT(s.notes[3], HasSubstr(at + "24:10: note: output.checkpoint_keep: 3 has no effect: "
+                                         "no checkpoint_interval is given"));
+  EXPECT_THAT(s.notes[4], HasSubstr(at + "23:38: note: walls[0].motion.axis: is given but has no "
+                                         "effect: the wall does not rotate"));
+  // The same settings where they act: no note.
+  std::string used = unused;
+  used.replace(used.find("  tangential: none\n"), 19, "  rolling: cdt\n  cohesion: sjkr\n");
+  used.replace(used.find("axis: [0, 0, 1]"), 15, "axis: [0, 0, 1], angular_velocity: 1");
+  used.replace(used.find("{checkpoint_keep: 3}"), 20,
+               "{checkpoint_keep: 3, checkpoint_interval: 0.1}");
+  EXPECT_TRUE(parse_scene(used, kLabel).notes.empty()) << parse_scene(used, kLabel).notes[0];
+  // wall_loads without walls.
+  const Scene no_walls = parse_scene(kBase + "output: {wall_loads: true}\n", kLabel);
+  ASSERT_EQ(no_walls.notes.size(), 1u);
+  EXPECT_THAT(no_walls.notes[0], HasSubstr("note: output.wall_loads: true has no effect: the "
+                                           "scene has no walls"));
+}
+
 TEST(SceneErrors, ModelSettingsMustMatchTheModel) {
   const std::string no_block = expect_at(error_of(with("normal: hertz", "normal: hooke")), 15, 1);
   EXPECT_THAT(no_block, HasSubstr("missing required key 'hooke' in contact; normal: hooke needs"));
