@@ -281,6 +281,82 @@ void find_open_edges(const std::vector<Vec3>& x, const std::vector<std::array<in
   }
 }
 
+// Closes T-junctions: a vertex lying inside another triangle's open edge (a CAD export that
+// split one side of a seam and not the other). Welding cannot join them (no vertex is near
+// another), and a sphere on that line would feel the triangle's edge as a second contact
+// besides the neighbours' face (rule 2 of docs/theory/walls.md sees no shared edge). The
+// triangle is split at such vertices (a fan from its opposite vertex, the same turning), so the
+// edge is shared. `tol`: how far off the edge a vertex may lie [m]. Repeats until none is
+// left (a triangle with such vertices on two edges); returns the vertices joined.
+long close_t_junctions(const std::vector<Vec3>& x, std::vector<std::array<int, 3>>& tris,
+                       double tol) {
+  long joined = 0;
+  for (int pass = 0; pass < 8; ++pass) {
+    std::unordered_map<std::uint64_t, int> uses;
+    auto edge = [](int a, int b) {
+      return static_cast<std::uint64_t>(std::min(a, b)) << 32 |
+             static_cast<std::uint32_t>(std::max(a, b));
+    };
+    for (const auto& t : tris)
+      for (int e = 0; e < 3; ++e) ++uses[edge(t[e], t[(e + 1) % 3])];
+    std::vector<char> on_rim(x.size(), 0);
+    double length = 0;
+    long open = 0;
+    for (const auto& [key, n] : uses)
+      if (n == 1) {
+        const int a = static_cast<int>(key >> 32), b = static_cast<int>(key & 0xffffffffu);
+        on_rim[a] = on_rim[b] = 1;
+        length += (x[a] - x[b]).norm();
+        ++open;
+      }
+    if (open == 0) return joined;
+    const double h = std::max(length / open, 4 * tol);
+    PointCells cells(h, x[0]);
+    for (std::size_t k = 0; k < x.size(); ++k)
+      if (on_rim[k]) cells.add(x[k], static_cast<int>(k));
+    std::vector<std::array<int, 3>> out;
+    out.reserve(tris.size());
+    long split = 0;
+    for (const auto& t : tris) {
+      bool done = false;
+      for (int e = 0; e < 3 && !done; ++e) {
+        const int a = t[e], b = t[(e + 1) % 3], c = t[(e + 2) % 3];
+        if (uses[edge(a, b)] != 1) continue;
+        const Vec3 ab = x[b] - x[a];
+        const double len = ab.norm();
+        // Rim vertices within tol of the edge's inside, by their place along it.
+        std::vector<std::pair<double, int>> on;
+        const int samples = static_cast<int>(std::ceil(len / h));
+        for (int q = 0; q <= samples; ++q)
+          cells.around(x[a] + (static_cast<double>(q) / samples) * ab, [&](int v) {
+            if (v == a || v == b || v == c) return;
+            const double s = (x[v] - x[a]).dot(ab) / (len * len);
+            if (!(s * len > tol && (1 - s) * len > tol)) return;
+            if ((x[v] - (x[a] + s * ab)).norm() > tol) return;
+            for (const auto& [s0, v0] : on)
+              if (v0 == v) return;
+            on.emplace_back(s, v);
+          });
+        if (on.empty()) continue;
+        std::sort(on.begin(), on.end());
+        int from = a;
+        for (const auto& [s0, v] : on) {
+          out.push_back({from, v, c});
+          from = v;
+        }
+        out.push_back({from, b, c});
+        split += static_cast<long>(on.size());
+        done = true;
+      }
+      if (!done) out.push_back(t);
+    }
+    tris.swap(out);
+    joined += split;
+    if (split == 0) return joined;
+  }
+  return joined;
+}
+
 }  // namespace
 
 Vec3 MeshTransform::apply(const Vec3& x) const {
@@ -379,6 +455,8 @@ TriangleMesh parse_stl(const std::string& bytes, const std::string& label,
   }
   rep.diagonal = diagonal * transform.scale;
   rep.weld_distance = weld_tolerance * rep.diagonal;
+  rep.t_junctions =
+      close_t_junctions(verts, tris, std::max(rep.weld_distance, 1e-9 * rep.diagonal));
   find_open_edges(verts, tris, rep);
   rep.vertices = static_cast<long>(verts.size());
   if (report) *report = rep;

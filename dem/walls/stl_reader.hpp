@@ -62,7 +62,9 @@ struct StlReport {
   long vertices = 0;            // after welding
   long welded = 0;              // vertices joined to another that was not bit-identical
   double weld_distance = 0;     // the tolerance in metres, after the placement's scale
-  long open_edges = 0;          // edges of one triangle only, after welding
+  long t_junctions = 0;         // vertices found inside another triangle's open edge, whose
+                                // triangle was split there (a CAD export's T-junction)
+  long open_edges = 0;          // edges of one triangle only, after welding and those splits
   // The closest two open-edge vertices that share no triangle, if closer than 1e-3 of the
   // diagonal (a likely seam): their distance in metres (placed), and a point (placed); -1
   // when there is none.

@@ -81,6 +81,10 @@ WallSet::WallSet(const Scene& scene)
         note << " (" << rep.degenerate_removed << " degenerate triangles removed)";
       note << "; " << rep.welded << " vertices welded (closer than " << rep.weld_distance
            << " m = " << w.mesh.weld_tolerance << " of the diagonal)";
+      if (rep.t_junctions > 0)
+        note << "; " << rep.t_junctions
+             << " T-junction(s) closed (a vertex inside another triangle's edge: that triangle "
+                "split there, so that the edge is shared)";
       if (rep.open_edges > 0)
         note << "; " << rep.open_edges
              << " open edges (of one triangle: the rim of an open surface, or seams)";

@@ -157,6 +157,42 @@ TEST(MeshWall, NearMissSeamIsWeldedToOneContact) {
   EXPECT_LT(open.restitution, 0.9 * e);
 }
 
+// A T-junction: a flat floor whose triangle A = (-L,0)(L,0)(0,-L) meets B and C on y > 0,
+// which share the vertex (0,0) inside A's long edge (a CAD export that split one side of a
+// seam only). No vertex is near another, so welding cannot join them; the reader splits A at
+// (0,0). A sphere dropped onto the junction line, 4 r from the vertex, feels one contact and
+// bounces as on the conforming mesh (A split in the file): e = 0.5 to 1e-6, no sideways kick.
+// Unsplit it felt A's edge besides B's face: e = 0.365 and 3 % of the speed sideways.
+TEST(MeshWall, TJunctionIsClosedToOneContact) {
+  const double e = 0.5, v = 0.5, L = 0.01;
+  test::MeshData tj;
+  tj.v = {Vec3(-L, 0, 0), Vec3(L, 0, 0), Vec3(0, -L, 0), Vec3(0, 0, 0), Vec3(0, L, 0)};
+  tj.t = {{0, 1, 2}, {0, 3, 4}, {3, 1, 4}};
+  for (auto& t : tj.t)  // counter-clockwise seen from +z
+    if ((tj.v[t[1]] - tj.v[t[0]]).cross(tj.v[t[2]] - tj.v[t[0]]).z() < 0) std::swap(t[1], t[2]);
+  test::MeshData conforming = tj;
+  conforming.t[0] = {0, 3, 2};
+  conforming.t.push_back({3, 1, 2});
+  for (auto& t : conforming.t)
+    if ((conforming.v[t[1]] - conforming.v[t[0]])
+            .cross(conforming.v[t[2]] - conforming.v[t[0]])
+            .z() < 0)
+      std::swap(t[1], t[2]);
+  StlReport rep;
+  read_stl(test::write_mesh(tj, "t_junction.stl"), {}, &rep);
+  EXPECT_EQ(rep.t_junctions, 1);
+  EXPECT_EQ(rep.open_edges, 4);  // the outer rim only (7 with the T-junction open)
+  const Vec3 target(4 * kR, 0.05 * kR, 0);
+  const Bounce joined = drop(tj, "t_junction.stl", target, Vec3::UnitZ(), e, v);
+  const Bounce reference =
+      drop(conforming, "t_junction_conforming.stl", target, Vec3::UnitZ(), e, v);
+  std::printf("[ measured ] T-junction: e = %.6f (%ld contact), conforming mesh e = %.6f\n",
+              joined.restitution, joined.max_contacts, reference.restitution);
+  EXPECT_EQ(joined.max_contacts, 1);
+  EXPECT_NEAR(joined.restitution, reference.restitution, 1e-6);
+  EXPECT_NEAR(joined.restitution, e, 0.01 * e);
+}
+
 // Same box (12 x 12 x 60 mm) from six planes and from a 12-triangle mesh: the same 400
 // spheres (r = 0.8-1.0 mm) settle to the same bed height, measured as twice the mean
 // centre height. The beds are frictionless: a frictional bed's height depends on its
