@@ -20,6 +20,9 @@ struct NoRolling {
   static constexpr const char* name = "none";
 };
 
+// Relative to |w_rel|: below it, w_r is rounding (CdtRolling).
+constexpr double kRollingRoundOff = 1e-12;
+
 struct CdtRolling {
   static constexpr bool enabled = true;
   static constexpr bool needs_inertia = false;
@@ -28,7 +31,11 @@ struct CdtRolling {
                      const ContactConstants&, Vec3& /*history*/, double /*dt*/) {
     const Vec3 wr = g.w_rel - g.w_rel.dot(g.n) * g.n;
     const double w = wr.norm();
-    if (w <= 0) return Vec3::Zero();
+    // A rolling part at the round-off of the relative spin is none: the spin about n of a
+    // sphere on a turntable, or spinning on a tilted plane, leaves |w_r| ~ 1e-16 |w_rel|
+    // pointing anywhere (|n| = 1 only to rounding), and the full torque in its direction spun
+    // a sphere resting on a turntable's axis up to 9 rad/s in 0.1 s.
+    if (!(w > kRollingRoundOff * g.w_rel.norm())) return Vec3::Zero();
     return (-m_max / w) * wr;
   }
 };

@@ -1435,7 +1435,7 @@ void note_unused_settings(const Map& top, Scene& s) {
       unused("cohesion_energy_density", s.contact.cohesion == CohesionModel::none, true,
              "contact.cohesion is none, so contacts do not attract; name `cohesion: sjkr` in "
              "contact to use it");
-      unused("friction", s.contact.tangential == TangentialModel::none, false,
+      unused("friction", s.contact.tangential == TangentialModel::none, true,
              "contact.tangential is none, so contacts are frictionless; name `tangential: "
              "history` in contact (the default) to use it");
     }
@@ -1450,6 +1450,20 @@ void note_unused_settings(const Map& top, Scene& s) {
     if (const auto w = m.find("wall_loads"); w && s.output.wall_loads && s.walls.empty())
       s.notes.push_back(w->note_at_key("true has no effect: the scene has no walls"));
   }
+  // A wall's surface moving in its own plane (a cylinder turning about its axis, a mesh
+  // conveyor) acts only through friction and rolling resistance.
+  if (s.contacts_possible && s.contact.tangential == TangentialModel::none &&
+      s.contact.rolling == RollingModel::none)
+    if (const auto walls = top.find("walls"))
+      for (const Field& wall : walls->items())
+        for (const char* key : {"angular_velocity", "surface_velocity"}) {
+          const auto v = wall.map().find(key);
+          if (!v || (v->node().IsScalar() ? v->number() == 0 : v->vec3().isZero(0))) continue;
+          s.notes.push_back(v->note_at_key(
+              "is given but has no effect: the wall's surface moves in its own plane, which "
+              "only friction and rolling resistance feel, and contact.tangential and "
+              "contact.rolling are none; name `tangential: history` in contact to use it"));
+        }
   if (const auto walls = top.find("walls"))
     for (const Field& wall : walls->items()) {
       const auto motion = wall.map().find("motion");

@@ -722,6 +722,21 @@ TEST(SceneNotes, SettingsWithoutEffectAreNamed) {
   used.replace(used.find("{checkpoint_keep: 3}"), 20,
                "{checkpoint_keep: 3, checkpoint_interval: 0.1}");
   EXPECT_TRUE(parse_scene(used, kLabel).notes.empty()) << parse_scene(used, kLabel).notes[0];
+  // A friction of 0 agrees with frictionless contacts: no note. A cylinder's turning with
+  // neither friction nor rolling resistance moves nothing: a note; with friction, none.
+  const std::string drum =
+      with("    restitution: 0.9\n", "    restitution: 0.9\n    friction: 0\n") +
+      "  tangential: none\n"
+      "walls:\n"
+      "  - {type: cylinder, axis_point: [0.5, 0.5, 0], axis: [0, 0, 1], radius: 0.4,\n"
+      "     angular_velocity: 3, material: glass}\n";
+  const Scene d = parse_scene(drum, kLabel);
+  ASSERT_EQ(d.notes.size(), 1u);
+  EXPECT_THAT(d.notes[0], HasSubstr(":21:6: note: walls[0].angular_velocity: is given but has no "
+                                    "effect: the wall's surface moves in its own plane"));
+  std::string rough = drum;
+  rough.replace(rough.find("  tangential: none\n"), 18, "  tangential: history\n");
+  EXPECT_TRUE(parse_scene(rough, kLabel).notes.empty());
   // wall_loads without walls.
   const Scene no_walls = parse_scene(kBase + "output: {wall_loads: true}\n", kLabel);
   ASSERT_EQ(no_walls.notes.size(), 1u);
