@@ -252,10 +252,16 @@ void find_open_edges(const std::vector<Vec3>& x, const std::vector<std::array<in
   for (const auto& t : tris)
     for (int e = 0; e < 3; ++e) ++uses[edge(t[e], t[(e + 1) % 3])];
   std::vector<char> on_rim(x.size(), 0);
+  std::vector<double> shortest(x.size(), INFINITY);  // open edge at each rim vertex
   for (const auto& [key, n] : uses)
     if (n == 1) {
       ++rep.open_edges;
-      on_rim[key >> 32] = on_rim[key & 0xffffffffu] = 1;
+      const auto a = static_cast<std::size_t>(key >> 32),
+                 b = static_cast<std::size_t>(key & 0xffffffffu);
+      on_rim[a] = on_rim[b] = 1;
+      const double len = (x[a] - x[b]).norm();
+      shortest[a] = std::min(shortest[a], len);
+      shortest[b] = std::min(shortest[b], len);
     }
   const double reach = 1e-3 * diagonal_of(x);
   if (rep.open_edges == 0 || !(reach > 0)) return;
@@ -270,7 +276,9 @@ void find_open_edges(const std::vector<Vec3>& x, const std::vector<std::array<in
     if (!on_rim[k]) continue;
     cells.around(x[k], [&](int q) {
       const double d = (x[q] - x[k]).norm();
-      if (d >= best) return;
+      // A seam's gap is small against the edges around it; vertices a rim's edge or two
+      // apart along a finely divided rim are not one.
+      if (d >= best || !(d < 0.5 * std::min(shortest[k], shortest[q]))) return;
       for (int t : around[q])
         if (std::find(around[k].begin(), around[k].end(), t) != around[k].end()) return;
       best = d;
@@ -355,6 +363,56 @@ long close_t_junctions(const std::vector<Vec3>& x, std::vector<std::array<int, 3
     if (split == 0) return joined;
   }
   return joined;
+}
+
+// The closest rim vertex to another triangle's open edge, inside the edge, within `reach`
+// and under half the edge's length and the vertex's own open edges, that the T-junction
+// closing left (beyond its tolerance): a T-junction left open (rep.t_gap, rep.t_gap_at).
+void find_t_gap(const std::vector<Vec3>& x, const std::vector<std::array<int, 3>>& tris,
+                double reach, StlReport& rep) {
+  std::unordered_map<std::uint64_t, int> uses;
+  auto edge = [](int a, int b) {
+    return static_cast<std::uint64_t>(std::min(a, b)) << 32 |
+           static_cast<std::uint32_t>(std::max(a, b));
+  };
+  for (const auto& t : tris)
+    for (int e = 0; e < 3; ++e) ++uses[edge(t[e], t[(e + 1) % 3])];
+  std::vector<double> shortest(x.size(), INFINITY);
+  std::vector<std::pair<int, int>> open;
+  double length = 0;
+  for (const auto& [key, n] : uses)
+    if (n == 1) {
+      const int a = static_cast<int>(key >> 32), b = static_cast<int>(key & 0xffffffffu);
+      const double len = (x[a] - x[b]).norm();
+      shortest[static_cast<std::size_t>(a)] = std::min(shortest[static_cast<std::size_t>(a)], len);
+      shortest[static_cast<std::size_t>(b)] = std::min(shortest[static_cast<std::size_t>(b)], len);
+      open.emplace_back(a, b);
+      length += len;
+    }
+  if (open.empty() || !(reach > 0)) return;
+  const double h = std::max(length / static_cast<double>(open.size()), reach);
+  PointCells cells(h, x[0]);
+  for (std::size_t k = 0; k < x.size(); ++k)
+    if (std::isfinite(shortest[k])) cells.add(x[k], static_cast<int>(k));
+  double best = reach;
+  for (const auto& [a, b] : open) {
+    const Vec3 ab = x[b] - x[a];
+    const double len = ab.norm();
+    const int samples = static_cast<int>(std::ceil(len / h));
+    for (int q = 0; q <= samples; ++q)
+      cells.around(x[a] + (static_cast<double>(q) / samples) * ab, [&](int v) {
+        if (v == a || v == b) return;
+        const double s = (x[v] - x[a]).dot(ab) / (len * len);
+        if (!(s > 0 && s < 1)) return;
+        const double d = (x[v] - (x[a] + s * ab)).norm();
+        if (!(d < best) || !(d < 0.5 * std::min(len, shortest[static_cast<std::size_t>(v)])) ||
+            !(s * len > d && (1 - s) * len > d))
+          return;
+        best = d;
+        rep.t_gap = d;
+        rep.t_gap_at = x[v];
+      });
+  }
 }
 
 }  // namespace
@@ -458,6 +516,7 @@ TriangleMesh parse_stl(const std::string& bytes, const std::string& label,
   rep.t_junctions =
       close_t_junctions(verts, tris, std::max(rep.weld_distance, 1e-9 * rep.diagonal));
   find_open_edges(verts, tris, rep);
+  find_t_gap(verts, tris, 1e-3 * rep.diagonal, rep);
   rep.vertices = static_cast<long>(verts.size());
   if (report) *report = rep;
   return TriangleMesh(std::move(verts), std::move(tris));

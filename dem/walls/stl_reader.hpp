@@ -70,6 +70,11 @@ struct StlReport {
   // when there is none.
   double seam_gap = -1;
   Vec3 seam_at = Vec3::Zero();
+  // The closest open-edge vertex to another triangle's open edge (inside it) that was not
+  // joined to it, if closer than 1e-3 of the diagonal and small against the edges there (a
+  // T-junction left open): the distance in metres (placed) and the vertex; -1 when none.
+  double t_gap = -1;
+  Vec3 t_gap_at = Vec3::Zero();
   double diagonal = 0;  // of the placed mesh's bounding box, m
 };
 

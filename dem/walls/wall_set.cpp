@@ -99,6 +99,18 @@ WallSet::WallSet(const Scene& scene)
              << rep.seam_gap / rep.diagonal << " (now " << w.mesh.weld_tolerance << ")";
         notes_.push_back(warn.str());
       }
+      if (rep.t_gap >= 0) {
+        std::ostringstream warn;
+        warn << "warning: wall '" << w.name << "' (" << w.mesh.file << "): an open-edge vertex at ("
+             << rep.t_gap_at[0] << ", " << rep.t_gap_at[1] << ", " << rep.t_gap_at[2] << ") lies "
+             << rep.t_gap
+             << " m from another triangle's open edge: a T-junction left open (a sphere on it "
+                "feels two contacts). If the vertex belongs on that edge, set `weld_tolerance` "
+                "above "
+             << rep.t_gap / rep.diagonal << " (now " << w.mesh.weld_tolerance
+             << "): the edge's triangle is then split at the vertex";
+        notes_.push_back(warn.str());
+      }
       e.mesh = static_cast<int>(meshes_.size());
       e.closed = rep.open_edges == 0;
       e.surface_velocity = w.mesh.surface_velocity;
