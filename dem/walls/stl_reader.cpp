@@ -240,17 +240,23 @@ std::vector<int> weld(const std::vector<Vec3>& x, double tol, long& welded) {
   return to;
 }
 
+// An undirected edge a - b as one number, and how many triangles use each edge.
+std::uint64_t edge_key(int a, int b) {
+  return static_cast<std::uint64_t>(std::min(a, b)) << 32 |
+         static_cast<std::uint32_t>(std::max(a, b));
+}
+std::unordered_map<std::uint64_t, int> edge_uses(const std::vector<std::array<int, 3>>& tris) {
+  std::unordered_map<std::uint64_t, int> uses;
+  for (const auto& t : tris)
+    for (int e = 0; e < 3; ++e) ++uses[edge_key(t[e], t[(e + 1) % 3])];
+  return uses;
+}
+
 // Counts the edges of one triangle, and finds the closest two vertices on such edges that
 // share no triangle, if closer than 1e-3 of the diagonal (a seam the welding left open).
 void find_open_edges(const std::vector<Vec3>& x, const std::vector<std::array<int, 3>>& tris,
                      StlReport& rep) {
-  std::unordered_map<std::uint64_t, int> uses;
-  auto edge = [](int a, int b) {
-    return static_cast<std::uint64_t>(std::min(a, b)) << 32 |
-           static_cast<std::uint32_t>(std::max(a, b));
-  };
-  for (const auto& t : tris)
-    for (int e = 0; e < 3; ++e) ++uses[edge(t[e], t[(e + 1) % 3])];
+  const std::unordered_map<std::uint64_t, int> uses = edge_uses(tris);
   std::vector<char> on_rim(x.size(), 0);
   std::vector<double> shortest(x.size(), INFINITY);  // open edge at each rim vertex
   for (const auto& [key, n] : uses)
@@ -300,13 +306,7 @@ long close_t_junctions(const std::vector<Vec3>& x, std::vector<std::array<int, 3
                        double tol) {
   long joined = 0;
   for (int pass = 0; pass < 8; ++pass) {
-    std::unordered_map<std::uint64_t, int> uses;
-    auto edge = [](int a, int b) {
-      return static_cast<std::uint64_t>(std::min(a, b)) << 32 |
-             static_cast<std::uint32_t>(std::max(a, b));
-    };
-    for (const auto& t : tris)
-      for (int e = 0; e < 3; ++e) ++uses[edge(t[e], t[(e + 1) % 3])];
+    const std::unordered_map<std::uint64_t, int> uses = edge_uses(tris);
     std::vector<char> on_rim(x.size(), 0);
     double length = 0;
     long open = 0;
@@ -329,7 +329,7 @@ long close_t_junctions(const std::vector<Vec3>& x, std::vector<std::array<int, 3
       bool done = false;
       for (int e = 0; e < 3 && !done; ++e) {
         const int a = t[e], b = t[(e + 1) % 3], c = t[(e + 2) % 3];
-        if (uses[edge(a, b)] != 1) continue;
+        if (uses.at(edge_key(a, b)) != 1) continue;
         const Vec3 ab = x[b] - x[a];
         const double len = ab.norm();
         // Rim vertices within tol of the edge's inside, by their place along it.
@@ -370,13 +370,7 @@ long close_t_junctions(const std::vector<Vec3>& x, std::vector<std::array<int, 3
 // closing left (beyond its tolerance): a T-junction left open (rep.t_gap, rep.t_gap_at).
 void find_t_gap(const std::vector<Vec3>& x, const std::vector<std::array<int, 3>>& tris,
                 double reach, StlReport& rep) {
-  std::unordered_map<std::uint64_t, int> uses;
-  auto edge = [](int a, int b) {
-    return static_cast<std::uint64_t>(std::min(a, b)) << 32 |
-           static_cast<std::uint32_t>(std::max(a, b));
-  };
-  for (const auto& t : tris)
-    for (int e = 0; e < 3; ++e) ++uses[edge(t[e], t[(e + 1) % 3])];
+  const std::unordered_map<std::uint64_t, int> uses = edge_uses(tris);
   std::vector<double> shortest(x.size(), INFINITY);
   std::vector<std::pair<int, int>> open;
   double length = 0;
