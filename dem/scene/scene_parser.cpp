@@ -1474,10 +1474,8 @@ void note_unused_settings(const Map& top, Scene& s) {
       for (const char* key : {"axis", "axis_point"})
         if (const auto a = m.find(key))
           s.notes.push_back(a->note_at_key(
-              "is given but has no effect: the wall does not rotate (motion.angular_velocity is " +
-              std::string(w ? "0" : "not given") +
-              "); give `angular_velocity: <rad/s>` to "
-              "turn it about this axis"));
+              "is given but has no effect: the wall does not rotate (motion.angular_velocity "
+              "is 0); give `angular_velocity: <rad/s>` to turn it about this axis"));
     }
 }
 

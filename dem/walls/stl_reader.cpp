@@ -389,7 +389,8 @@ void find_t_gap(const std::vector<Vec3>& x, const std::vector<std::array<int, 3>
   for (std::size_t k = 0; k < x.size(); ++k)
     if (std::isfinite(shortest[k])) cells.add(x[k], static_cast<int>(k));
   double best = reach;
-  for (const auto& [a, b] : open) {
+  for (const auto& edge : open) {
+    const int a = edge.first, b = edge.second;  // named: a lambda below uses them
     const Vec3 ab = x[b] - x[a];
     const double len = ab.norm();
     const int samples = static_cast<int>(std::ceil(len / h));

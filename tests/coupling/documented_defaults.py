@@ -431,7 +431,12 @@ CHECKS = [
 ]
 
 # Rows with a stated default that no run above can write down, and why.
-SKIPPED = {}
+SKIPPED = {
+    "allowLargeTimeStep": "acts only on a DEM step the time-step check refuses, where the "
+                          "run with the key left out stops at start-up (nothing to compare); "
+                          "coupling.refuses_bad_setup runs that case left out (refused) and "
+                          "with `yes` (it starts)",
+}
 
 # Everything of an outcome that two runs must share to count as the same.
 IGNORED = {"case"}
