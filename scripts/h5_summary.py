@@ -1,15 +1,35 @@
 #!/usr/bin/env python3
-"""Print what a grainflow particle snapshot holds: time, step, particle count, bounds.
+"""Print what grainflow particle snapshots and checkpoints hold: time, step, count, bounds.
 
-    scripts/h5_summary.py out/particles_000010.h5 [more files or directories ...]
+    scripts/h5_summary.py out/particles_000010.h5 [more files or output folders ...]
 
-A directory argument summarises every *.h5 snapshot in it, in name order.
+A file argument is summarised whatever its name: a snapshot (particles_*.h5) or a checkpoint
+(checkpoint_*.h5, whose particles are stored under /particles/).
+
+An output folder argument summarises the snapshots of the run that wrote it, the ones its
+particles.xdmf lists, in its order. Other particles_*.h5 files in the folder (left over from
+an earlier run in the same folder, not listed) are counted and named in a note, not
+summarised. Without particles.xdmf the snapshots are those carrying the scene_fingerprint of
+the newest file (said in a note). The folder's checkpoints are summarised after them; one whose
+stored log is not the start of the folder's log.csv is marked as left over from another run.
+A folder without any .h5 file is an error.
+
+Material indices are printed as the snapshot's material names (root attribute
+material_names; for a checkpoint, its stored scene). Coarse-grained parcels (an insertion's
+coarse_grain: k) are counted as the run counts them, one per parcel, and beside that the
+real particles they stand for (the real_count dataset, k^3 each) and the real particles'
+radius (parcel radius / k): docs/models/coarse-graining.md "Output".
+
+Exit status: 0, or 1 when a file cannot be read or a folder holds no .h5 file; 2 for usage.
 Needs h5py and numpy (Debian: python3-h5py python3-numpy).
 """
 import argparse
 import os
 import pathlib
+import re
+import signal
 import sys
+import xml.etree.ElementTree as ET
 
 try:
     import h5py
@@ -20,56 +40,219 @@ except ImportError:  # this python3 lacks them: scripts/python.sh finds one that
     _helper = os.path.join(os.path.dirname(os.path.realpath(__file__)), "python.sh")
     os.execv(_helper, [_helper, os.path.abspath(__file__), *sys.argv[1:]])
 
+SNAPSHOT = re.compile(r"particles_\d+\.h5$")
+CHECKPOINT = re.compile(r"checkpoint_\d+\.h5$")
 
-def files_from(args):
-    for a in args:
-        p = pathlib.Path(a)
-        if p.is_dir():
-            yield from sorted(p.glob("*.h5"))
-        else:
-            yield p
+
+class Unreadable(Exception):
+    """A file or folder that cannot be summarised; the message names it."""
 
 
 def attr(f, name, default=None):
     v = f.attrs.get(name, default)
-    return v.item() if hasattr(v, "item") else v
+    if isinstance(v, bytes):
+        return v.decode("utf-8", "replace")
+    return v.item() if hasattr(v, "item") and np.ndim(v) == 0 else v
 
 
-def summarise(path):
+def fingerprint(path):
+    try:
+        with h5py.File(path, "r") as f:
+            return attr(f, "scene_fingerprint")
+    except OSError:
+        return None
+
+
+def xdmf_files(index):
+    """The snapshot files particles.xdmf lists, in its order: the temporal collection's time
+    steps are named after their files' stems (an empty snapshot has no DataItem)."""
+    try:
+        root = ET.parse(index).getroot()
+    except (OSError, ET.ParseError) as e:
+        raise Unreadable(f"{index}: cannot read the snapshot index: {e}")
+    series = root.find("Domain/Grid")
+    if series is None:
+        raise Unreadable(f"{index}: not a grainflow snapshot index (no Domain/Grid)")
+    return [g.get("Name", "") + ".h5" for g in series.findall("Grid")]
+
+
+def folder_files(folder):
+    """(files to summarise, notes) for an output folder."""
+    notes = []
+    h5 = sorted(p for p in folder.iterdir() if p.name.endswith(".h5") and p.is_file())
+    if not h5:
+        raise Unreadable(f"{folder}: no .h5 file in this folder (no snapshot or checkpoint)")
+    snapshots = [p for p in h5 if SNAPSHOT.match(p.name)]
+    checkpoints = [p for p in h5 if CHECKPOINT.match(p.name)]
+    others = [p for p in h5 if p not in snapshots and p not in checkpoints]
+    if not snapshots and not checkpoints:
+        raise Unreadable(f"{folder}: no snapshot (particles_*.h5) or checkpoint in this folder; "
+                         f"other .h5 files: {', '.join(p.name for p in others)} (give them as "
+                         "file arguments)")
+    index = folder / "particles.xdmf"
+    if index.exists():
+        listed = [folder / n for n in xdmf_files(index)]
+        missing = [p for p in listed if not p.exists()]
+        if missing:
+            notes.append(f"{index} lists {len(missing)} snapshot(s) missing from the folder: "
+                         + ", ".join(p.name for p in missing))
+        chosen = [p for p in listed if p.exists()]
+        leftover = [p for p in snapshots if p not in listed]
+        notes.insert(0, f"{folder}: {len(chosen)} snapshot(s) listed in particles.xdmf")
+        why = "not listed in particles.xdmf"
+    else:
+        # No index: the newest file's run, by the scene fingerprint every snapshot carries.
+        newest = max(snapshots, key=lambda p: p.stat().st_mtime) if snapshots else None
+        mark = fingerprint(newest) if newest else None
+        chosen = [p for p in snapshots if fingerprint(p) == mark]
+        leftover = [p for p in snapshots if p not in chosen]
+        notes.insert(0, f"{folder}: no particles.xdmf; {len(chosen)} snapshot(s) with the "
+                        f"scene_fingerprint of the newest one ({newest.name if newest else '-'})")
+        why = "another scene_fingerprint"
+    if leftover:
+        notes.append(f"{len(leftover)} other particles_*.h5 file(s) in {folder} are left over "
+                     f"from other runs ({why}), not summarised: "
+                     + ", ".join(p.name for p in leftover))
+    if others:
+        notes.append(f"{len(others)} other .h5 file(s) in {folder}, not part of a run's "
+                     "series, not summarised (give them as file arguments): "
+                     + ", ".join(p.name for p in others))
+    return chosen + checkpoints, notes
+
+
+def material_names(f, group, count):
+    """Names of the material indices 0..count-1, or the indices as text."""
+    names = attr(f, "material_names")
+    if isinstance(names, str) and names:
+        parts = names.split(",")
+        if len(parts) >= count:
+            return parts
+    if group is not f and "scene/model" in f:  # a checkpoint: its scene's materials
+        model = bytes(f["scene/model"][...]).decode("utf-8", "replace")
+        listed = dict(re.findall(r"^materials\[(\d+)\]\.name = (.*)$", model, re.M))
+        ks = np.atleast_1d(f.attrs.get("material_coarse_grain", []))
+        real = np.atleast_1d(f.attrs.get("material_real", []))
+        out = []
+        for i in range(count):
+            if i < len(real) and str(int(real[i])) in listed:
+                base = listed[str(int(real[i]))]
+                out.append(base if ks[i] == 1 else f"{base}[k={ks[i]:g}]")
+            elif str(i) in listed:
+                out.append(listed[str(i)])
+            else:
+                return [str(j) for j in range(count)]
+        return out
+    return [str(j) for j in range(count)]
+
+
+def checkpoint_left_over(path, group_file):
+    """Whether a checkpoint in a folder is another run's: its stored log is not the start of
+    the folder's log.csv (a run's checkpoints keep its log up to their step)."""
+    log = path.parent / "log.csv"
+    if "log/table" not in group_file or not log.exists():
+        return False
+    table = bytes(group_file["log/table"][...])
+    with open(log, "rb") as f:
+        return f.read(len(table)) != table
+
+
+def summarise(path, in_folder=False):
     with h5py.File(path, "r") as f:
-        n = int(attr(f, "count", f["id"].shape[0] if "id" in f else 0))
+        checkpoint = "particles" in f and isinstance(f["particles"], h5py.Group)
+        g = f["particles"] if checkpoint else f
+        stored = g["id"].shape[0] if "id" in g else 0
+        n = stored if checkpoint else int(attr(f, "count", stored))
+        kind = "checkpoint" if checkpoint else "snapshot"
         print(f"{path}")
-        print(f"  time {attr(f, 'time', float('nan')):.9g} s  step {attr(f, 'step', -1)}  "
-              f"particles {n}")
+        if checkpoint and in_folder and checkpoint_left_over(path, f):
+            print("  note: left over from another run (its stored log is not the start of "
+                  "this folder's log.csv)")
+        mat = g["material"][...] if "material" in g and n > 0 else None
+        # Coarse graining: each particle's k and the real particles it stands for.
+        k = None
+        if "coarse_grain" in g:
+            k = g["coarse_grain"][...]
+        elif mat is not None and "material_coarse_grain" in f.attrs:
+            ks = np.atleast_1d(f.attrs["material_coarse_grain"])
+            k = ks[mat]
+        real = g["real_count"][...] if "real_count" in g else (k**3 if k is not None else None)
+        parcels = k is not None and n > 0 and np.any(k != 1)
+        line = (f"  time {attr(f, 'time', float('nan')):.9g} s  step {attr(f, 'step', -1)}  "
+                f"particles {n}")
+        if parcels:
+            line += (f" ({int((k != 1).sum())} parcels among them; together "
+                     f"{real.sum():.0f} real particles)")
+        if kind == "checkpoint":
+            line += "  (checkpoint)"
+        print(line)
         if n == 0:
             print("  (no particles)")
             return
-        x = f["position"][...]
+        x = g["position"][...]
         lo, hi = x.min(axis=0), x.max(axis=0)
         print("  position min [m]  " + "  ".join(f"{c:.6g}" for c in lo))
         print("  position max [m]  " + "  ".join(f"{c:.6g}" for c in hi))
-        if "radius" in f:
-            r = f["radius"][...]
-            print(f"  radius [m]  min {r.min():.6g}  mean {r.mean():.6g}  max {r.max():.6g}")
-        if "velocity" in f:
-            speed = np.linalg.norm(f["velocity"][...], axis=1)
+        r = g["radius"][...] if "radius" in g else None
+        if r is not None:
+            print(f"  radius [m]  min {r.min():.6g}  mean {r.mean():.6g}  max {r.max():.6g}"
+                  + ("  (parcels as simulated)" if parcels else ""))
+            if parcels:
+                rr = r / k
+                print(f"  real radius [m]  min {rr.min():.6g}  "
+                      f"mean {np.average(rr, weights=real):.6g}  max {rr.max():.6g}  "
+                      "(radius / k, mean over the real particles)")
+        if "velocity" in g:
+            speed = np.linalg.norm(g["velocity"][...], axis=1)
             print(f"  speed [m/s]  mean {speed.mean():.6g}  max {speed.max():.6g}")
-        if "material" in f:
-            mats, counts = np.unique(f["material"][...], return_counts=True)
-            print("  materials  " + "  ".join(f"{m}:{c}" for m, c in zip(mats, counts)))
+        if mat is not None:
+            mats, counts = np.unique(mat, return_counts=True)
+            names = material_names(f, g, int(mats.max()) + 1)
+            print("  materials  " + "  ".join(f"{names[m]}:{c}" for m, c in zip(mats, counts)))
+        if parcels:
+            for kv in np.unique(k):
+                if kv == 1:
+                    continue
+                sel = k == kv
+                sizes = "" if r is None else (
+                    f"; radius [m] parcels {r[sel].min():.6g} to {r[sel].max():.6g}, "
+                    f"real particles {r[sel].min() / kv:.6g} to {r[sel].max() / kv:.6g}")
+                print(f"  coarse grain k {kv:g}: {int(sel.sum())} parcels stand for "
+                      f"{real[sel].sum():.0f} real particles ({kv**3:g} each){sizes}")
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("paths", nargs="+", help="snapshot files (*.h5) or directories")
+    ap = argparse.ArgumentParser(
+        description=__doc__.splitlines()[0],
+        epilog="A folder: the snapshots its particles.xdmf lists, then its checkpoints; "
+               "files left over from other runs are named, not summarised.")
+    ap.add_argument("paths", nargs="+", help="snapshot or checkpoint files (*.h5), or output folders")
     args = ap.parse_args()
+    signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # `| head` ends the output quietly
     status = 0
-    for p in files_from(args.paths):
+    for a in args.paths:
+        p = pathlib.Path(a)
         try:
-            summarise(p)
-        except (OSError, KeyError) as e:
-            print(f"{p}: cannot read snapshot: {e}", file=sys.stderr)
+            if p.is_dir():
+                files, notes = folder_files(p)
+                for note in notes:
+                    print(f"note: {note}")
+                items = [(q, True) for q in files]
+            elif not p.exists():
+                raise Unreadable(f"{p}: no such file or folder")
+            else:
+                items = [(p, False)]
+        except (Unreadable, OSError) as e:
+            print(f"h5_summary.py: {e}", file=sys.stderr)
             status = 1
+            continue
+        for q, in_folder in items:
+            try:
+                summarise(q, in_folder)
+            except (OSError, KeyError, ValueError, TypeError, IndexError) as e:
+                sys.stdout.flush()
+                print(f"h5_summary.py: {q}: cannot read as a grainflow snapshot or checkpoint: "
+                      f"{e}", file=sys.stderr)
+                status = 1
     return status
 
 

@@ -4,6 +4,10 @@
     scripts/plot_log.py out/log.csv -c ke_trans_J ke_rot_J -o energy.png [--logy]
 
 Each column gets its own panel (the columns have different units); all share the time axis.
+A damaged row (not a number in every column) is left out and reported with its line number,
+on stderr and in the closing "wrote" line; a last row cut short by a killed run likewise.
+A missing, binary or non-log input, or an -o whose folder does not exist, is a one-line
+error, exit status 1 (2 for a usage error).
 Needs matplotlib and numpy (Debian: python3-matplotlib); no display is required.
 """
 import argparse
@@ -25,22 +29,56 @@ except ImportError:  # this python3 lacks them: scripts/python.sh finds one that
 DEFAULT_COLUMNS = ["particles", "ke_trans_J", "ke_rot_J", "max_overlap_ratio"]
 
 
+def fail(message):
+    """A clear one-line error, exit status 1."""
+    sys.exit(f"plot_log.py: {message}")
+
+
 def read_table(path):
-    with open(path, newline="") as f:
-        rows = list(csv.reader(f))
-    if not rows:
-        sys.exit(f"{path}: empty file, expected a header line")
-    header = rows[0]
-    values = []
-    for r in rows[1:]:
+    """(header, data rows, skipped) from a log table; skipped lists (line number, reason) of
+    each damaged row left out. A last row without its newline was cut short by a killed run."""
+    if os.path.isdir(path):
+        fail(f"{path} is a folder, not a log table (a run writes its table as "
+             f"{os.path.join(path, 'log.csv')})")
+    try:
+        with open(path, "rb") as f:
+            raw = f.read()
+    except FileNotFoundError:
+        fail(f"{path}: no such file")
+    except OSError as e:
+        fail(f"{path}: cannot read: {e.strerror or e}")
+    if raw.startswith(b"\x89HDF") or b"\0" in raw[:65536]:
+        fail(f"{path} is a binary file (an HDF5 snapshot or checkpoint?), not a CSV log table")
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        fail(f"{path} is not a text CSV log table (byte {e.start} is not UTF-8)")
+    lines = text.splitlines()
+    if not lines or not lines[0].strip():
+        fail(f"{path}: empty file, expected a header line")
+    header = next(csv.reader([lines[0]]))
+    if "time_s" not in header and "step" not in header:
+        fail(f"{path}: the first line is not a grainflow log header (time_s,step,...): "
+             f"{lines[0][:60]!r}")
+    values, skipped = [], []
+    for number, line in enumerate(lines[1:], start=2):
+        if not line.strip():
+            continue
+        fields = next(csv.reader([line]))
         try:
-            values.append([float(v) for v in r])
+            row = [float(v) for v in fields]
         except ValueError:
-            continue  # a last line cut short by a killed run
-        if len(values[-1]) != len(header):
-            values.pop()
+            row = None
+        # Even a last row that parses may be cut short (its wall_s cut to fewer digits).
+        cut = number == len(lines) and not text.endswith(("\n", "\r"))
+        if cut or row is None or len(row) != len(header):
+            reason = ("cut short (no newline at its end: a run killed while writing)" if cut
+                      else f"{len(fields)} fields, not {len(header)} numbers")
+            skipped.append((number, reason))
+            continue
+        values.append(row)
     data = np.array(values, dtype=float).reshape(-1, len(header))
-    return header, data
+    return header, data, skipped
 
 
 def main():
@@ -53,10 +91,20 @@ def main():
     ap.add_argument("--logy", action="store_true", help="logarithmic vertical axes")
     args = ap.parse_args()
 
-    header, data = read_table(args.log)
+    out_dir = os.path.dirname(os.path.abspath(args.output))
+    if os.path.isdir(args.output):
+        fail(f"-o {args.output} is a folder; give the PNG file's name")
+    if not os.path.isdir(out_dir):
+        fail(f"-o {args.output}: no folder {out_dir} to write it in")
+    header, data, skipped = read_table(args.log)
     unknown = [c for c in [args.x] + args.columns if c not in header]
     if unknown:
-        sys.exit(f"{args.log}: no column {', '.join(unknown)}; valid columns: {', '.join(header)}")
+        fail(f"{args.log}: no column {', '.join(unknown)}; valid columns: {', '.join(header)}")
+    for number, reason in skipped:
+        print(f"plot_log.py: {args.log}:{number}: damaged row skipped: {reason}",
+              file=sys.stderr)
+    if len(data) == 0:
+        fail(f"{args.log}: no complete data row to plot")
 
     x = data[:, header.index(args.x)]
     fig, axes = plt.subplots(len(args.columns), 1, sharex=True, squeeze=False,
@@ -69,8 +117,15 @@ def main():
         ax.grid(True, alpha=0.3)
     axes[-1, 0].set_xlabel(args.x)
     fig.tight_layout()
-    fig.savefig(args.output, dpi=120)
-    print(f"wrote {args.output} ({len(x)} rows)")
+    try:
+        fig.savefig(args.output, dpi=120)
+    except OSError as e:
+        fail(f"-o {args.output}: cannot write: {e.strerror or e}")
+    note = ""
+    if skipped:
+        note = (f"; skipped {len(skipped)} damaged row(s), line(s) "
+                + ", ".join(str(n) for n, _ in skipped))
+    print(f"wrote {args.output} ({len(x)} rows{note})")
     return 0
 
 

@@ -219,8 +219,9 @@ def main():
     for r in rows:
         diff = r["angle"] - reference if reference is not None else math.nan
         r["vs_k1"] = diff
+        vs = f"{diff:+.2f} deg" if reference is not None else "n/a (no k = 1 angle for this drum)"
         print(f"{r['k']:g} | {r['parcels']} | {r['angle']:.2f} deg | {r['spread']:.2f} | "
-              f"{diff:+.2f} deg | {r['trace']:.1f} deg | {r['steps']} | {r['cpu']:.1f}")
+              f"{vs} | {r['trace']:.1f} deg | {r['steps']} | {r['cpu']:.1f}")
         if r["k"] in allowed and r["k"] != 1:
             if reference is None:
                 failures.append("no k = 1 angle to compare with (run --ks 1 or set ANGLE_K1)")

@@ -2,11 +2,13 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <iostream>
 #include <string>
 #include <vector>
 
+#include "dem/core/fnv1a.hpp"
 #include "dem/engine/restored_state.hpp"
 #include "dem/engine/run.hpp"
 #include "dem/engine/simulation.hpp"
@@ -38,47 +40,75 @@ commands:
   --version           print the version
   --help              print this help
 
-exit codes: 0 success, 1 refused (time step) or run failure, 2 bad input or usage
+exit codes: 0 success; 1 refused (the time step; a checkpoint, also a missing one) or the
+            run failed; 2 bad input (the scene or a file it names) or usage
 docs: README.md (quick start, running a scene), docs/scene-reference.md (every scene key)
 )";
 
-int usage_error(const std::string& what) {
-  std::cerr << "grain: " << what << "\n\n" << kUsage;
-  return 2;
+// What parsing the command line and reading the scene came to on one rank.
+struct Start {
+  int code = 0;         // the exit code when `done`
+  bool done = false;    // nothing more to do: help, version, or an error
+  std::string message;  // what to print (standard output when code is 0, else standard error)
+  std::string cmd;      // "run" or "check" when not done
+  std::string scene_file;
+  grainflow::RunOptions options;
+  std::string scene_text;  // the scene file's bytes
+};
+
+Start finished(int code, std::string message) {
+  Start s;
+  s.code = code;
+  s.done = true;
+  s.message = std::move(message);
+  return s;
 }
 
-int dispatch(const std::string& program, const std::vector<std::string>& args, int rank) {
+Start usage_error(const std::string& what) {
+  return finished(2, "grain: " + what + "\n\n" + kUsage);
+}
+
+// The command line, on this rank alone.
+Start parse_command(const std::string& program, const std::vector<std::string>& args) {
   using namespace grainflow;
   if (args.empty()) return usage_error("no command given");
   const std::string& cmd = args[0];
-  if (cmd == "--help" || cmd == "-h" || cmd == "help") {
-    if (rank == 0) std::cout << kUsage;
-    return 0;
-  }
+  if (cmd == "--help" || cmd == "-h" || cmd == "help") return finished(0, kUsage);
   if (cmd == "--version") {
-    if (rank == 0) std::cout << "grain (grainflow) " << GRAINFLOW_VERSION << "\n";
-    return 0;
+    if (args.size() > 1)
+      return usage_error("'--version' takes nothing more, got '" + args[1] + "'");
+    return finished(0, std::string("grain (grainflow) ") + GRAINFLOW_VERSION + "\n");
   }
   if (cmd != "run" && cmd != "check")
-    return usage_error("unknown command '" + cmd + "'; allowed: run, check, --help, --version");
+    return usage_error("unknown command '" + cmd +
+                       "'; allowed: run, check, help (or --help), --version");
   // Options before or after the scene file, `--key value` or `--key=value`; each at most once.
-  RunOptions options;
-  options.program = program;
-  std::string scene_file;
+  // After `--` every word is the scene file (a file named `--x.yaml`).
+  Start s;
+  s.cmd = cmd;
+  s.options.program = program;
   std::vector<std::string> given;
+  bool options_end = false;
   for (std::size_t k = 1; k < args.size(); ++k) {
     const std::string& a = args[k];
-    if (a == "--help" || a == "-h") {  // `grain run --help`: the usage, as `grain --help`
-      if (rank == 0) std::cout << kUsage;
-      return 0;
-    }
-    if (!a.starts_with("--")) {
-      if (!scene_file.empty())
-        return usage_error("'" + cmd + "' takes one scene file, got '" + scene_file + "' and '" +
-                           a + "'");
-      scene_file = a;
+    if (!options_end && a == "--") {
+      options_end = true;
       continue;
     }
+    if (!options_end && (a == "--help" || a == "-h"))  // `grain run --help`: the usage
+      return finished(0, kUsage);
+    if (options_end || !a.starts_with("-") || a == "-") {
+      if (!s.scene_file.empty())
+        return usage_error("'" + cmd + "' takes one scene file, got '" + s.scene_file + "' and '" +
+                           a + "'");
+      s.scene_file = a;
+      continue;
+    }
+    if (!a.starts_with("--"))  // -o x: no short options but -h
+      return usage_error("unknown option '" + a + "' for '" + cmd +
+                         "'; options are long: --output, --restart, --no-progress, "
+                         "--allow-large-dt (a file whose name starts with '-': ./" +
+                         a + ")");
     const std::size_t eq = a.find('=');
     const std::string key = a.substr(0, eq);
     const bool takes_value = key == "--output" || key == "--restart";
@@ -107,14 +137,84 @@ int dispatch(const std::string& program, const std::vector<std::string>& args, i
       return usage_error("option '" + key + "': '~' in '" + value +
                          "' is not expanded (the shell expands it only at the start of a "
                          "word); write the full path");
-    if (key == "--output") options.output_directory = value;
-    if (key == "--restart") options.restart = value;
-    if (key == "--no-progress") options.progress = false;
-    if (key == "--allow-large-dt") options.allow_large_time_step = true;
+    if (key == "--output") s.options.output_directory = value;
+    if (key == "--restart") s.options.restart = value;
+    if (key == "--no-progress") s.options.progress = false;
+    if (key == "--allow-large-dt") s.options.allow_large_time_step = true;
   }
-  if (scene_file.empty()) return usage_error("'" + cmd + "' needs a scene file");
+  if (s.scene_file.empty()) return usage_error("'" + cmd + "' needs a scene file");
   try {
-    const Scene scene = load_scene(scene_file);
+    s.scene_text = read_scene_file(s.scene_file);
+  } catch (const SceneError& e) {
+    return finished(2, std::string(e.what()) + "\n");
+  }
+  return s;
+}
+
+// Every rank reads its own command line and scene file. Before anything collective the ranks
+// agree on what they got: a rank that failed (a scene only rank 0 can read, such as
+// /dev/stdin under mpirun, which feeds standard input to rank 0 alone; a file missing on one
+// node; an option given to one rank of a mixed launch) stops them all with its own message
+// and exit code, instead of leaving the others waiting for it. Returns the exit code when
+// the ranks stop here, or -1 when every rank goes on with the same command and scene.
+int agree_on_start(const Start& s, int rank, int size) {
+  const int failed = s.done && s.code != 0;
+  int first_failed = failed ? rank : size;
+  MPI_Allreduce(MPI_IN_PLACE, &first_failed, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  int code = s.code;
+  MPI_Allreduce(MPI_IN_PLACE, &code, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  if (first_failed < size) {
+    if (rank == first_failed) {
+      std::cerr << (rank == 0 ? ""
+                              : "grain (rank " + std::to_string(rank) + " of " +
+                                    std::to_string(size) + "): ")
+                << s.message;
+      if (rank != 0)
+        std::cerr << "grain: rank 0 got past this; under mpirun every rank reads the command "
+                     "line and the scene file itself: give them all the same arguments and a "
+                     "file each can read (not standard input, which mpirun gives to rank 0 "
+                     "only)\n";
+    }
+    return code;
+  }
+  int done[2] = {s.done ? 1 : 0, s.done ? 1 : 0};  // min, max
+  MPI_Allreduce(MPI_IN_PLACE, &done[0], 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, &done[1], 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  if (done[0] == 1) {  // help or version on every rank
+    if (rank == 0) std::cout << s.message;
+    return 0;
+  }
+  // The same command, options and scene bytes on every rank.
+  std::uint64_t mine = grainflow::fnv1a64(s.scene_text);
+  for (const std::string& part :
+       {s.cmd, s.scene_file, s.options.output_directory.value_or(""),
+        s.options.restart.value_or(""), std::string(s.options.progress ? "progress" : "quiet"),
+        std::string(s.options.allow_large_time_step ? "large" : "guarded")})
+    mine = grainflow::fnv1a64(part + '\0', mine);
+  std::uint64_t lo = done[1] == 1 ? 0 : mine, hi = mine;
+  MPI_Allreduce(MPI_IN_PLACE, &lo, 1, MPI_UINT64_T, MPI_MIN, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, &hi, 1, MPI_UINT64_T, MPI_MAX, MPI_COMM_WORLD);
+  if (lo != hi) {
+    if (rank == 0)
+      std::cerr << "grain: error: the ranks were given different command lines or read "
+                   "different scene files (rank 0: '"
+                << (s.done ? std::string("--help/--version") : s.cmd + " " + s.scene_file)
+                << "'); under mpirun every rank reads the command line and the scene file "
+                   "itself: give them all the same arguments and the same file (not "
+                   "standard input, /dev/stdin, which mpirun gives to rank 0 only)\n";
+    return 2;
+  }
+  return -1;
+}
+
+int dispatch(const std::string& program, const std::vector<std::string>& args, int rank, int size) {
+  using namespace grainflow;
+  Start start = parse_command(program, args);
+  if (const int code = agree_on_start(start, rank, size); code >= 0) return code;
+  const std::string& cmd = start.cmd;
+  const RunOptions& options = start.options;
+  try {
+    const Scene scene = parse_scene(start.scene_text, start.scene_file);
     if (cmd == "check") return check_scene(scene, std::cout, options.restart);
     run_scene(scene, options, MPI_COMM_WORLD, std::cout);
     return 0;
@@ -151,9 +251,11 @@ int dispatch(const std::string& program, const std::vector<std::string>& args, i
 int main(int argc, char** argv) {
   MPI_Init(&argc, &argv);
   int rank = 0;
+  int size = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
   const std::vector<std::string> args(argv + 1, argv + argc);
-  const int code = dispatch(argc > 0 ? argv[0] : "grain", args, rank);
+  const int code = dispatch(argc > 0 ? argv[0] : "grain", args, rank, size);
   MPI_Finalize();
   return code;
 }

@@ -7,12 +7,14 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <exception>
 #include <filesystem>
 #include <limits>
 #include <numbers>
 #include <optional>
 #include <ostream>
 #include <sstream>
+#include <vector>
 
 #include "dem/core/number_format.hpp"
 #include "dem/engine/checkpoint_series.hpp"
@@ -309,12 +311,16 @@ void refuse_inputs_the_run_overwrites(const Scene& scene, const std::string& dir
     std::error_code e;
     const fs::path in = fs::weakly_canonical(fs::absolute(file, e), e);
     if (e || in.parent_path() != out || !written_by_a_run(in.filename().string())) return;
+    const bool scene_file = file == scene.file;
     throw SetupError(where + ": error: the " + what + " '" + file + "' is in the output folder '" +
                      dir +
                      "' under a name the run writes there: the run would overwrite it. "
-                     "Move or copy it out of that folder (and point the scene at the copy), or "
-                     "write the output elsewhere (output.directory, or --output)");
+                     "Move or copy it out of that folder" +
+                     (scene_file ? std::string(" under another name")
+                                 : std::string(" (and point the scene at the copy)")) +
+                     ", or write the output elsewhere (output.directory, or --output)");
   };
+  check(scene.file, scene.file, "scene file");
   for (const Insertion& ins : scene.insertions) {
     check(ins.csv_file, ins.source, "CSV file");
     check(ins.snapshot_file, ins.source, "snapshot file");
@@ -322,6 +328,44 @@ void refuse_inputs_the_run_overwrites(const Scene& scene, const std::string& dir
   for (const Wall& w : scene.walls)
     if (w.kind == Wall::Kind::mesh) check(w.mesh.file, w.mesh.file_source, "STL file");
 }
+
+// The output folders a run makes for itself (the folder and any missing parents), removed
+// again, innermost first and only while empty, when the run stops with an error before it
+// writes anything there: an insertion that cannot place its particles, a refused time step
+// or checkpoint leave the file system as they found it (README, "a mistake in a scene stops
+// the program before any output is written"). Rank 0 removes them, after the output lock.
+class FoldersMadeForTheRun {
+ public:
+  FoldersMadeForTheRun(MPI_Comm comm, const std::string& dir)
+      : exceptions_(std::uncaught_exceptions()) {
+    namespace fs = std::filesystem;
+    int rank = 0;
+    MPI_Comm_rank(comm, &rank);
+    if (rank == 0) {
+      std::error_code ec;
+      fs::path p = fs::absolute(dir, ec).lexically_normal();
+      if (p.filename().empty()) p = p.parent_path();  // "out/"
+      while (!ec && !p.empty() && !fs::exists(p, ec) && !ec) {
+        made_.push_back(p);
+        if (p == p.parent_path()) break;
+        p = p.parent_path();
+      }
+    }
+    MPI_Barrier(comm);  // seen before any rank makes the folder
+  }
+  FoldersMadeForTheRun(const FoldersMadeForTheRun&) = delete;
+  FoldersMadeForTheRun& operator=(const FoldersMadeForTheRun&) = delete;
+  ~FoldersMadeForTheRun() {
+    if (std::uncaught_exceptions() <= exceptions_) return;
+    std::error_code ec;
+    for (const std::filesystem::path& p : made_)
+      if (!std::filesystem::remove(p, ec)) break;  // not empty, or gone: keep the rest
+  }
+
+ private:
+  int exceptions_;
+  std::vector<std::filesystem::path> made_;
+};
 
 // The particle files the insertions read, as absolute paths with their modification time
 // (UTC): a scene run from another folder reads the files beside the scene, which may be an
@@ -526,6 +570,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   // Before the output folder is made: a mistyped name changes nothing.
   if (options.restart) refuse_unusable_restart(*options.restart);
   refuse_inputs_the_run_overwrites(scene, dir);  // before the folder is made or touched
+  const FoldersMadeForTheRun made(comm, dir);    // removed if the start fails
   prepare_output_directory(dir);  // before any work: an unwritable directory fails now
   const OutputLock lock(comm, dir);  // one run per folder: a second is refused, naming this one
   std::ostream& say = speaker(comm, out);

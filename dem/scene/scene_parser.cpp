@@ -1612,7 +1612,7 @@ Scene parse_scene(const std::string& yaml_text, const std::string& file_label) {
   return build_scene(root);
 }
 
-Scene load_scene(const std::string& path) {
+std::string read_scene_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (std::error_code ec; fs::is_directory(path, ec))
     throw SceneError(path, 0, 0, "is a directory, not a scene file; name the .yaml file in it");
@@ -1624,7 +1624,9 @@ Scene load_scene(const std::string& path) {
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw SceneError(path, 0, 0, "cannot read the scene file; check its permissions");
-  return parse_scene(text.str(), path);
+  return text.str();
 }
+
+Scene load_scene(const std::string& path) { return parse_scene(read_scene_file(path), path); }
 
 }  // namespace grainflow

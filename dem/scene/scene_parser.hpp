@@ -15,6 +15,10 @@ namespace grainflow {
 // resolved against the scene file's folder. Scene::file is `path` as given.
 Scene load_scene(const std::string& path);
 
+// The bytes of the scene file at `path` (load_scene's first half): a SceneError with line 0
+// when it is missing, a directory or unreadable.
+std::string read_scene_file(const std::string& path);
+
 // Validates scene text. `file_label` names the text in messages and in
 // Insertion::source, becomes Scene::file, and its folder is where relative file names
 // inside the scene are looked up (tests pass a path inside tests/data/scenes/).

@@ -201,6 +201,14 @@ if(GRAINFLOW_PYTHON3)
                    ${MPIEXEC_EXECUTABLE})
   set_tests_properties(grain.disk_full PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}"
                        TIMEOUT 300 PROCESSORS 2 SKIP_RETURN_CODE 77)
+  # Ranks that got different command lines or scene files (standard input, a file missing on
+  # one node, an option on one rank) all stop with one message and exit 2, none waiting
+  # (rank_agreement.sh; about 20 s).
+  add_test(NAME grain.rank_agreement
+           COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/rank_agreement.sh ${_grain}
+                   ${_scenes}/minimal.yaml ${_work}/rank_agreement ${MPIEXEC_EXECUTABLE})
+  set_tests_properties(grain.rank_agreement PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}"
+                       TIMEOUT 600 PROCESSORS 2 LABELS mpi)
   # The "continue with:" line after SIGTERM, run as printed, continues in the --output folder
   # with the snapshot numbering going on (1 and 2 ranks).
   add_test(NAME grain.continue_command

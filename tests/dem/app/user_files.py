@@ -9,6 +9,10 @@ code, its message and what is on disk afterwards:
     naming the file and the output folder, the CSV unchanged (its bytes);
   * overwrite_snapshot: a snapshot insertion out/particles_000001.h5 with the output in out/:
     refused, unchanged; with --output elsewhere the same scene runs;
+  * overwrite_scene: the scene file itself saved as out/log.csv with the output in out/:
+    refused (exit 1) by run and check, unchanged;
+  * failed_start_writes_nothing: a fill that cannot place its particles (into a/b/out) and a
+    refused time step leave no output folder behind; a folder that was there is kept, empty;
   * second_document: keys after a '---' line: refused (exit 2) at that line, not dropped;
   * tilde: '~' in output.directory and in --output=~/x: refused (exit 2), no folder '~' made;
   * input_named: `grain check` and `grain run` name each particle file they read with its
@@ -131,6 +135,46 @@ def overwrite_snapshot():
     if digest(os.path.join(d, "out", "particles_000001.h5")) != before:
         fail(case, "the snapshot was changed")
     expect(case, grain(d, "run", "scene.yaml", "--output", "stage2"), 0, r"done:")
+
+
+def overwrite_scene():
+    """The scene file itself under a name the run writes, in its output folder."""
+    case = "overwrite_scene"
+    d = fresh(case)
+    os.makedirs(os.path.join(d, "out"))
+    scene(d, name=os.path.join("out", "log.csv"))
+    before = digest(os.path.join(d, "out", "log.csv"))
+    for command in (["run", "out/log.csv"], ["check", "out/log.csv"]):
+        expect(case, grain(d, *command), 1,
+               r"out/log\.csv: error: the scene file 'out/log\.csv' is in the output folder "
+               r"'out' under a name the run writes there: the run would overwrite it\. Move or "
+               r"copy it out of that folder under another name")
+    if digest(os.path.join(d, "out", "log.csv")) != before:
+        fail(case, "the scene file was changed")
+    if sorted(os.listdir(os.path.join(d, "out"))) != ["log.csv"]:
+        fail(case, f"out/ holds {sorted(os.listdir(os.path.join(d, 'out')))}")
+
+
+def failed_start_writes_nothing():
+    """A start that fails (a fill that cannot place its particles, a refused time step)
+    leaves no output folder behind, nested ones included; a folder that was there is kept."""
+    case = "failed_start_writes_nothing"
+    d = fresh(case)
+    crowded = FILL.replace("count: 50", "count: 2500")
+    scene(d, insert=crowded, directory="a/b/out")
+    expect(case, grain(d, "run", "scene.yaml"), 2, r"error: could place only \d+ particles")
+    if os.path.exists(os.path.join(d, "a")):
+        fail(case, "the failed fill left the folder a/ (or a/b/out) behind")
+    text = scene(d).replace("rayleigh_fraction: 0.2", "step: 1e-3")
+    with open(os.path.join(d, "scene.yaml"), "w") as out:
+        out.write(text)
+    expect(case, grain(d, "run", "scene.yaml"), 1, r"refusing to run with this time step")
+    if os.path.exists(os.path.join(d, "out")):
+        fail(case, "the refused time step left out/ behind")
+    os.makedirs(os.path.join(d, "out"))
+    expect(case, grain(d, "run", "scene.yaml"), 1, r"refusing to run with this time step")
+    if not os.path.isdir(os.path.join(d, "out")) or os.listdir(os.path.join(d, "out")):
+        fail(case, "the folder that was there before was removed or written to")
 
 
 def second_document():
@@ -485,7 +529,8 @@ def restart_advice():
 if __name__ == "__main__":
     GRAIN, WORK = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
     os.makedirs(WORK, exist_ok=True)
-    for check in (overwrite_csv, overwrite_snapshot, second_document, tilde, input_named,
+    for check in (overwrite_csv, overwrite_snapshot, overwrite_scene, failed_start_writes_nothing,
+                  second_document, tilde, input_named,
                   help_option, restart_at_end, check_restart, restart_missing_csv, restart_mesh,
                   restart_other_physics, restart_smaller_skin, hostile_text,
                   restart_advice):

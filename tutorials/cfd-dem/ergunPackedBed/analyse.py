@@ -16,7 +16,9 @@ Usage: analyse.py [--short]
 """
 import glob
 import math
+import os
 import sys
+import xml.etree.ElementTree as ET
 
 import h5py
 import matplotlib
@@ -24,6 +26,22 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
+
+
+def run_snapshots(folder):
+    """The snapshot files of the run that wrote `folder`, in time order, from the run's own
+    index particles.xdmf: snapshots an earlier run left in the folder are not listed there."""
+    index = os.path.join(folder, "particles.xdmf")
+    try:
+        steps = ET.parse(index).getroot().find("Domain/Grid")
+    except (OSError, ET.ParseError) as e:
+        sys.exit(f"analyse.py: cannot read {index}, the run's list of its snapshots: {e}")
+    files = [] if steps is None else \
+        [os.path.join(folder, g.get("Name", "") + ".h5") for g in steps.findall("Grid")]
+    if not files:
+        sys.exit(f"analyse.py: {index} lists no snapshot")
+    return files
+
 
 SHORT = "--short" in sys.argv
 rho_p, rho_f, mu, g = 2500.0, 1.2, 1.8e-5, 9.81
@@ -36,7 +54,7 @@ else:
                                (0.70, 0.6, 0.8)]
 
 # --- the bed just before the gas is turned on ------------------------------------------
-snaps = sorted(glob.glob("particles/particles_*.h5"))
+snaps = run_snapshots("particles")
 times = [h5py.File(f, "r").attrs["time"] for f in snaps]
 k = int(np.argmin([abs(t - flow_start) for t in times]))
 with h5py.File(snaps[k], "r") as f:

@@ -33,10 +33,10 @@ Exit status 1 if either fails. Plots: heatedBed.png (temperatures), heatedBed_pa
 with --short.
 """
 import argparse
-import glob
 import os
 import re
 import sys
+import xml.etree.ElementTree as ET
 
 import h5py
 import matplotlib
@@ -48,6 +48,22 @@ import yaml
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from foam_case import foam_entry, series  # noqa: E402 (tutorials/cfd-dem/foam_case.py)
+
+
+def run_snapshots(folder):
+    """The snapshot files of the run that wrote `folder`, in time order, from the run's own
+    index particles.xdmf: snapshots an earlier run left in the folder are not listed there."""
+    index = os.path.join(folder, "particles.xdmf")
+    try:
+        steps = ET.parse(index).getroot().find("Domain/Grid")
+    except (OSError, ET.ParseError) as e:
+        sys.exit(f"analyse.py: cannot read {index}, the run's list of its snapshots: {e}")
+    files = [] if steps is None else \
+        [os.path.join(folder, g.get("Name", "") + ".h5") for g in steps.findall("Grid")]
+    if not files:
+        sys.exit(f"analyse.py: {index} lists no snapshot")
+    return files
+
 
 ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 ap.add_argument("case", nargs="?", default=os.path.dirname(os.path.abspath(__file__)))
@@ -120,9 +136,7 @@ ok_est = below <= args.tolerance and above <= args.tolerance
 heating = upper_at - estimate_at > 0.02 * span
 where = (beads - estimate_at)[heating] / (upper_at - estimate_at)[heating]
 ok_cons = worst_cons < 0.01
-snaps = sorted(glob.glob(f"{case}/particles/particles_*.h5"))
-if not snaps:
-    sys.exit(f"analyse.py: no particle snapshots in {case}/particles")
+snaps = run_snapshots(f"{case}/particles")
 with h5py.File(snaps[-1], "r") as f:
     n_beads, bead_mass = len(f["id"]), float(np.sum(f["mass"][:]))
     # Coarse-grained parcels (an insertion's coarse_grain): each stands for real_count beads.

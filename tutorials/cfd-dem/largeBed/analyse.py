@@ -31,11 +31,11 @@ height over time), largeBed_fluidisation.png (dp against U_s), largeBed_particle
 largeBed_short*.png.
 """
 import argparse
-import glob
 import math
 import os
 import re
 import sys
+import xml.etree.ElementTree as ET
 
 import h5py
 import matplotlib
@@ -47,6 +47,22 @@ import yaml
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from foam_case import foam_entry, series  # noqa: E402 (tutorials/cfd-dem/foam_case.py)
+
+
+def run_snapshots(folder):
+    """The snapshot files of the run that wrote `folder`, in time order, from the run's own
+    index particles.xdmf: snapshots an earlier run left in the folder are not listed there."""
+    index = os.path.join(folder, "particles.xdmf")
+    try:
+        steps = ET.parse(index).getroot().find("Domain/Grid")
+    except (OSError, ET.ParseError) as e:
+        sys.exit(f"analyse.py: cannot read {index}, the run's list of its snapshots: {e}")
+    files = [] if steps is None else \
+        [os.path.join(folder, g.get("Name", "") + ".h5") for g in steps.findall("Grid")]
+    if not files:
+        sys.exit(f"analyse.py: {index} lists no snapshot")
+    return files
+
 
 ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 ap.add_argument("case", nargs="?", default=os.path.dirname(os.path.abspath(__file__)))
@@ -82,10 +98,7 @@ n = min(len(t_in), len(t_out), len(t_q))
 t, dp = t_in[:n], rho_f * (p_in[:n] - p_out[:n])  # [Pa]
 u_s = -q_in[:n] / area  # superficial inflow [m/s]; phi < 0 enters the domain
 
-snaps = sorted(glob.glob(f"{case}/particles/particles_*.h5"),
-               key=lambda s: int(re.findall(r"(\d+)\.h5$", s)[0]))
-if not snaps:
-    sys.exit(f"analyse.py: no particle snapshots in {case}/particles")
+snaps = run_snapshots(f"{case}/particles")
 heights, snap_t = [], []
 for s in snaps:
     with h5py.File(s, "r") as f:

@@ -7,8 +7,9 @@ Clift, Grace & Weber 1978), solved here by bisection. The simulated velocity is 
 after the particle has reached it (t > 10 response times). Exit status 1 when the mean
 differs from u_t by more than 3 %.
 """
-import glob
+import os
 import sys
+import xml.etree.ElementTree as ET
 
 import h5py
 import matplotlib
@@ -16,6 +17,22 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
+
+
+def run_snapshots(folder):
+    """The snapshot files of the run that wrote `folder`, in time order, from the run's own
+    index particles.xdmf: snapshots an earlier run left in the folder are not listed there."""
+    index = os.path.join(folder, "particles.xdmf")
+    try:
+        steps = ET.parse(index).getroot().find("Domain/Grid")
+    except (OSError, ET.ParseError) as e:
+        sys.exit(f"analyse.py: cannot read {index}, the run's list of its snapshots: {e}")
+    files = [] if steps is None else \
+        [os.path.join(folder, g.get("Name", "") + ".h5") for g in steps.findall("Grid")]
+    if not files:
+        sys.exit(f"analyse.py: {index} lists no snapshot")
+    return files
+
 
 d, rho_p, rho_f, mu, g = 2e-4, 2500.0, 1000.0, 1e-3, 9.81
 
@@ -33,7 +50,7 @@ for _ in range(200):
 u_t = 0.5 * (lo + hi)
 
 t, w = [], []
-for f in sorted(glob.glob("particles/particles_*.h5")):
+for f in run_snapshots("particles"):
     with h5py.File(f, "r") as h:
         t.append(h.attrs["time"])
         w.append(-h["velocity"][0][2])

@@ -12,9 +12,10 @@ Tanaka (1956) give the factor F = (tan(theta) tan(phi_d))^-0.35 (theta the hoppe
 half-angle from the vertical, phi_d ~ 45 deg the angle of the stagnant-zone
 boundary; Nedderman §10.3), 1.17 for this hopper's 32 deg half-angle -- drawn as a line.
 """
-import glob
 import math
+import os
 import sys
+import xml.etree.ElementTree as ET
 
 import h5py
 import matplotlib
@@ -23,8 +24,24 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+
+def run_snapshots(folder):
+    """The snapshot files of the run that wrote `folder`, in time order, from the run's own
+    index particles.xdmf: snapshots an earlier run left in the folder are not listed there."""
+    index = os.path.join(folder, "particles.xdmf")
+    try:
+        steps = ET.parse(index).getroot().find("Domain/Grid")
+    except (OSError, ET.ParseError) as e:
+        sys.exit(f"analyse.py: cannot read {index}, the run's list of its snapshots: {e}")
+    files = [] if steps is None else \
+        [os.path.join(folder, g.get("Name", "") + ".h5") for g in steps.findall("Grid")]
+    if not files:
+        sys.exit(f"analyse.py: {index} lists no snapshot")
+    return files
+
+
 out = sys.argv[1] if len(sys.argv) > 1 else "output/discharge"
-files = sorted(glob.glob(f"{out}/particles_*.h5"))
+files = run_snapshots(out)
 t, mass = [], []
 for name in files:
     with h5py.File(name, "r") as f:
@@ -49,6 +66,9 @@ F = (math.tan(theta) * math.tan(math.radians(45))) ** -0.35
 
 # Steady discharge: fit the hopper mass between 0.2 s (flow established) and 1.0 s.
 window = (t >= 0.2) & (t <= 1.0)
+if window.sum() < 2:
+    sys.exit(f"analyse.py: {out} holds {window.sum()} snapshot(s) between 0.2 and 1.0 s "
+             f"(the run ends at {t[-1]:.3g} s): the fit needs the full discharge (time.end 1.2)")
 slope, intercept = np.polyfit(t[window], mass[window], 1)
 w_measured = -slope
 rate_t = 0.5 * (t[1:] + t[:-1])

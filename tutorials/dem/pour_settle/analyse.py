@@ -8,9 +8,10 @@ packing range of frictional, monodisperse-like spheres: random loose packing
 (Scott & Kilgour 1969). With friction 0.5 a poured bed sits near the loose end.
 """
 import csv
-import glob
 import math
+import os
 import sys
+import xml.etree.ElementTree as ET
 
 import h5py
 import matplotlib
@@ -19,12 +20,28 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+
+def run_snapshots(folder):
+    """The snapshot files of the run that wrote `folder`, in time order, from the run's own
+    index particles.xdmf: snapshots an earlier run left in the folder are not listed there."""
+    index = os.path.join(folder, "particles.xdmf")
+    try:
+        steps = ET.parse(index).getroot().find("Domain/Grid")
+    except (OSError, ET.ParseError) as e:
+        sys.exit(f"analyse.py: cannot read {index}, the run's list of its snapshots: {e}")
+    files = [] if steps is None else \
+        [os.path.join(folder, g.get("Name", "") + ".h5") for g in steps.findall("Grid")]
+    if not files:
+        sys.exit(f"analyse.py: {index} lists no snapshot")
+    return files
+
+
 out = sys.argv[1] if len(sys.argv) > 1 else "output"
 rows = list(csv.DictReader(open(f"{out}/log.csv")))
 t = np.array([float(r["time_s"]) for r in rows])
 ke = np.array([float(r["ke_trans_J"]) + float(r["ke_rot_J"]) for r in rows])
 
-last = sorted(glob.glob(f"{out}/particles_*.h5"))[-1]
+last = run_snapshots(out)[-1]
 with h5py.File(last, "r") as f:
     x = f["position"][:]
     r = f["radius"][:]

@@ -8,9 +8,10 @@ gives the surface angle. For glass beads with friction 0.4 and rolling friction
 degrees (e.g. Yang, Zou & Yu 2003, Powder Technol. 130:138; Mellmann 2001), the band
 shown on the plot.
 """
-import glob
 import math
+import os
 import sys
+import xml.etree.ElementTree as ET
 
 import h5py
 import matplotlib
@@ -19,10 +20,26 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+
+def run_snapshots(folder):
+    """The snapshot files of the run that wrote `folder`, in time order, from the run's own
+    index particles.xdmf: snapshots an earlier run left in the folder are not listed there."""
+    index = os.path.join(folder, "particles.xdmf")
+    try:
+        steps = ET.parse(index).getroot().find("Domain/Grid")
+    except (OSError, ET.ParseError) as e:
+        sys.exit(f"analyse.py: cannot read {index}, the run's list of its snapshots: {e}")
+    files = [] if steps is None else \
+        [os.path.join(folder, g.get("Name", "") + ".h5") for g in steps.findall("Grid")]
+    if not files:
+        sys.exit(f"analyse.py: {index} lists no snapshot")
+    return files
+
+
 out = sys.argv[1] if len(sys.argv) > 1 else "output"
 R = 0.05
 times, angles = [], []
-for path in sorted(glob.glob(f"{out}/particles_*.h5")):
+for path in run_snapshots(out):
     with h5py.File(path, "r") as f:
         t = float(f.attrs["time"])
         x = f["position"][:]

@@ -1,0 +1,53 @@
+#!/bin/bash
+# Under mpirun every rank reads its own command line and scene file. A rank that cannot (a
+# scene on standard input, which mpirun gives to rank 0 only; a file missing on one node; an
+# option given to one rank of a mixed launch) must stop every rank with a message and exit
+# code 2, not leave the others waiting for it.
+#   rank_agreement.sh GRAIN SCENE WORKDIR MPIEXEC
+set -u
+grain=$1 scene=$2 work=$3 mpiexec=$4
+rm -rf "$work" && mkdir -p "$work" && cd "$work" || exit 1
+failures=0
+# expect NAME CODE REGEX -- COMMAND...: the command ends within 60 s with CODE, its output
+# matching REGEX (grep -E), and writes no output folder.
+expect() {
+  local name=$1 code=$2 regex=$3
+  shift 4
+  timeout 60 "$@" > "$name.txt" 2>&1
+  local rc=$?
+  if [ $rc -eq 124 ]; then
+    echo "FAIL $name: still running after 60 s (a rank waits for the others)"; failures=$((failures + 1))
+  elif [ $rc -ne "$code" ] || ! grep -Eq "$regex" "$name.txt"; then
+    echo "FAIL $name: exit $rc (expected $code), output:"; cat "$name.txt"; failures=$((failures + 1))
+  elif [ -e out ]; then
+    echo "FAIL $name: wrote the output folder"; failures=$((failures + 1)); rm -rf out
+  else
+    echo "ok $name: exit $rc, $(grep -E -m1 "$regex" "$name.txt" | cut -c1-150)"
+  fi
+}
+two=("$mpiexec" -np 2 --oversubscribe)
+one=("$mpiexec" -np 1 --oversubscribe)
+expect stdin 2 "the ranks were given different command lines or read different scene files .*standard input" -- \
+  bash -c "cat '$scene' | ${two[*]} '$grain' run /dev/stdin --output out --no-progress"
+expect option_on_one_rank 2 "^grain \(rank 1 of 2\): grain: unknown option '--bogus' for 'run'" -- \
+  "${one[@]}" "$grain" run "$scene" --output out --no-progress : \
+  -np 1 "$grain" run "$scene" --output out --no-progress --bogus
+expect scene_missing_on_one_rank 2 "^grain \(rank 1 of 2\): nosuch\.yaml: error: cannot open the scene file" -- \
+  "${one[@]}" "$grain" run "$scene" --output out --no-progress : \
+  -np 1 "$grain" run nosuch.yaml --output out --no-progress
+expect other_options_on_one_rank 2 "the ranks were given different command lines" -- \
+  "${one[@]}" "$grain" run "$scene" --output out --no-progress : -np 1 "$grain" run "$scene" --output out
+expect help_on_one_rank 2 "the ranks were given different command lines" -- \
+  "${one[@]}" "$grain" --help : -np 1 "$grain" check "$scene"
+# Agreeing ranks still run, and --version and usage errors print once.
+expect version_once 0 "^grain \(grainflow\)" -- "${two[@]}" "$grain" --version
+[ "$(grep -c "grain (grainflow)" version_once.txt)" = 1 ] ||
+  { echo "FAIL version_once: printed $(grep -c "grain (grainflow)" version_once.txt) times"; failures=$((failures + 1)); }
+expect usage_once 2 "unknown option '--bogus'" -- "${two[@]}" "$grain" run "$scene" --bogus
+[ "$(grep -c "^usage: grain" usage_once.txt)" = 1 ] ||
+  { echo "FAIL usage_once: the usage printed $(grep -c "^usage: grain" usage_once.txt) times"; failures=$((failures + 1)); }
+timeout 120 "${two[@]}" "$grain" run "$scene" --output ran --no-progress > ran.txt 2>&1 &&
+  grep -q "^done:" ran.txt && echo "ok agreeing ranks run" ||
+  { echo "FAIL agreeing ranks: "; cat ran.txt; failures=$((failures + 1)); }
+[ $failures -eq 0 ] || { echo "$failures failure(s)"; exit 1; }
+echo "every disagreement stops all ranks with a message"
