@@ -812,12 +812,18 @@ std::string DemLink::time_step_refusal(double fluid_dt) const {
   std::ostringstream o;
   o.precision(4);
   o << impl_->scene.file << ": error: refusing to run with this DEM time step (see the lines "
-    << "above); " << refusal_remedy(rep);
-  // time.step must divide the fluid step: the largest such step the limits allow.
+    << "above); ";
+  // time.step must divide the fluid step: the largest such step the limits allow. (Not
+  // time.rayleigh_fraction, as grain's advice offers: the step it gives divides deltaT only
+  // by chance, and grainFoam refuses one that does not.)
   if (std::isfinite(rep.refusal_step) && rep.refusal_step > 0 && fluid_dt > 0) {
     const double n = std::ceil(fluid_dt / rep.refusal_step * (1 - 1e-12));
-    o << "; for this fluid step (deltaT " << fluid_dt << " s) time.step " << fluid_dt / n
-      << " s (deltaT / " << n << ")";
+    o << "use a time.step <= " << rep.refusal_step
+      << " s, the smallest step proposed above, which every limit above allows, that divides "
+         "the fluid step (deltaT "
+      << fluid_dt << " s): time.step " << fluid_dt / n << " s (deltaT / " << n << ")";
+  } else {
+    o << "lower time.step (to a whole fraction of deltaT " << fluid_dt << " s)";
   }
   o << "; or set `allowLargeTimeStep yes;` in constant/couplingProperties to start anyway (the "
        "run-time guards still stop it at the first contact this step does not resolve, keys "

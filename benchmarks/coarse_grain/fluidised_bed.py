@@ -215,7 +215,7 @@ def analyse(case, t_from):
     n = min(len(t), len(p_out))
     t, dp = t[:n], RHO_F * (p_in[:n] - p_out[:n])
     window = t >= t_from - 1e-9
-    centres, reals, settled = [], [], None
+    centres, reals, settled, last = [], [], None, None
     for s in sorted(glob.glob(os.path.join(case, "particles", "particles_*.h5"))):
         with h5py.File(s, "r") as f:
             ts = float(f.attrs["time"])
@@ -228,6 +228,9 @@ def analyse(case, t_from):
                 settled = (real_height(z, r, m), float(np.sum(4 / 3 * math.pi * r**3) / AREA
                                                         / (2 * np.dot(m, z) / m.sum())))
             last = s
+    if last is None:
+        sys.exit(f"fluidised_bed.py: {case}/particles holds no snapshot (particles_*.h5): the run "
+                 f"ended before its first write time; run it longer (--end)")
     with h5py.File(last, "r") as f:
         d, m = f["diameter"][:], f["mass"][:]
         real = f["real_count"][:].sum() if "real_count" in f else len(d)

@@ -94,7 +94,7 @@ def main():
     parser.add_argument("--end", type=float, default=parcel_bed.END)
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--work", default="/tmp/packed_bed_bench")
-    parser.add_argument("--build", default=os.path.join(ROOT, "build"))
+    parser.add_argument("--build", default=os.environ.get("GRAINFLOW_BUILD_DIR", os.path.join(ROOT, "build")))
     parser.add_argument("--analyse-only", action="store_true")
     args = parser.parse_args()
     ks = [int(k) for k in parse_list(args.ks)]

@@ -249,8 +249,8 @@ std::vector<std::pair<std::string, std::string>> model_entries(const std::string
 }
 }  // namespace
 
-void check_model(const std::string& written, const Scene& scene,
-                 const std::string& checkpoint_file) {
+void check_model(const std::string& written, const Scene& scene, const std::string& checkpoint_file,
+                 std::string_view only) {
   if (written == scene.model_record) return;
   auto was = model_entries(written), is = model_entries(scene.model_record);
   // A checkpoint from before mesh walls were recorded by content (walls[k].file = <name>):
@@ -269,7 +269,9 @@ void check_model(const std::string& written, const Scene& scene,
     return nullptr;
   };
   std::string where = scene.file, path, here, there;
+  const auto skipped = [only](const std::string& p) { return !p.starts_with(only); };
   for (std::size_t k = 0; k < is.size() && path.empty(); ++k) {
+    if (skipped(is[k].first)) continue;
     const std::string* w = value_in(was, is[k].first);
     if (w && *w == is[k].second) continue;
     path = is[k].first;
@@ -278,7 +280,7 @@ void check_model(const std::string& written, const Scene& scene,
     if (k < scene.model_sources.size()) where = scene.model_sources[k];
   }
   for (std::size_t k = 0; k < was.size() && path.empty(); ++k)
-    if (!value_in(is, was[k].first)) {
+    if (!skipped(was[k].first) && !value_in(is, was[k].first)) {
       path = was[k].first;
       here = "not given (its default)";
       there = was[k].second;

@@ -10,6 +10,7 @@
 // names the first insertion and key that differ.
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 #include "dem/scene/scene.hpp"
 
@@ -39,8 +40,9 @@ void check_insertions(const std::string& written, const Scene& scene,
 // the message names the first key that differs (its file:line here), both values, and what to
 // do. A restart continues its run with the run's model: a changed heat capacity made the
 // particles' thermal energy jump by 37 % at the restart, a changed stiffness or friction would
-// have gone on as another run under the same name.
-void check_model(const std::string& written, const Scene& scene,
-                 const std::string& checkpoint_file);
+// have gone on as another run under the same name. With `only` ("domain."), only the keys
+// that start with it are compared.
+void check_model(const std::string& written, const Scene& scene, const std::string& checkpoint_file,
+                 std::string_view only = {});
 
 }  // namespace grainflow

@@ -302,6 +302,26 @@ void check_checkpoint(const CheckpointData& d, const Scene& scene, std::size_t w
 }
 
 void check_restart_step(const Scene& scene, const CheckpointData& d) {
+  // A step set by time.rayleigh_fraction is the checkpoint's too (the particles present may
+  // give another one): the run's own fraction continues it; another one, or a fraction where
+  // the run gave time.step, would be kept silently, so it is refused.
+  if (scene.time.rayleigh_fraction && d.rayleigh_fraction &&
+      *scene.time.rayleigh_fraction != *d.rayleigh_fraction) {
+    const std::string run = *d.rayleigh_fraction > 0
+                                ? "time.rayleigh_fraction = " + number(*d.rayleigh_fraction)
+                                : "time.step = " + number(d.dt) + " s";
+    throw SetupError(
+        scene.time.step_source + ": error: time.rayleigh_fraction = " +
+        number(*scene.time.rayleigh_fraction) + ", but checkpoint '" + d.file +
+        "' was written by a run with " + run + " (a step of " + number(d.dt) +
+        " s), which a restart keeps (the snapshot, log and checkpoint series count its steps): "
+        "set " +
+        (*d.rayleigh_fraction > 0 ? "time.rayleigh_fraction to " + number(*d.rayleigh_fraction)
+                                  : "time.step to " + number(d.dt)) +
+        " to restart; for another step from this state on, start a new run from its last "
+        "snapshot (insert `type: snapshot`, docs/scene-reference.md; contact springs start "
+        "afresh)");
+  }
   if (!scene.time.step || *scene.time.step == d.dt) return;
   throw SetupError(scene.time.step_source + ": error: time.step = " + number(*scene.time.step) +
                    " s, but checkpoint '" + d.file + "' was written with a step of " +

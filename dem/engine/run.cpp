@@ -452,7 +452,7 @@ void refuse_unusable_restart(const std::string& path) {
                       "': a .part file is a checkpoint that was being written when its run "
                       "was killed, possibly incomplete; restart from a complete "
                       "checkpoint_<step>.h5");
-  if (std::filesystem::path(path).filename().string().starts_with("particles_"))
+  if (is_particle_snapshot(path))  // by its contents: a snapshot renamed is still one
     throw OutputError("cannot restart from '" + path +
                       "': it is a snapshot, not a checkpoint (nothing was created or changed); a "
                       "restart needs a checkpoint_<step>.h5 (output.checkpoint_interval), and a "
@@ -656,9 +656,9 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     if (folder.empty()) folder = ".";
     if (kept == 0 && here != there)
       say << "note: the checkpoint is in " << folder << ", this restart writes into " << dir
-          << ", which holds none of its run's snapshots: the series here starts at t = "
-          << sim.time() << " s with particles_000000.h5 (to continue the run's own series, "
-          << "restart with --output " << folder << ")\n";
+          << ", which holds none of its run's snapshots: the snapshots this restart writes "
+          << "after t = " << sim.time() << " s start the series here at particles_000000.h5 "
+          << "(to continue the run's own series, restart with --output " << folder << ")\n";
     for (const std::string& gap : snapshots.missing())
       say << "note: " << dir << "/" << gap
           << " is a gap in the snapshot series (deleted or damaged since it was written): "

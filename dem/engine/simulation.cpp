@@ -824,6 +824,8 @@ void Simulation::restore(const CheckpointData& checkpoint) {
   // Before anything else uses the state (a material index indexes tables, a position bins).
   std::vector<long> delivered;
   for (std::size_t k = 0; k < streams_.size(); ++k) delivered.push_back(streams_.count_inserted(k));
+  // A changed domain first: the decomposition's rule below would take it for damage.
+  if (checkpoint.model) check_model(*checkpoint.model, scene_, checkpoint.file, "domain.");
   check_checkpoint(checkpoint, scene_, walls_.history_columns(), streams_.max_radius(), delivered);
 
   if (heat_ && !checkpoint.has_temperature)
@@ -908,6 +910,7 @@ void Simulation::write_checkpoint(const std::string& path) {
     d.largest_radius = largest_radius_;
     d.skin = skin_;
   }
+  d.rayleigh_fraction = scene_.time.rayleigh_fraction.value_or(0.0);
   d.removed = counters_.removed;
   MPI_Allreduce(MPI_IN_PLACE, &d.removed, 1, MPI_LONG, MPI_SUM, comm_);
   d.next_id = next_id_;

@@ -236,6 +236,10 @@ std::string write_file(const std::string& path, const CheckpointData& d) {
   if (fail.ok() && d.skin)
     fail.check(write_attribute(fail, f.id(), "skin", H5T_NATIVE_DOUBLE, *d.skin),
                "writing the attribute skin");
+  if (fail.ok() && d.rayleigh_fraction)
+    fail.check(
+        write_attribute(fail, f.id(), "rayleigh_fraction", H5T_NATIVE_DOUBLE, *d.rayleigh_fraction),
+        "writing the attribute rayleigh_fraction");
   if (fail.ok()) {
     const std::uint32_t sum = attributes_checksum(d);
     fail.check(write_attribute(fail, f.id(), "attributes_checksum", H5T_NATIVE_UINT32, sum),
@@ -401,6 +405,7 @@ void write_checkpoint(MPI_Comm comm, const std::string& path, const CheckpointDa
     d.rebuilds = local.rebuilds;
     d.largest_radius = local.largest_radius;
     d.skin = local.skin;
+    d.rayleigh_fraction = local.rayleigh_fraction;
     d.removed = local.removed;
     d.streams = local.streams;
     d.insertions = local.insertions;
@@ -463,6 +468,15 @@ std::optional<std::string> read_checkpoint_text(const std::string& path, const c
 
 }  // namespace
 
+bool is_particle_snapshot(const std::string& path) {
+  const QuietHdf5Errors quiet;
+  const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (f < 0) return false;
+  const bool snapshot = H5Aexists(f, "format") <= 0 && H5Lexists(f, "position", H5P_DEFAULT) > 0;
+  H5Fclose(f);
+  return snapshot;
+}
+
 std::optional<std::string> read_checkpoint_insertions(const std::string& path) {
   return read_checkpoint_text(path, "streams", "/streams/insertions");
 }
@@ -492,6 +506,7 @@ std::uint32_t attributes_checksum(const CheckpointData& d) {
     put(static_cast<std::int64_t>(d.removed));
   }
   if (d.skin) put(*d.skin);
+  if (d.rayleigh_fraction) put(*d.rayleigh_fraction);
   return fletcher32(bytes.data(), bytes.size());
 }
 
@@ -513,6 +528,11 @@ CheckpointData read_checkpoint(const std::string& path) {
       if (a >= 0) H5Aclose(a);
     };
     long long step = 0, next = 1;
+    if (H5Aexists(f, "format") <= 0 && H5Lexists(f, "position", H5P_DEFAULT) > 0)
+      error =
+          "it is a particle snapshot, not a checkpoint; a restart needs a "
+          "checkpoint_<step>.h5 (output.checkpoint_interval), and a new run starts from a "
+          "snapshot with the insertion `type: snapshot`";
     attr("time", H5T_NATIVE_DOUBLE, &d.time);
     attr("dt", H5T_NATIVE_DOUBLE, &d.dt);
     attr("step", H5T_NATIVE_LLONG, &step);
@@ -542,6 +562,11 @@ CheckpointData read_checkpoint(const std::string& path) {
       double skin = 0;
       attr("skin", H5T_NATIVE_DOUBLE, &skin);
       d.skin = skin;
+    }
+    if (error.empty() && H5Aexists(f, "rayleigh_fraction") > 0) {  // optional, as skin
+      double fraction = 0;
+      attr("rayleigh_fraction", H5T_NATIVE_DOUBLE, &fraction);
+      d.rayleigh_fraction = fraction;
     }
     // Optional (written since the parcel classes are checked on restart).
     if (error.empty() && !read_array_attribute(f, "material_coarse_grain", H5T_NATIVE_DOUBLE,

@@ -80,6 +80,11 @@ struct CheckpointData {
   // accepts the run's positions. Root attribute `skin`, optional (absent: files written before
   // it; written with largest_radius).
   std::optional<double> skin;
+  // How the run set its step: time.rayleigh_fraction's value, or 0 when it gave time.step.
+  // A restart keeps the run's step, and refuses a scene that sets it otherwise
+  // (check_restart_step). Root attribute `rayleigh_fraction`, optional (absent: files written
+  // before it, not checked then).
+  std::optional<double> rayleigh_fraction;
   // Particles that left through a bounded side before this checkpoint, over all ranks: the
   // restart's log and summary count on from it. Root attribute `removed`, optional (0).
   long removed = 0;
@@ -140,6 +145,11 @@ void write_checkpoint(MPI_Comm comm, const std::string& path, const CheckpointDa
 // Reads the whole checkpoint (not collective). Throws OutputError naming the file
 // and what is wrong with it.
 CheckpointData read_checkpoint(const std::string& path);
+
+// Whether the HDF5 file at `path` is a particle snapshot (datasets at its root, no
+// checkpoint `format` attribute), told by its contents, not its name; false when it cannot
+// be opened (read_checkpoint then names what is wrong).
+bool is_particle_snapshot(const std::string& path);
 
 // The record of the run's insertions (/streams/insertions) of the checkpoint at `path`, without
 // reading the rest; empty when the file cannot be read or holds no record.

@@ -423,9 +423,13 @@ def refuses_bad_setup(runner, checks):
         ("particles.yaml", "step: 1e-5 ", "step: 1e-4 ")])
     runner.run(case, "blockMesh", "blockMesh")
     log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
-    advised = re.search(r"refusing to run with this DEM time step \(see the lines above\); use dt "
-                        r"<= \S+ s .*; for this fluid step \(deltaT 0\.0001 s\) time\.step (\S+) s "
-                        r"\(deltaT / (\d+)\); or set `allowLargeTimeStep yes;`", log)
+    advised = re.search(r"refusing to run with this DEM time step \(see the lines above\); use a "
+                        r"time\.step <= \S+ s, .* that divides the fluid step \(deltaT 0\.0001 "
+                        r"s\): time\.step (\S+) s \(deltaT / (\d+)\); or set "
+                        r"`allowLargeTimeStep yes;`", log)
+    checks.expect("rayleigh_fraction" not in (advised.group(0) if advised else "x"),
+                  "the advice offers no time.rayleigh_fraction (its step divides deltaT only by "
+                  "chance)")
     checks.expect(advised is not None and "grainFoam DEM: error: dt is too large to resolve "
                   "contacts" in log and "grainFoam DEM: Rayleigh time t_R = " in log,
                   "DEM step 1e-4 s: refused at start-up after the DEM's lines, advising a step "

@@ -414,7 +414,7 @@ def main():
     ap.add_argument("--series", action="store_true", help="print the slip at every write time")
     ap.add_argument("--check", default=None, help="PCT_DRAG,PCT_RZ: exit 1 beyond these")
     ap.add_argument("--work", default="/tmp/hindered_settling")
-    ap.add_argument("--build", default=os.path.join(ROOT, "build"))
+    ap.add_argument("--build", default=os.environ.get("GRAINFLOW_BUILD_DIR", os.path.join(ROOT, "build")))
     a = ap.parse_args()
     if not 0 <= a.skew < 0.5:  # half a cell edge folds a cell over its neighbour
         ap.error(f"--skew: {a.skew} is not in [0, 0.5) cell edges")

@@ -224,7 +224,7 @@ def main():
                     help="with --check: also exit 1 unless the fluid's share of the particle's "
                          "fluid force at the end is within this many per cent of 1")
     ap.add_argument("--work", default="/tmp/settling_cells")
-    ap.add_argument("--build", default=os.path.join(ROOT, "build"))
+    ap.add_argument("--build", default=os.environ.get("GRAINFLOW_BUILD_DIR", os.path.join(ROOT, "build")))
     a = ap.parse_args()
     if not 0 < a.tau_fraction <= 1:
         ap.error(f"--tau-fraction {a.tau_fraction:g}: must be in (0, 1]")

@@ -306,7 +306,7 @@ def main():
                     help="diffusionBandwidth b in particle diameters (default: none)")
     ap.add_argument("--check", type=float, default=None)
     ap.add_argument("--work", default="/tmp/settling_pair")
-    ap.add_argument("--build", default=os.path.join(sc.ROOT, "build"))
+    ap.add_argument("--build", default=os.environ.get("GRAINFLOW_BUILD_DIR", os.path.join(sc.ROOT, "build")))
     a = ap.parse_args()
     k = 0.5 / a.spacing
     unbounded = 1 / (1 - 0.75 * k + 9 / 16 * k**2 - 59 / 64 * k**3)

@@ -13,6 +13,7 @@ WORK="$BUILD/hard_cases/coupled"
 export GRAINFLOW_STRESS_SCALE="$SCALE"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 export GRAINFLOW_FOAM_BASHRC="${GRAINFLOW_FOAM_BASHRC:-/usr/share/openfoam/etc/bashrc}"
+mkdir -p "$WORK"  # the logs go beside it, $WORK.<case>.log
 status=0
 for case in dense_bed_10x_umf particles_larger_than_cells on_faces_and_corners_2ranks \
             crowded_cell_2ranks emptied_and_refilled_cells fast_crossing_ranks; do

@@ -30,10 +30,16 @@ code, its message and what is on disk afterwards:
     a 200 000-character model name, number or wall name is shown by its first 60 characters;
   * restart_advice: the summary's "continue with" command, time.end raised, ends bit for bit
     where one longer run ends; a restart into another folder says so; a snapshot given to
-    --restart is named as one;
+    --restart is named as one, by its contents (renamed state.h5 too; a checkpoint copied to
+    particles_backup.h5 restarts);
   * restart_at_end: a restart whose time.end is the checkpoint's time runs nothing and leaves
     log.csv, particles.xdmf and every snapshot as they were (bytes), where it had cut the log
     back to the checkpoint;
+  * restart_other_step_setting: a restart whose time.rayleigh_fraction is not its run's, or
+    that gives one where the run gave time.step, is refused (run and check) naming the value
+    that restarts; followed, it runs;
+  * restart_other_domain: a domain changed before a restart is named (domain.max[2]), not
+    taken for a damaged checkpoint;
   * check_restart: `grain check --restart` verifies a checkpoint against the scene as the
     restart would: a good one passes with the steps the restart then runs (it runs exactly
     those), a changed gravity and a flipped byte are refused as `run --restart` refuses them,
@@ -245,6 +251,57 @@ def restart_at_end():
     if after != before:
         changed = sorted(n for n in set(before) | set(after) if before.get(n) != after.get(n))
         fail(case, f"files changed: {changed}")
+
+
+def restart_other_step_setting():
+    """A restart keeps its run's step: a scene whose time.rayleigh_fraction differs from the
+    run's, or that gives one where the run gave time.step, is refused by run and check with
+    the value that restarts; followed, the restart runs."""
+    case = "restart_other_step_setting"
+    d = fresh(case)
+    scene(d, end=0.004, extra=", checkpoint_interval: 0.002")
+    expect(case, grain(d, "run", "scene.yaml"), 0, r"done:")
+    first = first_checkpoint(d)
+    text = scene(d, end=0.006, extra=", checkpoint_interval: 0.002")
+    with open(os.path.join(d, "scene.yaml"), "w") as out:
+        out.write(text.replace("rayleigh_fraction: 0.2", "rayleigh_fraction: 0.1"))
+    for command in ("run", "check"):
+        expect(case, grain(d, command, "scene.yaml", "--restart", first), 1,
+               r"scene\.yaml:3: error: time\.rayleigh_fraction = 0\.1, but checkpoint "
+               r"'out/checkpoint_\d+\.h5' was written by a run with time\.rayleigh_fraction = "
+               r"0\.2 .*set time\.rayleigh_fraction to 0\.2 to restart")
+    with open(os.path.join(d, "scene.yaml"), "w") as out:
+        out.write(text)  # the advice: the run's 0.2
+    expect(case, grain(d, "run", "scene.yaml", "--restart", first), 0, r"done:")
+    # A run with time.step, restarted with a fraction: refused, naming the step.
+    d = fresh(case + "_step")
+    text = scene(d, end=0.004, extra=", checkpoint_interval: 0.002")
+    with open(os.path.join(d, "scene.yaml"), "w") as out:
+        out.write(text.replace("rayleigh_fraction: 0.2", "step: 2e-6"))
+    expect(case, grain(d, "run", "scene.yaml"), 0, r"done:")
+    first = first_checkpoint(d)
+    scene(d, end=0.006, extra=", checkpoint_interval: 0.002")
+    expect(case, grain(d, "run", "scene.yaml", "--restart", first), 1,
+           r"was written by a run with time\.step = 2e-06 s .*set time\.step to 2e-06 to restart")
+
+
+def restart_other_domain():
+    """A domain changed before a restart is named as the key that changed, not as a damaged
+    checkpoint (the decomposition's cuts no longer fit it)."""
+    case = "restart_other_domain"
+    d = fresh(case)
+    scene(d, end=0.004, extra=", checkpoint_interval: 0.002")
+    expect(case, grain(d, "run", "scene.yaml"), 0, r"done:")
+    first = first_checkpoint(d)
+    text = scene(d, end=0.006, extra=", checkpoint_interval: 0.002")
+    with open(os.path.join(d, "scene.yaml"), "w") as out:
+        out.write(text.replace("max: [0.01, 0.01, 0.02], periodic", "max: [0.01, 0.01, 0.03], periodic"))
+    for command in ("run", "check"):
+        got = grain(d, command, "scene.yaml", "--restart", first)
+        expect(case, got, 1, r"scene\.yaml:1: error: domain\.max\[2\] is 0\.03 here, 0\.02 in the "
+                             r"run that wrote checkpoint")
+        if "damaged" in got[1]:
+            fail(case, "the message still blames the checkpoint")
 
 
 def check_restart():
@@ -524,6 +581,15 @@ def restart_advice():
     expect(case, grain(d, "run", "scene.yaml", "--output", "x", "--restart",
                        "out/particles_000002.h5"), 1,
            r"cannot restart from 'out/particles_000002\.h5': it is a snapshot, not a checkpoint")
+    # Told by the contents, not the name: a snapshot renamed state.h5 is still one, and a
+    # checkpoint copied to particles_backup.h5 still restarts.
+    shutil.copy(os.path.join(d, "out", "particles_000002.h5"), os.path.join(d, "state.h5"))
+    for command in ("run", "check"):
+        expect(case, grain(d, command, "scene.yaml", "--restart", "state.h5"), 1,
+               r"cannot restart from 'state\.h5': it is a snapshot, not a checkpoint")
+    shutil.copy(os.path.join(d, m.group(1)), os.path.join(d, "particles_backup.h5"))
+    expect(case, grain(d, "run", "scene.yaml", "--output", "backup", "--restart",
+                       "particles_backup.h5"), 0, r"done:")
 
 
 if __name__ == "__main__":
@@ -531,7 +597,9 @@ if __name__ == "__main__":
     os.makedirs(WORK, exist_ok=True)
     for check in (overwrite_csv, overwrite_snapshot, overwrite_scene, failed_start_writes_nothing,
                   second_document, tilde, input_named,
-                  help_option, restart_at_end, check_restart, restart_missing_csv, restart_mesh,
+                  help_option, restart_at_end, restart_other_step_setting, restart_other_domain,
+                  check_restart,
+                  restart_missing_csv, restart_mesh,
                   restart_other_physics, restart_smaller_skin, hostile_text,
                   restart_advice):
         check()
