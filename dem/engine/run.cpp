@@ -14,6 +14,7 @@
 #include <optional>
 #include <ostream>
 #include <sstream>
+#include <string_view>
 #include <vector>
 
 #include "dem/core/number_format.hpp"
@@ -27,6 +28,7 @@
 #include "dem/fluid/fluid_forces.hpp"
 #include "dem/fluid/void_fraction_grid.hpp"
 #include "dem/insert/insertion.hpp"
+#include "dem/io/direct_write_driver.hpp"
 #include "dem/io/log_table.hpp"
 #include "dem/io/output_directory.hpp"
 #include "dem/io/progress_line.hpp"
@@ -329,6 +331,19 @@ void refuse_inputs_the_run_overwrites(const Scene& scene, const std::string& dir
     if (w.kind == Wall::Kind::mesh) check(w.mesh.file, w.mesh.file_source, "STL file");
 }
 
+// The environment variables grain reads, checked before anything is made: a value it would
+// not take is refused by name at start-up (GRAINFLOW_BUFFERED_WRITES had failed only at the
+// first snapshot, GRAINFLOW_SNAPSHOT_MPIIO=yes was taken for 0).
+void refuse_bad_environment() {
+  if (const std::string error = buffered_writes_error(); !error.empty()) throw OutputError(error);
+  const char* mpiio = std::getenv("GRAINFLOW_SNAPSHOT_MPIIO");
+  if (mpiio && *mpiio && std::string_view(mpiio) != "0" && std::string_view(mpiio) != "1")
+    throw OutputError(std::string("the environment variable GRAINFLOW_SNAPSHOT_MPIIO is '") +
+                      mpiio +
+                      "'; allowed values: 0 (ranks on one node hand their slices to rank 0, "
+                      "the default) or 1 (collective MPI-IO on one node too)");
+}
+
 // The output folders a run makes for itself (the folder and any missing parents), removed
 // again, innermost first and only while empty, when the run stops with an error before it
 // writes anything there: an insertion that cannot place its particles, a refused time step
@@ -500,6 +515,7 @@ std::string ends_before_checkpoint(const Scene& scene, const Simulation& sim,
 }  // namespace
 
 int check_scene(const Scene& scene, std::ostream& out, const std::optional<std::string>& restart) {
+  refuse_bad_environment();
   check_grids(scene);
   if (restart)
     refuse_unusable_restart(*restart);
@@ -565,6 +581,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   const auto since = [](std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   };
+  refuse_bad_environment();
   check_grids(scene);
   const std::string dir = options.output_directory.value_or(scene.output.directory);
   // Before the output folder is made: a mistyped name changes nothing.

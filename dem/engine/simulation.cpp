@@ -229,7 +229,9 @@ void Simulation::initialise() {
              : "contacts, and no contact can happen in this scene (" + std::to_string(p_.size()) +
                    " particle(s), " +
                    (scene_.walls.empty() ? "no walls" : "nothing they can touch") + ")") +
-        "; give time.step instead (`grain check` prints the fluid forces' limits on it)");
+        "; give time.step instead" +
+        (scene_.fluid ? std::string(" (`grain check` prints the fluid forces' limits on it)")
+                      : std::string()));
   }
   check_walls_travel();
 

@@ -33,6 +33,10 @@ void prepare_output_directory(const std::string& dir) {
   if (dir.empty()) fail(dir, "cannot use an empty path", "no directory given");
 
   std::error_code ec;
+  // A dangling symbolic link: create_directories says only "File exists".
+  if (fs::is_symlink(dir, ec) && !fs::exists(dir, ec))
+    fail(dir, "is a symbolic link to '" + fs::read_symlink(dir, ec).string() + "'",
+         "that folder does not exist; create it");
   fs::create_directories(dir, ec);
   if (ec) fail(dir, "cannot create directory", ec.message());
   // create_directories succeeds without creating anything when the last component exists,

@@ -49,6 +49,15 @@ grain_cli_test(run_end_between_steps 0
                "note: time.end / step = 2.5 is not whole: the run takes 2 steps, the nearest whole number, and ends at t = 0.0008 s;done: 2 steps"
                CMD ${_grain} run ${_scenes}/end_between_steps.yaml --output out --no-progress
                WORKDIR ${_work}/end_between_steps)
+# The environment variables grain reads: a value it would not take is refused by name at
+# start-up (it had failed at the first snapshot, or been taken for 0).
+grain_cli_test(bad_buffered_writes 1
+               "GRAINFLOW_BUFFERED_WRITES is 'yes'; allowed values: 0 .* or 1"
+               CMD env GRAINFLOW_BUFFERED_WRITES=yes ${_grain} check ${_scenes}/minimal.yaml)
+grain_cli_test(bad_snapshot_mpiio 1
+               "GRAINFLOW_SNAPSHOT_MPIIO is 'yes'; allowed values: 0 .* or 1"
+               CMD env GRAINFLOW_SNAPSHOT_MPIIO=yes ${_grain} run ${_scenes}/minimal.yaml --output out
+               WORKDIR ${_work}/bad_snapshot_mpiio)
 grain_cli_test(missing_scene_file 2 "no_such.yaml: error: cannot open the scene file"
                CMD ${_grain} check ${_scenes}/no_such.yaml)
 grain_cli_test(check_minimal 0 "Rayleigh time t_R = ;contact time t_c = ;steps per impact"

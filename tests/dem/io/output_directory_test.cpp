@@ -86,6 +86,21 @@ TEST(OutputDirectory, RegularFileItselfIsRejected) {
   EXPECT_NE(lower.find("not a directory"), std::string::npos) << message;
 }
 
+// A symbolic link to a folder that does not exist: named with its target (create_directories
+// says only "File exists"), and nothing is created.
+TEST(OutputDirectory, DanglingSymbolicLinkNamesItsTarget) {
+  const fs::path base = fresh_directory("dangling_link");
+  fs::create_directories(base);
+  const fs::path link = base / "out", target = base / "gone";
+  fs::create_directory_symlink(target, link);
+  const std::string message = error_for(link.string());
+  EXPECT_NE(
+      message.find("is a symbolic link to '" + target.string() + "': that folder does not exist"),
+      std::string::npos)
+      << message;
+  EXPECT_FALSE(fs::exists(target));
+}
+
 TEST(OutputDirectory, ReadOnlyDirectoryIsRejected) {
   if (::geteuid() == 0) GTEST_SKIP() << "root bypasses permission bits";
   const fs::path dir = fresh_directory("read_only");
