@@ -20,7 +20,12 @@ coarse_grain: k) are counted as the run counts them, one per parcel, and beside 
 real particles they stand for (the real_count dataset, k^3 each) and the real particles'
 radius (parcel radius / k): docs/models/coarse-graining.md "Output".
 
-Exit status: 0, or 1 when a file cannot be read or a folder holds no .h5 file; 2 for usage.
+Material indices present are looked up one by one; an index outside material_names is
+printed as such ("material 7 (not in material_names)").
+
+Exit status: 0, or 1 when a file cannot be read, is neither a snapshot nor a checkpoint, or
+holds impossible values (a coarse_grain k or a real_count not positive: a one-line message
+naming the file and dataset), or a folder holds no .h5 file; 2 for usage.
 Needs h5py and numpy (Debian: python3-h5py python3-numpy).
 """
 import argparse
@@ -120,29 +125,36 @@ def folder_files(folder):
     return chosen + checkpoints, notes
 
 
-def material_names(f, group, count):
-    """Names of the material indices 0..count-1, or the indices as text."""
+def material_labels(f, group, indices):
+    """{index: label} for the material indices present (and only those: an index may be any
+    int32, so no list of every name up to the largest is built). A name from the root
+    attribute material_names (for a checkpoint, its stored scene); an index outside the
+    materials named is said to be so; without any names, the index itself."""
+    indices = [int(m) for m in indices]
     names = attr(f, "material_names")
     if isinstance(names, str) and names:
         parts = names.split(",")
-        if len(parts) >= count:
-            return parts
+        return {m: parts[m] if 0 <= m < len(parts) else f"material {m} (not in material_names)"
+                for m in indices}
     if group is not f and "scene/model" in f:  # a checkpoint: its scene's materials
         model = bytes(f["scene/model"][...]).decode("utf-8", "replace")
         listed = dict(re.findall(r"^materials\[(\d+)\]\.name = (.*)$", model, re.M))
         ks = np.atleast_1d(f.attrs.get("material_coarse_grain", []))
         real = np.atleast_1d(f.attrs.get("material_real", []))
-        out = []
-        for i in range(count):
-            if i < len(real) and str(int(real[i])) in listed:
+        out = {}
+        for i in indices:
+            if 0 <= i < len(real) and str(int(real[i])) in listed:
                 base = listed[str(int(real[i]))]
-                out.append(base if ks[i] == 1 else f"{base}[k={ks[i]:g}]")
-            elif str(i) in listed:
-                out.append(listed[str(i)])
+                k = ks[i] if i < len(ks) else 1
+                out[i] = base if k == 1 else f"{base}[k={k:g}]"
+            elif 0 <= i and str(i) in listed:
+                out[i] = listed[str(i)]
+            elif listed:
+                out[i] = f"material {i} (not in the stored scene's materials)"
             else:
-                return [str(j) for j in range(count)]
+                out[i] = str(i)
         return out
-    return [str(j) for j in range(count)]
+    return {m: str(m) for m in indices}
 
 
 def checkpoint_left_over(path, group_file):
@@ -159,24 +171,51 @@ def checkpoint_left_over(path, group_file):
 def summarise(path, in_folder=False):
     with h5py.File(path, "r") as f:
         checkpoint = "particles" in f and isinstance(f["particles"], h5py.Group)
+        snapshot = not checkpoint and (
+            any(a in f.attrs for a in ("time", "step", "count"))
+            or any(isinstance(f.get(d), h5py.Dataset) for d in ("id", "position")))
+        if not snapshot and not checkpoint:
+            raise Unreadable(f"{path}: neither a grainflow snapshot (no root attribute time, "
+                             "step or count, no id or position dataset) nor a checkpoint "
+                             "(no /particles group)")
         g = f["particles"] if checkpoint else f
+        where = "/particles/" if checkpoint else "/"
         stored = g["id"].shape[0] if "id" in g else 0
         n = stored if checkpoint else int(attr(f, "count", stored))
         kind = "checkpoint" if checkpoint else "snapshot"
-        print(f"{path}")
-        if checkpoint and in_folder and checkpoint_left_over(path, f):
-            print("  note: left over from another run (its stored log is not the start of "
-                  "this folder's log.csv)")
         mat = g["material"][...] if "material" in g and n > 0 else None
         # Coarse graining: each particle's k and the real particles it stands for.
         k = None
         if "coarse_grain" in g:
             k = g["coarse_grain"][...]
+            k_from = f"dataset {where}coarse_grain"
         elif mat is not None and "material_coarse_grain" in f.attrs:
             ks = np.atleast_1d(f.attrs["material_coarse_grain"])
+            bad = mat[(mat < 0) | (mat >= len(ks))]
+            if len(bad):
+                raise Unreadable(f"{path}: dataset {where}material holds index {int(bad[0])}, "
+                                 f"outside the {len(ks)} entries of the root attribute "
+                                 "material_coarse_grain")
             k = ks[mat]
-        real = g["real_count"][...] if "real_count" in g else (k**3 if k is not None else None)
+            k_from = "root attribute material_coarse_grain"
+        if k is not None and n > 0 and np.any(~(k > 0)):
+            raise Unreadable(f"{path}: {k_from} holds {np.min(k):g}: a coarse-graining "
+                             "factor k must be positive")
+        if "real_count" in g:
+            real = g["real_count"][...]
+            if n > 0 and np.any(~(real > 0)):
+                bad = np.flatnonzero(~(real > 0))
+                raise Unreadable(f"{path}: dataset {where}real_count holds {real[bad[0]]:g} "
+                                 f"(at {len(bad)} of its {real.size} entries, the first at "
+                                 f"index {bad[0]}): each particle stands for at least one "
+                                 "real particle")
+        else:
+            real = k**3 if k is not None else None
         parcels = k is not None and n > 0 and np.any(k != 1)
+        print(f"{path}")
+        if checkpoint and in_folder and checkpoint_left_over(path, f):
+            print("  note: left over from another run (its stored log is not the start of "
+                  "this folder's log.csv)")
         line = (f"  time {attr(f, 'time', float('nan')):.9g} s  step {attr(f, 'step', -1)}  "
                 f"particles {n}")
         if parcels:
@@ -206,8 +245,9 @@ def summarise(path, in_folder=False):
             print(f"  speed [m/s]  mean {speed.mean():.6g}  max {speed.max():.6g}")
         if mat is not None:
             mats, counts = np.unique(mat, return_counts=True)
-            names = material_names(f, g, int(mats.max()) + 1)
-            print("  materials  " + "  ".join(f"{names[m]}:{c}" for m, c in zip(mats, counts)))
+            names = material_labels(f, g, mats)
+            print("  materials  " + "  ".join(f"{names[int(m)]}:{c}"
+                                              for m, c in zip(mats, counts)))
         if parcels:
             for kv in np.unique(k):
                 if kv == 1:
@@ -248,6 +288,10 @@ def main():
         for q, in_folder in items:
             try:
                 summarise(q, in_folder)
+            except Unreadable as e:
+                sys.stdout.flush()
+                print(f"h5_summary.py: {e}", file=sys.stderr)
+                status = 1
             except (OSError, KeyError, ValueError, TypeError, IndexError) as e:
                 sys.stdout.flush()
                 print(f"h5_summary.py: {q}: cannot read as a grainflow snapshot or checkpoint: "

@@ -6,8 +6,10 @@
 Each column gets its own panel (the columns have different units); all share the time axis.
 A damaged row (not a number in every column) is left out and reported with its line number,
 on stderr and in the closing "wrote" line; a last row cut short by a killed run likewise.
-A missing, binary or non-log input, or an -o whose folder does not exist, is a one-line
-error, exit status 1 (2 for a usage error).
+A missing, binary or non-log input, or an -o whose folder does not exist, whose extension
+is not an image format matplotlib writes (.png, .pdf, .svg, ...), or that is the log itself,
+is a one-line error, exit status 1 (2 for a usage error). A byte-order mark at the start of
+the log is ignored.
 Needs matplotlib and numpy (Debian: python3-matplotlib); no display is required.
 """
 import argparse
@@ -50,10 +52,13 @@ def read_table(path):
     if raw.startswith(b"\x89HDF") or b"\0" in raw[:65536]:
         fail(f"{path} is a binary file (an HDF5 snapshot or checkpoint?), not a CSV log table")
     try:
-        text = raw.decode("utf-8")
+        text = raw.decode("utf-8-sig")  # a byte-order mark (an editor's) is not the header's
     except UnicodeDecodeError as e:
         fail(f"{path} is not a text CSV log table (byte {e.start} is not UTF-8)")
     lines = text.splitlines()
+    # A log's fields are short numbers; a damaged one may be long (csv's default limit is
+    # 131072 characters, past which it raises): allow any field the file can hold.
+    csv.field_size_limit(max(len(text), csv.field_size_limit()))
     if not lines or not lines[0].strip():
         fail(f"{path}: empty file, expected a header line")
     header = next(csv.reader([lines[0]]))
@@ -96,6 +101,15 @@ def main():
         fail(f"-o {args.output} is a folder; give the PNG file's name")
     if not os.path.isdir(out_dir):
         fail(f"-o {args.output}: no folder {out_dir} to write it in")
+    if os.path.realpath(args.output) == os.path.realpath(args.log):
+        fail(f"-o {args.output} is the log table itself ({args.log}); give another file "
+             "name for the plot")
+    ext = os.path.splitext(args.output)[1].lstrip(".").lower()
+    formats = plt.gcf().canvas.get_supported_filetypes()
+    plt.close("all")
+    if ext and ext not in formats:
+        fail(f"-o {args.output}: matplotlib cannot write .{ext} files; give a name ending in "
+             + ", ".join("." + f for f in sorted(formats)))
     header, data, skipped = read_table(args.log)
     unknown = [c for c in [args.x] + args.columns if c not in header]
     if unknown:

@@ -2,10 +2,15 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <iostream>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "dem/core/fnv1a.hpp"
@@ -54,6 +59,7 @@ struct Start {
   std::string scene_file;
   grainflow::RunOptions options;
   std::string scene_text;  // the scene file's bytes
+  std::optional<grainflow::Scene> scene;  // parsed, when not done
 };
 
 Start finished(int code, std::string message) {
@@ -143,12 +149,60 @@ Start parse_command(const std::string& program, const std::vector<std::string>& 
     if (key == "--allow-large-dt") s.options.allow_large_time_step = true;
   }
   if (s.scene_file.empty()) return usage_error("'" + cmd + "' needs a scene file");
-  try {
+  try {  // parsed here: a file the scene names that is missing on one rank stops all ranks
     s.scene_text = read_scene_file(s.scene_file);
+    s.scene = parse_scene(s.scene_text, s.scene_file);
   } catch (const SceneError& e) {
     return finished(2, std::string(e.what()) + "\n");
   }
   return s;
+}
+
+// What every rank must have alike, in four parts compared apart so that the message can say
+// which differs: the command line (paths made absolute: the same folder named two ways is the
+// same, another working directory is not), the scene file's bytes, the files the scene and
+// --restart name (their absolute paths and sizes), and the environment variables grain reads.
+std::array<std::uint64_t, 4> start_fingerprints(const Start& s) {
+  namespace fs = std::filesystem;
+  using grainflow::fnv1a64;
+  const auto absolute = [](const std::string& path) {
+    std::error_code ec;
+    const fs::path p = fs::weakly_canonical(fs::absolute(path, ec), ec);
+    return (ec ? fs::path(path) : p).string();
+  };
+  const auto file = [&](const std::string& path) {
+    std::error_code ec;
+    const auto bytes = fs::file_size(path, ec);
+    std::string text = absolute(path);
+    text += ' ';
+    text += ec ? std::string("missing") : std::to_string(bytes);
+    return text;
+  };
+  std::array<std::uint64_t, 4> h{};
+  h.fill(grainflow::kFnv1a64Start);
+  const grainflow::Scene& scene = *s.scene;
+  for (const std::string& part :
+       {s.cmd, absolute(s.scene_file),
+        absolute(s.options.output_directory.value_or(scene.output.directory)),
+        s.options.restart ? absolute(*s.options.restart) : std::string(),
+        std::string(s.options.progress ? "progress" : "quiet"),
+        std::string(s.options.allow_large_time_step ? "large" : "guarded")})
+    h[0] = fnv1a64(part + '\0', h[0]);
+  h[1] = fnv1a64(s.scene_text, h[1]);
+  std::vector<std::string> files;
+  for (const grainflow::Insertion& ins : scene.insertions)
+    for (const std::string* f : {&ins.csv_file, &ins.snapshot_file})
+      if (!f->empty()) files.push_back(*f);
+  for (const grainflow::Wall& w : scene.walls)
+    if (!w.mesh.file.empty()) files.push_back(w.mesh.file);
+  if (s.options.restart) files.push_back(*s.options.restart);
+  for (const std::string& f : files) h[2] = fnv1a64(file(f) + '\0', h[2]);
+  for (const char* name : {"GRAINFLOW_BUFFERED_WRITES", "GRAINFLOW_SNAPSHOT_MPIIO"}) {
+    const char* value = std::getenv(name);
+    h[3] = fnv1a64(name, h[3]);
+    h[3] = fnv1a64(value ? std::string_view(value) : std::string_view("\0(unset)", 8), h[3]);
+  }
+  return h;
 }
 
 // Every rank reads its own command line and scene file. Before anything collective the ranks
@@ -184,24 +238,29 @@ int agree_on_start(const Start& s, int rank, int size) {
     if (rank == 0) std::cout << s.message;
     return 0;
   }
-  // The same command, options and scene bytes on every rank.
-  std::uint64_t mine = grainflow::fnv1a64(s.scene_text);
-  for (const std::string& part :
-       {s.cmd, s.scene_file, s.options.output_directory.value_or(""),
-        s.options.restart.value_or(""), std::string(s.options.progress ? "progress" : "quiet"),
-        std::string(s.options.allow_large_time_step ? "large" : "guarded")})
-    mine = grainflow::fnv1a64(part + '\0', mine);
-  std::uint64_t lo = done[1] == 1 ? 0 : mine, hi = mine;
-  MPI_Allreduce(MPI_IN_PLACE, &lo, 1, MPI_UINT64_T, MPI_MIN, MPI_COMM_WORLD);
-  MPI_Allreduce(MPI_IN_PLACE, &hi, 1, MPI_UINT64_T, MPI_MAX, MPI_COMM_WORLD);
-  if (lo != hi) {
+  // The same command line, scene, files and environment on every rank.
+  std::array<std::uint64_t, 4> lo{}, hi{};
+  if (!s.done) lo = hi = start_fingerprints(s);  // a rank with --help differs in the first
+  MPI_Allreduce(MPI_IN_PLACE, lo.data(), 4, MPI_UINT64_T, MPI_MIN, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, hi.data(), 4, MPI_UINT64_T, MPI_MAX, MPI_COMM_WORLD);
+  if (done[1] == 1) lo[0] = 0;
+  std::string differ;
+  const char* parts[4] = {"command lines (or working directories)", "scene files' bytes",
+                          "files the scene or --restart names (missing, or of other sizes)",
+                          "GRAINFLOW_* environment variables"};
+  for (int k = 0; k < 4; ++k)
+    if (lo[k] != hi[k]) {
+      if (!differ.empty()) differ += ", ";
+      differ += parts[k];
+    }
+  if (!differ.empty()) {
     if (rank == 0)
-      std::cerr << "grain: error: the ranks were given different command lines or read "
-                   "different scene files (rank 0: '"
+      std::cerr << "grain: error: the ranks differ in their " << differ << " (rank 0: '"
                 << (s.done ? std::string("--help/--version") : s.cmd + " " + s.scene_file)
-                << "'); under mpirun every rank reads the command line and the scene file "
-                   "itself: give them all the same arguments and the same file (not "
-                   "standard input, /dev/stdin, which mpirun gives to rank 0 only)\n";
+                << "'); under mpirun every rank reads the command line, the scene and its "
+                   "files itself: give them all the same arguments, working directory and "
+                   "environment, and files on a folder every rank sees (not standard input, "
+                   "/dev/stdin, which mpirun gives to rank 0 only)\n";
     return 2;
   }
   return -1;
@@ -214,7 +273,7 @@ int dispatch(const std::string& program, const std::vector<std::string>& args, i
   const std::string& cmd = start.cmd;
   const RunOptions& options = start.options;
   try {
-    const Scene scene = parse_scene(start.scene_text, start.scene_file);
+    const Scene& scene = *start.scene;
     if (cmd == "check") return check_scene(scene, std::cout, options.restart);
     run_scene(scene, options, MPI_COMM_WORLD, std::cout);
     return 0;

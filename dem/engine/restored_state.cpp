@@ -305,6 +305,10 @@ void check_restart_step(const Scene& scene, const CheckpointData& d) {
   // A step set by time.rayleigh_fraction is the checkpoint's too (the particles present may
   // give another one): the run's own fraction continues it; another one, or a fraction where
   // the run gave time.step, would be kept silently, so it is refused.
+  // Only values their checksum vouches for (dt, rayleigh_fraction): a damaged one is named as
+  // damage by Simulation::restore, not offered as the value to set.
+  if (d.attributes_checksum_stored && d.attributes_checksum_stored != d.attributes_checksum_read)
+    return;
   if (scene.time.rayleigh_fraction && d.rayleigh_fraction &&
       *scene.time.rayleigh_fraction != *d.rayleigh_fraction) {
     const std::string run = *d.rayleigh_fraction > 0

@@ -308,12 +308,28 @@ void refuse_inputs_the_run_overwrites(const Scene& scene, const std::string& dir
   std::error_code ec;
   const fs::path out = fs::weakly_canonical(fs::absolute(dir, ec), ec);
   if (ec) return;
+  // The folder's entries under names the run writes: one that is a symbolic or hard link to
+  // an input would be written through, over the input.
+  std::vector<fs::path> written_here;
+  for (const auto& entry : fs::directory_iterator(out, ec))
+    if (written_by_a_run(entry.path().filename().string())) written_here.push_back(entry.path());
   const auto check = [&](const std::string& file, const std::string& where, const char* what) {
     if (file.empty()) return;
     std::error_code e;
+    const bool scene_file = file == scene.file;
+    for (const fs::path& w : written_here)
+      if (std::error_code same; (fs::is_symlink(w, same) || fs::hard_link_count(w, same) > 1) &&
+                                fs::equivalent(w, file, same) && !same)
+        throw SetupError(where + ": error: the " + what + " '" + file + "' is " +
+                         (fs::absolute(file, e).lexically_normal() == w
+                              ? std::string("a link")
+                              : "linked as '" + w.string() + "'") +
+                         " in the output folder '" + dir +
+                         "' under a name the run writes there: the run would write over it. "
+                         "Remove that link, or write the output elsewhere (output.directory, "
+                         "or --output)");
     const fs::path in = fs::weakly_canonical(fs::absolute(file, e), e);
     if (e || in.parent_path() != out || !written_by_a_run(in.filename().string())) return;
-    const bool scene_file = file == scene.file;
     throw SetupError(where + ": error: the " + what + " '" + file + "' is in the output folder '" +
                      dir +
                      "' under a name the run writes there: the run would overwrite it. "
@@ -360,7 +376,9 @@ class FoldersMadeForTheRun {
       std::error_code ec;
       fs::path p = fs::absolute(dir, ec).lexically_normal();
       if (p.filename().empty()) p = p.parent_path();  // "out/"
-      while (!ec && !p.empty() && !fs::exists(p, ec) && !ec) {
+      // symlink_status: a symbolic link (also one to nowhere) is the user's, never made here.
+      std::error_code missing;  // set for a path that is not there: not an error here
+      while (!ec && !p.empty() && !fs::exists(fs::symlink_status(p, missing))) {
         made_.push_back(p);
         if (p == p.parent_path()) break;
         p = p.parent_path();

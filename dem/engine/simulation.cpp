@@ -892,7 +892,7 @@ void Simulation::restore(const CheckpointData& checkpoint) {
     throw StateError(checkpoint.file +
                      ": error: the root group's attributes (time, dt, step, next_id, rebuilds, "
                      "material_coarse_grain, material_real, wall_impulse, largest_radius, "
-                     "removed, skin) do not match their "
+                     "removed, skin, rayleigh_fraction) do not match their "
                      "checksum, attribute 'attributes_checksum' (" +
                      sums +
                      "): the checkpoint was changed or damaged after it was written; restart "

@@ -15,6 +15,7 @@ import subprocess
 import sys
 
 import h5py
+import numpy as np
 
 SOURCE = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCRIPTS = os.path.join(SOURCE, "scripts")
@@ -68,11 +69,29 @@ def grain_run(args, scene_path):
         sys.exit(f"scripts_test: grain run {scene_path} failed ({r.returncode}):\n{r.stdout}{r.stderr}")
 
 
-def script(args, name, *argv):
-    """(exit code, stdout + stderr) of one of the scripts, run by this Python."""
-    r = subprocess.run([sys.executable, os.path.join(SCRIPTS, name), *argv], cwd=args.work,
-                       capture_output=True, text=True)
+def script(args, name, *argv, timeout=60):
+    """(exit code, stdout + stderr) of one of the scripts, run by this Python; exit code None
+    when it ran past `timeout` seconds (a hang)."""
+    try:
+        r = subprocess.run([sys.executable, os.path.join(SCRIPTS, name), *argv], cwd=args.work,
+                           capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return None, f"(timed out after {timeout} s)"
     return r.returncode, r.stdout + r.stderr
+
+
+def edited_copy(args, source, name, edit):
+    """A copy of the HDF5 file `source` (under the work folder) as `name`, changed by
+    edit(h5py.File) in place; returns `name`."""
+    shutil.copy(os.path.join(args.work, source), os.path.join(args.work, name))
+    with h5py.File(os.path.join(args.work, name), "r+") as f:
+        edit(f)
+    return name
+
+
+def one_line_error(code, text, *expected):
+    return (code == 1 and "Traceback" not in text and len(text.strip().splitlines()) == 1
+            and all(e in text for e in expected))
 
 
 def particles_of(text, path):
@@ -127,6 +146,31 @@ def h5_summary_folder(args):
     code, text = script(args, "h5_summary.py", "first.yaml")
     check(code == 1 and "Traceback" not in text and len(text.strip().splitlines()) == 1,
           "a file that is not HDF5: one-line error, exit 1", text)
+    # HDF5 files that are neither a snapshot nor a checkpoint: an error, exit 1 (it printed
+    # "time nan s step -1 particles 0", exit 0).
+    with h5py.File(os.path.join(args.work, "empty.h5"), "w"):
+        pass
+    with h5py.File(os.path.join(args.work, "flat.h5"), "w") as f:
+        f["particles"] = np.zeros(3)  # /particles a dataset, not a checkpoint's group
+    for name in ("empty.h5", "flat.h5"):
+        code, text = script(args, "h5_summary.py", name)
+        check(one_line_error(code, text, name, "neither a grainflow snapshot",
+                             "nor a checkpoint"),
+              f"{name}: neither a snapshot nor a checkpoint: one-line error, exit 1", text)
+
+    # Material indices out of the names' range: 2^30 (it built a list of 2^30 names and
+    # hung), -1 (it printed the last name) and 7, each reported as not in material_names.
+    def bad_materials(f):
+        m = f["material"][...]
+        m[:3] = [2**30, -1, 7]
+        f["material"][...] = m
+    name = edited_copy(args, "out/particles_000002.h5", "badmat.h5", bad_materials)
+    code, text = script(args, "h5_summary.py", name, timeout=30)
+    check(code == 0 and "Traceback" not in text
+          and "material 1073741824 (not in material_names):1" in text
+          and "material -1 (not in material_names):1" in text
+          and "material 7 (not in material_names):1" in text and "glass:27" in text,
+          "material indices 2^30, -1, 7: each said not in material_names, promptly", text)
 
 
 def h5_summary_coarse_grain(args):
@@ -168,6 +212,17 @@ def h5_summary_coarse_grain(args):
                   "within the insertion's 0.4 to 0.6 mm", m.group(0))
         check(f"materials  glass[k=2]:{n}" in text, f"{path}: material by name glass[k=2]", text)
         check("real radius [m]  min" in text, f"{path}: the real radius line", text)
+    # Impossible parcel data: a real_count of 0 (np.average raised ZeroDivisionError) and a
+    # coarse_grain of 0 (radius / 0 = inf): one line naming the file and dataset, exit 1.
+    def zero(dataset):
+        def edit(f):
+            f[dataset][...] = np.zeros(f[dataset].shape)
+        return edit
+    for dataset in ("real_count", "coarse_grain"):
+        name = edited_copy(args, last, f"zero_{dataset}.h5", zero(dataset))
+        code, text = script(args, "h5_summary.py", name)
+        check(one_line_error(code, text, name, f"dataset /{dataset} holds 0"),
+              f"{dataset} all 0: one-line error naming {name} and /{dataset}, exit 1", text)
     # k = 1: no parcel lines, the material by name.
     grain_run(args, scene(args.work, "plain.yaml", "plain"))
     code, text = script(args, "h5_summary.py", "plain/particles_000004.h5")
@@ -187,6 +242,10 @@ def plot_log_bad_inputs(args):
         (["plot/log.csv", "-o", "nodir/p.png"], "-o nodir/p.png: no folder"),
         (["plot/log.csv", "-o", "plot"], "-o plot is a folder"),
         (["plot/log.csv", "-c", "ke_total", "-o", "p.png"], "no column ke_total; valid columns"),
+        (["plot/log.csv", "-o", "g.xyz"], "-o g.xyz: matplotlib cannot write .xyz files; "
+                                          "give a name ending in"),
+        (["plot/log.csv", "-o", "g.txt"], ".png"),
+        (["plot/log.csv", "-o", "plot/log.csv"], "-o plot/log.csv is the log table itself"),
     ]
     for argv, expected in cases:
         code, text = script(args, "plot_log.py", *argv)
@@ -196,6 +255,28 @@ def plot_log_bad_inputs(args):
     code, text = script(args, "plot_log.py", "plot/log.csv", "-o", "ok.png")
     check(code == 0 and re.search(r"wrote ok.png \(\d+ rows\)\n", text) is not None
           and "skipped" not in text, "an intact log plots, nothing skipped", text)
+    with open(os.path.join(args.work, "plot", "log.csv"), encoding="utf-8") as f:
+        lines = f.read().splitlines()
+    # A byte-order mark before the header (it made the first column '\ufefftime_s').
+    with open(os.path.join(args.work, "bom.csv"), "w", encoding="utf-8-sig") as f:
+        f.write("\n".join(lines) + "\n")
+    code, text = script(args, "plot_log.py", "bom.csv", "-x", "time_s", "-o", "bom.png")
+    check(code == 0 and f"wrote bom.png ({len(lines) - 1} rows)\n" in text,
+          "a log with a byte-order mark plots all its rows", text)
+    # A field longer than csv's default limit of 131072 characters (it raised _csv.Error):
+    # a damaged row, skipped and named.
+    with open(os.path.join(args.work, "long.csv"), "w") as f:
+        f.write("\n".join(lines[:3] + ["1" * 200000] + lines[3:]) + "\n")
+    code, text = script(args, "plot_log.py", "long.csv", "-o", "long.png")
+    check(code == 0 and "Traceback" not in text and "long.csv:4: damaged row skipped" in text
+          and f"wrote long.png ({len(lines) - 1} rows; skipped 1 damaged row(s), line(s) 4)"
+          in text, "a 200000-character field: that row skipped and named", text)
+    # And in the header: the last column's name 200000 characters long.
+    with open(os.path.join(args.work, "longhead.csv"), "w") as f:
+        f.write("\n".join([lines[0] + "x" * 200000] + lines[1:]) + "\n")
+    code, text = script(args, "plot_log.py", "longhead.csv", "-o", "longhead.png")
+    check(code == 0 and f"wrote longhead.png ({len(lines) - 1} rows)\n" in text,
+          "a 200000-character header field: the log plots", text)
 
 
 def plot_log_damaged_row(args):

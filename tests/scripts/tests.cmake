@@ -9,14 +9,19 @@
 #   five: the three snapshots particles.xdmf lists are summarised (30 particles each), the two
 #   left over are counted and named, the checkpoint reports its 50 particles and is marked as
 #   another run's; without particles.xdmf the newest file's scene_fingerprint decides; a
-#   folder without .h5 files and a file that is not HDF5 are one-line errors, exit 1.
+#   folder without .h5 files, a file that is not HDF5, and HDF5 files that are neither a
+#   snapshot nor a checkpoint (empty; /particles a dataset) are one-line errors, exit 1; material
+#   indices 2^30, -1 and 7 are each said to be not in material_names (no hang, no wrap-around).
 # scripts.h5_summary_coarse_grain: 20 parcels of k = 2 (snapshot and checkpoint): k, the 20
 #   parcels and the 160 = 20 x 2^3 real particles they stand for, the real radius = parcel
 #   radius / 2 within the insertion's 0.4-0.6 mm, the material as glass[k=2]; a k = 1 run
-#   keeps the plain summary (material by name).
+#   keeps the plain summary (material by name); a real_count or coarse_grain of 0 is a
+#   one-line error naming the file and dataset, exit 1.
 # scripts.plot_log_bad_inputs: a missing log, a folder, an HDF5 file, a file that is not a
-#   log, -o into a missing folder or onto a folder, an unknown column: each exit 1 with one
-#   line naming it, no Python traceback.
+#   log, -o into a missing folder or onto a folder, -o with an extension matplotlib cannot
+#   write (.xyz, .txt), -o the log itself, an unknown column: each exit 1 with one line naming
+#   it, no Python traceback; a log with a byte-order mark plots, and a field over csv's
+#   131072-character limit (in a row: that row skipped; in the header) is no traceback.
 # scripts.plot_log_damaged_row: a damaged row at line 51 and a last row cut short are left out
 #   and reported by line number; the other rows are plotted.
 grainflow_find_python(GRAINFLOW_SCRIPTS_PYTHON "h5py,numpy,matplotlib" "the scripts.* tests are")

@@ -9,6 +9,7 @@ rm -rf "$work"
 mkdir -p "$work/cfd-dem"
 cp "$src/tutorials/cfd-dem/run_case.sh" "$work/cfd-dem/"
 cp "$src/tutorials/cfd-dem/foam_case.py" "$work/cfd-dem/"
+cp "$src/tutorials/run_index.py" "$work/"
 cp -r "$src/tutorials/cfd-dem/$case" "$work/cfd-dem/"
 cd "$work/cfd-dem/$case"
 ./Allclean

@@ -194,8 +194,8 @@ elif case in ("dt_bit", "time_bit"):  # attributes have no HDF5 checksum: only g
     name = case.split("_")[0]
     flip_bytes_bit(attribute_offset(name), 0)  # the lowest mantissa bit: one ulp
     expect = f_ + r": error: the root group's attributes \(time, dt, step, next_id, rebuilds, " \
-        r"material_coarse_grain, material_real, wall_impulse, largest_radius, removed, skin\) do not " \
-        r"match their checksum, " \
+        r"material_coarse_grain, material_real, wall_impulse, largest_radius, removed, skin, " \
+        r"rayleigh_fraction\) do not match their checksum, " \
         r"attribute 'attributes_checksum' \(stored 0x[0-9a-f]{8}, computed 0x[0-9a-f]{8}\): the " \
         r"checkpoint was changed or damaged after it was written"
 elif case == "chunk_record":  # HDF5 then reads zeros for every position, with no error

@@ -9,10 +9,12 @@ code, its message and what is on disk afterwards:
     naming the file and the output folder, the CSV unchanged (its bytes);
   * overwrite_snapshot: a snapshot insertion out/particles_000001.h5 with the output in out/:
     refused, unchanged; with --output elsewhere the same scene runs;
-  * overwrite_scene: the scene file itself saved as out/log.csv with the output in out/:
-    refused (exit 1) by run and check, unchanged;
+  * overwrite_scene: the scene file itself saved as out/log.csv with the output in out/, or
+    linked into the output folder as particles.xdmf (symbolic or hard link): refused (exit 1),
+    unchanged;
   * failed_start_writes_nothing: a fill that cannot place its particles (into a/b/out) and a
-    refused time step leave no output folder behind; a folder that was there is kept, empty;
+    refused time step leave no output folder behind; a folder that was there is kept, empty,
+    and so is a symbolic link to nowhere given as the output folder;
   * second_document: keys after a '---' line: refused (exit 2) at that line, not dropped;
   * tilde: '~' in output.directory and in --output=~/x: refused (exit 2), no folder '~' made;
   * input_named: `grain check` and `grain run` name each particle file they read with its
@@ -159,6 +161,25 @@ def overwrite_scene():
         fail(case, "the scene file was changed")
     if sorted(os.listdir(os.path.join(d, "out"))) != ["log.csv"]:
         fail(case, f"out/ holds {sorted(os.listdir(os.path.join(d, 'out')))}")
+    # Linked into the folder under such a name: a symbolic link (run as the link or as its
+    # target) and a hard link would be written through.
+    scene(d, name="keep.yaml")
+    before = digest(os.path.join(d, "keep.yaml"))
+    for link, kind in (("sym", "symbolic"), ("hard", "hard")):
+        os.makedirs(os.path.join(d, link))
+        target = os.path.join(d, link, "particles.xdmf")
+        if kind == "symbolic":
+            os.symlink(os.path.join("..", "keep.yaml"), target)
+        else:
+            os.link(os.path.join(d, "keep.yaml"), target)
+        expect(case, grain(d, "run", "keep.yaml", "--output", link), 1,
+               rf"keep\.yaml: error: the scene file 'keep\.yaml' is linked as '.*{link}/particles"
+               rf"\.xdmf' in the output folder '{link}' under a name the run writes there")
+        if kind == "symbolic":
+            expect(case, grain(d, "run", f"{link}/particles.xdmf", "--output", link), 1,
+                   rf"the scene file '{link}/particles\.xdmf' is a link in the output folder")
+    if digest(os.path.join(d, "keep.yaml")) != before:
+        fail(case, "the linked scene file was written over")
 
 
 def failed_start_writes_nothing():
@@ -181,6 +202,13 @@ def failed_start_writes_nothing():
     expect(case, grain(d, "run", "scene.yaml"), 1, r"refusing to run with this time step")
     if not os.path.isdir(os.path.join(d, "out")) or os.listdir(os.path.join(d, "out")):
         fail(case, "the folder that was there before was removed or written to")
+    # A symbolic link to a folder that does not exist is the user's: kept.
+    os.symlink(os.path.join(d, "nowhere"), os.path.join(d, "results"))
+    expect(case, grain(d, "run", "scene.yaml", "--output", "results"), 1,
+           r"output directory 'results': is a symbolic link to '.*nowhere': that folder does "
+           r"not exist")
+    if not os.path.islink(os.path.join(d, "results")):
+        fail(case, "the failed start removed the user's symbolic link 'results'")
 
 
 def second_document():
@@ -270,6 +298,14 @@ def restart_other_step_setting():
                r"scene\.yaml:3: error: time\.rayleigh_fraction = 0\.1, but checkpoint "
                r"'out/checkpoint_\d+\.h5' was written by a run with time\.rayleigh_fraction = "
                r"0\.2 .*set time\.rayleigh_fraction to 0\.2 to restart")
+    # A damaged attribute is named as damage, not offered as the value to set.
+    import h5py
+    damaged = os.path.join(d, "damaged.h5")
+    shutil.copy(os.path.join(d, first), damaged)
+    with h5py.File(damaged, "r+") as f:
+        f.attrs["rayleigh_fraction"] = 0.1
+    expect(case, grain(d, "run", "scene.yaml", "--output", "x", "--restart", "damaged.h5"), 1,
+           r"root group's attributes \(.*rayleigh_fraction\) do not match their checksum")
     with open(os.path.join(d, "scene.yaml"), "w") as out:
         out.write(text)  # the advice: the run's 0.2
     expect(case, grain(d, "run", "scene.yaml", "--restart", first), 0, r"done:")

@@ -25,9 +25,7 @@ the plots are called fluidisedBed_short*.png.
 import argparse
 import math
 import os
-import re
 import sys
-import xml.etree.ElementTree as ET
 
 import h5py
 import matplotlib
@@ -41,21 +39,8 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 # tutorials/cfd-dem/foam_case.py
 from foam_case import foam_entry, mean_wall_share, series  # noqa: E402
 
-
-def run_snapshots(folder):
-    """The snapshot files of the run that wrote `folder`, in time order, from the run's own
-    index particles.xdmf: snapshots an earlier run left in the folder are not listed there."""
-    index = os.path.join(folder, "particles.xdmf")
-    try:
-        steps = ET.parse(index).getroot().find("Domain/Grid")
-    except (OSError, ET.ParseError) as e:
-        sys.exit(f"analyse.py: cannot read {index}, the run's list of its snapshots: {e}")
-    files = [] if steps is None else \
-        [os.path.join(folder, g.get("Name", "") + ".h5") for g in steps.findall("Grid")]
-    if not files:
-        sys.exit(f"analyse.py: {index} lists no snapshot")
-    return files
-
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+from run_index import run_snapshots  # noqa: E402 (tutorials/run_index.py)
 
 ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 ap.add_argument("case", nargs="?", default=os.path.dirname(os.path.abspath(__file__)))
@@ -76,11 +61,22 @@ plot_name = "fluidisedBed_short" if args.short else "fluidisedBed"
 
 
 # --- fluid, beads, geometry ------------------------------------------------------------
+if not os.path.isdir(case):
+    sys.exit(f"analyse.py: no case folder {case}")
+for needed in ("constant/transportProperties", "constant/couplingProperties"):
+    if not os.path.isfile(os.path.join(case, needed)):
+        sys.exit(f"analyse.py: no {os.path.join(case, needed)}: {case} is not a grainFoam case "
+                 "folder (give the fluidisedBed case folder)")
 transport = f"{case}/constant/transportProperties"
 rho_f = float(foam_entry(transport, "rho"))
 mu = rho_f * float(foam_entry(transport, "nu"))
 scene_file = os.path.join(case, foam_entry(f"{case}/constant/couplingProperties", "scene"))
-scene = yaml.safe_load(open(scene_file))
+try:
+    with open(scene_file) as f:
+        scene = yaml.safe_load(f)
+except OSError as e:
+    sys.exit(f"analyse.py: cannot read {scene_file}, the scene constant/couplingProperties "
+             f"names: {e.strerror or e}")
 g = float(np.linalg.norm(scene.get("gravity", [0, 0, 0])))
 
 t_in, p_in, area = series(case, "pInlet")

@@ -36,7 +36,6 @@ import argparse
 import os
 import re
 import sys
-import xml.etree.ElementTree as ET
 
 import h5py
 import matplotlib
@@ -49,21 +48,8 @@ import yaml
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from foam_case import foam_entry, series  # noqa: E402 (tutorials/cfd-dem/foam_case.py)
 
-
-def run_snapshots(folder):
-    """The snapshot files of the run that wrote `folder`, in time order, from the run's own
-    index particles.xdmf: snapshots an earlier run left in the folder are not listed there."""
-    index = os.path.join(folder, "particles.xdmf")
-    try:
-        steps = ET.parse(index).getroot().find("Domain/Grid")
-    except (OSError, ET.ParseError) as e:
-        sys.exit(f"analyse.py: cannot read {index}, the run's list of its snapshots: {e}")
-    files = [] if steps is None else \
-        [os.path.join(folder, g.get("Name", "") + ".h5") for g in steps.findall("Grid")]
-    if not files:
-        sys.exit(f"analyse.py: {index} lists no snapshot")
-    return files
-
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+from run_index import run_snapshots  # noqa: E402 (tutorials/run_index.py)
 
 ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 ap.add_argument("case", nargs="?", default=os.path.dirname(os.path.abspath(__file__)))

@@ -15,7 +15,6 @@ boundary; Nedderman §10.3), 1.17 for this hopper's 32 deg half-angle -- drawn a
 import math
 import os
 import sys
-import xml.etree.ElementTree as ET
 
 import h5py
 import matplotlib
@@ -24,21 +23,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-
-def run_snapshots(folder):
-    """The snapshot files of the run that wrote `folder`, in time order, from the run's own
-    index particles.xdmf: snapshots an earlier run left in the folder are not listed there."""
-    index = os.path.join(folder, "particles.xdmf")
-    try:
-        steps = ET.parse(index).getroot().find("Domain/Grid")
-    except (OSError, ET.ParseError) as e:
-        sys.exit(f"analyse.py: cannot read {index}, the run's list of its snapshots: {e}")
-    files = [] if steps is None else \
-        [os.path.join(folder, g.get("Name", "") + ".h5") for g in steps.findall("Grid")]
-    if not files:
-        sys.exit(f"analyse.py: {index} lists no snapshot")
-    return files
-
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+from run_index import run_snapshots  # noqa: E402 (tutorials/run_index.py)
 
 out = sys.argv[1] if len(sys.argv) > 1 else "output/discharge"
 files = run_snapshots(out)

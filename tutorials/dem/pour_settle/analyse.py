@@ -11,7 +11,6 @@ import csv
 import math
 import os
 import sys
-import xml.etree.ElementTree as ET
 
 import h5py
 import matplotlib
@@ -20,26 +19,26 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-
-def run_snapshots(folder):
-    """The snapshot files of the run that wrote `folder`, in time order, from the run's own
-    index particles.xdmf: snapshots an earlier run left in the folder are not listed there."""
-    index = os.path.join(folder, "particles.xdmf")
-    try:
-        steps = ET.parse(index).getroot().find("Domain/Grid")
-    except (OSError, ET.ParseError) as e:
-        sys.exit(f"analyse.py: cannot read {index}, the run's list of its snapshots: {e}")
-    files = [] if steps is None else \
-        [os.path.join(folder, g.get("Name", "") + ".h5") for g in steps.findall("Grid")]
-    if not files:
-        sys.exit(f"analyse.py: {index} lists no snapshot")
-    return files
-
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+from run_index import run_snapshots  # noqa: E402 (tutorials/run_index.py)
 
 out = sys.argv[1] if len(sys.argv) > 1 else "output"
-rows = list(csv.DictReader(open(f"{out}/log.csv")))
-t = np.array([float(r["time_s"]) for r in rows])
-ke = np.array([float(r["ke_trans_J"]) + float(r["ke_rot_J"]) for r in rows])
+if not os.path.isdir(out):
+    sys.exit(f"analyse.py: no output folder {out} (run ./Allrun first, or give the folder "
+             "`grain run` wrote)")
+log = os.path.join(out, "log.csv")
+try:
+    with open(log, newline="") as f:
+        rows = list(csv.DictReader(f))
+    t = np.array([float(r["time_s"]) for r in rows])
+    ke = np.array([float(r["ke_trans_J"]) + float(r["ke_rot_J"]) for r in rows])
+except OSError as e:
+    sys.exit(f"analyse.py: cannot read {log}, the run's log table: {e.strerror or e}")
+except (KeyError, TypeError, ValueError, csv.Error) as e:
+    sys.exit(f"analyse.py: {log} is not a grainflow log table (time_s, ke_trans_J, ke_rot_J): "
+             f"{type(e).__name__} {e}")
+if not len(t):
+    sys.exit(f"analyse.py: {log} holds no row")
 
 last = run_snapshots(out)[-1]
 with h5py.File(last, "r") as f:
