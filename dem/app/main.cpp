@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <optional>
 #include <string>
@@ -189,14 +190,23 @@ std::array<std::uint64_t, 4> start_fingerprints(const Start& s) {
         std::string(s.options.allow_large_time_step ? "large" : "guarded")})
     h[0] = fnv1a64(part + '\0', h[0]);
   h[1] = fnv1a64(s.scene_text, h[1]);
-  std::vector<std::string> files;
+  // The particle files by their contents (a CSV or snapshot of the same size but other
+  // particles had hung the ranks), the STL files by the model record's digests of them, the
+  // checkpoint (read by every rank, and large) by its size.
   for (const grainflow::Insertion& ins : scene.insertions)
-    for (const std::string* f : {&ins.csv_file, &ins.snapshot_file})
-      if (!f->empty()) files.push_back(*f);
+    for (const std::string* f : {&ins.csv_file, &ins.snapshot_file}) {
+      if (f->empty()) continue;
+      h[2] = fnv1a64(file(*f) + '\0', h[2]);
+      std::ifstream in(*f, std::ios::binary);
+      std::array<char, 1 << 16> buffer;
+      while (in.read(buffer.data(), buffer.size()) || in.gcount() > 0)
+        h[2] =
+            fnv1a64(std::string_view(buffer.data(), static_cast<std::size_t>(in.gcount())), h[2]);
+    }
   for (const grainflow::Wall& w : scene.walls)
-    if (!w.mesh.file.empty()) files.push_back(w.mesh.file);
-  if (s.options.restart) files.push_back(*s.options.restart);
-  for (const std::string& f : files) h[2] = fnv1a64(file(f) + '\0', h[2]);
+    if (!w.mesh.file.empty()) h[2] = fnv1a64(file(w.mesh.file) + '\0', h[2]);
+  h[2] = fnv1a64(scene.model_record, h[2]);
+  if (s.options.restart) h[2] = fnv1a64(file(*s.options.restart), h[2]);
   for (const char* name : {"GRAINFLOW_BUFFERED_WRITES", "GRAINFLOW_SNAPSHOT_MPIIO"}) {
     const char* value = std::getenv(name);
     h[3] = fnv1a64(name, h[3]);
@@ -243,10 +253,13 @@ int agree_on_start(const Start& s, int rank, int size) {
   if (!s.done) lo = hi = start_fingerprints(s);  // a rank with --help differs in the first
   MPI_Allreduce(MPI_IN_PLACE, lo.data(), 4, MPI_UINT64_T, MPI_MIN, MPI_COMM_WORLD);
   MPI_Allreduce(MPI_IN_PLACE, hi.data(), 4, MPI_UINT64_T, MPI_MAX, MPI_COMM_WORLD);
-  if (done[1] == 1) lo[0] = 0;
   std::string differ;
+  if (done[1] == 1) {  // --help or --version on some ranks only: their command lines differ
+    lo = hi = std::array<std::uint64_t, 4>{};
+    lo[0] = 1;
+  }
   const char* parts[4] = {"command lines (or working directories)", "scene files' bytes",
-                          "files the scene or --restart names (missing, or of other sizes)",
+                          "files the scene or --restart names (missing, or other contents)",
                           "GRAINFLOW_* environment variables"};
   for (int k = 0; k < 4; ++k)
     if (lo[k] != hi[k]) {

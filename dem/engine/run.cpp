@@ -308,11 +308,17 @@ void refuse_inputs_the_run_overwrites(const Scene& scene, const std::string& dir
   std::error_code ec;
   const fs::path out = fs::weakly_canonical(fs::absolute(dir, ec), ec);
   if (ec) return;
-  // The folder's entries under names the run writes: one that is a symbolic or hard link to
-  // an input would be written through, over the input.
+  // The folder's entries under names the run writes in place: one that is a symbolic or hard
+  // link to an input would be written through, over the input. (Snapshots and checkpoints
+  // are written as .part files renamed over their names, which replaces a link; a fresh
+  // log.csv is made anew, LogTable; particles.xdmf is renamed into place before its appends.)
   std::vector<fs::path> written_here;
-  for (const auto& entry : fs::directory_iterator(out, ec))
-    if (written_by_a_run(entry.path().filename().string())) written_here.push_back(entry.path());
+  for (const auto& entry : fs::directory_iterator(out, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (written_by_a_run(name) && (name == "log.csv" || name == "particles.xdmf" ||
+                                   name.ends_with(".part") || name.ends_with(".tmp")))
+      written_here.push_back(entry.path());
+  }
   const auto check = [&](const std::string& file, const std::string& where, const char* what) {
     if (file.empty()) return;
     std::error_code e;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -56,6 +57,9 @@ LogTable::LogTable(MPI_Comm comm, const std::string& path, const std::vector<std
   MPI_Comm_rank(comm_, &rank_);
   int err = 0;
   if (rank_ == 0) {
+    // A new file, not the old one truncated: a hard link to it elsewhere (a `cp -al` backup
+    // of the folder) keeps the earlier run's log.
+    std::remove(path_.c_str());
     errno = 0;
     file_ = std::fopen(path_.c_str(), "w");
     if (!file_)

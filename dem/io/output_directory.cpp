@@ -34,8 +34,10 @@ void prepare_output_directory(const std::string& dir) {
 
   std::error_code ec;
   // A dangling symbolic link: create_directories says only "File exists".
-  if (fs::is_symlink(dir, ec) && !fs::exists(dir, ec))
-    fail(dir, "is a symbolic link to '" + fs::read_symlink(dir, ec).string() + "'",
+  fs::path link = fs::path(dir).lexically_normal();  // "out/": the link "out"
+  if (link.filename().empty()) link = link.parent_path();
+  if (fs::is_symlink(link, ec) && !fs::exists(link, ec))
+    fail(dir, "is a symbolic link to '" + fs::read_symlink(link, ec).string() + "'",
          "that folder does not exist; create it");
   fs::create_directories(dir, ec);
   if (ec) fail(dir, "cannot create directory", ec.message());

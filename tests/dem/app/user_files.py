@@ -12,6 +12,8 @@ code, its message and what is on disk afterwards:
   * overwrite_scene: the scene file itself saved as out/log.csv with the output in out/, or
     linked into the output folder as particles.xdmf (symbolic or hard link): refused (exit 1),
     unchanged;
+  * hard_linked_backup: a run into a folder whose files are hard-linked into a backup (`cp
+    -al`), reading a snapshot from the backup, runs and leaves the backup's bytes (log.csv too);
   * failed_start_writes_nothing: a fill that cannot place its particles (into a/b/out) and a
     refused time step leave no output folder behind; a folder that was there is kept, empty,
     and so is a symbolic link to nowhere given as the output folder;
@@ -209,6 +211,27 @@ def failed_start_writes_nothing():
            r"not exist")
     if not os.path.islink(os.path.join(d, "results")):
         fail(case, "the failed start removed the user's symbolic link 'results'")
+
+
+def hard_linked_backup():
+    """A backup of an output folder made of hard links (`cp -al out backup`): a new run into
+    the folder, reading a snapshot from the backup, runs (snapshots and checkpoints are renamed
+    into place, which replaces a link) and leaves every backup file as it was, log.csv too."""
+    case = "hard_linked_backup"
+    d = fresh(case)
+    scene(d, name="stage1.yaml", extra=", checkpoint_interval: 0.002")
+    expect(case, grain(d, "run", "stage1.yaml"), 0, r"done:")
+    os.makedirs(os.path.join(d, "backup"))
+    for name in os.listdir(os.path.join(d, "out")):
+        if not name.startswith("."):
+            os.link(os.path.join(d, "out", name), os.path.join(d, "backup", name))
+    before = {n: digest(os.path.join(d, "backup", n)) for n in os.listdir(os.path.join(d, "backup"))}
+    scene(d, insert="  - {type: snapshot, file: backup/particles_000001.h5}", end=0.003)
+    expect(case, grain(d, "run", "scene.yaml"), 0, r"done:")
+    after = {n: digest(os.path.join(d, "backup", n)) for n in os.listdir(os.path.join(d, "backup"))}
+    if after != before:
+        fail(case, "backup files changed: "
+             + str(sorted(n for n in before if before[n] != after.get(n))))
 
 
 def second_document():
@@ -631,7 +654,8 @@ def restart_advice():
 if __name__ == "__main__":
     GRAIN, WORK = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
     os.makedirs(WORK, exist_ok=True)
-    for check in (overwrite_csv, overwrite_snapshot, overwrite_scene, failed_start_writes_nothing,
+    for check in (overwrite_csv, overwrite_snapshot, overwrite_scene, hard_linked_backup,
+                  failed_start_writes_nothing,
                   second_document, tilde, input_named,
                   help_option, restart_at_end, restart_other_step_setting, restart_other_domain,
                   check_restart,

@@ -98,6 +98,7 @@ TEST(OutputDirectory, DanglingSymbolicLinkNamesItsTarget) {
       message.find("is a symbolic link to '" + target.string() + "': that folder does not exist"),
       std::string::npos)
       << message;
+  EXPECT_NE(error_for(link.string() + "/").find("is a symbolic link to"), std::string::npos);
   EXPECT_FALSE(fs::exists(target));
 }
 
