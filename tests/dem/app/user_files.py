@@ -180,6 +180,8 @@ def overwrite_scene():
         if kind == "symbolic":
             expect(case, grain(d, "run", f"{link}/particles.xdmf", "--output", link), 1,
                    rf"the scene file '{link}/particles\.xdmf' is a link in the output folder")
+        os.remove(target)  # the advice: remove that link
+        expect(case, grain(d, "run", "keep.yaml", "--output", link), 0, r"done:")
     if digest(os.path.join(d, "keep.yaml")) != before:
         fail(case, "the linked scene file was written over")
 
@@ -211,6 +213,11 @@ def failed_start_writes_nothing():
            r"not exist")
     if not os.path.islink(os.path.join(d, "results")):
         fail(case, "the failed start removed the user's symbolic link 'results'")
+    scene(d)  # a scene that starts, into the link once its folder exists (the advice)
+    os.makedirs(os.path.join(d, "nowhere"))
+    expect(case, grain(d, "run", "scene.yaml", "--output", "results"), 0, r"done:")
+    if not os.path.isfile(os.path.join(d, "nowhere", "log.csv")):
+        fail(case, "the run through the link did not write into its folder")
 
 
 def hard_linked_backup():
@@ -304,18 +311,25 @@ def restart_at_end():
         fail(case, f"files changed: {changed}")
 
 
-def restart_other_step_setting():
-    """A restart keeps its run's step: a scene whose time.rayleigh_fraction differs from the
-    run's, or that gives one where the run gave time.step, is refused by run and check with
-    the value that restarts; followed, the restart runs."""
-    case = "restart_other_step_setting"
+def run_then_change(case, old, new):
+    """A run with a checkpoint in folder `case`; then its scene, 2 ms longer, with `old`
+    replaced by `new`. Returns the folder, the first checkpoint and the unchanged text."""
     d = fresh(case)
     scene(d, end=0.004, extra=", checkpoint_interval: 0.002")
     expect(case, grain(d, "run", "scene.yaml"), 0, r"done:")
     first = first_checkpoint(d)
     text = scene(d, end=0.006, extra=", checkpoint_interval: 0.002")
     with open(os.path.join(d, "scene.yaml"), "w") as out:
-        out.write(text.replace("rayleigh_fraction: 0.2", "rayleigh_fraction: 0.1"))
+        out.write(text.replace(old, new))
+    return d, first, text
+
+
+def restart_other_step_setting():
+    """A restart keeps its run's step: a scene whose time.rayleigh_fraction differs from the
+    run's, or that gives one where the run gave time.step, is refused by run and check with
+    the value that restarts; followed, the restart runs."""
+    case = "restart_other_step_setting"
+    d, first, text = run_then_change(case, "rayleigh_fraction: 0.2", "rayleigh_fraction: 0.1")
     for command in ("run", "check"):
         expect(case, grain(d, command, "scene.yaml", "--restart", first), 1,
                r"scene\.yaml:3: error: time\.rayleigh_fraction = 0\.1, but checkpoint "
@@ -348,19 +362,17 @@ def restart_other_domain():
     """A domain changed before a restart is named as the key that changed, not as a damaged
     checkpoint (the decomposition's cuts no longer fit it)."""
     case = "restart_other_domain"
-    d = fresh(case)
-    scene(d, end=0.004, extra=", checkpoint_interval: 0.002")
-    expect(case, grain(d, "run", "scene.yaml"), 0, r"done:")
-    first = first_checkpoint(d)
-    text = scene(d, end=0.006, extra=", checkpoint_interval: 0.002")
-    with open(os.path.join(d, "scene.yaml"), "w") as out:
-        out.write(text.replace("max: [0.01, 0.01, 0.02], periodic", "max: [0.01, 0.01, 0.03], periodic"))
+    d, first, text = run_then_change(case, "max: [0.01, 0.01, 0.02], periodic",
+                                     "max: [0.01, 0.01, 0.03], periodic")
     for command in ("run", "check"):
         got = grain(d, command, "scene.yaml", "--restart", first)
         expect(case, got, 1, r"scene\.yaml:1: error: domain\.max\[2\] is 0\.03 here, 0\.02 in the "
-                             r"run that wrote checkpoint")
+                             r"run that wrote checkpoint .* Restore domain\.max\[2\] to 0\.02")
         if "damaged" in got[1]:
             fail(case, "the message still blames the checkpoint")
+    with open(os.path.join(d, "scene.yaml"), "w") as out:
+        out.write(text)  # the advice: domain.max[2] restored
+    expect(case, grain(d, "run", "scene.yaml", "--restart", first), 0, r"done:")
 
 
 def check_restart():
