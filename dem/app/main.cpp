@@ -162,7 +162,7 @@ Start parse_command(const std::string& program, const std::vector<std::string>& 
 // What every rank must have alike, in four parts compared apart so that the message can say
 // which differs: the command line (paths made absolute: the same folder named two ways is the
 // same, another working directory is not), the scene file's bytes, the files the scene and
-// --restart name (their absolute paths and sizes), and the environment variables grain reads.
+// --restart name (their absolute paths and contents), and the environment variables grain reads.
 std::array<std::uint64_t, 4> start_fingerprints(const Start& s) {
   namespace fs = std::filesystem;
   using grainflow::fnv1a64;
@@ -190,23 +190,24 @@ std::array<std::uint64_t, 4> start_fingerprints(const Start& s) {
         std::string(s.options.allow_large_time_step ? "large" : "guarded")})
     h[0] = fnv1a64(part + '\0', h[0]);
   h[1] = fnv1a64(s.scene_text, h[1]);
-  // The particle files by their contents (a CSV or snapshot of the same size but other
-  // particles had hung the ranks), the STL files by the model record's digests of them, the
-  // checkpoint (read by every rank, and large) by its size.
+  const auto contents = [&](const std::string& path) {
+    h[2] = fnv1a64(file(path) + '\0', h[2]);
+    std::ifstream in(path, std::ios::binary);
+    std::array<char, 1 << 16> buffer;
+    while (in.read(buffer.data(), buffer.size()) || in.gcount() > 0)
+      h[2] = fnv1a64(std::string_view(buffer.data(), static_cast<std::size_t>(in.gcount())), h[2]);
+  };
+  // The particle files and the checkpoint by their contents (every rank reads each of them
+  // whole anyway; a file of the same size but other particles had hung the ranks or, for a
+  // checkpoint, restored other states on different ranks), the STL files by the model
+  // record's digests of them.
   for (const grainflow::Insertion& ins : scene.insertions)
-    for (const std::string* f : {&ins.csv_file, &ins.snapshot_file}) {
-      if (f->empty()) continue;
-      h[2] = fnv1a64(file(*f) + '\0', h[2]);
-      std::ifstream in(*f, std::ios::binary);
-      std::array<char, 1 << 16> buffer;
-      while (in.read(buffer.data(), buffer.size()) || in.gcount() > 0)
-        h[2] =
-            fnv1a64(std::string_view(buffer.data(), static_cast<std::size_t>(in.gcount())), h[2]);
-    }
+    for (const std::string* f : {&ins.csv_file, &ins.snapshot_file})
+      if (!f->empty()) contents(*f);
   for (const grainflow::Wall& w : scene.walls)
     if (!w.mesh.file.empty()) h[2] = fnv1a64(file(w.mesh.file) + '\0', h[2]);
   h[2] = fnv1a64(scene.model_record, h[2]);
-  if (s.options.restart) h[2] = fnv1a64(file(*s.options.restart), h[2]);
+  if (s.options.restart) contents(*s.options.restart);
   for (const char* name : {"GRAINFLOW_BUFFERED_WRITES", "GRAINFLOW_SNAPSHOT_MPIIO"}) {
     const char* value = std::getenv(name);
     h[3] = fnv1a64(name, h[3]);

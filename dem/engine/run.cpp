@@ -379,18 +379,30 @@ class FoldersMadeForTheRun {
     int rank = 0;
     MPI_Comm_rank(comm, &rank);
     if (rank == 0) {
+      // Each folder along the path as written, for the folders made on the way: "x/../y"
+      // makes x too. symlink_status: a symbolic link (also one to nowhere) is the user's,
+      // never made here; a prefix is taken as made only if neither it nor its lexically
+      // normal form is there (x/../y, x missing, names y, which may exist).
       std::error_code ec;
-      fs::path p = fs::absolute(dir, ec).lexically_normal();
-      if (p.filename().empty()) p = p.parent_path();  // "out/"
-      // symlink_status: a symbolic link (also one to nowhere) is the user's, never made here.
-      std::error_code missing;  // set for a path that is not there: not an error here
-      while (!ec && !p.empty() && !fs::exists(fs::symlink_status(p, missing))) {
-        made_.push_back(p);
-        if (p == p.parent_path()) break;
-        p = p.parent_path();
+      const fs::path whole = fs::absolute(dir, ec);
+      fs::path p;
+      for (const fs::path& part : whole) {
+        p /= part;
+        if (ec || part.empty() || part == "." || part == ".." || p == p.root_path()) continue;
+        std::error_code missing;  // set for a path that is not there: not an error here
+        if (!fs::exists(fs::symlink_status(p, missing)) &&
+            !fs::exists(fs::symlink_status(p.lexically_normal(), missing)))
+          made_.push_back(p);
       }
+      std::reverse(made_.begin(), made_.end());  // the deepest first
     }
     MPI_Barrier(comm);  // seen before any rank makes the folder
+  }
+  // The folders made, the deepest first (on rank 0; empty on the others).
+  std::vector<std::string> paths() const {
+    std::vector<std::string> out;
+    for (const std::filesystem::path& p : made_) out.push_back(p.string());
+    return out;
   }
   FoldersMadeForTheRun(const FoldersMadeForTheRun&) = delete;
   FoldersMadeForTheRun& operator=(const FoldersMadeForTheRun&) = delete;
@@ -617,10 +629,22 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   std::ostream& say = speaker(comm, out);
   if (!options.restart) print_input_files(scene, comm, out);
 
+  // A signal while the particles are placed (a large fill takes minutes) or the checkpoint is
+  // read: said, and the lock and the folders made go, as after a failed start.
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  std::optional<StartupSignals> startup_signals;
+  startup_signals.emplace(
+      options.handle_stop_signals, rank == 0,
+      options.restart ? "reading the checkpoint" : "placing the particles",
+      rank == 0 ? std::vector<std::string>{(std::filesystem::path(dir) / ".grain.lock").string()}
+                : std::vector<std::string>{},
+      made.paths());
   // A restart takes its particles from the checkpoint instead of inserting them.
   Simulation sim(scene, !options.restart, comm);
   std::optional<std::string> checkpoint_log;  // the log table the checkpoint keeps
   if (options.restart) checkpoint_log = restore_checkpoint(sim, scene, *options.restart, comm, out);
+  startup_signals.reset();  // from here on, the run loop's StopSignals (a checkpoint at a step)
   // fluid_force needs the force terms' share kept, at the steps that write a snapshot.
   const bool wants_fluid_force = (scene.output.fields & snapshot_field_bit("fluid_force")) != 0;
   sim.record_fluid_force(wants_fluid_force);  // the first forces (snapshot of step 0)
@@ -741,8 +765,6 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     // An earlier run's files in the folder: this run overwrites the snapshots it writes under
     // the same numbers; the others stay beside them (a script taking the newest file takes
     // theirs), and so do its checkpoints. Said, not deleted.
-    int rank = 0;
-    MPI_Comm_rank(comm, &rank);
     if (rank == 0) {
       long earlier_snapshots = 0, earlier_checkpoints = 0;
       std::error_code ec;
@@ -949,8 +971,6 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   // write over (another snapshot_interval, an earlier end): said, not deleted, as for a fresh
   // run in a used folder. (A script taking the last file by name would take theirs.)
   if (options.restart) {
-    int rank = 0;
-    MPI_Comm_rank(comm, &rank);
     if (rank == 0)
       if (const std::vector<std::string> left = snapshots.files_after_series(); !left.empty())
         say << "note: " << dir << " still holds " << left.size() << " snapshot(s) numbered after "

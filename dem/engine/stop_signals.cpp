@@ -1,6 +1,10 @@
 #include "dem/engine/stop_signals.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <csignal>
+#include <utility>
 
 namespace grainflow {
 namespace {
@@ -11,7 +15,55 @@ volatile std::sig_atomic_t stop_signal = 0;
 
 extern "C" void on_stop_signal(int signal) { stop_signal = signal; }
 
+// What the start-up handler needs, prepared before it is installed.
+struct Startup {
+  std::string term_message, int_message;
+  std::vector<std::string> files, folders;
+};
+Startup* startup = nullptr;
+
+extern "C" void on_startup_signal(int signal) {
+  if (startup != nullptr) {
+    const std::string& m = signal == SIGINT ? startup->int_message : startup->term_message;
+    [[maybe_unused]] const ssize_t n = ::write(2, m.data(), m.size());
+    for (const std::string& f : startup->files) ::unlink(f.c_str());
+    for (const std::string& d : startup->folders) ::rmdir(d.c_str());  // only if empty
+  }
+  ::_exit(128 + signal);
+}
+
 }  // namespace
+
+StartupSignals::StartupSignals(bool install, bool speak, const std::string& what,
+                               std::vector<std::string> files, std::vector<std::string> folders)
+    : installed_(install) {
+  if (!installed_) return;
+  static Startup state;
+  state.files = std::move(files);
+  state.folders = std::move(folders);
+  for (const int signal : {SIGTERM, SIGINT}) {
+    std::string& m = signal == SIGINT ? state.int_message : state.term_message;
+    m.clear();
+    if (speak)
+      m = std::string("grain: received ") + StopSignals::name(signal) + " during start-up (" +
+          what +
+          "); stopped before the first step: nothing was run, no checkpoint or snapshot was "
+          "written (a run stops at a step with a checkpoint only once it steps)\n";
+  }
+  startup = &state;
+  struct sigaction action = {};
+  action.sa_handler = on_startup_signal;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGTERM, &action, &old_term_);
+  sigaction(SIGINT, &action, &old_int_);
+}
+
+StartupSignals::~StartupSignals() {
+  if (!installed_) return;
+  sigaction(SIGTERM, &old_term_, nullptr);
+  sigaction(SIGINT, &old_int_, nullptr);
+  startup = nullptr;
+}
 
 StopSignals::StopSignals(bool install) : installed_(install) {
   stop_signal = 0;

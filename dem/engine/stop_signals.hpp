@@ -7,6 +7,9 @@
 #include <mpi.h>
 #include <signal.h>
 
+#include <string>
+#include <vector>
+
 namespace grainflow {
 
 class StopSignals {
@@ -20,6 +23,25 @@ class StopSignals {
   // Collective: one MPI_Allreduce of an int, so that every rank stops at the same step.
   static int agreed(MPI_Comm comm);
   static const char* name(int signal) { return signal == SIGINT ? "SIGINT" : "SIGTERM"; }
+
+ private:
+  bool installed_;
+  struct sigaction old_term_ = {};
+  struct sigaction old_int_ = {};
+};
+
+// SIGTERM and SIGINT during a run's start-up (placing the particles of a large fill, reading a
+// checkpoint), which has no step boundary to stop at: the handler prints `message` (a line
+// per signal name, formatted here, since a handler may only call async-signal-safe functions),
+// removes `files` and then the empty `folders` (the lock and the folders the start made), and
+// ends the process with 128 + the signal, as the signal would. Used by `grain run` only.
+class StartupSignals {
+ public:
+  StartupSignals(bool install, bool speak, const std::string& what, std::vector<std::string> files,
+                 std::vector<std::string> folders);
+  ~StartupSignals();
+  StartupSignals(const StartupSignals&) = delete;
+  StartupSignals& operator=(const StartupSignals&) = delete;
 
  private:
   bool installed_;

@@ -67,6 +67,33 @@ expect file_missing_on_one_rank 2 "the ranks differ in their command lines \(or 
   -np 1 -wdir "$work/b" "$grain" run csv.yaml --no-progress
 [ ! -e /tmp/grainflow_rank_agreement_never_made ] ||
   { echo "FAIL file_missing_on_one_rank: wrote the output folder"; failures=$((failures + 1)); }
+# A checkpoint of the same size but other contents on one rank (as a node's stale copy): it
+# had been compared by its size only, and each rank restored its own copy's particles.
+cp a/beads.csv b/beads.csv
+sed 's/end: 0.002/end: 0.004/; s#output: {directory: [^}]*}#output: {directory: ck, checkpoint_interval: 0.001}#' \
+  a/csv.yaml > a/ck.yaml
+timeout 60 "$grain" run a/ck.yaml --output a/ck --no-progress > ck_run.txt 2>&1 ||
+  { echo "FAIL checkpoint run:"; cat ck_run.txt; failures=$((failures + 1)); }
+first=$(ls a/ck/checkpoint_*.h5 | head -1)
+cp a/ck.yaml b/ck.yaml && cp "$first" a/ckpt.h5 && cp "$first" b/ckpt.h5
+python3 - b/ckpt.h5 << 'PY'
+import sys
+with open(sys.argv[1], "r+b") as f:  # one byte of the file's last part (particle data) flipped
+    f.seek(-100, 2); b = f.read(1); f.seek(-100, 2); f.write(bytes([b[0] ^ 0xFF]))
+PY
+# The same path must hold the same bytes on both ranks: rank 1 sees b's copy through a bind
+# mount in its own mount namespace (where unshare is allowed; skipped otherwise).
+if unshare -m true 2> /dev/null; then
+  expect checkpoint_differs_on_one_rank 2 "the ranks differ in their files the scene or --restart names" -- \
+    "${one[@]}" "$grain" run a/ck.yaml --restart a/ckpt.h5 --output out --no-progress : \
+    -np 1 unshare -m bash -c "mount --bind b/ckpt.h5 a/ckpt.h5 && exec '$grain' run a/ck.yaml --restart a/ckpt.h5 --output out --no-progress"
+else
+  echo "skip checkpoint_differs_on_one_rank: no mount namespaces here"
+fi
+expect checkpoint_alike 0 "^done:" -- \
+  "${one[@]}" "$grain" run a/ck.yaml --restart a/ckpt.h5 --output ck2 --no-progress : \
+  -np 1 "$grain" run a/ck.yaml --restart a/ckpt.h5 --output ck2 --no-progress
+rm -rf ck2
 # Agreeing ranks still run, and --version and usage errors print once.
 expect version_once 0 "^grain \(grainflow\)" -- "${two[@]}" "$grain" --version
 [ "$(grep -c "grain (grainflow)" version_once.txt)" = 1 ] ||

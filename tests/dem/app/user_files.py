@@ -15,8 +15,10 @@ code, its message and what is on disk afterwards:
   * hard_linked_backup: a run into a folder whose files are hard-linked into a backup (`cp
     -al`), reading a snapshot from the backup, runs and leaves the backup's bytes (log.csv too);
   * failed_start_writes_nothing: a fill that cannot place its particles (into a/b/out) and a
-    refused time step leave no output folder behind; a folder that was there is kept, empty,
-    and so is a symbolic link to nowhere given as the output folder;
+    refused time step leave no output folder behind (nor x/ of --output x/../y); a folder that
+    was there is kept, empty, and so is a symbolic link to nowhere given as the output folder;
+  * signal_during_start: SIGTERM while a fill of 400 000 particles is placed: a message, exit
+    143, no folder left;
   * second_document: keys after a '---' line: refused (exit 2) at that line, not dropped;
   * tilde: '~' in output.directory and in --output=~/x: refused (exit 2), no folder '~' made;
   * input_named: `grain check` and `grain run` name each particle file they read with its
@@ -55,8 +57,10 @@ import hashlib
 import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
+import time
 
 SCENE = """domain: {{min: [0, 0, 0], max: [0.01, 0.01, 0.02], periodic: [true, true, false]}}
 gravity: [0, 0, -9.81]
@@ -206,6 +210,15 @@ def failed_start_writes_nothing():
     expect(case, grain(d, "run", "scene.yaml"), 1, r"refusing to run with this time step")
     if not os.path.isdir(os.path.join(d, "out")) or os.listdir(os.path.join(d, "out")):
         fail(case, "the folder that was there before was removed or written to")
+    # A path through a folder that is not there: "x/../y" makes x too, which goes again;
+    # "x/../out" names the folder that was there, which stays.
+    for given in ("x/../y", "x/../out"):
+        expect(case, grain(d, "run", "scene.yaml", "--output", given), 1,
+               r"refusing to run with this time step")
+        if os.path.exists(os.path.join(d, "x")) or os.path.exists(os.path.join(d, "y")):
+            fail(case, f"--output {given}: the failed start left x/ or y/ behind")
+        if not os.path.isdir(os.path.join(d, "out")):
+            fail(case, f"--output {given}: the folder out/ that was there was removed")
     # A symbolic link to a folder that does not exist is the user's: kept.
     os.symlink(os.path.join(d, "nowhere"), os.path.join(d, "results"))
     expect(case, grain(d, "run", "scene.yaml", "--output", "results"), 1,
@@ -218,6 +231,33 @@ def failed_start_writes_nothing():
     expect(case, grain(d, "run", "scene.yaml", "--output", "results"), 0, r"done:")
     if not os.path.isfile(os.path.join(d, "nowhere", "log.csv")):
         fail(case, "the run through the link did not write into its folder")
+
+
+def signal_during_start():
+    """SIGTERM while a large fill places its particles (before the first step, where the run
+    loop would write a checkpoint): a message, exit 143, and no folder left behind."""
+    case = "signal_during_start"
+    d = fresh(case)
+    big = FILL.replace("count: 50", "count: 400000").replace("[0.01, 0.01, 0.019]",
+                                                             "[0.1, 0.1, 0.19]")
+    text = scene(d, insert=big, directory="a/b/out").replace("[0.01, 0.01, 0.02]",
+                                                             "[0.1, 0.1, 0.2]")
+    with open(os.path.join(d, "scene.yaml"), "w") as out:
+        out.write(text)
+    p = subprocess.Popen([GRAIN, "run", "scene.yaml"], cwd=d, stdout=subprocess.PIPE,
+                         stderr=subprocess.STDOUT, text=True)
+    lock = os.path.join(d, "a", "b", "out", ".grain.lock")
+    for _ in range(600):  # the lock is taken just before the particles are placed
+        if os.path.exists(lock) or p.poll() is not None:
+            break
+        time.sleep(0.01)
+    p.send_signal(signal.SIGTERM)
+    out, _ = p.communicate(timeout=120)
+    expect(case, (p.returncode, out), 143,
+           r"grain: received SIGTERM during start-up \(placing the particles\); stopped before "
+           r"the first step: nothing was run, no checkpoint or snapshot was written")
+    if os.path.exists(os.path.join(d, "a")):
+        fail(case, f"the stopped start left a/ behind: {sorted(os.listdir(os.path.join(d, 'a')))}")
 
 
 def hard_linked_backup():
@@ -667,7 +707,7 @@ if __name__ == "__main__":
     GRAIN, WORK = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
     os.makedirs(WORK, exist_ok=True)
     for check in (overwrite_csv, overwrite_snapshot, overwrite_scene, hard_linked_backup,
-                  failed_start_writes_nothing,
+                  failed_start_writes_nothing, signal_during_start,
                   second_document, tilde, input_named,
                   help_option, restart_at_end, restart_other_step_setting, restart_other_domain,
                   check_restart,
