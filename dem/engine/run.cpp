@@ -687,8 +687,10 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   if (const double last = static_cast<double>(end_step) * sim.dt();
       std::abs(last - scene.time.end) > kEndTolerance * scene.time.end)
     say << "note: time.end / step = " << significant(scene.time.end / sim.dt(), 6)
-        << " is not whole: the run takes " << end_step << " steps, the nearest whole number, and "
-        << "ends at t = " << significant(last, 9) << " s\n";
+        << " is not whole: the run takes " << end_step << (end_step == 1 ? " step" : " steps")
+        << ", the nearest whole number"
+        << (scene.time.end / sim.dt() < 0.5 ? " of at least one" : "")
+        << ", and ends at t = " << significant(last, 9) << " s\n";
 
   SnapshotWriter snapshots(comm, dir, "particles", scene.output.fields);
   snapshots.set_coarse_grain(scene.coarse_grain_table(), scene.real_material_table());
@@ -785,7 +787,10 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   LogTable& log = *log_table;
   if (!log.note().empty()) say << "note: " << log.note() << "\n";
   sim.set_log_record(&log.record());  // each checkpoint keeps the log up to its step
-  ProgressLine progress(comm, scene.time.end, options.progress && scene.output.progress, out);
+  // Against the time the last step reaches (time.end within half a step): a finished run shows
+  // 100 %.
+  ProgressLine progress(comm, static_cast<double>(end_step) * sim.dt(),
+                        options.progress && scene.output.progress, out);
   CheckpointSeries checkpoints(comm, dir, scene.output.checkpoint_keep,
                                options.restart ? first_step : -1, insertion_record(scene),
                                scene.model_record);
@@ -890,12 +895,23 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
 
   RunSummary sum;
   // Output counters as the uninterrupted run has them at this step: the index of the last
-  // interval written, so a restart writes the same steps as the uninterrupted run.
+  // target origin + i * every written, so a restart writes the same steps as the uninterrupted
+  // run. Decided by the loop's own test below (t >= origin + i * every - dt/2, the same
+  // floating-point expression): the quotient (t0 + dt/2) / every rounds otherwise when the
+  // checkpoint sits half a step before a target, and a restart had then skipped or repeated
+  // that snapshot and log row.
   const double t0 = sim.time();
-  auto written = [&](double every) {
-    return every > 0 ? static_cast<long>(std::floor((t0 + 0.5 * dt) / every)) : 0L;
+  const auto due = [dt](double t, double origin, long i, double every) {
+    return t >= origin + static_cast<double>(i) * every - 0.5 * dt;
   };
-  long log_index = written(log_every);
+  auto written = [&](double every, double origin) {
+    if (every <= 0) return 0L;
+    long i = static_cast<long>(std::floor((t0 - origin + 0.5 * dt) / every));
+    while (due(t0, origin, i + 1, every)) ++i;
+    while (i > 0 && !due(t0, origin, i, every)) --i;
+    return i;
+  };
+  long log_index = written(log_every, 0.0);
   // Snapshots at origin + i * snap_every inside the window [output.start, output.stop]
   // (within half a step), and at the last step when it is inside; snap_index is the last i
   // written (-1: the window has not begun).
@@ -904,10 +920,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   const auto in_window = [&](double t) {
     return t >= snap_origin - 0.5 * dt && t <= snap_end + 0.5 * dt;
   };
-  long snap_index = t0 < snap_origin - 0.5 * dt
-                        ? -1L
-                        : static_cast<long>(std::floor((t0 - snap_origin + 0.5 * dt) / snap_every));
-  long check_index = written(check_every);
+  long snap_index = t0 < snap_origin - 0.5 * dt ? -1L : written(snap_every, snap_origin);
+  long check_index = written(check_every, 0.0);
   long snap_step = first_step, log_step = first_step;  // last step written
   if (!options.restart) {
     if (in_window(sim.time())) write_snapshot(sim.time(), 0);
@@ -921,7 +935,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   double particle_steps = 0;  // this rank's
   std::ostringstream stop_message;
   const auto snapshot_due = [&](double t, long k) {
-    return in_window(t) && (t >= snap_origin + (snap_index + 1) * snap_every - 0.5 * dt ||
+    return in_window(t) && (due(t, snap_origin, snap_index + 1, snap_every) ||
                             (k == total_steps && snap_step != k));
   };
   for (long k = first_step + 1; k <= total_steps; ++k) {
@@ -933,7 +947,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     particle_steps += static_cast<double>(sim.particles().size());
     const double t = sim.time();
     const bool last = k == total_steps;
-    if (t >= (log_index + 1) * log_every - 0.5 * dt || (last && log_step != k)) {
+    if (due(t, 0.0, log_index + 1, log_every) || (last && log_step != k)) {
       log_step = k;
       log_index = static_cast<long>(std::floor(t / log_every + 0.5));
       global_particles = write_log().particles;
@@ -945,7 +959,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
       snap_index = static_cast<long>(std::floor((t - snap_origin) / snap_every + 0.5));
       write_snapshot(t, k);
     }
-    if (check_every > 0 && !last && t >= (check_index + 1) * check_every - 0.5 * dt) {
+    if (check_every > 0 && !last && due(t, 0.0, check_index + 1, check_every)) {
       check_index = static_cast<long>(std::floor(t / check_every + 0.5));
       write_checkpoint();
     }
@@ -991,7 +1005,13 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   say << (sum.stop_checkpoint.empty() ? "done: " : "stopped: ") << sum.steps << " steps, "
       << sum.particles_end << " particles (" << sum.removed << " removed), " << sum.rebuilds
       << " neighbour rebuilds, " << sum.wall_seconds << " s wall, " << sum.particle_steps_per_second
-      << " particle-steps/s\n"
+      << " particle-steps/s";
+  // The counts above are the run's since t = 0; a restart ran only those after its checkpoint.
+  if (options.restart)
+    say << " (steps and rebuilds counted from t = 0; this restart ran " << sum.steps - first_step
+        << (sum.steps - first_step == 1 ? " step" : " steps") << ", after the checkpoint's step "
+        << first_step << ")";
+  say << "\n"
       << "output: " << dir << "/particles.xdmf (open in ParaView), " << dir << "/log.csv\n";
   // None is written at the end: the newest, and how to extend the run exactly from it.
   if (sum.stop_checkpoint.empty() && !checkpoints.newest().empty())

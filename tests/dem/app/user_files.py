@@ -38,6 +38,9 @@ code, its message and what is on disk afterwards:
     where one longer run ends; a restart into another folder says so; a snapshot given to
     --restart is named as one, by its contents (renamed state.h5 too; a checkpoint copied to
     particles_backup.h5 restarts);
+  * restart_output_series: restarts from every periodic checkpoint of 14 scenes whose output
+    intervals are odd numbers of half steps write the uninterrupted run's snapshots and log
+    rows, at the same steps under the same numbers;
   * restart_at_end: a restart whose time.end is the checkpoint's time runs nothing and leaves
     log.csv, particles.xdmf and every snapshot as they were (bytes), where it had cut the log
     back to the checkpoint;
@@ -258,6 +261,66 @@ def signal_during_start():
            r"the first step: nothing was run, no checkpoint or snapshot was written")
     if os.path.exists(os.path.join(d, "a")):
         fail(case, f"the stopped start left a/ behind: {sorted(os.listdir(os.path.join(d, 'a')))}")
+
+
+def restart_output_series():
+    """A restart writes the snapshots and log rows of the uninterrupted run, at the same steps
+    and under the same numbers, also when its checkpoint sits half a step before an output
+    target (an interval of an odd number of half steps): random intervals of 3 to 13 half
+    steps, restarted from every periodic checkpoint. Those ties had skipped or repeated a
+    snapshot and a log row (e.g. dt = 3e-4 s, interval 1.05e-3 s, checkpoint at step 10)."""
+    import random
+    import h5py
+    case = "restart_output_series"
+    d = fresh(case)
+    with open(os.path.join(d, "p.csv"), "w") as out:
+        out.write("x,y,z,radius,vx,vy,vz\n0.5,0.5,0.5,0.001,0.3,0,0.2\n")
+
+    def series(folder):
+        steps = []
+        for name in sorted(os.listdir(folder)):
+            if name.startswith("particles_") and name.endswith(".h5"):
+                with h5py.File(os.path.join(folder, name), "r") as f:
+                    steps.append((name, int(f.attrs["step"]), float(f.attrs["time"])))
+        with open(os.path.join(folder, "log.csv")) as f:
+            rows = [line.split(",")[1] for line in f.read().split()[1:]]
+        return steps, rows
+
+    # Values as a user types them (decimal, 6 digits): (step, output interval, checkpoint
+    # interval, end). The first two are the ties found first.
+    combos = [("3e-4", "0.00105", "0.003", "0.01"), ("3e-4", "0.00165", "0.0048", "0.012")]
+    rng = random.Random(7)
+    while len(combos) < 14:
+        dt = rng.choice([3e-4, 1e-3, 7e-5, 1.1e-4, 2.5e-4, 3.3e-5])
+        combos.append((f"{dt:.6g}", f"{dt * rng.randrange(3, 14, 2) / 2:.6g}",
+                       f"{dt * rng.randrange(5, 30):.6g}", f"{dt * rng.randrange(40, 80):.6g}"))
+    checked = 0
+    for n, (dt, every, check, end) in enumerate(combos):
+        text = (f"domain: {{min: [-100, -100, -100], max: [100, 100, 100]}}\n"
+                f"gravity: [0, 0, -9.81]\ntime: {{step: {dt}, end: {end}}}\n"
+                f"materials: [{{name: glass, density: 2500}}]\n"
+                f"insert: [{{type: csv, file: p.csv, material: glass}}]\n"
+                f"output: {{progress: false, snapshot_interval: {every}, log_interval: {every}, "
+                f"checkpoint_interval: {check}, checkpoint_keep: 1000}}\n")
+        with open(os.path.join(d, f"s{n}.yaml"), "w") as out:
+            out.write(text)
+        full = f"full{n}"
+        expect(case, grain(d, "run", f"s{n}.yaml", "--output", full), 0, r"done:")
+        want = series(os.path.join(d, full))
+        for name in sorted(os.listdir(os.path.join(d, full))):
+            if not name.startswith("checkpoint_"):
+                continue
+            again = f"again{n}_{name[11:20]}"
+            shutil.copytree(os.path.join(d, full), os.path.join(d, again))
+            expect(case, grain(d, "run", f"s{n}.yaml", "--output", again, "--restart",
+                               f"{again}/{name}"), 0, r"done:")
+            got = series(os.path.join(d, again))
+            checked += 1
+            if got != want:
+                fail(case, f"dt {dt}, interval {every} s, restart from {name}: snapshots "
+                           f"{[g[1] for g in got[0]]} and log steps {got[1]}, the uninterrupted "
+                           f"run's {[w[1] for w in want[0]]} and {want[1]}")
+    print(f"ok {case}: {checked} restarts from {len(combos)} scenes, each the uninterrupted series")
 
 
 def hard_linked_backup():
@@ -713,7 +776,7 @@ if __name__ == "__main__":
                   check_restart,
                   restart_missing_csv, restart_mesh,
                   restart_other_physics, restart_smaller_skin, hostile_text,
-                  restart_advice):
+                  restart_advice, restart_output_series):
         check()
     if failures:
         sys.exit(f"{len(failures)} failure(s)")
