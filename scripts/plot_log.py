@@ -9,7 +9,7 @@ on stderr and in the closing "wrote" line; a last row cut short by a killed run 
 A missing, binary or non-log input, or an -o whose folder does not exist, whose extension
 is not an image format matplotlib writes (.png, .pdf, .svg, ...), or that is the log itself,
 is a one-line error, exit status 1 (2 for a usage error). A byte-order mark at the start of
-the log is ignored.
+the log is ignored. An -o without an extension writes <name>.png, and says so.
 Needs matplotlib and numpy (Debian: python3-matplotlib); no display is required.
 """
 import argparse
@@ -99,6 +99,8 @@ def main():
     out_dir = os.path.dirname(os.path.abspath(args.output))
     if os.path.isdir(args.output):
         fail(f"-o {args.output} is a folder; give the PNG file's name")
+    if not os.path.splitext(args.output)[1]:
+        args.output += ".png"  # what matplotlib writes for a name without an extension
     if not os.path.isdir(out_dir):
         fail(f"-o {args.output}: no folder {out_dir} to write it in")
     if os.path.realpath(args.output) == os.path.realpath(args.log):

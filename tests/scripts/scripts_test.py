@@ -277,6 +277,11 @@ def plot_log_bad_inputs(args):
     code, text = script(args, "plot_log.py", "longhead.csv", "-o", "longhead.png")
     check(code == 0 and f"wrote longhead.png ({len(lines) - 1} rows)\n" in text,
           "a 200000-character header field: the log plots", text)
+    # -o without an extension: matplotlib writes <name>.png, and the script names that file.
+    code, text = script(args, "plot_log.py", "bom.csv", "-o", "noext")
+    check(code == 0 and "wrote noext.png (" in text
+          and os.path.isfile(os.path.join(args.work, "noext.png")), "-o noext writes and names "
+          "noext.png", text)
 
 
 def plot_log_damaged_row(args):

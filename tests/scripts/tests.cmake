@@ -21,7 +21,8 @@
 #   log, -o into a missing folder or onto a folder, -o with an extension matplotlib cannot
 #   write (.xyz, .txt), -o the log itself, an unknown column: each exit 1 with one line naming
 #   it, no Python traceback; a log with a byte-order mark plots, and a field over csv's
-#   131072-character limit (in a row: that row skipped; in the header) is no traceback.
+#   131072-character limit (in a row: that row skipped; in the header) is no traceback; -o
+#   without an extension writes and names <name>.png.
 # scripts.plot_log_damaged_row: a damaged row at line 51 and a last row cut short are left out
 #   and reported by line number; the other rows are plotted.
 grainflow_find_python(GRAINFLOW_SCRIPTS_PYTHON "h5py,numpy,matplotlib" "the scripts.* tests are")
