@@ -1,6 +1,5 @@
 #include "dem/engine/stop_signals.hpp"
 
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <csignal>
@@ -32,6 +31,23 @@ extern "C" void on_startup_signal(int signal) {
   ::_exit(128 + signal);
 }
 
+// Installs `handler` for SIGTERM and SIGINT, keeping the handlers it replaces; restore_handlers
+// puts them back.
+void install_handlers(void (*handler)(int), int flags, struct sigaction& old_term,
+                      struct sigaction& old_int) {
+  struct sigaction action = {};
+  action.sa_handler = handler;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = flags;
+  sigaction(SIGTERM, &action, &old_term);
+  sigaction(SIGINT, &action, &old_int);
+}
+
+void restore_handlers(const struct sigaction& old_term, const struct sigaction& old_int) {
+  sigaction(SIGTERM, &old_term, nullptr);
+  sigaction(SIGINT, &old_int, nullptr);
+}
+
 }  // namespace
 
 StartupSignals::StartupSignals(bool install, bool speak, const std::string& what,
@@ -51,35 +67,24 @@ StartupSignals::StartupSignals(bool install, bool speak, const std::string& what
           "written (a run stops at a step with a checkpoint only once it steps)\n";
   }
   startup = &state;
-  struct sigaction action = {};
-  action.sa_handler = on_startup_signal;
-  sigemptyset(&action.sa_mask);
-  sigaction(SIGTERM, &action, &old_term_);
-  sigaction(SIGINT, &action, &old_int_);
+  install_handlers(on_startup_signal, 0, old_term_, old_int_);
 }
 
 StartupSignals::~StartupSignals() {
   if (!installed_) return;
-  sigaction(SIGTERM, &old_term_, nullptr);
-  sigaction(SIGINT, &old_int_, nullptr);
+  restore_handlers(old_term_, old_int_);
   startup = nullptr;
 }
 
 StopSignals::StopSignals(bool install) : installed_(install) {
   stop_signal = 0;
   if (!installed_) return;
-  struct sigaction action = {};
-  action.sa_handler = on_stop_signal;
-  sigemptyset(&action.sa_mask);
-  action.sa_flags = SA_RESETHAND;
-  sigaction(SIGTERM, &action, &old_term_);
-  sigaction(SIGINT, &action, &old_int_);
+  install_handlers(on_stop_signal, SA_RESETHAND, old_term_, old_int_);
 }
 
 StopSignals::~StopSignals() {
   if (!installed_) return;
-  sigaction(SIGTERM, &old_term_, nullptr);
-  sigaction(SIGINT, &old_int_, nullptr);
+  restore_handlers(old_term_, old_int_);
 }
 
 int StopSignals::agreed(MPI_Comm comm) {
