@@ -103,14 +103,20 @@ DemLink::DemLink(const std::string& scene_file, double fluid_density, double flu
   m.curl = needs_vorticity();
   const FluidSettings& f = *m.scene.fluid;
   std::ostringstream why;
+  // 12 digits: the values agree to 1e-9 relative, so the printed one typed back passes.
+  why.precision(12);
   if (!close(f.field.density, fluid_density))
     why << f.source << ": error: fluid.density is " << f.field.density
         << " kg/m^3 but the fluid solver's rho is " << fluid_density
-        << " kg/m^3 (constant/transportProperties); make them equal\n";
+        << " kg/m^3 (constant/transportProperties); make them equal (to 1e-9 relative), e.g. "
+           "fluid.density: "
+        << fluid_density << "\n";
   if (!close(f.field.viscosity, fluid_viscosity))
     why << f.source << ": error: fluid.viscosity is " << f.field.viscosity
         << " Pa s but the fluid solver's rho*nu is " << fluid_viscosity
-        << " Pa s (constant/transportProperties); make them equal\n";
+        << " Pa s (constant/transportProperties); make them equal (to 1e-9 relative), e.g. "
+           "fluid.viscosity: "
+        << fluid_viscosity << "\n";
   if (f.field.hydrostatic_pressure)
     why << f.source
         << ": error: grainFoam's pressure excludes the hydrostatic part (rho_f g.x); add "

@@ -113,8 +113,17 @@ WrittenFilesCheck check_written_files(const std::string& folder) {
       record +
       " and start again; otherwise restart from an earlier time folder (or from 0) that "
       "is intact.";
+  // Not "delete its line": without the time's own uniform/time and uniform/grainflowCheckpoint
+  // the fluid would go on from this time while the DEM started again from the scene.
+  const std::string position_advice =
+      "uniform/time and uniform/grainflowCheckpoint say where the fluid and the DEM stand at "
+      "this time (the time index, the DEM checkpoint); a restart cannot do without them as "
+      "written, and they cannot be remade by hand. Restart from another time folder that is "
+      "intact (startFrom startTime; startTime <time> in system/controlDict), or start afresh "
+      "from time 0.";
   std::ostringstream problems;
   int bad = 0;
+  bool positionBad = false;  // uniform/time or uniform/grainflowCheckpoint among them
   std::string line;
   int number = 0;
   bool entries = false;  // past the FoamFile header's closing brace
@@ -135,8 +144,11 @@ WrittenFilesCheck check_written_files(const std::string& folder) {
       return check;
     }
     const std::string name = match[1].str(), path = folder + "/" + name;
+    // uniform/time and uniform/grainflowCheckpoint say where the fluid and the DEM stand.
+    const bool position = name == "uniform/time" || name == "uniform/grainflowCheckpoint";
     if (!fs::is_regular_file(path)) {
       ++bad;
+      positionBad = positionBad || position;
       problems << "  " << path << " is missing (line " << number << " of the record)\n";
       continue;
     }
@@ -145,11 +157,13 @@ WrittenFilesCheck check_written_files(const std::string& folder) {
       now = file_checksum(path);
     } catch (const std::exception& e) {
       ++bad;
+      positionBad = positionBad || position;
       problems << "  " << e.what() << '\n';
       continue;
     }
     if (hex(now) != match[2].str()) {
       ++bad;
+      positionBad = positionBad || position;
       problems << "  " << path << ": FNV-1a checksum " << hex(now) << ", recorded "
                << match[2].str() << " (line " << number << ")\n";
       continue;
@@ -168,7 +182,7 @@ WrittenFilesCheck check_written_files(const std::string& folder) {
                     (bad == 1 ? " file of time folder " : " files of time folder ") +
                     fs::path(folder).filename().string() + (bad == 1 ? " differs" : " differ") +
                     " from what grainFoam wrote there (its record " + record + "):\n" +
-                    problems.str() + advice;
+                    problems.str() + (positionBad ? position_advice : advice);
   return check;
 }
 

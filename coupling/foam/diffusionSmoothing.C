@@ -4,7 +4,7 @@
 
 namespace grainflow::foam {
 
-DiffusionSmoothing::DiffusionSmoothing(const Foam::fvMesh& mesh, double bandwidth)
+DiffusionSmoothing::DiffusionSmoothing(const Foam::fvMesh& mesh, double bandwidth, double maxSteps)
     : mesh_(mesh), bandwidth_(bandwidth) {
   using namespace Foam;
   // |S_f| / |d_f| per face: deltaCoeffs is 1 / |d| between the two cell centres (across a
@@ -38,7 +38,11 @@ DiffusionSmoothing::DiffusionSmoothing(const Foam::fvMesh& mesh, double bandwidt
   // tables with diffusionBandwidth assume; docs/models/undisturbed-velocity.md.)
   const double T = 0.25 * bandwidth * bandwidth;
   const double full = 0.5 / maxRate;
-  steps_ = std::max(1, static_cast<int>(std::ceil(T / full - 1e-9)));
+  // Counted in double: b^2 / (4 full) exceeds an int for bandwidths far beyond the mesh.
+  neededSteps_ = std::max(1.0, std::ceil(T / full - 1e-9));
+  maxBandwidth_ = 2 * std::sqrt(maxSteps * full);
+  if (!(neededSteps_ <= maxSteps)) return;
+  steps_ = static_cast<int>(neededSteps_);
   const double dtau = std::min(T, full);
   lastScale_ = steps_ > 1 ? (T - (steps_ - 1) * full) / full : 1.0;
   stepRate_ = dtau * maxRate;

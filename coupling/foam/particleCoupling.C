@@ -5,8 +5,12 @@
 #include <chrono>
 #include <climits>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <limits>
+#include <set>
 #include <sstream>
+#include <utility>
 
 #include "coupling/accuracy_table.hpp"
 #include "coupling/floating_point_traps.hpp"
@@ -69,6 +73,14 @@ constexpr double kFarOutside = 1e9;
 // orthogonal up to round-off (the correction changes the term by ~|k| relative).
 constexpr double kOrthogonalCorrection = 1e-9;
 
+// deltaT / time.step must be whole to this relative amount: the round-off of decimal inputs
+// (1e-3 / 2e-5 is 50 to 1.4e-16) and of a value typed with 11 digits or more.
+constexpr double kRatioTolerance = 1e-10;
+
+// diffusionBandwidth: at most this many explicit steps (each a pass over the faces per
+// averaged field and fluid step); a bandwidth beyond them averages over more than about 18
+// of the smallest cells in every direction, wider than any closure asks for.
+constexpr double kMaxSmoothingSteps = 1000;
 
 // Patch types for a derived field: constraint patches (processor, cyclic, empty, ...)
 // keep their type, every other patch is zeroGradient.
@@ -110,6 +122,36 @@ std::string checkpointChecksum(const std::string& path) {
   }
   MPI_Bcast(text, sizeof text, MPI_CHAR, 0, MPI_COMM_WORLD);
   return text;
+}
+
+// The DEM checkpoint a time folder's uniform/grainflowCheckpoint names ("" when none).
+std::string namedCheckpoint(const Foam::fileName& timeDir) {
+  std::ifstream in((timeDir / "uniform" / "grainflowCheckpoint").c_str());
+  std::string key, value;
+  while (in >> key) {
+    if (key == "checkpoint" && in >> value) {
+      if (!value.empty() && value.back() == ';') value.pop_back();
+      return value;
+    }
+  }
+  return std::string();
+}
+
+// The time folders (other than 0) in the case folder and in processor0/, each with the DEM
+// checkpoint it names (an empty name when it names none).
+std::vector<std::pair<std::string, std::string>> keptTimeFolders(const Foam::fileName& caseDir) {
+  using namespace Foam;
+  std::vector<std::pair<std::string, std::string>> found;
+  for (const fileName& dir : {caseDir, caseDir / "processor0"}) {
+    if (!isDir(dir)) continue;
+    for (const instant& t : Time::findTimes(dir)) {
+      if (t.value() == 0) continue;
+      const std::string shown =
+          dir == caseDir ? std::string(t.name()) : "processor0/" + std::string(t.name());
+      found.emplace_back(shown, namedCheckpoint(dir / t.name()));
+    }
+  }
+  return found;
 }
 
 }  // namespace
@@ -315,7 +357,21 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
              "sharpInterface (the layers are read from the cells' own void fractions, which "
              "the averaging spreads); set diffusionBandwidth 0 or dragVoidFraction cell"
           << exit(FatalIOError);
-    smoothing_ = std::make_unique<DiffusionSmoothing>(mesh, bandwidth);
+    smoothing_ = std::make_unique<DiffusionSmoothing>(mesh, bandwidth, kMaxSmoothingSteps);
+    if (!(smoothing_->neededSteps() <= kMaxSmoothingSteps)) {
+      // The largest b to 4 significant digits, rounded down: typed back, it is allowed.
+      const double largest = smoothing_->maxBandwidth();
+      const double unit = std::pow(10.0, std::floor(std::log10(largest)) - 3);
+      std::ostringstream m;
+      m.precision(4);
+      m << "diffusionBandwidth " << bandwidth << " m would take " << smoothing_->neededSteps()
+        << " explicit diffusion steps per field and fluid step on this mesh; allowed: 0 "
+           "(none) or 0 < b <= "
+        << std::floor(largest / unit) * unit << " m (at most " << kMaxSmoothingSteps
+        << " steps; b is a length in metres, typically a few particle diameters: 2.83 d is "
+           "the tested value)";
+      FatalIOErrorInFunction(dict) << m.str().c_str() << exit(FatalIOError);
+    }
     Info << "grainFoam coupling: diffusionBandwidth b = " << bandwidth
          << " m: eps, Ksl, KslUs, fParticles and the fluid the particles read are averaged "
             "by diffusion to pseudo-time b^2/4 (Gaussian exp(-r^2/b^2), sigma = b/sqrt(2) = "
@@ -331,6 +387,18 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
     smoothGradP_ = work("smoothedGradP");
     smoothDivTau_ = work("smoothedDivTau");
     smoothCurlU_ = work("smoothedCurlU");
+  }
+
+  // The settings that shape the deposited eps and Ksl, recorded with each write time: a
+  // restart's differing written fields can then be put down to the setting that changed.
+  {
+    std::ostringstream o;
+    o.precision(17);
+    o << "voidFraction " << method << "; dividedResolution " << resolution << "; smoothingFactor "
+      << smoothing << "; minVoidFraction " << minVoidFraction_ << "; diffusionBandwidth "
+      << bandwidth << "; dragVoidFraction " << dragEps << "; undisturbedVelocity " << undisturbed
+      << "; sampling " << sampling << "; facePressure " << facePressure;
+    depositSettings_ = o.str();
   }
 
   // --- the DEM ----------------------------------------------------------------------
@@ -466,6 +534,31 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
 
   // --- restart: a time that grainFoam wrote names its DEM checkpoint ------------------
   restartIndex_ = mesh.time().timeIndex();
+  // A time folder grainFoam did not write (a copy of 0, a folder whose uniform/ was lost)
+  // has time index 0: the DEM would start afresh from the scene at t = 0 while the fluid
+  // goes on from the folder's time.
+  if (restartIndex_ == 0 && std::abs(mesh.time().value()) > 1e-6 * mesh.time().deltaTValue()) {
+    const fileName uniform = mesh.time().timePath() / "uniform";
+    std::string missing;
+    for (const char* name : {"time", "grainflowCheckpoint"})
+      if (!isFile(uniform / name))
+        missing += std::string(missing.empty() ? "" : " and ") + "uniform/" + name;
+    const word startFrom = mesh.time().controlDict().lookupOrDefault<word>("startFrom", "?");
+    FatalErrorInFunction
+        << "grainFoam: error: the run starts at time " << mesh.time().timeName()
+        << " (system/controlDict: startFrom " << startFrom.c_str() << "), but time folder "
+        << mesh.time().timeName() << " was not written by grainFoam: "
+        << (missing.empty() ? std::string("its time index is 0")
+                            : "it has no " + missing + " (in " + std::string(uniform) + ")")
+               .c_str()
+        << ". A restart continues the DEM from the checkpoint a written time names; without "
+           "one the DEM would start afresh from the scene at t = 0 while the fluid goes on from "
+        << mesh.time().timeName()
+        << ". Restart from a time grainFoam wrote (startFrom startTime; startTime <that "
+           "time>), or start afresh from time 0 (startFrom startTime; startTime 0; with "
+           "startFrom latestTime, remove or rename folder "
+        << mesh.time().timeName() << ")" << exit(FatalError);
+  }
   if (restartIndex_ > 0) {
     const IOdictionary info(IOobject("grainflowCheckpoint", mesh.time().timeName(), "uniform",
                                      mesh.time(), IOobject::READ_IF_PRESENT,
@@ -559,27 +652,94 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
         << "deltaT " << typed(dtFluid).c_str() << " s must be positive: a whole number of DEM "
         << "steps of " << typed(dtDem).c_str() << " s (the scene's time step), e.g. deltaT "
         << typed(dtDem).c_str() << exit(FatalIOError);
+  // The ratio must be whole to round-off (kRatioTolerance): the DEM advances N x dt_DEM per
+  // fluid step, so a ratio off by r puts it r dt_CFD behind the fluid at every step, and the
+  // restart check below, which allows what start-up allowed, would otherwise refuse the run's
+  // own restart after enough steps.
   subSteps_ = static_cast<int>(std::min(std::lround(ratio), long(INT_MAX)));
-  if (subSteps_ < 1 || std::abs(ratio - subSteps_) > 1e-6 * ratio) {
+  if (subSteps_ < 1 || std::abs(ratio - subSteps_) > kRatioTolerance * ratio) {
     const long below = std::lround(std::floor(ratio)), above = std::lround(std::ceil(ratio));
     std::string use = "deltaT " + typed(above * dtDem);
     if (below >= 1) use = "deltaT " + typed(below * dtDem) + " or " + use;
+    // The DEM step that divides deltaT exactly, with every digit it needs.
+    std::ostringstream exact;
+    exact.precision(17);
+    const long nearest = std::max(1L, std::lround(ratio));
+    exact << "time.step " << dtFluid / nearest << " (deltaT / " << nearest << ")";
     FatalIOErrorInFunction(time.controlDict())
         << "deltaT " << typed(dtFluid).c_str() << " s is " << typed(ratio).c_str()
         << " DEM steps of " << typed(dtDem).c_str()
-        << " s (the scene's time step); dt_CFD / dt_DEM must be an integer: use " << use.c_str()
-        << ", or change the scene's time.step" << exit(FatalIOError);
+        << " s (the scene's time step); dt_CFD / dt_DEM must be an integer to round-off "
+           "(relative "
+        << kRatioTolerance << "): use " << use.c_str() << ", or set the scene's "
+        << exact.str().c_str() << exit(FatalIOError);
   }
-  if (restartIndex_ > 0 && (dem_->steps() != restartIndex_ * subSteps_ ||
-                            std::abs(dem_->time() - time.value()) > 1e-6 * dtFluid))
-    FatalErrorInFunction << "the DEM checkpoint is at step " << dem_->steps() << " (t = "
-                         << dem_->time() << " s) but the fluid restarts at time "
-                         << time.timeName() << ", time index " << restartIndex_ << " = DEM step "
-                         << restartIndex_ * subSteps_ << " (" << subSteps_
-                         << " DEM steps per fluid step): the checkpoint belongs to another "
-                            "time, or deltaT or the scene's time step changed"
-                         << exit(FatalError);
-  checkpointKeep_ = time.controlDict().lookupOrDefault<label>("purgeWrite", 0);
+  if (restartIndex_ > 0) {
+    // What start-up allows, accumulated over the run's steps, plus the time's own round-off.
+    const double allowed = 1e-6 * dtFluid + 2 * kRatioTolerance * dtFluid * restartIndex_;
+    const double timeOff = std::abs(dem_->time() - time.value());
+    const long steps = dem_->steps();
+    if (steps != restartIndex_ * subSteps_ || timeOff > allowed) {
+      std::ostringstream m;
+      m.precision(17);
+      m << "grainFoam: error: restart at time " << time.timeName() << " (time index "
+        << restartIndex_ << "): the DEM checkpoint is at step " << steps << " (t = " << dem_->time()
+        << " s), but " << restartIndex_ << " fluid steps of deltaT ";
+      m.precision(12);
+      m << dtFluid << " s (system/controlDict) are DEM step " << restartIndex_ * subSteps_ << " ("
+        << subSteps_ << " DEM steps of " << dtDem << " s per fluid step). ";
+      const long runSub = steps % restartIndex_ == 0 ? steps / restartIndex_ : 0;
+      if (timeOff <= allowed && runSub > 0) {
+        // Same time, other step count: deltaT (or time.step with it) changed.
+        m << "This time was run with " << runSub << " DEM steps per fluid step, deltaT "
+          << runSub * (dem_->time() / steps)
+          << " s. A restart continues with the deltaT and "
+             "the time.step its time was run with: set deltaT "
+          << runSub * (dem_->time() / steps)
+          << " in system/controlDict (and the scene's time.step as it was) to restart. To run "
+             "on with another deltaT, start a new run from time 0 (startFrom startTime; "
+             "startTime 0); to keep the particles, insert this run's snapshot of this time "
+             "with `type: snapshot` (docs/scene-reference.md) and copy the fluid fields into 0/";
+      } else {
+        m << "The checkpoint belongs to another time: restart from a time whose checkpoint "
+             "is this run's, or start from time 0";
+      }
+      FatalErrorInFunction << m.str().c_str() << exit(FatalError);
+    }
+  }
+  // A fresh run writes its snapshots and checkpoints over those of an earlier run in the
+  // same folder (under the same names): said, with the time folders that name them.
+  if (restartIndex_ == 0 && Pstream::master()) {
+    long snapshotFiles = 0, checkpointFiles = 0;
+    std::error_code error;
+    for (const auto& e : std::filesystem::directory_iterator(std::string(snapshotDir_), error)) {
+      const std::string name = e.path().filename().string();
+      const bool h5 = name.size() > 3 && name.compare(name.size() - 3, 3, ".h5") == 0;
+      if (h5 && name.rfind("particles_", 0) == 0) ++snapshotFiles;
+      if (h5 && name.rfind("checkpoint_", 0) == 0) ++checkpointFiles;
+    }
+    if (snapshotFiles + checkpointFiles > 0) {
+      std::string naming;
+      int listed = 0;
+      for (const auto& [folder, name] :
+           keptTimeFolders(mesh.time().rootPath() / mesh.time().globalCaseName()))
+        if (!name.empty() && isFile(snapshotDir_ / name)) {
+          naming += (listed ? ", " : "") + folder;
+          ++listed;
+        }
+      Info << "grainFoam coupling: note: " << snapshotDir_.c_str() << " holds " << snapshotFiles
+           << " snapshot(s) and " << checkpointFiles
+           << " checkpoint(s) of an earlier run; this run starts at time 0 and writes its own "
+              "over those of the same names (the snapshots from the first, the checkpoints "
+              "at its write times)";
+      if (listed > 0)
+        Info << "; time folder(s) " << naming.c_str()
+             << " name checkpoints there, and cannot be restarted from once theirs is "
+                "written over. To keep them, give this run another output.directory in the "
+                "scene, or copy the case first";
+      Info << endl;
+    }
+  }
 
   // --- output.snapshot_interval: snapshots at fluid steps, the first at or after each
   // multiple of the interval (within half a fluid step, as grain does with its steps) ----
@@ -819,12 +979,8 @@ void ParticleCoupling::continueVoidFraction() {
          << endl;
   } else {
     WarningInFunction << "the written voidfraction differs from the particles' deposit by "
-                      << difference
-                      << " (fields written with fewer than 17 digits, or another particle "
-                         "state): continuing from the deposit; the restart is not "
-                         "bit-identical. Use writeFormat binary (or writePrecision 17) in "
-                         "system/controlDict for exact restarts"
-                      << endl;
+                      << difference << " (" << restartCause().c_str()
+                      << "): continuing from the deposit; the restart is not bit-identical" << endl;
   }
 
   // Ksl likewise: the first fluid samples after the restart read it (the face pressures of
@@ -846,11 +1002,48 @@ void ParticleCoupling::continueVoidFraction() {
   } else {
     Info << "grainFoam coupling: restart Ksl: the written field differs from the particles' "
             "deposit by "
-         << kslDifference
-         << " of its largest value: continuing from the deposit (the first samples after "
-            "the restart may differ in the last digits)"
-         << endl;
+         << kslDifference << " of its largest value (" << restartCause().c_str()
+         << "): continuing from the deposit" << endl;
   }
+}
+
+std::string ParticleCoupling::restartCause() const {
+  using namespace Foam;
+  // The settings of the written time (uniform/grainflowCheckpoint), key by key.
+  const IOdictionary info(IOobject("grainflowCheckpoint", mesh_.time().timeName(), "uniform",
+                                   mesh_.time(), IOobject::READ_IF_PRESENT, IOobject::NO_WRITE,
+                                   false));
+  const auto split = [](const std::string& text) {
+    std::vector<std::pair<std::string, std::string>> out;
+    std::istringstream in(text);
+    std::string item;
+    while (std::getline(in, item, ';')) {
+      std::istringstream kv(item);
+      std::string key, value;
+      if (kv >> key >> value) out.emplace_back(key, value);
+    }
+    return out;
+  };
+  std::string changed;
+  if (info.found("depositSettings")) {
+    const auto then = split(info.get<string>("depositSettings"));
+    for (const auto& [key, value] : split(depositSettings_))
+      for (const auto& [oldKey, oldValue] : then)
+        if (key == oldKey && value != oldValue)
+          changed +=
+              (changed.empty() ? "" : ", ") + key + " " + oldValue + " then, " + value + " now";
+  }
+  if (!changed.empty())
+    return "constant/couplingProperties changed since this time was written: " + changed +
+           "; the deposit follows the new setting";
+  const dictionary& control = mesh_.time().controlDict();
+  const bool exact = control.lookupOrDefault<word>("writeFormat", "ascii") == "binary" ||
+                     control.lookupOrDefault<label>("writePrecision", 6) >= 17;
+  if (!exact)
+    return "the fields were written with fewer than 17 digits: use writeFormat binary (or "
+           "writePrecision 17) in system/controlDict for exact restarts";
+  return "the fields were written exactly and the coupling settings are the same: the "
+         "particles or the fields are not those the run wrote at this time";
 }
 
 ParticleCoupling::~ParticleCoupling() = default;
@@ -2095,6 +2288,11 @@ std::string ParticleCoupling::remedies(const FluidState& state) const {
       if (subSteps_ == 1)
         m << "; deltaT is a whole number of DEM steps, so lower the scene's time step with it "
              "(time.step, or time.rayleigh_fraction)";
+      // A restart keeps the deltaT its time was run with (the restart check says so).
+      if (restartIndex_ > 0 || time.timeIndex() > 1)
+        m << "; a restart continues with the deltaT its time was run with, so a new deltaT "
+             "means a new run from time 0 (to keep the particles, insert a snapshot with "
+             "`type: snapshot`)";
       m << ")";
     }
     if (state.jump > 0.25) m << "; or, for the void fraction's jump, " << jumpRemedies();
@@ -2200,6 +2398,35 @@ void ParticleCoupling::writeSnapshotIfDue() {
   lastSnapshotIndex_ = time.timeIndex();
 }
 
+void ParticleCoupling::purgeCheckpoints(const std::string& newest) {
+  using namespace Foam;
+  // OpenFOAM's purgeWrite deletes the time folders this run wrote beyond the newest N (its
+  // list holds only this run's times: the folders of the run a restart continues stay). A
+  // checkpoint is deleted when this run wrote it and no time folder names it any more, so
+  // every time folder that exists keeps its checkpoint. Called after runTime.write(), which
+  // purges the folders first.
+  const Time& time = mesh_.time();
+  if (std::find(ownCheckpoints_.begin(), ownCheckpoints_.end(), newest) == ownCheckpoints_.end())
+    ownCheckpoints_.push_back(newest);
+  if (time.controlDict().lookupOrDefault<label>("purgeWrite", 0) <= 0 || !Pstream::master()) return;
+  std::set<std::string> named{newest};
+  for (const auto& folder : keptTimeFolders(time.rootPath() / time.globalCaseName()))
+    named.insert(folder.second);
+  std::vector<std::string> kept;
+  for (const std::string& name : ownCheckpoints_) {
+    if (named.count(name)) {
+      kept.push_back(name);
+      continue;
+    }
+    std::error_code error;
+    std::filesystem::remove(std::string(snapshotDir_ / name), error);
+    if (error)
+      Info << "grainFoam coupling: warning: could not delete the old checkpoint "
+           << (snapshotDir_ / name).c_str() << ": " << error.message().c_str() << endl;
+  }
+  ownCheckpoints_.swap(kept);
+}
+
 void ParticleCoupling::write() {
   using namespace Foam;
   Stopwatch clock;
@@ -2210,8 +2437,8 @@ void ParticleCoupling::write() {
   std::string checkpoint;
   try {
     if (snapshotInterval_ <= 0) writeSnapshot();
-    checkpoint = dem_->write_checkpoint(
-        snapshotDir_, checkpointKeep_ > 0 ? static_cast<int>(checkpointKeep_) : INT_MAX);
+    // Old checkpoints are deleted here (purgeCheckpoints), not by the DEM's series.
+    checkpoint = dem_->write_checkpoint(snapshotDir_, INT_MAX);
   } catch (const std::exception& e) {
     FatalErrorInFunction << "\n" << e.what() << exit(FatalError);
   }
@@ -2223,7 +2450,9 @@ void ParticleCoupling::write() {
            word("fnv1a64_" + checkpointChecksum(std::string(snapshotDir_ / checkpoint))));
   info.add("demStep", label(dem_->steps()));
   info.add("demTime", dem_->time());
+  info.add("depositSettings", string(depositSettings_));
   info.regIOobject::write();
+  purgeCheckpoints(checkpoint);
   // The particle output is timed apart: like the fluid's field output (runTime.write()),
   // it is not part of the DEM / coupling / fluid split.
   add(kOutput, clock);

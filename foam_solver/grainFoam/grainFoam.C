@@ -31,11 +31,16 @@
 // fvc::reconstruct, which v1912 compiles wrong).
 #include <mpi.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
 #include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "coupling/floating_point_traps.hpp"
 #include "coupling/foam/fluxReconstruction.H"
@@ -242,6 +247,122 @@ void checkWrittenFiles(const Foam::Time& runTime) {
          << ": its fields are read unchecked" << endl;
 }
 
+// With runTimeModifiable, OpenFOAM re-reads system/controlDict (and any dictionary registered
+// MUST_READ_IF_MODIFIED) at the start of each step, in Time::run(). What the coupling fixed at
+// start-up must survive it: deltaT is a whole number of DEM steps (the DEM's sub-steps and a
+// restart's step count depend on it), and the run's end is the earlier of controlDict's
+// endTime and the scene's time.end. A re-read endTime is taken with the scene's end still
+// holding; a re-read deltaT is not taken (said once per value); edits of the coupling's and
+// the fluid's property files are not taken during a run (said once per file).
+class RunTimeEdits {
+ public:
+  RunTimeEdits(Foam::Time& runTime, double sceneEnd, const std::string& sceneEndSource)
+      : runTime_(runTime),
+        deltaT_(runTime.deltaTValue()),
+        seenDeltaT_(deltaT_),
+        sceneEnd_(sceneEnd),
+        foamEnd_(runTime.endTime().value()),
+        sceneEndSource_(sceneEndSource) {
+    using namespace Foam;
+    // Time::readDict takes deltaT from a re-read controlDict unless it has been set.
+    runTime.setDeltaT(deltaT_, false);
+    setEnd();
+    // The property files: the master compares them (the warning is the master's line).
+    const fileName constant = runTime.rootPath() / runTime.globalCaseName() / "constant";
+    if (Pstream::master())
+      for (const char* name : {"couplingProperties", "transportProperties"}) {
+        Watched w;
+        w.path = constant / name;
+        w.shown = "constant/" + std::string(name);
+        w.stamp = highResLastModified(w.path);
+        w.text = contents(w.path);
+        watched_.push_back(w);
+      }
+  }
+  // After Time::run() (its re-read): true when the run has reached its end.
+  bool reachedEnd() {
+    using namespace Foam;
+    if (runTime_.endTime().value() != end_) {  // controlDict re-read (or stopAt)
+      foamEnd_ = runTime_.endTime().value();
+      const scalar before = end_;
+      setEnd();
+      if (end_ != before && foamEnd_ < 0.1 * GREAT)
+        Info << "grainFoam: system/controlDict re-read: endTime " << text(foamEnd_).c_str()
+             << " s; the run ends at t = " << text(end_).c_str() << " s, " << endName().c_str()
+             << endl;
+    }
+    const scalar dt = runTime_.controlDict().lookupOrDefault<scalar>("deltaT", deltaT_);
+    if (dt != seenDeltaT_ && dt != deltaT_)
+      Info << "grainFoam: warning: system/controlDict was re-read with deltaT " << text(dt).c_str()
+           << " s; the run keeps deltaT " << text(deltaT_).c_str()
+           << " s. The coupling fixes deltaT at start-up as a whole number of DEM steps, and a "
+              "restart continues with the deltaT its time was run with, so a changed deltaT "
+              "is not taken during a run. To run with another deltaT, start a new run from "
+              "time 0 (set deltaT back to "
+           << text(deltaT_).c_str() << " in system/controlDict to silence this)" << endl;
+    seenDeltaT_ = dt;
+    if (runTime_.runTimeModifiable())
+      for (Watched& w : watched_) {
+        const double stamp = highResLastModified(w.path);
+        if (stamp == w.stamp) continue;
+        w.stamp = stamp;
+        if (w.warned || contents(w.path) == w.text) continue;
+        w.warned = true;
+        Info << "grainFoam: warning: " << w.shown.c_str()
+             << " was edited during the run; grainFoam read it at start-up and does not "
+                "take changes to it during a run: the run goes on with the settings it "
+                "started with (said once)"
+             << endl;
+      }
+    return runTime_.value() >= end_ - 0.5 * runTime_.deltaTValue();
+  }
+  // The last line when the scene's end stopped the run (empty otherwise); true where it is.
+  std::string finalLine() const {
+    if (!(sceneEnd_ < foamEnd_) ||
+        std::abs(runTime_.value() - sceneEnd_) > 0.5 * runTime_.deltaTValue())
+      return std::string();
+    return "grainFoam: stopped at the scene's time.end, t = " + text(sceneEnd_) + " s (" +
+           sceneEndSource_ + "), before system/controlDict's endTime " + text(foamEnd_) +
+           " s; to run longer, raise both";
+  }
+
+ private:
+  struct Watched {
+    Foam::fileName path;
+    std::string shown, text;
+    double stamp = 0;
+    bool warned = false;
+  };
+  static std::string contents(const Foam::fileName& path) {
+    std::ifstream in(path.c_str(), std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+  // As typed (6 digits), not at the case's writePrecision.
+  static std::string text(double x) {
+    std::ostringstream s;
+    s << x;
+    return s.str();
+  }
+  std::string endName() const {
+    return sceneEnd_ < foamEnd_ ? "the scene's time.end (" + sceneEndSource_ + ")"
+                                : std::string("system/controlDict's endTime");
+  }
+  void setEnd() {
+    end_ = std::min(sceneEnd_, foamEnd_);
+    runTime_.setEndTime(end_);
+  }
+  Foam::Time& runTime_;
+  const double deltaT_;
+  double seenDeltaT_;
+  const double sceneEnd_;
+  double foamEnd_;
+  double end_ = 0;
+  const std::string sceneEndSource_;
+  std::vector<Watched> watched_;
+};
+
 // The solver proper; everything it creates (the DEM included) is gone when it returns,
 // before MPI is finalised.
 void solve(const Foam::argList& args) {
@@ -327,7 +448,6 @@ void solve(const Foam::argList& args) {
   // The run ends at the earlier of system/controlDict's endTime and the scene's time.end.
   // When the scene's is earlier, the last line says so again: a log read from its tail should
   // not look like a run to controlDict's endTime.
-  std::string sceneCut;
   {
     const scalar sceneEnd = particles.sceneEndTime(), foamEnd = runTime.endTime().value();
     // As typed (6 digits), not at the case's writePrecision.
@@ -340,10 +460,6 @@ void solve(const Foam::argList& args) {
       Info << "grainFoam: ends at t = " << text(sceneEnd).c_str() << " s, the scene's time.end ("
            << particles.sceneEndTimeSource().c_str() << "), before system/controlDict's endTime "
            << text(foamEnd).c_str() << " s" << endl;
-      runTime.setEndTime(sceneEnd);
-      sceneCut = "grainFoam: stopped at the scene's time.end, t = " + text(sceneEnd) + " s (" +
-                 particles.sceneEndTimeSource() + "), before system/controlDict's endTime " +
-                 text(foamEnd) + " s; to run longer, raise both";
     } else {
       Info << "grainFoam: ends at t = " << text(foamEnd).c_str()
            << " s, system/controlDict's endTime (the scene's time.end, "
@@ -369,12 +485,14 @@ void solve(const Foam::argList& args) {
            << " s, where it ends (" << which.c_str() << "); to run longer, raise both "
            << "system/controlDict's endTime and the scene's time.end" << endl;
   }
+  RunTimeEdits edits(runTime, particles.sceneEndTime(), particles.sceneEndTimeSource());
   particles.checkStartingFlow();
   particles.writeSnapshotIfDue();
   readingTraps.reset();
 
   Info << "\nStarting time loop\n" << endl;
   while (runTime.run()) {
+    if (edits.reachedEnd()) break;
     ++runTime;
     Info << "Time = " << runTime.timeName() << nl << endl;
 
@@ -529,7 +647,8 @@ void solve(const Foam::argList& args) {
       return;
     }
   }
-  if (!sceneCut.empty()) Info << sceneCut.c_str() << endl;
+  const std::string last = edits.finalLine();
+  if (!last.empty()) Info << last.c_str() << endl;
   Info << "End\n" << endl;
 }
 
@@ -547,6 +666,25 @@ int main(int argc, char* argv[]) {
   MPI_Initialized(&mpiReady);
   const bool ownMpi = !mpiReady;
   if (ownMpi) MPI_Init(&argc, &argv);
+  // Started by mpirun on several ranks without -parallel, each rank would run the whole case
+  // on its own (and the coupling would blame the decomposition).
+  int ranks = 1, rank = 0;
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  if (!Pstream::parRun() && ranks > 1) {
+    if (rank == 0)
+      std::cerr << "grainFoam: error: started on " << ranks
+                << " MPI ranks without -parallel: each rank would run the whole case by "
+                   "itself. Add -parallel (mpirun -np "
+                << ranks
+                << " grainFoam -parallel, on a case decomposed by decomposePar into as many "
+                   "processor folders), or run grainFoam without mpirun for a serial run"
+                << std::endl;
+    MPI_Finalize();
+    // Not through return or exit(): under mpirun the process then ended with status 0
+    // (measured; something registered at exit by the OpenFOAM libraries), and mpirun with it.
+    std::_Exit(1);
+  }
   solve(args);
   if (ownMpi) MPI_Finalize();
   return 0;

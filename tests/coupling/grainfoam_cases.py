@@ -1765,12 +1765,375 @@ def diffusion_smoothing(runner, checks):
     checks.expect(expected in log and "0 for none" in log,
                   f"smoothing_negative: refused ('{expected}', naming 0 for none)")
 
+# --- coupling.restart_unwritten_time, coupling.run_time_edits, coupling.restart_time_step,
+# --- coupling.checkpoint_keeping, coupling.setup_messages --------------------------------
+
+# neutral_particle cut short: endTime 0.002 (2 fluid steps of 50 DEM steps), written each step.
+SHORT = [("system/controlDict", "endTime         0.1;", "endTime         0.002;"),
+         ("system/controlDict", "writeInterval   0.05;", "writeInterval   0.001;")]
+
+
+def set_keys(case, path, **keys):
+    """Sets `key value;` lines of a case dictionary (each key must be there)."""
+    full = os.path.join(case, path)
+    with open(full) as f:
+        text = f.read()
+    for key, value in keys.items():
+        text, n = re.subn(r"^" + key + r"\s+[^;]*;", f"{key} {value};", text, flags=re.M)
+        if n != 1:
+            raise RuntimeError(f"{full}: no line `{key} ...;`")
+    with open(full, "w") as f:
+        f.write(text)
+
+
+def fluid_and_dem_time(case, folder):
+    """(fluid time, time index, DEM time, DEM step) that grainFoam wrote at a time folder."""
+    def value(path, key):
+        full = os.path.join(case, folder, "uniform", path)
+        if not os.path.exists(full):
+            return float("nan")
+        with open(full) as f:
+            m = re.search(r"^" + key + r"\s+(\S+);", f.read(), re.M)
+        return float(m.group(1)) if m else float("nan")
+    return (value("time", "value"), value("time", "index"),
+            value("grainflowCheckpoint", "demTime"), value("grainflowCheckpoint", "demStep"))
+
+
+def restart_unwritten_time(runner, checks):
+    """A time folder grainFoam did not write has no time index (uniform/time) and names no DEM
+    checkpoint (uniform/grainflowCheckpoint): a restart from it would start the DEM afresh at
+    t = 0 while the fluid goes on from the folder's time. (a) 0 copied to 0.002 with startFrom
+    latestTime: refused, naming the missing files and both ways forward, nothing written.
+    (b) 0.002 written by grainFoam with its uniform/ lost: refused by the checksum record
+    without the advice "delete its line" (followed, it led to the same mismatch); the lines
+    deleted anyway: refused by (a)'s check. The advice given (restart from an intact time,
+    0.001) runs, and at 0.003 the DEM's time is the fluid's (3 fluid steps = 150 DEM steps).
+    (c) only uniform/grainflowCheckpoint lost: refused with the same advice."""
+    case = runner.fresh_case("neutral_particle", "unwritten_copy", SHORT)
+    runner.run(case, "blockMesh", "blockMesh")
+    shutil.copytree(os.path.join(case, "0"), os.path.join(case, "0.002"))
+    set_keys(case, "system/controlDict", startFrom="latestTime", endTime="0.003")
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    checks.expect("time folder 0.002 was not written by grainFoam: it has no uniform/time and "
+                  "uniform/grainflowCheckpoint" in log and "startTime 0" in log
+                  and "Restart from a time grainFoam wrote" in log,
+                  "0 copied to 0.002, startFrom latestTime: refused, naming uniform/time and "
+                  "uniform/grainflowCheckpoint, advising a written time or time 0")
+    checks.expect(not os.path.exists(os.path.join(case, "0.003")),
+                  "0 copied to 0.002: nothing written at 0.003")
+
+    stopped = runner.fresh_case("neutral_particle", "unwritten_stopped", SHORT)
+    runner.solve(stopped, 1)
+
+    def restart_copy(name):
+        case = os.path.join(runner.work, name)
+        shutil.rmtree(case, ignore_errors=True)
+        shutil.copytree(stopped, case)
+        set_keys(case, "system/controlDict", startFrom="latestTime", endTime="0.003")
+        return case
+
+    case = restart_copy("unwritten_lost_uniform")
+    shutil.rmtree(os.path.join(case, "0.002", "uniform"))
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    checks.expect("uniform/time is missing" in log and "delete its line" not in log
+                  and "Restart from another time folder that is intact" in log,
+                  "0.002/uniform lost: refused by the checksums, without 'delete its line', "
+                  "advising another intact time or time 0")
+    record = os.path.join(case, "0.002", "grainflowChecksums")
+    with open(record) as f:
+        lines = f.read().splitlines(keepends=True)
+    with open(record, "w") as f:
+        f.writelines(line for line in lines if not line.startswith('"uniform/'))
+    log = runner.run(case, "grainFoam.lines_deleted", runner.solver, expect_failure=True)
+    checks.expect("time folder 0.002 was not written by grainFoam" in log,
+                  "0.002/uniform lost and its lines deleted from the record anyway: refused "
+                  "(it had run with the DEM at t = 0.001 against the fluid's 0.003)")
+    # The advice given: restart from another intact time folder.
+    set_keys(case, "system/controlDict", startFrom="startTime", startTime="0.001")
+    runner.run(case, "grainFoam.advised", runner.solver)
+    fluid, index, dem, step = fluid_and_dem_time(case, "0.003")
+    checks.expect(abs(fluid - 0.003) < 1e-12 and index == 3 and abs(dem - fluid) < 1e-12
+                  and step == 150,
+                  f"advice rerun (startTime 0.001): at 0.003 fluid t = {fluid:.17g} (index "
+                  f"{index:g}), DEM t = {dem:.17g} (step {step:g}); equal, step 150")
+
+    case = restart_copy("unwritten_lost_checkpoint_name")
+    os.remove(os.path.join(case, "0.002", "uniform", "grainflowCheckpoint"))
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    checks.expect("uniform/grainflowCheckpoint is missing" in log and "delete its line" not in log,
+                  "0.002/uniform/grainflowCheckpoint lost: refused, without 'delete its line'")
+
+
+# timeActivatedFileUpdate (OpenFOAM's function object) copies a file over another at a given
+# time and has the run re-read it: an edit made during the run, at a known step.
+FILE_UPDATE = """
+functions
+{{
+{entries}
+}}
+"""
+FILE_UPDATE_ENTRY = """    {name}
+    {{
+        type            timeActivatedFileUpdate;
+        libs            ("libutilityFunctionObjects.so");
+        writeControl    timeStep;
+        writeInterval   1;
+        fileToUpdate    "$FOAM_CASE/{target}";
+        timeVsFile      (({at} "$FOAM_CASE/{target}.edited"));
+    }}
+"""
+
+
+def edit_during_run(case, updates):
+    """updates: [(file, at time, {key: value} of the edited copy)]. Writes <file>.edited, the
+    function objects that put it in place at the time, and dates the files an hour back
+    (OpenFOAM takes a file as modified only when it is fileModificationSkew, 10 s, newer than
+    when it was read; a copy at the start would use up the one re-read)."""
+    entries = []
+    for n, (target, at, keys) in enumerate(updates):
+        entries.append(FILE_UPDATE_ENTRY.format(name=f"edit{n}", target=target, at=at))
+    control = os.path.join(case, "system", "controlDict")
+    with open(control, "a") as f:
+        f.write(FILE_UPDATE.format(entries="".join(entries)))
+    for target, at, keys in updates:
+        path = os.path.join(case, target)
+        shutil.copy(path, path + ".edited")
+        set_keys(case, target + ".edited", **keys)
+    hour_ago = time.time() - 3600
+    for target, _, _ in updates:
+        os.utime(os.path.join(case, target), (hour_ago, hour_ago))
+
+
+def run_time_edits(runner, checks):
+    """runTimeModifiable true: system/controlDict, couplingProperties and transportProperties
+    edited during a run (cases/neutral_particle, 1 ms steps of 50 DEM steps). (a) deltaT 1e-3
+    -> 2e-3 at t = 0.003: the run keeps 1e-3 (10 steps to 0.01) and says so once; at 0.01 the
+    DEM's time is the fluid's (it had fallen behind: 50 sub-steps of 2e-5 s in each 2e-3 s
+    step). (b) scene time.end 0.006 before endTime 0.01, writeInterval edited at 0.002: the
+    run still ends at 0.006, the last line says so and the DEM is there too (it had run on to
+    0.01 under a last line claiming 0.006); then endTime edited to 0.004 (< time.end): the run
+    ends at 0.004 and the last line does not claim the scene's end. (c) couplingProperties and
+    transportProperties edited at 0.002: each said once not to be taken during the run."""
+    base = [("system/controlDict", "runTimeModifiable false;", "runTimeModifiable true;"),
+                        ("system/controlDict", "endTime         0.1;", "endTime         0.01;"),
+                        ("system/controlDict", "writeInterval   0.05;", "writeInterval   0.005;")]
+    case = runner.fresh_case("neutral_particle", "edit_delta_t", base)
+    edit_during_run(case, [("system/controlDict", 0.003, {"deltaT": "2e-3"})])
+    log = runner.solve(case, 1)
+    steps = re.findall(r"^Time = (\S+)$", log, re.M)
+    warned = log.count("system/controlDict was re-read with deltaT 0.002 s; the run keeps deltaT 0.001 s")
+    checks.expect(len(steps) == 10 and warned == 1,
+                  f"deltaT edited to 2e-3 at 0.003: {len(steps)} steps of 1e-3 (10), the change "
+                  f"refused in {warned} warning (1)")
+    last = time_folders(case)[-1]
+    fluid, index, dem, step = fluid_and_dem_time(case, last)
+    checks.expect(last == "0.01" and abs(dem - fluid) < 1e-12 and step == 500,
+                  f"the last time folder {last}: fluid t = {fluid:.17g}, DEM t = {dem:.17g} "
+                  f"(step {step:g}): 0.01, equal, step 500")
+
+    case = runner.fresh_case("neutral_particle", "edit_end", base + [
+        ("particle.yaml", "  end: 1\n", "  end: 0.006\n")])
+    edit_during_run(case, [("system/controlDict", 0.002, {"writeInterval": "0.002"})])
+    log = runner.solve(case, 1)
+    steps = re.findall(r"^Time = (\S+)$", log, re.M)
+    checks.expect(len(steps) == 6 and abs(float(steps[-1]) - 0.006) < 1e-12,
+                  f"writeInterval edited during a run with time.end 0.006 < endTime 0.01: "
+                  f"{len(steps)} steps, the last at {steps[-1] if steps else None} (6, 0.006)")
+    checks.expect(re.search(r"grainFoam: stopped at the scene's time.end, t = 0.006 s "
+                            r"\(\S*particle\.yaml:9\), before system/controlDict's endTime "
+                            r"0.01 s; to run longer, raise both\nEnd", log) is not None,
+                  "the last line says the scene's time.end stopped the run, and it did")
+    last = time_folders(case)
+    fluid, _, dem, _ = fluid_and_dem_time(case, last[-1]) if last else (0, 0, 0, 0)
+    checks.expect(last and abs(fluid - 0.006) < 1e-12 and abs(dem - 0.006) < 1e-12,
+                  f"the last time folder {last[-1] if last else None}: fluid t = {fluid:.17g}, "
+                  f"DEM t = {dem:.17g} (0.006)")
+
+    case = runner.fresh_case("neutral_particle", "edit_end_earlier", base + [
+        ("particle.yaml", "  end: 1\n", "  end: 0.006\n")])
+    edit_during_run(case, [("system/controlDict", 0.002, {"endTime": "0.004"})])
+    log = runner.solve(case, 1)
+    steps = re.findall(r"^Time = (\S+)$", log, re.M)
+    checks.expect(len(steps) == 4 and "stopped at the scene's time.end" not in log
+                  and "system/controlDict re-read: endTime 0.004 s; the run ends at t = 0.004 s, "
+                      "system/controlDict's endTime" in log,
+                  f"endTime edited to 0.004 (< time.end 0.006): {len(steps)} steps (4), said, "
+                  "and the last line does not claim the scene's end")
+
+    case = runner.fresh_case("neutral_particle", "edit_properties", base)
+    edit_during_run(case, [("constant/couplingProperties", 0.002, {"voidFraction": "centre"}),
+                           ("constant/transportProperties", 0.002, {"nu": "2e-6"})])
+    log = runner.solve(case, 1)
+    for name in ("constant/couplingProperties", "constant/transportProperties"):
+        said = log.count(f"grainFoam: warning: {name} was edited during the run; grainFoam read "
+                         "it at start-up and does not take changes to it during a run")
+        checks.expect(said == 1, f"{name} edited at 0.002: said {said} time(s) (once)")
+
+
+def restart_time_step(runner, checks):
+    """deltaT and time.step at start-up and at a restart (cases/neutral_particle). (a) time.step
+    3.333333e-6 with deltaT 1e-4 (30.000003 DEM steps): it used to start (a relative 1e-6 was
+    allowed) and fall 1e-11 s behind the fluid per step, and its own restart was refused.
+    Refused at start-up now, offering the exact step deltaT / 30; that step runs 20 steps and
+    restarts (DEM time = fluid time at 0.003). (b) A restart with deltaT 5e-4 after 1e-3:
+    refused, naming deltaT 0.001 as the way to restart and a new run from time 0 for the new
+    deltaT; deltaT 0.001 put back restarts. (c) voidFraction divided -> centre at a restart:
+    the written voidfraction differs from the deposit, and the warning names the changed
+    setting (it blamed the written precision, already 17 digits)."""
+    case = runner.fresh_case("neutral_particle", "step_near_divisor", [
+        ("system/controlDict", "endTime         0.1;", "endTime         0.002;"),
+        ("system/controlDict", "deltaT          1e-3;", "deltaT          1e-4;"),
+        ("system/controlDict", "writeInterval   0.05;", "writeInterval   0.001;"),
+        ("particle.yaml", "  step: 2e-5 ", "  step: 3.333333e-6 ")])
+    runner.run(case, "blockMesh", "blockMesh")
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    m = re.search(r"or set the scene's time.step (\S+) \(deltaT / 30\)", log)
+    checks.expect(m is not None and "30.000003 DEM steps" in log,
+                  f"time.step 3.333333e-6, deltaT 1e-4: refused, offering the exact step "
+                  f"({m.group(1) if m else None})")
+    if m:
+        with open(os.path.join(case, "particle.yaml")) as f:
+            text = f.read()
+        with open(os.path.join(case, "particle.yaml"), "w") as f:
+            f.write(text.replace("step: 3.333333e-6", "step: " + m.group(1)))
+        runner.run(case, "grainFoam.advised", runner.solver)
+        set_keys(case, "system/controlDict", startFrom="latestTime", endTime="0.003")
+        runner.run(case, "grainFoam.restart", runner.solver)
+        fluid, index, dem, step = fluid_and_dem_time(case, "0.003")
+        checks.expect(index == 30 and step == 900 and abs(dem - fluid) < 1e-12,
+                      f"the offered step runs and restarts: at 0.003 index {index:g}, DEM step "
+                      f"{step:g} (30, 900), DEM t - fluid t = {dem - fluid:.3g} (< 1e-12)")
+
+    case = runner.fresh_case("neutral_particle", "restart_delta_t", SHORT)
+    runner.solve(case, 1)
+    set_keys(case, "system/controlDict", startFrom="latestTime", endTime="0.003", deltaT="5e-4")
+    log = runner.run(case, "grainFoam.restart", runner.solver, expect_failure=True)
+    checks.expect("This time was run with 50 DEM steps per fluid step, deltaT 0.001 s" in log
+                  and "set deltaT 0.001 in system/controlDict" in log
+                  and "start a new run from time 0" in log,
+                  "restart with deltaT 5e-4 after 1e-3: refused, naming deltaT 0.001 to restart "
+                  "and a new run from time 0 for another deltaT")
+    set_keys(case, "system/controlDict", deltaT="0.001")
+    runner.run(case, "grainFoam.advised", runner.solver)
+    fluid, index, dem, step = fluid_and_dem_time(case, "0.003")
+    checks.expect(index == 3 and step == 150 and abs(dem - fluid) < 1e-12,
+                  f"advice rerun (deltaT 0.001): at 0.003 index {index:g}, DEM step {step:g}")
+
+    case = runner.fresh_case("neutral_particle", "restart_void_fraction", SHORT)
+    runner.solve(case, 1)
+    set_keys(case, "system/controlDict", startFrom="latestTime", endTime="0.003")
+    set_keys(case, "constant/couplingProperties", voidFraction="centre")
+    log = runner.run(case, "grainFoam.restart", runner.solver)
+    checks.expect("constant/couplingProperties changed since this time was written: "
+                  "voidFraction divided then, centre now" in log and "fewer than 17 digits" not in log,
+                  "voidFraction divided -> centre at a restart: the warning names the change, "
+                  "not the precision")
+
+
+def checkpoint_keeping(runner, checks):
+    """DEM checkpoints against the time folders OpenFOAM keeps (cases/neutral_particle,
+    1 ms steps written each). (a) purgeWrite 2, run to 0.004 (folders 0.003, 0.004), restarted
+    to 0.006: OpenFOAM keeps 0.003 and 0.004 (its purge list is the run's own) besides 0.005
+    and 0.006; every kept folder's checkpoint is kept (150 and 200 had been deleted), only
+    those of the purged folders go, and 0.004 restarts. (b) A fresh run (time 0) into that
+    case says that particles/ holds an earlier run's snapshots and checkpoints, and names the
+    time folders that name them."""
+    case = runner.fresh_case("neutral_particle", "purge_restart", [
+        ("system/controlDict", "endTime         0.1;", "endTime         0.004;"),
+        ("system/controlDict", "writeInterval   0.05;", "writeInterval   0.001;"),
+        ("system/controlDict", "purgeWrite      0;", "purgeWrite      2;")])
+    runner.solve(case, 1)
+    set_keys(case, "system/controlDict", startFrom="latestTime", endTime="0.006")
+    runner.run(case, "grainFoam.restart", runner.solver)
+    folders = time_folders(case)
+    particles = os.path.join(case, "particles")
+    kept = sorted(n for n in os.listdir(particles) if n.startswith("checkpoint_"))
+    named = []
+    for folder in folders:
+        with open(os.path.join(case, folder, "uniform", "grainflowCheckpoint")) as f:
+            named.append(re.search(r"^checkpoint\s+(\S+);", f.read(), re.M).group(1))
+    checks.expect(folders == ["0.003", "0.004", "0.005", "0.006"] and kept == sorted(named),
+                  f"purgeWrite 2 and a restart: folders {folders}, checkpoints {kept}, each "
+                  f"folder's {named} kept and no other")
+    set_keys(case, "system/controlDict", startFrom="startTime", startTime="0.004",
+             endTime="0.005")
+    log = runner.run(case, "grainFoam.from_0.004", runner.solver)
+    checks.expect("restart at time 0.004" in log, "restarted from the kept folder 0.004")
+
+    set_keys(case, "system/controlDict", startTime="0", endTime="0.001", purgeWrite="0")
+    log = runner.run(case, "grainFoam.fresh", runner.solver)
+    m = re.search(r"note: \S+particles holds (\d+) snapshot\(s\) and (\d+) checkpoint\(s\) of an "
+                  r"earlier run; this run starts at time 0 and writes its own over those of the "
+                  r"same names.*time folder\(s\) ([^;]*) name checkpoints there", log)
+    checks.expect(m is not None and int(m.group(2)) == len(kept) and "0.004" in m.group(3),
+                  f"a fresh run into the case: the note names the earlier run's files and the "
+                  f"folders naming them ({m.group(0)[:80] if m else None} ...)")
+
+
+def setup_messages(runner, checks):
+    """Start-up messages a user acts on. (a) diffusionBandwidth 60 m on 2 mm cells: its 2.7e9
+    explicit steps overflowed an int (the log said 1 step, almost no averaging) and 5 m asked
+    for 1.9e7 passes per field and step: refused naming the key, the file, the steps and the
+    allowed range, whose upper end then runs. (b) mpirun -np 2 without -parallel: refused,
+    saying to add -parallel (it blamed the decomposition, and decomposePar did not help).
+    (c) rho 998.2, nu 1.0034e-6 against fluid.viscosity 1.0016e-3: refused printing rho*nu to
+    12 digits; the printed value typed into the scene runs (6 digits were refused again)."""
+    for b in ("60", "5"):
+        case = runner.fresh_case("neutral_particle", f"bandwidth_{b}", SHORT + [
+            ("constant/couplingProperties", "sampling        cell;",
+             f"diffusionBandwidth {b};\nsampling        cell;")])
+        runner.run(case, "blockMesh", "blockMesh")
+        log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+        m = re.search(r"diffusionBandwidth " + b + r" m would take \S+ explicit diffusion steps "
+                      r"per field and fluid step on this mesh; allowed: 0 \(none\) or 0 < b <= "
+                      r"(\S+) m \(at most 1000 steps", log)
+        checks.expect(m is not None and "couplingProperties" in log,
+                      f"diffusionBandwidth {b} m: refused naming the file, the steps and the "
+                      f"range (b <= {m.group(1) if m else None} m)")
+    if m:
+        case = runner.fresh_case("neutral_particle", "bandwidth_largest", SHORT + [
+            ("constant/couplingProperties", "sampling        cell;",
+             f"diffusionBandwidth {m.group(1)};\nsampling        cell;")])
+        log = runner.solve(case, 1)
+        checks.expect("in 1000 explicit steps" in log,
+                      f"the largest allowed b = {m.group(1)} m runs in 1000 steps")
+
+    case = runner.fresh_case("periodic_box", "no_parallel", [])
+    runner.run(case, "blockMesh", "blockMesh")
+    runner.run(case, "decomposePar", "decomposePar")
+    r = subprocess.run([runner.foam_env, runner.mpiexec, "-np", "2", "--oversubscribe",
+                        runner.solver, "-case", case], cwd=case, env=runner.env, text=True,
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=300)
+    checks.expect(r.returncode != 0 and "started on 2 MPI ranks without -parallel" in r.stdout
+                  and "Add -parallel" in r.stdout and "shared decomposition" not in r.stdout,
+                  f"mpirun -np 2 without -parallel: exit {r.returncode}, says to add -parallel")
+
+    case = runner.fresh_case("neutral_particle", "viscosity_digits", SHORT + [
+        ("particle.yaml", "  density: 1000\n", "  density: 998.2\n"),
+        ("particle.yaml", "viscosity: 1e-3", "viscosity: 1.0016e-3")])
+    set_keys(case, "constant/transportProperties", rho="998.2", nu="1.0034e-6")
+    runner.run(case, "blockMesh", "blockMesh")
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    m = re.search(r"fluid\.viscosity is 0\.0010016 Pa s but the fluid solver's rho\*nu is (\S+) Pa s", log)
+    checks.expect(m is not None and m.group(1) == "0.00100159388",
+                  f"fluid.viscosity 1.0016e-3 against rho*nu: refused, printing rho*nu as "
+                  f"{m.group(1) if m else None} (0.00100159388)")
+    if m:
+        with open(os.path.join(case, "particle.yaml")) as f:
+            text = f.read()
+        with open(os.path.join(case, "particle.yaml"), "w") as f:
+            f.write(text.replace("viscosity: 1.0016e-3", "viscosity: " + m.group(1)))
+        runner.run(case, "grainFoam.advised", runner.solver)
+        checks.expect(True, "the printed rho*nu typed as fluid.viscosity runs")
+
+
 TESTS = {f.__name__: f for f in (void_fraction_volume, exchange_balance, neutrally_buoyant,
                                   cellpoint_ranks,
                                  refuses_bad_setup, hostile_fields, restart, restart_files, restart_bed_surface, stop_signal, nan_guard,
                                  scene_output, heat_equilibrium, heat_parcels, heat_balance,
                                  heat_front, balanced_decomposition,
-                                 diffusion_smoothing)}
+                                 diffusion_smoothing, restart_unwritten_time, run_time_edits,
+                                 restart_time_step, checkpoint_keeping, setup_messages)}
 
 
 if __name__ == "__main__":

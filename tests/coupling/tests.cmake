@@ -75,6 +75,26 @@
 #       cases/periodic_box in a flow with b = 5 mm on 1 and 2 ranks: exchange balanced and
 #       volume conserved to 1e-12, eps(2 ranks) = eps(1 rank) to 1e-12; a negative b and b
 #       with cellPoint refused. About 10 s.
+#   coupling.restart_unwritten_time  cases/neutral_particle: a time folder grainFoam did not
+#       write (0 copied to 0.002; 0.002 with uniform/ or uniform/grainflowCheckpoint lost) is
+#       refused with startFrom latestTime (the DEM had restarted at t = 0 under the fluid's
+#       0.002), without the advice "delete its line", whose following is refused too; the
+#       advice given (an intact earlier time) runs with the DEM's time the fluid's.
+#   coupling.run_time_edits        runTimeModifiable true, files edited during the run at a set
+#       time (timeActivatedFileUpdate): a changed deltaT is not taken (said once; the DEM's
+#       time stays the fluid's), the scene's time.end still ends the run after a controlDict
+#       edit and the last line is true, an earlier endTime is taken, couplingProperties and
+#       transportProperties edits are said once not to be taken. About 10 s.
+#   coupling.restart_time_step     a DEM step dividing deltaT only to 1e-7 refused at start-up
+#       with the exact divisor, which runs and restarts; a restart with another deltaT refused
+#       naming the deltaT that restarts (which then runs) and a new run for the new one; a
+#       changed voidFraction at a restart named as the cause of the differing fields.
+#   coupling.checkpoint_keeping    purgeWrite 2 and a restart: every time folder OpenFOAM keeps
+#       keeps its DEM checkpoint, and restarts; a fresh run into that case notes the earlier
+#       run's snapshots and checkpoints and the folders naming them.
+#   coupling.setup_messages        diffusionBandwidth 60 m and 5 m refused with the allowed
+#       range, whose end runs; mpirun -np 2 without -parallel says to add it; a
+#       fluid.viscosity unlike rho*nu printed to 12 digits, which typed back run.
 if(NOT TARGET grainFoam)
   return()
 endif()
@@ -211,6 +231,11 @@ grainflow_coupling_test(heat_balance 2)
 grainflow_coupling_test(heat_front 1)
 grainflow_coupling_test(balanced_decomposition 2)
 grainflow_coupling_test(diffusion_smoothing 2)
+grainflow_coupling_test(restart_unwritten_time 1)
+grainflow_coupling_test(run_time_edits 1)
+grainflow_coupling_test(restart_time_step 1)
+grainflow_coupling_test(checkpoint_keeping 1)
+grainflow_coupling_test(setup_messages 2)
 set_tests_properties(coupling.balanced_decomposition PROPERTIES TIMEOUT 300)  # ~40 s loaded
 set_tests_properties(coupling.stop_signal PROPERTIES TIMEOUT 600)  # ~25 s on a quiet machine
 
