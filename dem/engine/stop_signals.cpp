@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <csignal>
+#include <ctime>
 #include <utility>
 
 namespace grainflow {
@@ -11,8 +12,32 @@ namespace {
 // The signal that asked the run to stop (0: none). A signal handler can reach nothing but a
 // global, and may only store to a volatile sig_atomic_t (C++20 [support.signal]).
 volatile std::sig_atomic_t stop_signal = 0;
+// When it came (CLOCK_MONOTONIC); written and read by the handler only.
+timespec stop_signal_time = {};
 
-extern "C" void on_stop_signal(int signal) { stop_signal = signal; }
+// A second signal within this many seconds of the first is the same request delivered twice:
+// GNU timeout sends its signal to the process and then to its process group, and a batch
+// system may signal both mpiexec and the ranks. Later, it kills the run as the signal would.
+constexpr double kSameRequestSeconds = 1.0;
+
+extern "C" void on_stop_signal(int signal) {
+  timespec now = {};
+  clock_gettime(CLOCK_MONOTONIC, &now);  // async-signal-safe (POSIX)
+  if (stop_signal == 0) {
+    stop_signal_time = now;
+    stop_signal = signal;
+    return;
+  }
+  const double since = static_cast<double>(now.tv_sec - stop_signal_time.tv_sec) +
+                       1e-9 * static_cast<double>(now.tv_nsec - stop_signal_time.tv_nsec);
+  if (since < kSameRequestSeconds) return;
+  // Asked again: the default action, once this handler returns (the signal is blocked in it).
+  struct sigaction fallback = {};
+  fallback.sa_handler = SIG_DFL;
+  sigemptyset(&fallback.sa_mask);
+  sigaction(signal, &fallback, nullptr);
+  raise(signal);
+}
 
 // What the start-up handler needs, prepared before it is installed.
 struct Startup {
@@ -79,11 +104,14 @@ StartupSignals::~StartupSignals() {
 StopSignals::StopSignals(bool install) : installed_(install) {
   stop_signal = 0;
   if (!installed_) return;
-  install_handlers(on_stop_signal, SA_RESETHAND, old_term_, old_int_);
+  install_handlers(on_stop_signal, 0, old_term_, old_int_);
 }
 
 StopSignals::~StopSignals() {
-  if (!installed_) return;
+  // After a stop, the handler stays: the run is ending, and a copy of the same request that
+  // comes while it writes its last lines is still the same request (GNU timeout's second
+  // SIGTERM had killed runs that had stopped within the millisecond before it).
+  if (!installed_ || stop_signal != 0) return;
   restore_handlers(old_term_, old_int_);
 }
 

@@ -2,8 +2,10 @@
 // SIGTERM and SIGINT while a run is in progress: the handler only records the signal, and
 // the run loop asks, at a step boundary and on every rank at once, whether any rank got
 // one — then finishes cleanly (checkpoint, message, exit code 0). The previous handlers
-// come back when the object goes. SA_RESETHAND: a second signal of the same kind kills the
-// run as usual. Used by `grain run` and by grainFoam, so this header is C++17-clean.
+// come back when the object goes. A second signal more than a second after the first kills
+// the run as the signal would; one sooner is the same request delivered twice (GNU timeout
+// signals the process and its process group). Used by `grain run` and by grainFoam, so this
+// header is C++17-clean.
 #include <mpi.h>
 #include <signal.h>
 

@@ -163,6 +163,11 @@ if(GRAINFLOW_PYTHON3)
            COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/stop_signal.sh ${_grain}
                    ${_scenes}/stop_signal.yaml ${_work}/stop_signal_2 ${GRAINFLOW_PYTHON3}
                    ${MPIEXEC_EXECUTABLE} 2)
+  # Two SIGTERMs a millisecond apart (GNU timeout's way) stop the run once, cleanly.
+  add_test(NAME grain.stop_signal_twice
+           COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/stop_signal_twice.sh ${_grain}
+                   ${_scenes}/stop_signal.yaml ${_work}/stop_signal_twice)
+  set_tests_properties(grain.stop_signal_twice PROPERTIES TIMEOUT 300)
   set_tests_properties(grain.stop_signal_writes_checkpoint grain.stop_signal_two_ranks
                        PROPERTIES ENVIRONMENT "${GRAINFLOW_MPIEXEC_ENV}" TIMEOUT 60)
   set_tests_properties(grain.stop_signal_two_ranks PROPERTIES PROCESSORS 2)
