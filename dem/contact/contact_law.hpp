@@ -197,11 +197,20 @@ struct ContactLaw {
   }
 
   // The normal part of evaluate()'s force on i, as its component along g.n (the same
-  // operations, so the same value): for contact reports, which split the force.
+  // operations on the same velocities, so the same value): for contact reports, which split
+  // the force. The dashpot reads g.v_pred, or integrates over the step's cell (predicted), as
+  // evaluate() does; g.v_rel is not set for every law.
   template <class PC>
-  static double normal_force(const ContactGeometry& g, const PC& pc, const ContactConstants& cc) {
+  static double normal_force(const ContactGeometry& g, const PC& pc, const ContactConstants& cc,
+                             double dt) {
     const SpringDashpot s = Normal::coefficients(pc, cc, g.r_star, g.m_star, g.overlap);
-    const double fn = s.kn * g.overlap - s.gn * dot(g.v_rel, g.n);
+    double fn;
+    if constexpr (PredictedDashpot) {
+      double fn_prev = 0;
+      fn = s.kn * g.overlap + cell_dashpot(g, s, dt, fn_prev);
+    } else {
+      fn = s.kn * g.overlap - s.gn * dot(g.v_pred, g.n);
+    }
     if constexpr (Cohesion::enabled) return fn - Cohesion::force(g, pc.cohesion_energy_density);
     return fn;
   }

@@ -919,7 +919,7 @@ void report_contacts(const ContactSweep& s, ContactNetwork& out) {
     const ContactGeometry geo =
         pair_geometry<Law>(d, a, b, reduced_radius(a, b), reduced_mass(a, b), overlap);
     const ContactResult r = Law::evaluate(geo, pc, s.constants, ht, hr, s.dt, s.spring_dt);
-    const double fn = Law::normal_force(geo, pc, s.constants);
+    const double fn = Law::normal_force(geo, pc, s.constants, s.dt);
     const Vec3 normal = fn * geo.n;
     pairs.id.push_back({ia, ib});
     pairs.ends.push_back(xa);
@@ -982,7 +982,7 @@ void report_contacts(const ContactSweep& s, ContactNetwork& out) {
     const PairCoefficients& pc = s.table(p.material[i], material);
     const ContactResult r =
         Law::evaluate(geo, pc, s.constants, h.tangential, h.rolling, s.dt, s.spring_dt);
-    const double fn = Law::normal_force(geo, pc, s.constants);
+    const double fn = Law::normal_force(geo, pc, s.constants, s.dt);
     const Vec3 normal = fn * geo.n;
     const Vec3 point = p.x[i] - geo.arm_i * geo.n;
     walls.id.push_back(p.id[i]);
