@@ -937,6 +937,15 @@ void Simulation::write_checkpoint(const std::string& path) {
       d.wall_impulse.insert(d.wall_impulse.end(), {j[0], j[1], j[2]});
     MPI_Allreduce(MPI_IN_PLACE, d.wall_impulse.data(), static_cast<int>(d.wall_impulse.size()),
                   MPI_DOUBLE, MPI_SUM, comm_);
+    // This run goes on as a restart from the file does (restore): the sums so far on rank 0,
+    // none on the others, so that the next row adds the ranks' parts in the same order (on 2
+    // ranks a restart's row had differed from its run's in the last bit).
+    int rank = 0;
+    MPI_Comm_rank(comm_, &rank);
+    for (std::size_t w = 0; w < wall_impulse_.size(); ++w)
+      wall_impulse_[w] = rank == 0 ? Vec3(d.wall_impulse[3 * w], d.wall_impulse[3 * w + 1],
+                                          d.wall_impulse[3 * w + 2])
+                                   : Vec3::Zero();
     d.wall_impulse.push_back(wall_load_time_);
   }
   CheckpointGrid& grid = d.grid.emplace();
