@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -759,7 +760,10 @@ void DemLink::write_snapshot(const std::string& directory, long step, long conti
       m.snapshots->set_coarse_grain(m.scene.coarse_grain_table(), m.scene.real_material_table());
       m.snapshots->set_material_names(m.scene.material_names());
       m.snapshot_directory = directory;
-      if (continue_after >= 0) m.snapshots->continue_series(continue_after);
+      // (The files after the last one taken are written again, as the index's times are
+      // not compared with the restart's here.)
+      if (continue_after >= 0)
+        m.snapshots->continue_series(continue_after, -std::numeric_limits<double>::infinity());
     }
     // A restored run's first forces come from the checkpoint, without a network: a snapshot
     // before the first advance has none.

@@ -709,7 +709,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   if (sim.heat() != nullptr) wall_columns.emplace_back("thermal_J");
   std::optional<LogTable> log_table;
   if (options.restart) {
-    const std::size_t kept = snapshots.continue_series(first_step);
+    const std::size_t kept = snapshots.continue_series(first_step, sim.time() + 0.5 * sim.dt());
     log_table.emplace(comm, log_path, first_step, wall_columns, checkpoint_log);
     say << "restart: from " << *options.restart << " at step " << first_step
         << " (t = " << sim.time() << " s); continuing " << dir
@@ -730,6 +730,12 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
       say << "note: " << dir << "/" << gap
           << " is a gap in the snapshot series (deleted or damaged since it was written): "
              "particles.xdmf lists the snapshots around it\n";
+    for (const std::string& again : snapshots.reused())
+      say << "note: " << dir << "/" << again
+          << " comes after the last snapshot this restart takes over, and particles.xdmf does "
+             "not say when it was written: the restart writes its next snapshot under that "
+             "number (if it held a state before the checkpoint, the numbers after it now differ "
+             "from the uninterrupted run's)\n";
     // Intervals left to their defaults follow time.end: a restart that extends the run (as
     // the summary advises) would space its snapshots and log rows otherwise than the run it
     // continues, unsaid. The earlier spacing is read off the snapshots and rows taken over.

@@ -10,7 +10,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <limits>
+#include <map>
+#include <sstream>
 #include <stdexcept>
 #include <string_view>
 #include <utility>
@@ -347,11 +350,12 @@ SnapshotWriter::SnapshotWriter(MPI_Comm comm, std::string directory, std::string
   }
 }
 
-std::size_t SnapshotWriter::continue_series(long up_to_step) {
+std::size_t SnapshotWriter::continue_series(long up_to_step, double up_to_time) {
   QuietHdf5Errors quiet;
   entries_.clear();
   foreign_file_.clear();
   missing_.clear();
+  reused_.clear();
   next_number_ = 0;
   index_.reset();  // the next write() rewrites the index with the entries taken over
   // The highest number in the folder: a file missing or unreadable below it is a gap (deleted,
@@ -408,7 +412,48 @@ std::size_t SnapshotWriter::continue_series(long up_to_step) {
     skipped.clear();
   }
   H5Eclear2(H5E_DEFAULT);
+  // Files missing or unreadable after the last one taken: the index the run wrote dates them.
+  // One dated at or before the checkpoint is a gap of the series (and so is every one before
+  // it); one dated after it is the stopped run's, written again; an undated one is written
+  // again and said.
+  if (foreign_file_.empty() && !skipped.empty()) {
+    const std::map<std::string, double> listed = index_times();
+    const auto number_of = [&](const std::string& gap) {
+      return std::stol(gap.substr(basename_.size() + 1, 6));
+    };
+    for (const std::string& gap : skipped) {
+      const auto it = listed.find(gap.substr(0, basename_.size() + 7));  // particles_NNNNNN
+      if (it != listed.end() && it->second <= up_to_time) next_number_ = number_of(gap) + 1;
+    }
+    for (const std::string& gap : skipped) {
+      if (number_of(gap) < next_number_)
+        missing_.push_back(gap);
+      else if (listed.find(gap.substr(0, basename_.size() + 7)) == listed.end())
+        reused_.push_back(gap);
+    }
+  }
   return entries_.size();
+}
+
+std::map<std::string, double> SnapshotWriter::index_times() const {
+  // particles.xdmf: each time step is <Grid Name="particles_000003" ...> then <Time Value="t"/>.
+  std::map<std::string, double> out;
+  std::ifstream in(index_path(), std::ios::binary);
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string text = buffer.str();
+  const std::string grid = "<Grid Name=\"" + basename_ + "_", time = "<Time Value=\"";
+  for (std::size_t at = text.find(grid); at != std::string::npos; at = text.find(grid, at + 1)) {
+    const std::size_t name_at = at + 12;  // after <Grid Name="
+    const std::size_t name_end = text.find('"', name_at);
+    const std::size_t t = text.find(time, at);
+    if (name_end == std::string::npos || t == std::string::npos) break;
+    const std::string name = text.substr(name_at, name_end - name_at);
+    char* end = nullptr;
+    const double value = std::strtod(text.c_str() + t + time.size(), &end);
+    if (end != text.c_str() + t + time.size()) out.emplace(name, value);
+  }
+  return out;
 }
 
 std::vector<std::pair<long, std::string>> SnapshotWriter::numbered_files() const {

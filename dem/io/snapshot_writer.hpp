@@ -16,6 +16,7 @@
 #include <mpi.h>
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <utility>
@@ -66,12 +67,19 @@ class SnapshotWriter {
   // directory, in number order, up to the first one past `up_to_step` or of another scene's
   // run, so the next write() gets the number after the last one taken and later files of a
   // stopped run are overwritten. A number missing or unreadable before the last one taken is a
-  // gap (missing()); the files after it are taken over. Every rank reads the files' attributes
-  // (no communication). Returns how many.
-  std::size_t continue_series(long up_to_step);
+  // gap (missing()); the files after it are taken over. So is one missing or unreadable after
+  // the last one taken that particles.xdmf dates at or before `up_to_time` (the checkpoint's
+  // time plus half a step): its number is the series', and reusing it would number every later
+  // snapshot otherwise than the uninterrupted run does. One the index does not date is
+  // written again (reused()). Every rank reads the files' attributes (no communication).
+  // Returns how many.
+  std::size_t continue_series(long up_to_step, double up_to_time);
   // After continue_series: the gaps it stepped over ("particles_000003.h5 (missing)" or
   // "(unreadable)").
   const std::vector<std::string>& missing() const { return missing_; }
+  // After continue_series: files missing or unreadable after the last one taken whose numbers
+  // the restart writes again, as the index did not say they came before the checkpoint.
+  const std::vector<std::string>& reused() const { return reused_; }
 
   std::size_t snapshots_written() const { return entries_.size(); }
   // The series' entries so far (after continue_series: the snapshots it took over).
@@ -109,6 +117,8 @@ class SnapshotWriter {
   std::vector<std::string> files_after_series() const;
   // The series' files in the folder (<basename>_NNNNNN.h5) with their numbers, in order.
   std::vector<std::pair<long, std::string>> numbered_files() const;
+  // The time of each snapshot particles.xdmf lists, by name without ".h5" (empty without it).
+  std::map<std::string, double> index_times() const;
 
  private:
   std::vector<double> coarse_grain_;
@@ -117,6 +127,7 @@ class SnapshotWriter {
   std::string material_names_;
   std::string foreign_file_;
   std::vector<std::string> missing_;
+  std::vector<std::string> reused_;
   long next_number_ = 0;  // the number of the next file write() makes
   MPI_Comm comm_;
   int rank_ = 0;

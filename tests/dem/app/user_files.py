@@ -41,6 +41,8 @@ code, its message and what is on disk afterwards:
   * restart_output_series: restarts from every periodic checkpoint of 14 scenes whose output
     intervals are odd numbers of half steps write the uninterrupted run's snapshots and log
     rows, at the same steps under the same numbers;
+  * restart_lost_snapshots: the last two snapshots before the checkpoint deleted, or the one at
+    its step truncated: the restart keeps the uninterrupted run's numbers and names the gaps;
   * restart_at_end: a restart whose time.end is the checkpoint's time runs nothing and leaves
     log.csv, particles.xdmf and every snapshot as they were (bytes), where it had cut the log
     back to the checkpoint;
@@ -321,6 +323,63 @@ def restart_output_series():
                            f"{[g[1] for g in got[0]]} and log steps {got[1]}, the uninterrupted "
                            f"run's {[w[1] for w in want[0]]} and {want[1]}")
     print(f"ok {case}: {checked} restarts from {len(combos)} scenes, each the uninterrupted series")
+
+
+def restart_lost_snapshots():
+    """Snapshots lost before a restart's checkpoint (the last two deleted, or the one at the
+    checkpoint's own step truncated): the restart writes its snapshots under the uninterrupted
+    run's numbers, with the lost ones named as gaps (particles.xdmf dates them). They had been
+    numbered over, shifting every later file by the count lost."""
+    import h5py
+    case = "restart_lost_snapshots"
+    d = fresh(case)
+    scene(d, end=0.012, extra=", checkpoint_interval: 0.006, checkpoint_keep: 10")
+    with open(os.path.join(d, "scene.yaml")) as f:
+        text = f.read().replace("snapshot_interval: 0.001", "snapshot_interval: 0.002")
+    with open(os.path.join(d, "scene.yaml"), "w") as f:
+        f.write(text)
+    expect(case, grain(d, "run", "scene.yaml"), 0, r"done:")
+
+    def series(folder):
+        out = {}
+        for name in sorted(os.listdir(os.path.join(d, folder))):
+            if name.startswith("particles_") and name.endswith(".h5"):
+                try:
+                    with h5py.File(os.path.join(d, folder, name), "r") as f:
+                        out[name] = round(float(f.attrs["time"]), 9)
+                except OSError:
+                    out[name] = None
+        return out
+
+    want = series("out")
+    checkpoint = sorted(n for n in os.listdir(os.path.join(d, "out")) if n.startswith("checkpoint_"))[0]
+    with h5py.File(os.path.join(d, "out", checkpoint), "r") as f:
+        t_check = float(f.attrs["time"])
+    before = sorted(n for n, t in want.items() if t <= t_check + 1e-9)
+    assert len(before) >= 3, before
+    lost = {"deleted": before[-2:], "truncated": before[-1:]}
+    for how, names in lost.items():
+        folder = f"out_{how}"
+        shutil.copytree(os.path.join(d, "out"), os.path.join(d, folder))
+        for name in names:
+            path = os.path.join(d, folder, name)
+            if how == "deleted":
+                os.remove(path)
+            else:
+                os.truncate(path, 1000)
+        rc, out = grain(d, "run", "scene.yaml", "--output", folder, "--restart",
+                        f"{folder}/{checkpoint}")
+        expect(case, (rc, out), 0, r"done:")
+        for name in names:
+            if not re.search(rf"note: {folder}/{name} \((missing|unreadable)\) is a gap", out):
+                fail(case, f"{how}: no note names {name} as a gap:\n{out}")
+        got = series(folder)
+        for name, t in want.items():
+            if name in names:
+                continue
+            if got.get(name) != t:
+                fail(case, f"{how} {names}: {name} holds t = {got.get(name)}, the uninterrupted "
+                           f"run's holds {t}")
 
 
 def hard_linked_backup():
@@ -776,7 +835,7 @@ if __name__ == "__main__":
                   check_restart,
                   restart_missing_csv, restart_mesh,
                   restart_other_physics, restart_smaller_skin, hostile_text,
-                  restart_advice, restart_output_series):
+                  restart_advice, restart_output_series, restart_lost_snapshots):
         check()
     if failures:
         sys.exit(f"{len(failures)} failure(s)")
