@@ -379,10 +379,11 @@ class FoldersMadeForTheRun {
     int rank = 0;
     MPI_Comm_rank(comm, &rank);
     if (rank == 0) {
-      // Each folder along the path as written, for the folders made on the way: "x/../y"
-      // makes x too. symlink_status: a symbolic link (also one to nowhere) is the user's,
-      // never made here; a prefix is taken as made only if neither it nor its lexically
-      // normal form is there (x/../y, x missing, names y, which may exist).
+      // Each folder along the path as written, for the folders made on the way ("x/../y"
+      // makes x too), each taken as the kernel will resolve it once the folders before it
+      // exist: weakly_canonical resolves the part that exists (symbolic links included) and
+      // the rest lexically, as folders made here hold no links. A folder is taken as made
+      // only if it is not there now (symlink_status: a link, even to nowhere, is the user's).
       std::error_code ec;
       const fs::path whole = fs::absolute(dir, ec);
       fs::path p;
@@ -390,9 +391,10 @@ class FoldersMadeForTheRun {
         p /= part;
         if (ec || part.empty() || part == "." || part == ".." || p == p.root_path()) continue;
         std::error_code missing;  // set for a path that is not there: not an error here
-        if (!fs::exists(fs::symlink_status(p, missing)) &&
-            !fs::exists(fs::symlink_status(p.lexically_normal(), missing)))
-          made_.push_back(p);
+        const fs::path resolved = fs::weakly_canonical(p, missing);
+        if (missing || fs::exists(fs::symlink_status(resolved, missing))) continue;
+        if (std::find(made_.begin(), made_.end(), resolved) == made_.end())
+          made_.push_back(resolved);
       }
       std::reverse(made_.begin(), made_.end());  // the deepest first
     }
@@ -408,9 +410,13 @@ class FoldersMadeForTheRun {
   FoldersMadeForTheRun& operator=(const FoldersMadeForTheRun&) = delete;
   ~FoldersMadeForTheRun() {
     if (std::uncaught_exceptions() <= exceptions_) return;
-    std::error_code ec;
-    for (const std::filesystem::path& p : made_)
-      if (!std::filesystem::remove(p, ec)) break;  // not empty, or gone: keep the rest
+    // Each only if it is still an empty folder (a file or link put there is not touched); one
+    // that is not empty keeps its parents, whose removal then fails too.
+    for (const std::filesystem::path& p : made_) {
+      std::error_code ec;
+      if (std::filesystem::is_directory(std::filesystem::symlink_status(p, ec)))
+        std::filesystem::remove(p, ec);
+    }
   }
 
  private:
@@ -636,7 +642,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   std::optional<StartupSignals> startup_signals;
   startup_signals.emplace(
       options.handle_stop_signals, rank == 0,
-      options.restart ? "reading the checkpoint" : "placing the particles",
+      options.restart ? "reading the checkpoint, preparing the first step"
+                      : "placing the particles, preparing the first step",
       rank == 0 ? std::vector<std::string>{(std::filesystem::path(dir) / ".grain.lock").string()}
                 : std::vector<std::string>{},
       made.paths());
@@ -644,7 +651,6 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   Simulation sim(scene, !options.restart, comm);
   std::optional<std::string> checkpoint_log;  // the log table the checkpoint keeps
   if (options.restart) checkpoint_log = restore_checkpoint(sim, scene, *options.restart, comm, out);
-  startup_signals.reset();  // from here on, the run loop's StopSignals (a checkpoint at a step)
   // fluid_force needs the force terms' share kept, at the steps that write a snapshot.
   const bool wants_fluid_force = (scene.output.fields & snapshot_field_bit("fluid_force")) != 0;
   sim.record_fluid_force(wants_fluid_force);  // the first forces (snapshot of step 0)
@@ -809,6 +815,9 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     say << "note: deleted the partial checkpoint " << partial
         << " (left by a run killed while writing it; never a complete checkpoint)\n";
   if (!checkpoints.warning().empty()) say << checkpoints.warning() << "\n";
+  // From here on, the run loop's handler (a checkpoint at a step); the start-up one held
+  // through the first lists and forces and the output's opening.
+  startup_signals.reset();
   const StopSignals signals(options.handle_stop_signals);
 
   const double dt = sim.dt();

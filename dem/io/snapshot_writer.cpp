@@ -416,8 +416,16 @@ std::size_t SnapshotWriter::continue_series(long up_to_step, double up_to_time) 
   // One dated at or before the checkpoint is a gap of the series (and so is every one before
   // it); one dated after it is the stopped run's, written again; an undated one is written
   // again and said.
+  const std::map<std::string, double> listed =
+      foreign_file_.empty() ? index_times() : std::map<std::string, double>{};
+  // The index's snapshots after the highest file in the folder (all missing: the ones at
+  // the checkpoint and after it deleted) are looked at as the skipped ones are.
+  for (const auto& [name, t] : listed)
+    if (name.size() == basename_.size() + 7 &&
+        name.find_first_not_of("0123456789", basename_.size() + 1) == std::string::npos &&
+        std::stol(name.substr(basename_.size() + 1)) > highest)
+      skipped.push_back(name + ".h5 (missing)");
   if (foreign_file_.empty() && !skipped.empty()) {
-    const std::map<std::string, double> listed = index_times();
     const auto number_of = [&](const std::string& gap) {
       return std::stol(gap.substr(basename_.size() + 1, 6));
     };

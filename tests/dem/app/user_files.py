@@ -16,7 +16,8 @@ code, its message and what is on disk afterwards:
     -al`), reading a snapshot from the backup, runs and leaves the backup's bytes (log.csv too);
   * failed_start_writes_nothing: a fill that cannot place its particles (into a/b/out) and a
     refused time step leave no output folder behind (nor x/ of --output x/../y); a folder that
-    was there is kept, empty, and so is a symbolic link to nowhere given as the output folder;
+    was there is kept, empty (also one named through a link and '..'), and so is a symbolic
+    link to nowhere given as the output folder;
   * signal_during_start: SIGTERM while a fill of 400 000 particles is placed: a message, exit
     143, no folder left;
   * second_document: keys after a '---' line: refused (exit 2) at that line, not dropped;
@@ -41,8 +42,9 @@ code, its message and what is on disk afterwards:
   * restart_output_series: restarts from every periodic checkpoint of 14 scenes whose output
     intervals are odd numbers of half steps write the uninterrupted run's snapshots and log
     rows, at the same steps under the same numbers;
-  * restart_lost_snapshots: the last two snapshots before the checkpoint deleted, or the one at
-    its step truncated: the restart keeps the uninterrupted run's numbers and names the gaps;
+  * restart_lost_snapshots: the last two snapshots before the checkpoint deleted, the one at
+    its step truncated, or that one and all later ones deleted: the restart keeps the
+    uninterrupted run's numbers and names the gaps;
   * restart_at_end: a restart whose time.end is the checkpoint's time runs nothing and leaves
     log.csv, particles.xdmf and every snapshot as they were (bytes), where it had cut the log
     back to the checkpoint;
@@ -224,6 +226,17 @@ def failed_start_writes_nothing():
             fail(case, f"--output {given}: the failed start left x/ or y/ behind")
         if not os.path.isdir(os.path.join(d, "out")):
             fail(case, f"--output {given}: the folder out/ that was there was removed")
+    # Through a symbolic link and up again: L/b/../../c names other/c once L/b is made, a
+    # folder the user had (empty); only L/b, made by the run, goes.
+    os.makedirs(os.path.join(d, "other", "a2"))
+    os.makedirs(os.path.join(d, "other", "c"))
+    os.symlink(os.path.join(d, "other", "a2"), os.path.join(d, "L"))
+    expect(case, grain(d, "run", "scene.yaml", "--output", "L/b/../../c"), 1,
+           r"refusing to run with this time step")
+    if not os.path.isdir(os.path.join(d, "other", "c")):
+        fail(case, "--output L/b/../../c: the failed start removed the user's folder other/c")
+    if os.path.exists(os.path.join(d, "other", "a2", "b")):
+        fail(case, "--output L/b/../../c: the failed start left L/b behind")
     # A symbolic link to a folder that does not exist is the user's: kept.
     os.symlink(os.path.join(d, "nowhere"), os.path.join(d, "results"))
     expect(case, grain(d, "run", "scene.yaml", "--output", "results"), 1,
@@ -259,7 +272,8 @@ def signal_during_start():
     p.send_signal(signal.SIGTERM)
     out, _ = p.communicate(timeout=120)
     expect(case, (p.returncode, out), 143,
-           r"grain: received SIGTERM during start-up \(placing the particles\); stopped before "
+           r"grain: received SIGTERM during start-up \(placing the particles, preparing the first "
+           r"step\); stopped before "
            r"the first step: nothing was run, no checkpoint or snapshot was written")
     if os.path.exists(os.path.join(d, "a")):
         fail(case, f"the stopped start left a/ behind: {sorted(os.listdir(os.path.join(d, 'a')))}")
@@ -357,13 +371,17 @@ def restart_lost_snapshots():
         t_check = float(f.attrs["time"])
     before = sorted(n for n, t in want.items() if t <= t_check + 1e-9)
     assert len(before) >= 3, before
-    lost = {"deleted": before[-2:], "truncated": before[-1:]}
+    # The last two before the checkpoint deleted; the one at its step truncated; that one and
+    # every later file deleted (no file after it is left to show the gap: the index does).
+    after = sorted(n for n in want if n not in before)
+    lost = {"deleted": before[-2:], "truncated": before[-1:],
+            "deleted_to_the_end": before[-1:] + after}
     for how, names in lost.items():
         folder = f"out_{how}"
         shutil.copytree(os.path.join(d, "out"), os.path.join(d, folder))
         for name in names:
             path = os.path.join(d, folder, name)
-            if how == "deleted":
+            if how.startswith("deleted"):
                 os.remove(path)
             else:
                 os.truncate(path, 1000)
@@ -371,11 +389,13 @@ def restart_lost_snapshots():
                         f"{folder}/{checkpoint}")
         expect(case, (rc, out), 0, r"done:")
         for name in names:
+            if name in after:  # the stopped run's, after the checkpoint: written again
+                continue
             if not re.search(rf"note: {folder}/{name} \((missing|unreadable)\) is a gap", out):
                 fail(case, f"{how}: no note names {name} as a gap:\n{out}")
         got = series(folder)
         for name, t in want.items():
-            if name in names:
+            if name in names and name not in after:
                 continue
             if got.get(name) != t:
                 fail(case, f"{how} {names}: {name} holds t = {got.get(name)}, the uninterrupted "
