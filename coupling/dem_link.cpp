@@ -45,6 +45,7 @@ struct DemLink::Impl {
   std::string snapshot_directory;
   std::optional<CheckpointData> restart;  // until initialise()
   long restored_step = -1;                // the checkpoint's DEM step, after a restart
+  double restored_time = 0;               // the checkpoint's time, after a restart
   std::unique_ptr<CheckpointSeries> checkpoints;
   std::vector<double> forwarded;     // particles(): the values forwarded to ghosts, reused
   std::vector<CoupledSample> pending;  // begin_fluid() .. end_fluid()
@@ -254,6 +255,7 @@ void DemLink::initialise() {
       check_restart_step(m.scene, *m.restart);
       m.sim->restore(*m.restart);
       m.restored_step = m.restart->step;
+      m.restored_time = m.sim->time();
       m.restart.reset();
     }
     if (m.grid)
@@ -743,15 +745,17 @@ std::array<double, 3> DemLink::momentum() const {
   return {sum[0], sum[1], sum[2]};
 }
 
-void DemLink::write_snapshot(const std::string& directory, long step, long continue_after) {
+std::vector<std::string> DemLink::write_snapshot(const std::string& directory, long step,
+                                                 long continue_after) {
   Impl& m = *impl_;
+  std::vector<std::string> notes;
   try {
     // The scene's output window: outside it no snapshot is written (the checkpoints are).
     const Simulation& sim = m.simulation();
     const double half = 0.5 * sim.dt();
     if ((m.scene.output.start && sim.time() < *m.scene.output.start - half) ||
         (m.scene.output.stop && sim.time() > *m.scene.output.stop + half))
-      return;
+      return notes;
     if (!m.snapshots || m.snapshot_directory != directory) {
       prepare_output_directory(directory);
       m.snapshots = std::make_unique<SnapshotWriter>(m.dem_comm, directory, "particles",
@@ -760,10 +764,21 @@ void DemLink::write_snapshot(const std::string& directory, long step, long conti
       m.snapshots->set_coarse_grain(m.scene.coarse_grain_table(), m.scene.real_material_table());
       m.snapshots->set_material_names(m.scene.material_names());
       m.snapshot_directory = directory;
-      // (The files after the last one taken are written again, as the index's times are
-      // not compared with the restart's here.)
-      if (continue_after >= 0)
-        m.snapshots->continue_series(continue_after, -std::numeric_limits<double>::infinity());
+      // A restart: the series goes on after the snapshots written up to the checkpoint;
+      // those lost since (listed in particles.xdmf up to the checkpoint's time, the restart
+      // does not write them again) stay gaps, so later files keep their numbers.
+      if (continue_after >= 0) {
+        m.snapshots->continue_series(continue_after, m.restored_time + 0.5 * sim.dt());
+        for (const std::string& gap : m.snapshots->missing())
+          notes.push_back(directory + "/" + gap +
+                          " is a gap in the snapshot series (deleted or damaged since it was "
+                          "written): particles.xdmf lists the snapshots around it");
+        for (const std::string& again : m.snapshots->reused())
+          notes.push_back(directory + "/" + again +
+                          " comes after the last snapshot this restart takes over, and "
+                          "particles.xdmf does not say when it was written: the restart writes "
+                          "a snapshot under that number");
+      }
     }
     // A restored run's first forces come from the checkpoint, without a network: a snapshot
     // before the first advance has none.
@@ -774,6 +789,7 @@ void DemLink::write_snapshot(const std::string& directory, long step, long conti
   } catch (const std::exception& e) {
     throw std::runtime_error(e.what());
   }
+  return notes;
 }
 
 std::string DemLink::write_checkpoint(const std::string& directory, int keep) {

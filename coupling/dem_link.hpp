@@ -270,8 +270,11 @@ class DemLink {
   // the scene's output.fields (fluid_force: the coupling's force on each particle at the end
   // of the last advance) and, with output.contacts, the contact network of the last
   // advance's last sub-step; outside the scene's output.start / output.stop nothing is
-  // written.
-  void write_snapshot(const std::string& directory, long step, long continue_after = -1);
+  // written. Returns notes for the log (empty but for the first call after restore(): each
+  // snapshot lost since it was written, which the series keeps as a gap, and each lost file
+  // whose number the series writes again).
+  std::vector<std::string> write_snapshot(const std::string& directory, long step,
+                                          long continue_after = -1);
   // Writes the complete DEM state to <directory>/checkpoint_<DEM step>.h5 and deletes the
   // oldest beyond `keep` (after restore(), the directory's checkpoints up to the restored
   // step count as the oldest). Rebuilds the neighbour lists as a restart will, so that a

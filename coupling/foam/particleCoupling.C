@@ -12,6 +12,7 @@
 #include <sstream>
 #include <utility>
 
+#include "IFstream.H"
 #include "coupling/accuracy_table.hpp"
 #include "coupling/floating_point_traps.hpp"
 #include "coupling/foam/cellSearch.H"
@@ -189,6 +190,34 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
                              IOobject::MUST_READ_IF_MODIFIED, IOobject::NO_WRITE));
 
   // --- settings -------------------------------------------------------------------
+  // OpenFOAM keeps the last of two entries with one key, silently: read the file once more,
+  // with duplicates an error, and refuse a key given twice at both its lines.
+  {
+    const fileName file = dict.filePath();
+    dictionary entries;
+    const bool wasThrowing = FatalIOError.throwExceptions();
+    try {
+      IFstream is(file);
+      entries.name() = is.name();
+      while (!is.eof() && entry::New(entries, is, entry::inputMode::ERROR, 0)) {
+      }
+      FatalIOError.throwExceptions(wasThrowing);
+    } catch (const IOerror& e) {
+      FatalIOError.throwExceptions(wasThrowing);
+      const std::string text = e.message();
+      const std::string::size_type at = text.find("duplicate entry: ");
+      if (at == std::string::npos) throw;
+      std::string key = text.substr(at + 17);
+      key.erase(key.find_last_not_of(" \n\t") + 1);
+      const entry* first = entries.findEntry(key, keyType::LITERAL);
+      const std::string message =
+          "key '" + key + "' is given twice (at line " +
+          (first ? std::to_string(first->startLineNumber()) + " and line " : std::string()) +
+          std::to_string(e.ioStartLineNumber()) +
+          "); OpenFOAM would silently take the last one: keep only the one you mean";
+      FatalIOErrorInFunction(dict) << message.c_str() << exit(FatalIOError);
+    }
+  }
   // A misspelt key would silently fall back to its default: refuse unknown keys.
   {
     const wordList allowed{"scene",
@@ -2375,7 +2404,9 @@ void ParticleCoupling::evolve() {
 
 void ParticleCoupling::writeSnapshot() {
   const Foam::Time& time = mesh_.time();
-  dem_->write_snapshot(snapshotDir_, time.timeIndex(), restartIndex_ > 0 ? restartIndex_ : -1);
+  for (const std::string& note :
+       dem_->write_snapshot(snapshotDir_, time.timeIndex(), restartIndex_ > 0 ? restartIndex_ : -1))
+    Foam::Info << "grainFoam: note: " << note.c_str() << Foam::endl;
 }
 
 void ParticleCoupling::writeSnapshotIfDue() {

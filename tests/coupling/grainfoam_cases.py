@@ -474,6 +474,28 @@ def refuses_bad_setup(runner, checks):
     checks.expect('scene "particle.yaml" (line 10): no such file' in log and "couplingProperties"
                   in log, "scene particle.yaml: refused naming the key, line 10 and the file")
 
+    # A key given twice: OpenFOAM takes the last silently (voidFraction centre ran, against the
+    # divided the user saw first). Refused at both lines, in serial and on 2 ranks; keeping one
+    # of the two, as advised, runs.
+    case = runner.fresh_case("periodic_box", "duplicate_key", [
+        ("constant/couplingProperties", "minVoidFraction 0.2;",
+         "minVoidFraction 0.2;\nvoidFraction    centre;")])
+    runner.run(case, "blockMesh", "blockMesh")
+    log = runner.run(case, "grainFoam", runner.solver, expect_failure=True)
+    checks.expect("key 'voidFraction' is given twice (at line 11 and line 14); OpenFOAM would "
+                  "silently take the last one" in log and "couplingProperties" in log,
+                  "voidFraction given twice: refused at lines 11 and 14, naming the file")
+    runner.run(case, "decomposePar", "decomposePar")
+    log = runner.run(case, "grainFoam.parallel", runner.solver, ranks=2, expect_failure=True)
+    checks.expect("key 'voidFraction' is given twice" in log,
+                  "voidFraction given twice, 2 ranks: refused")
+    with open(os.path.join(case, "constant/couplingProperties")) as f:
+        text = f.read()
+    with open(os.path.join(case, "constant/couplingProperties"), "w") as f:
+        f.write(text.replace("\nvoidFraction    centre;", ""))
+    runner.run(case, "grainFoam.advised", runner.solver)  # raises unless it runs to the end
+    checks.expect(True, "the duplicate removed, as advised, runs")
+
     # 2b. deltaT 0 and an endTime before the start: refused, saying why.
     case = runner.fresh_case("periodic_box", "deltaT_zero", [
         ("system/controlDict", "deltaT          1e-4;", "deltaT          0;")])
@@ -1765,6 +1787,50 @@ def diffusion_smoothing(runner, checks):
     checks.expect(expected in log and "0 for none" in log,
                   f"smoothing_negative: refused ('{expected}', naming 0 for none)")
 
+# --- coupling.restart_lost_snapshots -------------------------------------------------------
+
+
+def restart_lost_snapshots(runner, checks):
+    """Snapshots lost before a restart keep their numbers as gaps. cases/periodic_box with
+    output.snapshot_interval 0.005 s (snapshot n at t = n * 0.005 s), written every 50 fluid
+    steps, is stopped at t = 0.01 s (snapshots 0, 1, 2); 1 and 2 (the one at the checkpoint)
+    are deleted, and the run restarts to
+    0.02 s. Its next snapshots must be 3 and 4, at 0.015 and 0.02 s, as in the uninterrupted
+    run, and the log must name 1 and 2 as gaps. (Before, with no file left after 0, the
+    restart numbered its snapshots 1 and 2, so that particles_000001.h5 held t = 0.015 s.)"""
+    case = runner.fresh_case("periodic_box", "lost_snapshots", [
+        ("system/controlDict", "endTime         2e-4;", "endTime         1e-2;"),
+        ("system/controlDict", "writeInterval   1;", "writeInterval   50;"),
+        ("particles.yaml", "buoyancy]\n", "buoyancy]\noutput: {snapshot_interval: 0.005}\n")])
+    runner.solve(case, 1)
+    folder = os.path.join(case, "particles")
+    written = sorted(n for n in os.listdir(folder) if n.startswith("particles_"))
+    checks.expect(written == [f"particles_00000{n}.h5" for n in range(3)],
+                  f"the stopped run wrote snapshots 0, 1, 2 ({written})")
+    for n in (1, 2):
+        os.remove(os.path.join(folder, f"particles_00000{n}.h5"))
+    set_keys(case, "system/controlDict", endTime="2e-2", startFrom="latestTime")
+    log = runner.run(case, "grainFoam.restart", runner.solver)
+    for n in (1, 2):
+        checks.expect(f"particles/particles_00000{n}.h5 (missing) is a gap in "
+                      "the snapshot series" in log,
+                      f"the log names the deleted snapshot {n} as a gap")
+    times = {}
+    for name in sorted(os.listdir(folder)):
+        if name.startswith("particles_") and name.endswith(".h5"):
+            with h5py.File(os.path.join(folder, name), "r") as f:
+                times[int(name[10:16])] = float(f.attrs["time"])
+    checks.expect(sorted(times) == [0, 3, 4] and
+                  all(abs(t - 0.005 * n) < 1e-12 for n, t in times.items()),
+                  f"after the restart snapshot n holds t = n * 0.005 s, 1 and 2 gaps ({times})")
+    with open(os.path.join(folder, "particles.xdmf")) as f:
+        index = f.read()
+    listed = [float(t) for t in re.findall(r'<Time Value="([^"]+)"', index)]
+    checks.expect(listed == [0.0, 0.015, 0.02] or
+                  np.allclose(listed, [0.0, 0.015, 0.02], rtol=0, atol=1e-12),
+                  f"particles.xdmf lists the snapshots on disk at 0, 0.015, 0.02 s ({listed})")
+
+
 # --- coupling.restart_unwritten_time, coupling.run_time_edits, coupling.restart_time_step,
 # --- coupling.checkpoint_keeping, coupling.setup_messages --------------------------------
 
@@ -2133,7 +2199,8 @@ TESTS = {f.__name__: f for f in (void_fraction_volume, exchange_balance, neutral
                                  scene_output, heat_equilibrium, heat_parcels, heat_balance,
                                  heat_front, balanced_decomposition,
                                  diffusion_smoothing, restart_unwritten_time, run_time_edits,
-                                 restart_time_step, checkpoint_keeping, setup_messages)}
+                                 restart_time_step, checkpoint_keeping, setup_messages,
+                                 restart_lost_snapshots)}
 
 
 if __name__ == "__main__":

@@ -18,7 +18,8 @@
 #       output.start between the two write times only the second has a snapshot.
 #   coupling.refuses_bad_setup     processor meshes that are not boxes (2 ranks), deltaT not
 #       a whole number of DEM steps, fluid.density != rho, undisturbedVelocity unknown or with
-#       cellPoint, meanPressureGradient unknown or with walls across gravity: each stops with
+#       cellPoint, meanPressureGradient unknown or with walls across gravity, a couplingProperties
+#       key given twice (also on 2 ranks; the advice, one removed, runs): each stops with
 #       its message.
 #   coupling.restart               cases/periodic_box under 10 g in a flow: 400 fluid steps vs
 #       200 + restart (startFrom latestTime) + 200, on 1 and on 2 ranks: every particle and
@@ -95,6 +96,9 @@
 #   coupling.setup_messages        diffusionBandwidth 60 m and 5 m refused with the allowed
 #       range, whose end runs; mpirun -np 2 without -parallel says to add it; a
 #       fluid.viscosity unlike rho*nu printed to 12 digits, which typed back run.
+#   coupling.restart_lost_snapshots  snapshots 1 and 2 (the one at the checkpoint) deleted
+#       before a restart: named as gaps, the restart's snapshots keep the uninterrupted run's
+#       numbers 3 and 4 (t = n * 0.005 s).
 if(NOT TARGET grainFoam)
   return()
 endif()
@@ -236,6 +240,7 @@ grainflow_coupling_test(run_time_edits 1)
 grainflow_coupling_test(restart_time_step 1)
 grainflow_coupling_test(checkpoint_keeping 1)
 grainflow_coupling_test(setup_messages 2)
+grainflow_coupling_test(restart_lost_snapshots 1)
 set_tests_properties(coupling.balanced_decomposition PROPERTIES TIMEOUT 300)  # ~40 s loaded
 set_tests_properties(coupling.stop_signal PROPERTIES TIMEOUT 600)  # ~25 s on a quiet machine
 
