@@ -220,7 +220,7 @@ def summarise(path, in_folder=False):
                 f"particles {n}")
         if parcels:
             line += (f" ({int((k != 1).sum())} parcels among them; together "
-                     f"{real.sum():.0f} real particles)")
+                     f"{real.sum():.12g} real particles)")
         if kind == "checkpoint":
             line += "  (checkpoint)"
         print(line)
@@ -257,7 +257,7 @@ def summarise(path, in_folder=False):
                     f"; radius [m] parcels {r[sel].min():.6g} to {r[sel].max():.6g}, "
                     f"real particles {r[sel].min() / kv:.6g} to {r[sel].max() / kv:.6g}")
                 print(f"  coarse grain k {kv:g}: {int(sel.sum())} parcels stand for "
-                      f"{real[sel].sum():.0f} real particles ({kv**3:g} each){sizes}")
+                      f"{real[sel].sum():.12g} real particles ({kv**3:.12g} each){sizes}")
 
 
 def main():

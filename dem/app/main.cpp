@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <new>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -311,6 +312,13 @@ int dispatch(const std::string& program, const std::vector<std::string>& args, i
     return 1;
   } catch (const OutputError& e) {  // agreed on by all ranks
     if (rank == 0) std::cerr << "grain: error: " << e.what() << "\n";
+    return 1;
+  } catch (const std::bad_alloc&) {  // on any rank: say what ran out
+    std::cerr << "grain: error on rank " << rank << ": out of memory (std::bad_alloc): the "
+              << "scene's particles, neighbour lists or output need more memory than this "
+              << "machine gives the run; fewer or larger particles, coarse-grained parcels "
+              << "(`coarse_grain: k`), or more ranks on more nodes\n";
+    MPI_Abort(MPI_COMM_WORLD, 1);
     return 1;
   } catch (const std::exception& e) {  // unexpected: print on every rank, with the rank
     std::cerr << "grain: error on rank " << rank << ": " << e.what() << "\n";

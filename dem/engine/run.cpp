@@ -188,11 +188,12 @@ void print_coarse_grain_report(const Scene& scene, const Particles& p, const Wal
   o << "coarse graining (docs/models/coarse-graining.md):\n";
   for (const ParcelClass& c : classes)
     o << "  '" << c.name << "': " << c.parcels << " parcels of k = " << c.k << " stand for "
-      << c.real << " real particles, " << c.mass << " kg in all (real radius up to "
-      << c.largest_diameter / (2 * c.k) << " m, parcel radius up to " << c.largest_diameter / 2
-      << " m)" << (c.parcels == 0 ? "; none yet: a stream inserts them" : "") << "\n";
-  o << "  all particles: " << parcels << " computed, " << real << " real, mass " << mass
-    << " kg\n";
+      << significant(c.real, 12) << " real particles, " << c.mass
+      << " kg in all (real radius up to " << c.largest_diameter / (2 * c.k)
+      << " m, parcel radius up to " << c.largest_diameter / 2 << " m)"
+      << (c.parcels == 0 ? "; none yet: a stream inserts them" : "") << "\n";
+  o << "  all particles: " << parcels << " computed, " << significant(real, 12) << " real, mass "
+    << mass << " kg\n";
   const Vec3 extent = scene.domain.hi - scene.domain.lo;
   for (const std::string& w : parcel_domain_warnings(classes, extent, scene.domain.periodic))
     o << "  " << w << "\n";
@@ -1035,8 +1036,9 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
         << continue_command(scene.file, options, ranks, checkpoints.newest()) << "\n";
   if (!scene.coarse_grain_table().empty()) {
     const ParticleTotals end = particle_totals(scene, sim.particles(), comm);
-    say << "coarse graining: the " << end.computed << " particles stand for " << end.real
-        << " real particles (" << end.mass << " kg); each parcel counts as one particle in the "
+    say << "coarse graining: the " << end.computed << " particles stand for "
+        << significant(end.real, 12) << " real particles (" << end.mass
+        << " kg); each parcel counts as one particle in the "
         << "counts above, in the removed ones and in log.csv\n";
   }
   sum.startup_seconds = setup_seconds + first_snapshot_seconds;
@@ -1059,13 +1061,17 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
     say << "stream " << streams.source(k) << ": " << streams.count_inserted(k) << " particles"
         << (kc != 1 ? " (parcels of k = " + significant(kc, 6) + ": " +
                           significant(static_cast<double>(streams.count_inserted(k)) * kc * kc * kc,
-                                      6) +
+                                      12) +
                           " real particles)"
                     : std::string())
-        << ", " << streams.mass_inserted(k) << " kg delivered since t = 0"
-        << (streams.lag(k) > 0 ? ", " + std::to_string(streams.lag(k)) + " behind (face blocked)"
-                               : std::string())
-        << "\n";
+        << ", " << streams.mass_inserted(k) << " kg delivered since t = 0";
+    if (streams.lag(k) > 0) {
+      say << ", ";
+      if (streams.lag_mass(k) > 0) say << streams.lag_mass(k) << " kg (";
+      say << (streams.lag_is_lower_bound(k) ? "at least " : "") << streams.lag(k)
+          << (streams.lag_mass(k) > 0 ? " particles)" : "") << " behind (face blocked)";
+    }
+    say << "\n";
   }
   for (const std::string& line : sim.force_term_reports())
     if (!line.empty()) say << line << "\n";

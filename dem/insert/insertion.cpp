@@ -1,5 +1,7 @@
 #include "dem/insert/insertion.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -8,8 +10,8 @@
 #include <sstream>
 #include <unordered_map>
 
-#include "dem/engine/restored_state.hpp"
 #include "dem/core/number_format.hpp"
+#include "dem/engine/restored_state.hpp"
 #include "dem/io/snapshot_reader.hpp"
 #include "dem/walls/wall_contact.hpp"
 
@@ -178,6 +180,15 @@ bool sample_centre(const Region& reg, double r, std::mt19937_64& rng, Vec3& x) {
   return true;
 }
 
+// Whether the point x lies in the region (a sphere's centre: the sphere may reach out).
+bool inside_region(const Region& reg, const Vec3& x) {
+  if (reg.kind == Region::Kind::box)
+    return (x.array() >= reg.lo.array()).all() && (x.array() <= reg.hi.array()).all();
+  const Vec3 d = x - reg.base;
+  const double along = d.dot(reg.axis);
+  return along >= 0 && along <= reg.height && (d - along * reg.axis).norm() <= reg.radius;
+}
+
 // `tolerance`: how far a sphere may poke through a bounded side (a settled particle overlaps
 // a wall that lies on that side by a little).
 bool inside_domain(const Domain& d, const Vec3& x, double r, double tolerance = 0) {
@@ -254,6 +265,36 @@ std::string inside_a_wall(const Scene& s, const WallSet* walls, const Vec3& x, d
   return o.str();
 }
 
+namespace {
+// A fill draws all its radii and holds every particle it places on each rank before they
+// are shared out: at least this many bytes per particle (a run of 1e6 beads peaked at
+// 340 bytes each), so a fill of more than physical memory / kFillBytesPerParticle surely
+// cannot be held.
+constexpr double kFillBytesPerParticle = 200;
+
+double physical_memory_bytes() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && page > 0 ? static_cast<double>(pages) * static_cast<double>(page)
+                               : std::numeric_limits<double>::infinity();
+}
+
+// The error for a fill of at least `n` particles that memory cannot hold.
+[[noreturn]] void refuse_fill_size(const Insertion& ins, double n, double memory) {
+  std::ostringstream msg;
+  msg.precision(3);
+  msg << ins.source << ": error: this fill would insert " << (ins.count ? "" : "about ") << n
+      << " particles";
+  if (ins.volume_fraction)
+    msg << " (volume_fraction " << *ins.volume_fraction << " of its region with these radii)";
+  msg << ", at least " << kFillBytesPerParticle << " bytes each in memory ("
+      << n * kFillBytesPerParticle / 1e9 << " GB), more than this machine's " << memory / 1e9
+      << " GB: fewer or larger particles fit, or coarse-grained parcels "
+      << "(`coarse_grain: k`: each parcel stands for k^3 particles; "
+         "docs/models/coarse-graining.md)";
+  throw InsertionError(msg.str());
+}
+}  // namespace
+
 void fill_region(const Scene& scene, const WallSet* walls, const Insertion& ins, Particles& p,
                  GlobalId& next_id, OverlapGrid& grid, std::vector<std::string>* notes) {
   std::mt19937_64 rng(ins.seed);
@@ -267,6 +308,7 @@ void fill_region(const Scene& scene, const WallSet* walls, const Insertion& ins,
   // particle.
   std::vector<long> by_wall(scene.walls.size(), 0);
   long sampled = 0, outside = 0, walled = 0;
+  const std::size_t earlier = p.size();  // the particles of earlier insertions
   const auto wall_of = [&](const Vec3& x, double r) {
     if (walls) return walls->deepest_overlap(x, r).wall;
     int wall = -1;
@@ -285,11 +327,24 @@ void fill_region(const Scene& scene, const WallSet* walls, const Insertion& ins,
   // the distribution asks for; largest first, the small ones fill the gaps the large ones
   // leave, and dense fills reach the packing they would in any order or more.
   std::vector<double> radii;
+  const double memory = physical_memory_bytes();
+  const double most = memory / kFillBytesPerParticle;
   if (ins.count) {
+    if (static_cast<double>(target_count) > most)
+      refuse_fill_size(ins, static_cast<double>(target_count), memory);
     radii.reserve(static_cast<std::size_t>(target_count));
     for (long k = 0; k < target_count; ++k) radii.push_back(sample_radius(ins.radius, rng));
   } else {
+    // The count a volume fraction asks, from the mean volume of 10 000 radii drawn from a
+    // copy of the generator (the fill's own draws stay as they were).
+    std::mt19937_64 probe = rng;
+    double drawn = 0;
+    for (int k = 0; k < 10000; ++k) drawn += sphere_volume(sample_radius(ins.radius, probe));
+    if (const double n = target_volume / (drawn / 10000); n > most)
+      refuse_fill_size(ins, n, memory);
     for (double v = 0; v < target_volume;) {
+      if (static_cast<double>(radii.size()) > most)
+        refuse_fill_size(ins, static_cast<double>(radii.size()), memory);
       radii.push_back(sample_radius(ins.radius, rng));
       v += sphere_volume(radii.back());
     }
@@ -312,14 +367,24 @@ void fill_region(const Scene& scene, const WallSet* walls, const Insertion& ins,
       const double usable =
           sampled > 0 ? 1 - static_cast<double>(walled + outside) / static_cast<double>(sampled)
                       : 1.0;
+      // What earlier insertions already hold of the region (their centres inside it).
+      double before = 0;
+      for (std::size_t i = 0; i < earlier; ++i)
+        if (inside_region(ins.region, p.x[i])) before += sphere_volume(p.radius[i]);
+      const double taken = before / region_volume(ins.region);
+      const double reached = volume / region_volume(ins.region);
       if (walled > 0 && 2 * walled >= sampled) {
         const auto worst = std::max_element(by_wall.begin(), by_wall.end()) - by_wall.begin();
         msg << "; " << walled << " of the " << sampled << " centres drawn in the region touched "
             << "a wall or lay behind it (" << by_wall[worst] << " wall '" << scene.walls[worst].name
-            << "'): the walls leave " << 100 * usable
-            << " % of the region to the particles. Check that wall (a plane's normal points to "
-               "the side the particles live on, a cylinder's `side`), or move the region to "
-               "the walls' inner side";
+            << "'): the walls leave " << 100 * usable << " % of the region to the particles";
+        if (ins.volume_fraction)
+          msg << ". `volume_fraction` counts the whole region, so " << *ins.volume_fraction
+              << " of it is " << *ins.volume_fraction / usable
+              << " of the space the walls leave, where random insertion saturates near 0.35";
+        msg << ". If the particles should have more room, check that wall (a plane's normal "
+               "points to the side the particles live on, a cylinder's `side`), or move the "
+               "region to the walls' inner side";
       } else {
         msg << "; enlarge the region, or lower `count` / `volume_fraction` (random insertion "
                "saturates near 0.35";
@@ -328,25 +393,27 @@ void fill_region(const Scene& scene, const WallSet* walls, const Insertion& ins,
               << " % of the region, so that is about " << 0.35 * usable
               << " of the region's volume";
         msg << ")";
-        // What this fill reached is the surer figure where walls are near: beds pack less
-        // densely against them than in the open (0.2749 estimated, 0.2403 reached in a drum
-        // 6.7 bead diameters wide), so an estimate-based request was refused again. The
-        // particles placed are the largest drawn (largest first), so the figure is a safe
-        // one, not the most that fits: a whole draw of the distribution, smaller on average,
-        // packs at least as well. A count is the volume reached over the mean volume drawn.
-        const double reached = volume / region_volume(ins.region);
-        if (ins.volume_fraction && reached < 0.35 * usable) {
-          msg << "; this fill reached " << reached << " before its attempts ran out: a "
-              << "`volume_fraction` of " << round_down_3(0.95 * reached) << " fits";
-        } else if (ins.count && placed > 1) {
-          double drawn = 0;
-          for (double r : radii) drawn += sphere_volume(r);
-          const double mean = drawn / static_cast<double>(radii.size());
-          const long fits = std::max<long>(static_cast<long>(0.95 * volume / mean),
-                                           static_cast<long>(0.95 * static_cast<double>(placed)));
-          msg << "; this fill placed " << placed << " (its largest) before its attempts ran "
-              << "out, " << reached << " of the region: a `count` of " << fits << " fits";
-        }
+      }
+      if (taken > 0.01)
+        msg << "; earlier insertions already fill " << taken
+            << " of the region (their particles count against this fill's room)";
+      // What this fill reached is the surer figure where walls are near: beds pack less
+      // densely against them than in the open (0.2749 estimated, 0.2403 reached in a drum
+      // 6.7 bead diameters wide), so an estimate-based request was refused again. The
+      // particles placed are the largest drawn (largest first), so the figure is a safe
+      // one, not the most that fits: a whole draw of the distribution, smaller on average,
+      // packs at least as well. A count is the volume reached over the mean volume drawn.
+      if (ins.volume_fraction && placed > 1) {
+        msg << "; this fill reached " << reached << " before its attempts ran out: a "
+            << "`volume_fraction` of " << round_down_3(0.95 * reached) << " fits";
+      } else if (ins.count && placed > 1) {
+        double drawn = 0;
+        for (double r : radii) drawn += sphere_volume(r);
+        const double mean = drawn / static_cast<double>(radii.size());
+        const long fits = std::max<long>(static_cast<long>(0.95 * volume / mean),
+                                         static_cast<long>(0.95 * static_cast<double>(placed)));
+        msg << "; this fill placed " << placed << " (its largest) before its attempts ran "
+            << "out, " << reached << " of the region: a `count` of " << fits << " fits";
       }
       if (ins.coarse_grain != 1)
         msg << "; the particles are parcels of radius up to " << max_radius(ins.radius)
@@ -377,6 +444,24 @@ void fill_region(const Scene& scene, const WallSet* walls, const Insertion& ins,
   // Radii are drawn until their volume reaches the fraction, so the last one overshoots it:
   // by little in a large region, by much where one particle is a sizeable part of it.
   const double reached = volume / region_volume(ins.region);
+  // volume_fraction counts the whole region: where walls or the domain's sides take a part of
+  // it, the particles stand denser in the rest than the fraction reads (a drum in a box region:
+  // 0.1 asked, 0.354 in the drum). Said, with the share they left, estimated from the
+  // centres drawn.
+  const double usable =
+      sampled > 0 ? 1 - static_cast<double>(walled + outside) / static_cast<double>(sampled) : 1.0;
+  if (ins.volume_fraction && notes && sampled >= 100 && usable < 0.9) {
+    std::ostringstream o;
+    o.precision(3);
+    o << "note: " << ins.source << ": the walls" << (outside > 0 ? " and the domain's sides" : "")
+      << " leave about " << 100 * usable << " % of the fill's region to the particles (of the "
+      << sampled << " centres drawn, " << walled + outside << " touched a wall or lay outside); "
+      << "volume_fraction counts the whole region, so its " << reached << " is about "
+      << reached / usable << " solid fraction in the space left; for " << reached
+      << " there, ask volume_fraction " << round_down_3(reached * usable)
+      << " or fit the region to that space";
+    notes->push_back(o.str());
+  }
   if (ins.volume_fraction && notes && reached > 1.05 * *ins.volume_fraction) {
     std::ostringstream o;
     o.precision(4);

@@ -156,6 +156,8 @@ long StreamInsertion::insert(double t, Particles& p, const WallSet& walls,
   for (Stream& s : streams_) {
     const long due_now = due(s, t);
     s.lag = due_now;
+    s.lag_mass = 0;
+    s.lag_lower_bound = false;
     if (due_now == 0) continue;
     // No more than the face holds can be placed in one step: the rest of a backlog waits.
     const long need = std::min(due_now, s.capacity);
@@ -226,6 +228,15 @@ long StreamInsertion::insert(double t, Particles& p, const WallSet& walls,
     }
     s.pending.erase(s.pending.begin(), s.pending.begin() + placed);
     s.lag = due_now - placed;
+    // due() counts at most kMaxPerStep: the backlog beyond it, from the target itself.
+    const Insertion& e = s.entry;
+    const double elapsed = std::min(t, *e.stop) - e.start;
+    if (e.mass_rate) {
+      if (s.lag > 0) s.lag_mass = std::max(0.0, *e.mass_rate * elapsed - s.mass);
+      s.lag_lower_bound = due_now == kMaxPerStep;
+    } else {
+      s.lag = std::max(0L, static_cast<long>(std::floor(*e.count_rate * elapsed + 0.5)) - s.count);
+    }
     total += placed;
   }
   return total;

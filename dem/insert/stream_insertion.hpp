@@ -51,8 +51,13 @@ class StreamInsertion {
   // Totals of stream k over all ranks (the same on every rank).
   double mass_inserted(std::size_t k) const { return streams_[k].mass; }
   long count_inserted(std::size_t k) const { return streams_[k].count; }
-  // How far stream k is behind its target at the last insert(), in particles.
+  // How far stream k is behind its target at the last insert(), in particles: exact for a
+  // count rate; for a mass rate, a lower bound when lag_is_lower_bound(k) (the radii of a
+  // backlog are drawn only as far as one step's most, kMaxPerStep).
   long lag(std::size_t k) const { return streams_[k].lag; }
+  bool lag_is_lower_bound(std::size_t k) const { return streams_[k].lag_lower_bound; }
+  // For a mass rate: the mass [kg] stream k is behind its target (0 for a count rate).
+  double lag_mass(std::size_t k) const { return streams_[k].lag_mass; }
   std::size_t size() const { return streams_.size(); }
   const std::string& source(std::size_t k) const { return streams_[k].entry.source; }
   // Stream k's coarse-graining factor (1: real particles; k: parcels of k^3 real ones).
@@ -74,6 +79,8 @@ class StreamInsertion {
     double mass = 0;
     long count = 0;
     long lag = 0;
+    double lag_mass = 0;
+    bool lag_lower_bound = false;
     // The most particles the face can hold at once: their discs on the face lie inside it
     // and do not overlap, so at most its area over the smallest disc's. A blocked stream's
     // backlog is tried only up to it per step (its cost had grown with the backlog).

@@ -28,6 +28,7 @@
 #include <iomanip>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -1414,6 +1415,44 @@ void record_mesh_contents(Scene& s) {
   s.model_record = record;
 }
 
+// A normal radius distribution is drawn cut to [min, max]; where the cut moves the mean of
+// the radii drawn by more than 1 % (a wide stddev meets the default lower bound mean/10, as in
+// mean 2e-3, stddev 2e-3: radii of mean 2.64e-3), a note gives the mean and standard deviation
+// of the cut distribution (Johnson, Kotz & Balakrishnan 1994, Continuous Univariate
+// Distributions 1, sec. 10.1): with a = (min - mean)/stddev, b = (max - mean)/stddev,
+// Z = Phi(b) - Phi(a), the mean is mean + stddev (phi(a) - phi(b))/Z and the variance
+// stddev^2 (1 + (a phi(a) - b phi(b))/Z - ((phi(a) - phi(b))/Z)^2).
+void note_cut_normal_radii(const Map& top, Scene& s) {
+  const auto list = top.find("insert");
+  if (!list) return;
+  const std::vector<Field> items = list->items();
+  for (std::size_t i = 0; i < items.size() && i < s.insertions.size(); ++i) {
+    const SizeDistribution& d = s.insertions[i].radius;
+    if (d.kind != SizeDistribution::Kind::normal || !(d.stddev > 0)) continue;
+    const auto phi = [](double x) {
+      return std::exp(-0.5 * x * x) / std::sqrt(2 * std::numbers::pi);
+    };
+    const auto Phi = [](double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); };
+    const double a = (d.min - d.mean) / d.stddev, b = (d.max - d.mean) / d.stddev;
+    const double z = Phi(b) - Phi(a);
+    if (!(z > 0)) continue;
+    const double shift = (phi(a) - phi(b)) / z;
+    const double mean = d.mean + d.stddev * shift;
+    const double sd =
+        d.stddev * std::sqrt(std::max(0.0, 1 + (a * phi(a) - b * phi(b)) / z - shift * shift));
+    if (std::abs(mean - d.mean) <= 0.01 * d.mean) continue;
+    std::ostringstream o;
+    o.precision(4);
+    o << "the normal distribution is drawn cut to [min, max] = [" << d.min << ", " << d.max
+      << "] m, so the radii drawn have mean " << mean << " m (" << std::showpos
+      << 100 * (mean / d.mean - 1) << std::noshowpos << " % on the given mean " << d.mean
+      << " m) and standard deviation " << sd << " m (the given " << d.stddev
+      << " m is the uncut distribution's); for radii of mean " << d.mean
+      << " m, give a smaller stddev or min and max symmetric about the mean";
+    s.notes.push_back(items[i].map().get("radius").note_at_key(o.str()));
+  }
+}
+
 // Settings that are accepted (a scene may keep them while a model is switched off) but have no
 // effect in this scene: each named in Scene::notes, with what would use it.
 void note_unused_settings(const Map& top, Scene& s) {
@@ -1533,6 +1572,7 @@ Scene build_scene(const Field& root) {
     if (const auto f = top.find(section)) add_model_lines(f->node(), section, root.source(), s);
   record_mesh_contents(s);
   note_unused_settings(top, s);
+  note_cut_normal_radii(top, s);
   // The Rayleigh time needs the elastic constants of every material a particle uses.
   if (s.time.rayleigh_fraction)
     for (const Material& mat : s.materials)

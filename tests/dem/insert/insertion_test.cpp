@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <regex>
 
 #include "dem/scene/scene_parser.hpp"
 #include "tests/dem/support/test_scene.hpp"
@@ -534,6 +535,194 @@ TEST(FillInsertion, AVolumeFractionOvershotByItsLastParticleIsReported) {
                                  "0.2681 of its region, where volume_fraction asks 0.01"));
   EXPECT_NEAR(one, 0.2681, 5e-5);
   EXPECT_TRUE(notes_of(0.02, 0.2, 5e-4).empty());
+}
+
+// A box region around a drum (a cylinder wall of radius 6 mm in a 20 mm box): the walls leave
+// the particles' centres pi (R - r)^2 / (20 mm - 2 r)^2 of the region (constant r = 0.5 mm:
+// 0.2633), and `volume_fraction` counts the whole region, so 0.05 asked stood as 0.19 in the
+// drum, without a word. The note gives the share left (to the sampling's 1 %) and the solid
+// fraction there (the placed volume over the share, checked from the particles in the drum);
+// a fill that cannot be placed says how much volume_fraction is of the space left, and its
+// advice, rerun, fits. A fill into a region earlier particles hold 0.3 of says so.
+TEST(FillInsertion, AVolumeFractionOfARegionWallsMostlyTakeIsSaidInTheSpaceLeft) {
+  const auto scene = [](double fraction, const std::string& extra) {
+    return parse_scene(
+        "domain: {min: [0, 0, 0], max: [0.02, 0.02, 0.02]}\n"
+        "time: {step: 1e-6, end: 1e-6}\n"
+        "materials: [{name: glass, youngs_modulus: 5e6, poisson_ratio: 0.3, density: 2500}]\n"
+        "interaction_defaults: {restitution: 0.9, friction: 0.5}\n"
+        "contact: {normal: hertz}\n"
+        "walls:\n"
+        "  - {type: cylinder, name: drum, axis_point: [0.01, 0.01, 0], axis: [0, 0, 1], "
+        "radius: 0.006, material: glass}\n"
+        "insert:\n" +
+            extra +
+            "  - {type: fill, region: {box: {min: [0, 0, 0], max: [0.02, 0.02, 0.02]}}, "
+            "volume_fraction: " +
+            std::to_string(fraction) + ", material: glass, radius: 5e-4}\n",
+        "drum.yaml");
+  };
+  const double r = 5e-4, left = std::numbers::pi * (0.006 - r) * (0.006 - r) / (0.019 * 0.019);
+  {
+    const Scene s = scene(0.05, "");
+    Particles p;
+    GlobalId next = 1;
+    std::vector<std::string> notes;
+    insert_particles(s, p, next, nullptr, &notes);
+    ASSERT_EQ(notes.size(), 1u);
+    double volume = 0;
+    for (double ri : p.radius) volume += sphere_volume(ri);
+    const double reached = volume / 8e-6;
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(notes[0], m,
+                                  std::regex("leave about ([0-9.]+) % of the fill's "
+                                             "region.*so its [0-9.]+ is about "
+                                             "([0-9.]+) solid fraction")))
+        << notes[0];
+    const double said = std::stod(m[1]) / 100, there = std::stod(m[2]);
+    std::printf(
+        "[ measured ] %s\n[ measured ] share left %.4f (closed form %.4f); %.4f placed, "
+        "%.3f in the space left (said %.3f)\n",
+        notes[0].c_str(), said, left, reached, reached / left, there);
+    EXPECT_NEAR(said, left, 0.01);             // the share left, sampled
+    EXPECT_NEAR(there, reached / said, 1e-3);  // printed to 3 digits
+    EXPECT_NEAR(there, reached / left, 0.05 * reached / left);
+    // In the drum itself: the particles' volume over the drum's (their centres all inside).
+    double in_drum = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      EXPECT_LE(std::hypot(p.x[i][0] - 0.01, p.x[i][1] - 0.01), 0.006 - p.radius[i] + 1e-12);
+      in_drum += sphere_volume(p.radius[i]);
+    }
+    const double drum = std::numbers::pi * 0.006 * 0.006 * 0.02;
+    std::printf("[ measured ] solid fraction in the drum %.3f\n", in_drum / drum);
+    EXPECT_GT(in_drum / drum, 0.17);  // 0.05 of the region: 3.5 times that in the drum
+  }
+  const std::string error = [&] {
+    try {
+      const Scene s = scene(0.115, "");
+      Particles p;
+      GlobalId next = 1;
+      insert_particles(s, p, next, nullptr, nullptr);
+    } catch (const InsertionError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  }();
+  std::printf("[ measured ] %s\n", error.c_str());
+  EXPECT_THAT(error, HasSubstr("`volume_fraction` counts the whole region, so 0.115 of it is"));
+  std::smatch fits;
+  ASSERT_TRUE(std::regex_search(error, fits, std::regex("a `volume_fraction` of ([0-9.]+) fits")));
+  {
+    const Scene s = scene(std::stod(fits[1]), "");
+    Particles p;
+    GlobalId next = 1;
+    EXPECT_NO_THROW(insert_particles(s, p, next, nullptr, nullptr)) << fits[1];
+  }
+  // Earlier particles: a first fill of 0.06 in the same region, then 0.1 more.
+  const std::string crowded = [&] {
+    try {
+      const Scene s = scene(0.1,
+                            "  - {type: fill, region: {box: {min: [0, 0, 0], max: [0.02, "
+                            "0.02, 0.02]}}, volume_fraction: 0.06, material: glass, "
+                            "radius: 5e-4}\n");
+      Particles p;
+      GlobalId next = 1;
+      insert_particles(s, p, next, nullptr, nullptr);
+    } catch (const InsertionError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  }();
+  std::printf("[ measured ] %s\n", crowded.c_str());
+  EXPECT_THAT(crowded, HasSubstr("earlier insertions already fill 0.06"));
+}
+
+// A normal distribution is drawn cut to [min, max]; with mean 2 mm, stddev 2 mm and the
+// default bounds (mean/10, mean + 3 stddev) the radii drawn average 2.64 mm, and a note says
+// so. Reference: the cut distribution's mean and standard deviation by quadrature of the
+// normal density over [min, max] (independent of the note's closed form), and the mean of
+// 20 000 radii a fill draws (within 4 standard errors). Bounds at mean +- 3 stddev: no note.
+TEST(FillInsertion, ANormalDistributionCutFarFromSymmetricSaysItsMean) {
+  const auto scene = [](const std::string& radius) {
+    return parse_scene(
+        "domain: {min: [0, 0, 0], max: [1, 1, 1]}\n"
+        "time: {step: 1e-6, end: 1e-6}\n"
+        "materials: [{name: glass, youngs_modulus: 5e6, poisson_ratio: 0.3, density: 2500}]\n"
+        "interaction_defaults: {restitution: 0.9, friction: 0.5}\n"
+        "contact: {normal: hertz}\n"
+        "insert:\n"
+        "  - {type: fill, region: {box: {min: [0, 0, 0], max: [1, 1, 1]}}, count: 20000, "
+        "material: glass, radius: " +
+            radius + "}\n",
+        "normal.yaml");
+  };
+  const Scene s = scene("{distribution: normal, mean: 2e-3, stddev: 2e-3}");
+  ASSERT_EQ(s.notes.size(), 1u);
+  const double lo = 2e-4, hi = 8e-3, mu = 2e-3, sigma = 2e-3;
+  double w = 0, m1 = 0, m2 = 0;
+  const int n = 200000;
+  for (int k = 0; k < n; ++k) {  // midpoint rule
+    const double x = lo + (hi - lo) * (k + 0.5) / n;
+    const double f = std::exp(-0.5 * (x - mu) * (x - mu) / (sigma * sigma));
+    w += f;
+    m1 += f * x;
+    m2 += f * x * x;
+  }
+  const double mean = m1 / w, sd = std::sqrt(m2 / w - mean * mean);
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(s.notes[0], m,
+                                std::regex("have mean ([0-9.e-]+) m .* standard deviation "
+                                           "([0-9.e-]+) m")))
+      << s.notes[0];
+  Particles p;
+  GlobalId next = 1;
+  insert_particles(s, p, next, nullptr, nullptr);
+  double sum = 0;
+  for (double r : p.radius) sum += r;
+  const double sample = sum / static_cast<double>(p.size());
+  std::printf(
+      "[ measured ] %s\n[ measured ] quadrature: mean %.6g sd %.6g; note %s %s; 20000 "
+      "radii drawn: mean %.6g\n",
+      s.notes[0].c_str(), mean, sd, m[1].str().c_str(), m[2].str().c_str(), sample);
+  EXPECT_THAT(s.notes[0], HasSubstr("normal.yaml:7:"));
+  EXPECT_NEAR(std::stod(m[1]), mean, 5e-4 * mean);  // printed to 4 digits
+  EXPECT_NEAR(std::stod(m[2]), sd, 5e-4 * sd);
+  EXPECT_NEAR(sample, mean, 4 * sd / std::sqrt(20000.0));
+  EXPECT_TRUE(scene("{distribution: normal, mean: 2e-3, stddev: 2e-4}").notes.empty());
+}
+
+// A fill larger than memory can hold (1e11 particles of 0.1 um, a volume fraction of 0.2 of
+// 0.1 um radii in a 2 cm box: 3.8e14) died in std::bad_alloc (or, for the volume fraction,
+// grew its radius list until the machine ran out of memory). Refused before anything is
+// drawn, naming the count and the memory.
+TEST(FillInsertion, AFillLargerThanMemoryIsRefusedBeforeItIsDrawn) {
+  const auto error_of = [](const std::string& amount) {
+    const Scene s = parse_scene(
+        "domain: {min: [0, 0, 0], max: [0.02, 0.02, 0.02]}\n"
+        "time: {step: 1e-6, end: 1e-6}\n"
+        "materials: [{name: glass, youngs_modulus: 5e6, poisson_ratio: 0.3, density: 2500}]\n"
+        "interaction_defaults: {restitution: 0.9, friction: 0.5}\n"
+        "contact: {normal: hertz}\n"
+        "insert:\n"
+        "  - {type: fill, region: {box: {min: [0, 0, 0], max: [0.02, 0.02, 0.02]}}, " +
+            amount + ", material: glass, radius: 1e-7}\n",
+        "huge.yaml");
+    try {
+      Particles p;
+      GlobalId next = 1;
+      insert_particles(s, p, next, nullptr, nullptr);
+    } catch (const InsertionError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string by_count = error_of("count: 1e11"),
+                    by_fraction = error_of("volume_fraction: 0.2");
+  std::printf("[ measured ] %s\n[ measured ] %s\n", by_count.c_str(), by_fraction.c_str());
+  EXPECT_THAT(by_count, HasSubstr("huge.yaml:7: error: this fill would insert 1e+11 particles"));
+  EXPECT_THAT(by_count, HasSubstr("coarse_grain"));
+  // 0.2 x 8e-6 m^3 / (4/3 pi 1e-21 m^3) = 3.82e14
+  EXPECT_THAT(by_fraction, HasSubstr("this fill would insert about 3.82e+14 particles"));
 }
 
 }  // namespace
