@@ -474,8 +474,22 @@ namespace {
 // When the last step's time misses time.end by more than this share of it, `grain check` and
 // `grain run` say at which time the run ends.
 constexpr double kEndTolerance = 1e-3;
-long steps_to_end(double end, double dt) {
-  return std::max(1L, static_cast<long>(std::ceil(end / dt - 0.5 - 1e-9)));
+// The run's whole number of steps to time.end; more than a run can count (9e15, where a
+// double still holds every whole number) is refused: it had wrapped to one step, "the
+// nearest whole number".
+long steps_to_end(const Scene& scene, double dt) {
+  const double steps = std::ceil(scene.time.end / dt - 0.5 - 1e-9);
+  if (!(steps <= 9e15)) {
+    std::ostringstream o;
+    o.precision(4);
+    o << scene.time.end_source << ": error: time.end " << scene.time.end << " s is "
+      << scene.time.end / dt << " steps of dt = " << dt << " s (" << scene.time.step_source
+      << "), more than the 9e15 steps a run can count; give a time.end of at most "
+      << round_down_3(9e15 * dt) << " s (a run can be stopped at any time with SIGTERM or "
+      << "Ctrl-C, and continued from its checkpoint)";
+    throw SetupError(o.str());
+  }
+  return std::max(1L, static_cast<long>(steps));
 }
 
 }  // namespace
@@ -586,7 +600,7 @@ int check_scene(const Scene& scene, std::ostream& out, const std::optional<std::
   print_drag_range_report(scene, MPI_COMM_WORLD, out);
   const TimeStepReport& rep = sim.time_step_report();
   if (restart) {
-    const long first = sim.counters().steps, end = steps_to_end(scene.time.end, sim.dt());
+    const long first = sim.counters().steps, end = steps_to_end(scene, sim.dt());
     if (end < first) {
       speaker(MPI_COMM_WORLD, out) << ends_before_checkpoint(scene, sim, *restart) << "\n";
       return 1;
@@ -601,7 +615,7 @@ int check_scene(const Scene& scene, std::ostream& out, const std::optional<std::
       say << "the restart runs " << end - first << " steps of dt = " << sim.dt()
           << " s to t = " << significant(static_cast<double>(end) * sim.dt(), 9) << " s\n";
   } else if (rep.dt > 0 && std::isfinite(rep.dt)) {
-    const long steps = steps_to_end(scene.time.end, rep.dt);
+    const long steps = steps_to_end(scene, rep.dt);
     const double last = static_cast<double>(steps) * rep.dt;
     std::ostream& say = speaker(MPI_COMM_WORLD, out);
     say << "steps to reach t_end = " << scene.time.end << " s: " << steps;
@@ -678,7 +692,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options, MPI_Comm com
   guard_finite(sim, has_non_finite(sim.particles(), sim.heat() != nullptr), dir, comm);
   // A restart whose scene ends before the checkpoint would run no step, and would first cut
   // the snapshot series and log back to the checkpoint: refused before anything is touched.
-  const long end_step = steps_to_end(scene.time.end, sim.dt());
+  const long end_step = steps_to_end(scene, sim.dt());
   if (options.restart && end_step < first_step)
     throw SetupError(ends_before_checkpoint(scene, sim, *options.restart));
   // At exactly the checkpoint's step: nothing to run, and nothing in the folder is touched

@@ -1478,6 +1478,31 @@ void note_unused_settings(const Map& top, Scene& s) {
              "contact.tangential is none, so contacts are frictionless; name `tangential: "
              "history` in contact (the default) to use it");
     }
+    // The mirror: a rolling or cohesion model named while every pair's coefficient is 0 (the
+    // default) does nothing, though the contact law line names it.
+    const auto none_positive = [&](double MaterialPair::*coefficient) {
+      return std::none_of(s.pairs.begin(), s.pairs.end(),
+                          [&](const MaterialPair& q) { return q.*coefficient > 0; });
+    };
+    const auto model_key = [&](const char* key) -> std::optional<Field> {
+      const auto c = top.find("contact");
+      return c && c->node().IsMap() ? c->map().find(key) : std::nullopt;
+    };
+    if (s.contact.rolling != RollingModel::none && none_positive(&MaterialPair::rolling_friction))
+      if (const auto k = model_key("rolling"))
+        s.notes.push_back(k->note_at_key(
+            k->node().Scalar() +
+            " has no effect: no pair of materials has a rolling_friction above 0 (the default "
+            "is 0), so contacts resist no rolling; give `rolling_friction: <mu_r>` in "
+            "interaction_defaults or interactions"));
+    if (s.contact.cohesion != CohesionModel::none &&
+        none_positive(&MaterialPair::cohesion_energy_density))
+      if (const auto k = model_key("cohesion"))
+        s.notes.push_back(k->note_at_key(
+            k->node().Scalar() +
+            " has no effect: no pair of materials has a cohesion_energy_density above 0 (the "
+            "default is 0), so contacts do not attract; give `cohesion_energy_density: "
+            "<J/m^3>` in interaction_defaults or interactions"));
   }
   if (const auto o = top.find("output")) {
     const Map m = o->map();
@@ -1608,10 +1633,27 @@ YAML::Node load_yaml(const std::string& text, const Source& src) {
   {
     std::istringstream lines(text);
     bool content = false;
-    int n = 0;
+    int n = 0, ended = -1;  // ended: the line of a document-end marker '...'
+    const auto is_marker = [](const std::string& line, const char* marker) {
+      return line.starts_with(marker) &&
+             (line.size() == 3 || line[3] == ' ' || line[3] == '\t' || line[3] == '\r');
+    };
     for (std::string line; std::getline(lines, line); ++n) {
-      const bool marker = line.starts_with("---") && (line.size() == 3 || line[3] == ' ' ||
-                                                      line[3] == '\t' || line[3] == '\r');
+      const bool marker = is_marker(line, "---");
+      const std::size_t from = line.find_first_not_of(" \t\r");
+      const bool keys = from != std::string::npos && line[from] != '#' && line[from] != '%';
+      if (ended >= 0 && keys) {
+        YAML::Mark at = start_of_file();
+        at.line = ended;
+        raise(src, at,
+              "the YAML document ends here (a '...' line), and the keys after it, from line " +
+                  std::to_string(n + 1) +
+                  ", would not be read: a scene is one document; remove the '...' line");
+      }
+      if (is_marker(line, "...")) {
+        ended = n;
+        continue;
+      }
       if (marker && content) {
         YAML::Mark at = start_of_file();
         at.line = n;

@@ -431,6 +431,42 @@ def second_document():
         out.write(text.replace("gravity:", "---\ngravity:"))
     expect(case, grain(d, "check", "scene.yaml"), 2,
            r"scene\.yaml:2:1: error: a second YAML document starts here \(a '---' line after")
+    # A document-end marker '...' before keys: yaml-cpp read the scene up to it and dropped
+    # the rest (output.directory after it was not used, without a word).
+    with open(os.path.join(d, "scene.yaml"), "w") as out:
+        out.write(text.replace("gravity:", "...\ngravity:"))
+    expect(case, grain(d, "check", "scene.yaml"), 2,
+           r"scene\.yaml:2:1: error: the YAML document ends here \(a '\.\.\.' line\), and the "
+           r"keys after it, from line 3, would not be read")
+    # At the end, with only comments after it, it ends the scene as YAML allows.
+    with open(os.path.join(d, "scene.yaml"), "w") as out:
+        out.write(text + "...\n# the end\n")
+    expect(case, grain(d, "check", "scene.yaml"), 0, r"")
+
+
+def end_beyond_count():
+    """time.end of 1e14 s at a step of about 3.5e-6 s is 2.9e19 steps, beyond what a run
+    counts: it had wrapped to one step, which `grain check` called "the nearest whole number"
+    and `grain run` ran, exit 0. Refused at time.end with the largest end; that end, typed
+    back, is taken (check prints its step count)."""
+    case = "end_beyond_count"
+    d = fresh(case)
+    scene(d, end="1e14")
+    for command in ("check", "run"):
+        expect(case, grain(d, command, "scene.yaml"), 1,
+               r"scene\.yaml:3: error: time\.end 1e\+14 s is \S+ steps of dt = \S+ s "
+               r"\(scene\.yaml:3\), more than the 9e15 steps a run can count; give a time\.end "
+               r"of at most \S+ s")
+    if os.path.exists(os.path.join(d, "out")):
+        fail(case, "the refused run made its output folder")
+    rc, out = grain(d, "check", "scene.yaml")
+    most = re.search(r"of at most (\S+) s", out)
+    if most:
+        scene(d, end=most.group(1))
+        rc, out = grain(d, "check", "scene.yaml")
+        steps = re.search(r"steps to reach t_end = \S+ s: (\d+)", out)
+        if rc != 0 or not steps or not 1e15 < int(steps.group(1)) <= 9e15:
+            fail(case, f"the advised end {most.group(1)}: exit {rc}, {out[-400:]}")
 
 
 def tilde():
@@ -850,7 +886,7 @@ if __name__ == "__main__":
     os.makedirs(WORK, exist_ok=True)
     for check in (overwrite_csv, overwrite_snapshot, overwrite_scene, hard_linked_backup,
                   failed_start_writes_nothing, signal_during_start,
-                  second_document, tilde, input_named,
+                  second_document, end_beyond_count, tilde, input_named,
                   help_option, restart_at_end, restart_other_step_setting, restart_other_domain,
                   check_restart,
                   restart_missing_csv, restart_mesh,

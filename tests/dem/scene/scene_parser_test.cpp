@@ -742,6 +742,22 @@ TEST(SceneNotes, SettingsWithoutEffectAreNamed) {
   ASSERT_EQ(no_walls.notes.size(), 1u);
   EXPECT_THAT(no_walls.notes[0], HasSubstr("note: output.wall_loads: true has no effect: the "
                                            "scene has no walls"));
+  // The mirror of the first two: a rolling or cohesion model named while every pair's
+  // coefficient is 0, the default (the run was bit for bit the one without the model).
+  const Scene models = parse_scene(kBase + "  rolling: epsd\n  cohesion: sjkr\n", kLabel);
+  ASSERT_EQ(models.notes.size(), 2u);
+  EXPECT_THAT(models.notes[0],
+              HasSubstr(":17:3: note: contact.rolling: epsd has no effect: no pair of materials "
+                        "has a rolling_friction above 0"));
+  EXPECT_THAT(models.notes[1],
+              HasSubstr(":18:3: note: contact.cohesion: sjkr has no effect: no pair of "
+                        "materials has a cohesion_energy_density above 0"));
+  EXPECT_TRUE(parse_scene(with("    restitution: 0.9\n",
+                               "    restitution: 0.9\n    rolling_friction: 0.1\n"
+                               "    cohesion_energy_density: 1e4\n") +
+                              "  rolling: epsd\n  cohesion: sjkr\n",
+                          kLabel)
+                  .notes.empty());
 }
 
 TEST(SceneErrors, ModelSettingsMustMatchTheModel) {
