@@ -7,12 +7,17 @@ A file argument is summarised whatever its name: a snapshot (particles_*.h5) or 
 (checkpoint_*.h5, whose particles are stored under /particles/).
 
 An output folder argument summarises the snapshots of the run that wrote it, the ones its
-particles.xdmf lists, in its order. Other particles_*.h5 files in the folder (left over from
-an earlier run in the same folder, not listed) are counted and named in a note, not
-summarised. Without particles.xdmf the snapshots are those carrying the scene_fingerprint of
-the newest file (said in a note). The folder's checkpoints are summarised after them; one whose
-stored log is not the start of the folder's log.csv is marked as left over from another run.
-A folder without any .h5 file is an error.
+particles.xdmf lists, in its order. Other particles_*.h5 files in the folder are counted and
+named in a note, not summarised: those that cannot be read as damaged or truncated (such as a
+gap a restart reported), the others as left over from an earlier run in the same folder.
+Without a readable particles.xdmf (missing, or damaged: said in a note, with the remedy) the
+snapshots are those carrying the scene_fingerprint of the newest readable file, in number
+order while their step increases, up to the last complete row of the folder's log.csv (the
+last run's log); snapshots past it are named as ones it cannot tell apart (this run's, if it
+was killed after them, or an earlier, longer run's of the same scene), and without log.csv
+the note says that runs of one scene cannot be told apart. The folder's checkpoints are
+summarised after them; one whose stored log is not the start of the folder's log.csv is
+marked as left over from another run. A folder without any .h5 file is an error.
 
 Material indices are printed as the snapshot's material names (root attribute
 material_names; for a checkpoint, its stored scene). Coarse-grained parcels (an insertion's
@@ -45,7 +50,7 @@ except ImportError:  # this python3 lacks them: scripts/python.sh finds one that
     _helper = os.path.join(os.path.dirname(os.path.realpath(__file__)), "python.sh")
     os.execv(_helper, [_helper, os.path.abspath(__file__), *sys.argv[1:]])
 
-SNAPSHOT = re.compile(r"particles_\d+\.h5$")
+SNAPSHOT = re.compile(r"particles_(\d+)\.h5$")
 CHECKPOINT = re.compile(r"checkpoint_\d+\.h5$")
 
 
@@ -60,25 +65,106 @@ def attr(f, name, default=None):
     return v.item() if hasattr(v, "item") and np.ndim(v) == 0 else v
 
 
-def fingerprint(path):
+def snapshot_head(path):
+    """(time, step, scene_fingerprint) of a snapshot, or None when it cannot be read (a file
+    damaged or truncated, or without the time and step attributes every snapshot carries)."""
     try:
         with h5py.File(path, "r") as f:
-            return attr(f, "scene_fingerprint")
+            return float(attr(f, "time")), int(attr(f, "step")), attr(f, "scene_fingerprint")
+    except (OSError, KeyError, ValueError, TypeError):
+        return None
+
+
+def log_end(log):
+    """(time, step) of the last complete row of a log table (log.csv), or None when it is
+    missing or holds none. A last row without its newline (cut short by a killed run, or read
+    while the run writes it) and a row that is not a number in every column are passed over,
+    as plot_log.py does."""
+    try:
+        with open(log, "rb") as f:
+            text = f.read().decode("utf-8-sig", "replace")
     except OSError:
         return None
+    lines = text.splitlines()
+    if not text.endswith(("\n", "\r")):
+        lines = lines[:-1]
+    header = lines[0].split(",") if lines else []
+    if "time_s" not in header or "step" not in header:
+        return None
+    for line in reversed(lines[1:]):
+        fields = line.split(",")
+        try:
+            row = [float(v) for v in fields]
+        except ValueError:
+            continue
+        if len(row) == len(header):
+            return row[header.index("time_s")], row[header.index("step")]
+    return None
 
 
 def xdmf_files(index):
     """The snapshot files particles.xdmf lists, in its order: the temporal collection's time
-    steps are named after their files' stems (an empty snapshot has no DataItem)."""
+    steps are named after their files' stems (an empty snapshot has no DataItem). Raises
+    ET.ParseError for an index that is not XML (damaged)."""
     try:
         root = ET.parse(index).getroot()
-    except (OSError, ET.ParseError) as e:
-        raise Unreadable(f"{index}: cannot read the snapshot index: {e}")
+    except OSError as e:
+        raise Unreadable(f"{index}: cannot read the snapshot index: {e.strerror or e}")
     series = root.find("Domain/Grid")
     if series is None:
         raise Unreadable(f"{index}: not a grainflow snapshot index (no Domain/Grid)")
     return [g.get("Name", "") + ".h5" for g in series.findall("Grid")]
+
+
+def unindexed_run(folder, snapshots, heads, notes):
+    """(chosen, left over, why) without a readable particles.xdmf: the snapshots with the
+    newest readable one's scene_fingerprint, in number order while their step increases (a
+    series that starts over is an earlier run's later files), and not past the last complete
+    row of the folder's log.csv, the last run's log (an earlier, longer run of the same scene
+    left its later snapshots beyond it). Those past it cannot be told from this run's own
+    written after its last log row (a killed run): named in a note, not summarised.
+    tutorials/run_index.py chooses the same way (keep the two alike)."""
+    readable = [p for p in snapshots if heads[p] is not None]
+    if not readable:
+        return [], [], ""
+    newest = max(readable, key=lambda p: p.stat().st_mtime)
+    mark = heads[newest][2]
+    chosen, leftover, over = [], [], []
+    for p in readable:
+        if heads[p][2] != mark:
+            leftover.append(p)
+        elif over or (chosen and heads[p][1] <= heads[chosen[-1]][1]):
+            over.append(p)
+        else:
+            chosen.append(p)
+    log = folder / "log.csv"
+    end = log_end(log)
+    if end is None:
+        notes.append(f"{log} is missing or holds no complete row: snapshots an earlier run of "
+                     "the same scene left in the folder cannot be told from this run's; all "
+                     f"{len(chosen)} with the newest snapshot's scene_fingerprint are summarised")
+        past = []
+    else:
+        past = [p for p in chosen if heads[p][1] > end[1]]
+        chosen = [p for p in chosen if heads[p][1] <= end[1]]
+    state = ("damaged particles.xdmf" if (folder / "particles.xdmf").exists()
+             else "no particles.xdmf")
+    notes.insert(0, f"{folder}: {state}; {len(chosen)} snapshot(s) with the "
+                    f"scene_fingerprint of the newest one ({newest.name})"
+                    + (f", up to the end of log.csv (step {end[1]:.0f}, t = {end[0]:.6g} s)"
+                       if end else ""))
+    if over:
+        notes.append(f"{len(over)} particles_*.h5 file(s) in {folder} of the same scene are "
+                     f"left over from an earlier run, not summarised: from {over[0].name} on "
+                     "the step starts over (an earlier, longer run's later files): "
+                     + ", ".join(p.name for p in over))
+    if past:
+        notes.append(f"cannot tell whether {len(past)} snapshot(s) of the same scene past the "
+                     f"end of {log} are this run's (written after its last log row, if it was "
+                     "killed) or left over from an earlier, longer run in the same folder; not "
+                     "summarised (give them as file arguments): "
+                     + ", ".join(p.name for p in past))
+    return chosen, leftover, "another scene_fingerprint"
 
 
 def folder_files(folder):
@@ -95,25 +181,41 @@ def folder_files(folder):
                          f"other .h5 files: {', '.join(p.name for p in others)} (give them as "
                          "file arguments)")
     index = folder / "particles.xdmf"
+    listed = None
     if index.exists():
-        listed = [folder / n for n in xdmf_files(index)]
+        try:
+            listed = [folder / n for n in xdmf_files(index)]
+        except ET.ParseError as e:
+            notes.append(f"{index} cannot be read ({e}): damaged, e.g. by a power loss or an "
+                         "operating-system crash during an append (docs/reliability.md); the "
+                         "snapshots are chosen as without it. A restart (grain run --restart) "
+                         "from one of the folder's checkpoints before the run's end rewrites "
+                         "the index from the snapshot files (and runs on from there)")
+    # Files listed are summarised whatever their state (an error each if damaged); of the
+    # others, the unreadable ones are said to be so, not taken for another run's.
+    heads = {p: snapshot_head(p) for p in snapshots if listed is None or p not in listed}
+    unreadable = [p for p in heads if heads[p] is None]
+    if listed is not None:
         missing = [p for p in listed if not p.exists()]
         if missing:
             notes.append(f"{index} lists {len(missing)} snapshot(s) missing from the folder: "
                          + ", ".join(p.name for p in missing))
         chosen = [p for p in listed if p.exists()]
-        leftover = [p for p in snapshots if p not in listed]
+        leftover = [p for p in snapshots if p not in listed and p not in unreadable]
         notes.insert(0, f"{folder}: {len(chosen)} snapshot(s) listed in particles.xdmf")
         why = "not listed in particles.xdmf"
     else:
-        # No index: the newest file's run, by the scene fingerprint every snapshot carries.
-        newest = max(snapshots, key=lambda p: p.stat().st_mtime) if snapshots else None
-        mark = fingerprint(newest) if newest else None
-        chosen = [p for p in snapshots if fingerprint(p) == mark]
-        leftover = [p for p in snapshots if p not in chosen]
-        notes.insert(0, f"{folder}: no particles.xdmf; {len(chosen)} snapshot(s) with the "
-                        f"scene_fingerprint of the newest one ({newest.name if newest else '-'})")
-        why = "another scene_fingerprint"
+        chosen, leftover, why = unindexed_run(folder, snapshots, heads, notes)
+    if unreadable:
+        numbers = sorted(int(SNAPSHOT.match(p.name).group(1)) for p in chosen)
+        inside = [p for p in unreadable
+                  if numbers and numbers[0] < int(SNAPSHOT.match(p.name).group(1))
+                  < numbers[-1]]
+        notes.append(f"{len(unreadable)} particles_*.h5 file(s) in {folder} cannot be read "
+                     "(damaged or truncated), not summarised: "
+                     + ", ".join(p.name for p in unreadable)
+                     + (f" ({len(inside)} of them inside the numbers of the series summarised: "
+                        "a gap in it)" if inside else ""))
     if leftover:
         notes.append(f"{len(leftover)} other particles_*.h5 file(s) in {folder} are left over "
                      f"from other runs ({why}), not summarised: "

@@ -231,6 +231,116 @@ def h5_summary_coarse_grain(args):
           "k = 1: the plain summary, materials by name", text)
 
 
+def listed(args, folder):
+    """The snapshot files a run's particles.xdmf lists (the run's own index: the reference)."""
+    import xml.etree.ElementTree as ET
+    grid = ET.parse(os.path.join(args.work, folder, "particles.xdmf")).getroot().find("Domain/Grid")
+    return [g.get("Name") + ".h5" for g in grid.findall("Grid")]
+
+
+def summarised(text, folder):
+    """The snapshot files h5_summary's output summarises (a `folder/particles_N.h5` line)."""
+    return re.findall(r"^" + re.escape(folder) + r"/(particles_\d+\.h5)$", text, re.M)
+
+
+def grain_restart(args, scene_path, out, checkpoint):
+    r = subprocess.run([args.grain, "run", scene_path, "--no-progress", "--output", out,
+                        "--restart", os.path.join(out, checkpoint)], cwd=args.work,
+                       capture_output=True, text=True)
+    if r.returncode != 0:
+        sys.exit(f"scripts_test: the restart from {checkpoint} failed ({r.returncode}):\n"
+                 f"{r.stdout}{r.stderr}")
+    return r.stdout + r.stderr
+
+
+def h5_summary_no_index(args):
+    """Without particles.xdmf, two runs of one scene in one folder (the same scene_fingerprint):
+    a 0.02 s run (snapshots 0-4) and then a 0.01 s run (0-2, over the first three). The
+    reference is the second run's own index, read before it is removed: 0-2. Snapshots 3 and 4
+    lie past the end of log.csv (the second run's, t = 0.01 s): not summarised, named as ones
+    it cannot tell apart (it summarised all five as the second run's). Without log.csv it says
+    that it cannot tell runs of one scene apart. A single run's particles.xdmf cut short (a
+    power loss): its five snapshots, the damaged index named with the remedy, a restart, which
+    the test then runs and which rewrites an index listing the five (it summarised nothing,
+    exit 1)."""
+    long = scene(args.work, "long.yaml", "out", end=0.02)
+    short = scene(args.work, "short.yaml", "out", end=0.01)
+    grain_run(args, long)
+    grain_run(args, short)
+    own = listed(args, "out")
+    check(own == [f"particles_00000{i}.h5" for i in range(3)],
+          "the second run's index lists particles_000000-2", " ".join(own))
+    with open(os.path.join(args.work, "out", "log.csv")) as f:
+        log_end_time = float(f.read().splitlines()[-1].split(",")[0])
+    check(abs(log_end_time - 0.01) < 1e-4, f"log.csv (the second run's) ends at 0.01 s "
+          f"({log_end_time})")
+    shutil.copytree(os.path.join(args.work, "out"), os.path.join(args.work, "damaged"))
+    os.remove(os.path.join(args.work, "out", "particles.xdmf"))
+    code, text = script(args, "h5_summary.py", "out")
+    check(code == 0 and summarised(text, "out") == own,
+          f"no index: the second run's {len(own)} snapshots are summarised, no more "
+          f"(summarised {summarised(text, 'out')})", text)
+    check("cannot tell whether 2 snapshot(s) of the same scene past the end of out/log.csv"
+          in text and "particles_000003.h5, particles_000004.h5" in text,
+          "no index: snapshots 3 and 4 past the end of log.csv are named as not told apart",
+          text)
+    os.remove(os.path.join(args.work, "out", "log.csv"))
+    code, text = script(args, "h5_summary.py", "out")
+    check(code == 0 and "out/log.csv is missing or holds no complete row: snapshots an earlier "
+          "run of the same scene left in the folder cannot be told from this run's" in text,
+          "no index, no log.csv: says it cannot tell runs of one scene apart", text)
+    # The index of a single 0.02 s run cut short, as an append's blocks lost to a power loss
+    # can leave it: its five snapshots (listed before the cut: the reference) are summarised.
+    single = scene(args.work, "single.yaml", "damaged", end=0.02)
+    grain_run(args, single)
+    own = listed(args, "damaged")
+    index = os.path.join(args.work, "damaged", "particles.xdmf")
+    with open(index, "rb") as f:
+        intact = f.read()
+    with open(index, "wb") as f:
+        f.write(intact[:len(intact) // 2])
+    code, text = script(args, "h5_summary.py", "damaged")
+    check(code == 0 and summarised(text, "damaged") == own,
+          f"damaged index: the run's {len(own)} snapshots are summarised "
+          f"(summarised {summarised(text, 'damaged')})", text)
+    check("note: damaged/particles.xdmf cannot be read (" in text
+          and "A restart (grain run --restart) from one of the folder's checkpoints before the "
+          "run's end rewrites the index" in text, "damaged index: named, with the remedy", text)
+    checkpoint = sorted(c for c in os.listdir(os.path.join(args.work, "damaged"))
+                        if c.startswith("checkpoint_"))[0]
+    grain_restart(args, single, "damaged", checkpoint)
+    check(listed(args, "damaged") == own, "the remedy holds: a restart from "
+          f"{checkpoint} rewrote particles.xdmf, which lists {own[0]} ... {own[-1]}")
+
+
+def h5_summary_unreadable_snapshot(args):
+    """A run's own snapshot that cannot be read (particles_000001.h5 cut to 1000 bytes), a
+    gap the restart from the 0.01 s checkpoint reports: h5_summary calls it unreadable (damaged
+    or truncated) and a gap in the series, with or without particles.xdmf, not a file "left
+    over from other runs" or of "another scene_fingerprint" (it said both)."""
+    path = scene(args.work, "gap.yaml", "out")
+    grain_run(args, path)
+    with open(os.path.join(args.work, "out", "particles_000001.h5"), "r+b") as f:
+        f.truncate(1000)
+    checkpoint = sorted(c for c in os.listdir(os.path.join(args.work, "out"))
+                        if c.startswith("checkpoint_"))[0]
+    restart = grain_restart(args, path, "out", checkpoint)
+    check("particles_000001.h5 (unreadable) is a gap" in restart,
+          "the restart reports particles_000001.h5 as a gap", restart)
+    expected = ("1 particles_*.h5 file(s) in out cannot be read (damaged or truncated), not "
+                "summarised: particles_000001.h5 (1 of them inside the numbers of the series "
+                "summarised: a gap in it)")
+    for label in ("with particles.xdmf", "without particles.xdmf"):
+        code, text = script(args, "h5_summary.py", "out")
+        check(code == 0 and expected in text and "left over" not in text.split("out/checkpoint")[0]
+              and "another scene_fingerprint" not in text,
+              f"{label}: particles_000001.h5 is unreadable, a gap, not another run's", text)
+        check(summarised(text, "out") == [f"particles_00000{i}.h5" for i in (0, 2, 3, 4)],
+              f"{label}: snapshots 0, 2, 3, 4 are summarised", text)
+        os.remove(os.path.join(args.work, "out", "particles.xdmf")) if label.startswith("with ") \
+            else None
+
+
 def plot_log_bad_inputs(args):
     """Each bad input is a one-line error naming it, exit 1, no traceback."""
     grain_run(args, scene(args.work, "plot.yaml", "plot"))
@@ -310,6 +420,7 @@ def plot_log_damaged_row(args):
 
 
 CASES = {f.__name__: f for f in (h5_summary_folder, h5_summary_coarse_grain,
+                                 h5_summary_no_index, h5_summary_unreadable_snapshot,
                                  plot_log_bad_inputs, plot_log_damaged_row)}
 
 

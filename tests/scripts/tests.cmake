@@ -1,6 +1,6 @@
 # Tests of the analysis scripts (included by tests/CMakeLists.txt): scripts/h5_summary.py and
 # scripts/plot_log.py on the files tiny `grain run` scenes write (50 beads or 20 parcels,
-# 0.02 s; each test runs in about 2 s). tests/scripts/scripts_test.py writes the scenes into
+# 0.02 s; each test runs in about 2-4 s). tests/scripts/scripts_test.py writes the scenes into
 # the test's work folder, runs grain and the script, and checks the output; each case is a
 # function there.
 #
@@ -17,6 +17,15 @@
 #   radius / 2 within the insertion's 0.4-0.6 mm, the material as glass[k=2]; a k = 1 run
 #   keeps the plain summary (material by name); a real_count or coarse_grain of 0 is a
 #   one-line error naming the file and dataset, exit 1.
+# scripts.h5_summary_no_index: a folder without particles.xdmf holding two runs of one scene
+#   (same scene_fingerprint; 0.02 s, then 0.01 s): only the second run's 3 snapshots (its own
+#   index, read before removal, is the reference), the 2 past the end of its log.csv named as
+#   ones it cannot tell apart; without log.csv it says it cannot tell runs of one scene
+#   apart; an index cut in half: the run's 5 snapshots, the damaged index named with its
+#   remedy, a restart from the checkpoint, which the test runs and which rewrites the index.
+# scripts.h5_summary_unreadable_snapshot: a run's own snapshot cut to 1000 bytes, reported as a
+#   gap by the restart from its checkpoint, is named as unreadable (damaged or truncated) and
+#   a gap, with and without particles.xdmf, not as another run's; the 4 others summarised.
 # scripts.plot_log_bad_inputs: a missing log, a folder, an HDF5 file, a file that is not a
 #   log, -o into a missing folder or onto a folder, -o with an extension matplotlib cannot
 #   write (.xyz, .txt), -o the log itself, an unknown column: each exit 1 with one line naming
@@ -30,7 +39,8 @@ if(NOT GRAINFLOW_SCRIPTS_PYTHON)
   return()
 endif()
 
-foreach(_case h5_summary_folder h5_summary_coarse_grain plot_log_bad_inputs plot_log_damaged_row)
+foreach(_case h5_summary_folder h5_summary_coarse_grain h5_summary_no_index
+              h5_summary_unreadable_snapshot plot_log_bad_inputs plot_log_damaged_row)
   add_test(NAME scripts.${_case}
            COMMAND ${GRAINFLOW_SCRIPTS_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/scripts_test.py ${_case}
                    --grain $<TARGET_FILE:grain>
