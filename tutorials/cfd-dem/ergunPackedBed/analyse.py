@@ -14,7 +14,6 @@ every fixed-bed stage is within 10 % of Ergun and every fluidised stage within 5
 weight; prints one line per stage and exits 1 otherwise. Writes ergunPackedBed.png.
 Usage: analyse.py [--short]
 """
-import glob
 import math
 import os
 import sys
@@ -25,6 +24,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from foam_case import series  # noqa: E402 (tutorials/cfd-dem/foam_case.py)
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 from run_index import run_snapshots  # noqa: E402 (tutorials/run_index.py)
@@ -78,14 +80,19 @@ def ergun(u):
 
 
 # --- measured pressure drop --------------------------------------------------------------
-rows = np.loadtxt(glob.glob("postProcessing/inletPressure/*/surfaceFieldValue.dat")[0])
-t, dp = rows[:, 0], rho_f * rows[:, 1]
+# Every postProcessing/inletPressure/<start time>/ folder: a restart adds one.
+t, p_inlet, _ = series(".", "inletPressure")
+dp = rho_f * p_inlet
 print(f"ergunPackedBed: {n} particles, d = {d * 1e3:.3f} mm, bed eps = {eps:.4f}, height "
       f"{height * 1e3:.2f} mm, U_mf(Wen-Yu) = {u_mf:.3f} m/s, weight/area = {weight:.2f} Pa")
 ok = True
 results = []
 for u, t0, t1 in stages:
     window = (t > t0 + 0.4 * (t1 - t0)) & (t <= t1)  # the last 60 % of the stage
+    if not window.any():
+        sys.exit(f"analyse.py: postProcessing/inletPressure holds no time in "
+                 f"{t0 + 0.4 * (t1 - t0):g}-{t1:g} s, the stage at U = {u:.2f} m/s (it runs "
+                 f"from {t[0]:g} to {t[-1]:g} s): has the run reached {t1:g} s?")
     measured = dp[window].mean()
     if u < u_mf:
         ref, tol, name = ergun(u), 0.10, "Ergun"

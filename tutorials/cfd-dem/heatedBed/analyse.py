@@ -1,12 +1,15 @@
 #!/usr/bin/env python3
 """Heated bubbling bed: the mean bead temperature against an energy-balance estimate.
 
-usage: analyse.py [--short] [--tolerance F] [CASE]
+usage: analyse.py [--short] [--tolerance F] [--log LOG ...] [CASE]
 
 Reads, from the case folder CASE (default: this script's folder):
   log.grainFoam                     the thermal energies at every write time (`grainFoam
                                     thermal energy: particles E_p J (m c C_p J/K), fluid ...`):
-                                    the mean bead temperature is E_p / C_p exactly;
+                                    the mean bead temperature is E_p / C_p exactly; they must
+                                    start at the run's start: for a restarted run give every
+                                    piece of its log, oldest first (--log); a restart's log
+                                    alone is refused, naming its start time;
   postProcessing/inletFlow          Q = -sum(phi) over the inlet, every fluid step;
   postProcessing/heatIn, heatOut    sum(phi T) over the inlet and the outlet, every fluid step;
   particles/particles_*.h5          the snapshots (picture);
@@ -55,6 +58,10 @@ ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 ap.add_argument("case", nargs="?", default=os.path.dirname(os.path.abspath(__file__)))
 ap.add_argument("--short", action="store_true", help="the Allrun --short case")
 ap.add_argument("--tolerance", type=float, default=None)
+ap.add_argument("--log", nargs="+", metavar="LOG",
+                help="grainFoam's logs of the run, oldest first: for a restarted run (whose "
+                     "log.grainFoam starts at the restart) every piece, each restart's after "
+                     "the log it continues (default: CASE/log.grainFoam)")
 args = ap.parse_args()
 case = args.case
 if args.tolerance is None:
@@ -66,14 +73,58 @@ NUM = r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
 ENERGY = re.compile(r"grainFoam thermal energy: particles " + NUM + r" J \(m c " + NUM +
                     r" J/K\), fluid " + NUM + r" J \(eps rho c_p V " + NUM + r" J/K\), sum " +
                     NUM + " J")
-log = open(os.path.join(case, "log.grainFoam")).read()
-times = [(m.start(), float(m.group(1))) for m in re.finditer(r"^Time = " + NUM + "$", log, re.M)]
+RESTART = re.compile(r"^grainFoam coupling: restart at time " + NUM, re.M)
+TIME = re.compile(r"^Time = " + NUM + "$", re.M)
+
+
+def energy_rows(path):
+    """(rows [t, E_p, C_p, E_f, C_f, sum], restart time or None) of one grainFoam log; a log
+    that starts with a restart (its `grainFoam coupling: restart at time` line before the
+    first time step) dates the energy lines before its first `Time =` at the restart."""
+    try:
+        text = open(path).read()
+    except OSError as e:
+        sys.exit(f"analyse.py: cannot read {path}, grainFoam's log: {e.strerror or e}")
+    times = [(m.start(), float(m.group(1))) for m in TIME.finditer(text)]
+    restart = RESTART.search(text)
+    if restart and times and restart.start() > times[0][0]:
+        restart = None  # a restart later in the log: logs of two pieces joined into one
+    start = float(restart.group(1)) if restart else 0.0
+    rows = []
+    for m in ENERGY.finditer(text):
+        before = [t for pos, t in times if pos < m.start()]
+        rows.append([before[-1] if before else start] + [float(x) for x in m.groups()])
+    return rows, (start if restart else None)
+
+
+# The energy balance starts from the thermal energies at the run's start: the log of a restart
+# alone starts elsewhere. A restarted run's log comes in pieces, joined here oldest first.
+# A --log name is taken as given, or else in the case folder.
+logs = ([p if os.path.exists(p) else os.path.join(case, p) for p in args.log] if args.log
+        else [os.path.join(case, "log.grainFoam")])
+pieces = sorted(os.path.basename(p) for p in os.listdir(case) if p.startswith("log.grainFoam"))
 rows = []
-for m in ENERGY.finditer(log):
-    before = [t for pos, t in times if pos < m.start()]
-    rows.append([before[-1] if before else 0.0] + [float(x) for x in m.groups()])
-if not rows:
-    sys.exit("analyse.py: no `grainFoam thermal energy` lines in log.grainFoam")
+for i, path in enumerate(logs):
+    piece, restart = energy_rows(path)
+    if not piece:
+        sys.exit(f"analyse.py: no `grainFoam thermal energy` lines in {path}")
+    if i == 0 and restart is not None:
+        sys.exit(f"analyse.py: {path} starts at t = {restart:g} s, the log of a restart "
+                 f"(`grainFoam coupling: restart at time {restart:g}`): the energy balance "
+                 "needs the thermal energies from the run's start, t = 0. Give every piece "
+                 "of the run's log, oldest first: --log FIRST_LOG [...] "
+                 f"{os.path.basename(path)} (logs in {case}: {', '.join(pieces)})")
+    if i > 0:
+        if restart is None:
+            sys.exit(f"analyse.py: {path}, after {logs[i - 1]} in --log, is not a restart's "
+                     "log (no `grainFoam coupling: restart at time` before its first time "
+                     "step): give the logs of one run, oldest first")
+        if restart > rows[-1][0] + 1e-9:
+            sys.exit(f"analyse.py: {path} continues from t = {restart:g} s, and the log "
+                     f"before it, {logs[i - 1]}, ends at t = {rows[-1][0]:g} s: the log of "
+                     "the piece between them is missing from --log")
+        rows = [r for r in rows if r[0] <= restart + 1e-9]  # a restart replaces what follows
+    rows += piece
 e = np.array(rows)   # t, E_p, C_p, E_f, C_f, sum
 _, keep = np.unique(e[:, 0], return_index=True)
 e = e[keep]
@@ -86,6 +137,11 @@ t_hi, h_in, _ = series(case, "heatIn")
 t_ho, h_out, _ = series(case, "heatOut")
 n = min(len(t_q), len(t_hi), len(t_ho))
 t, q, h_in, h_out = t_q[:n], -q[:n], -h_in[:n], h_out[:n]   # inflow positive
+if e[0, 0] > t[0] + 1e-9:
+    sys.exit(f"analyse.py: the thermal energies in {', '.join(logs)} start at t = "
+             f"{e[0, 0]:g} s, the enthalpy flows (postProcessing/inletFlow) at t = {t[0]:g} s: "
+             "the energy balance needs the energies from the run's start; give the log of "
+             "every piece of the run with --log, oldest first")
 dt = np.diff(np.concatenate(([0.0], t)))
 
 # 1. Conservation: E(t) - E(0) against the enthalpy carried in minus out (Euler sums: the

@@ -6,12 +6,15 @@ Beverloo, Leniger & van de Velde (1961), Chem. Eng. Sci. 15:260:
 with C = 0.58 and k = 1.5, the values Beverloo et al. fitted for circular orifices
 (Nedderman 1992, "Statics and kinematics of granular materials", §10.2, quotes C =
 0.58 +- 0.05 and k = 1.5 for spheres). rho_b is the bulk density of the settled bed,
-measured here from the first snapshot; d is the mean diameter (2.0 mm); D0 = 12 mm.
+measured here from the first snapshot (the bed at t = 0; --bed FILE gives it for a run
+restarted into another folder, whose series starts at the restart); d is the mean diameter
+(2.0 mm); D0 = 12 mm.
 Beverloo's data are for flat-bottomed bins: a conical hopper flows faster. Rose &
 Tanaka (1956) give the factor F = (tan(theta) tan(phi_d))^-0.35 (theta the hopper
 half-angle from the vertical, phi_d ~ 45 deg the angle of the stagnant-zone
 boundary; Nedderman §10.3), 1.17 for this hopper's 32 deg half-angle -- drawn as a line.
 """
+import argparse
 import math
 import os
 import sys
@@ -26,7 +29,13 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 from run_index import run_snapshots  # noqa: E402 (tutorials/run_index.py)
 
-out = sys.argv[1] if len(sys.argv) > 1 else "output/discharge"
+ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+ap.add_argument("out", nargs="?", default="output/discharge",
+                help="the discharge's output folder (default output/discharge)")
+ap.add_argument("--bed", help="the settled bed at t = 0 (a snapshot), for a series that does "
+                              "not start at t = 0: a run restarted into another folder")
+args = ap.parse_args()
+out = args.out
 files = run_snapshots(out)
 t, mass = [], []
 for name in files:
@@ -38,7 +47,17 @@ t, mass = np.array(t), np.array(mass)
 
 # Bulk density of the bed at t = 0: solid volume of the centres inside a central
 # cylinder (radius 5 mm, z 10-25 mm, at least 6 mm from the cone wall) over its volume.
-with h5py.File(files[0], "r") as f:
+# A run restarted into another folder starts its series there at the restart: its first
+# snapshot is a bed already part emptied.
+bed = args.bed or files[0]
+if args.bed is None and t[0] > 0:
+    sys.exit(f"analyse.py: the snapshot series of {out} starts at t = {t[0]:.6g} s "
+             f"({files[0]}), not with the settled bed at t = 0 (a run restarted into another "
+             "folder starts its series there at the restart): the bulk density needs the bed "
+             "at t = 0. Give the folder the run started in, or give the bed with --bed: "
+             "output/settled.h5 (the bed discharge.yaml starts from) or the first snapshot of "
+             "the folder the run started in")
+with h5py.File(bed, "r") as f:
     x, r, m = f["position"][:], f["radius"][:], f["mass"][:]
 rho_p = float(np.mean(m / (4 / 3 * math.pi * r**3)))
 inside = (np.hypot(x[:, 0], x[:, 1]) < 0.005) & (x[:, 2] > 0.010) & (x[:, 2] < 0.025)
@@ -50,8 +69,10 @@ w_beverloo = C * rho_b * math.sqrt(g) * (D0 - k * d) ** 2.5
 theta = math.atan((0.025 - D0 / 2) / 0.030)
 F = (math.tan(theta) * math.tan(math.radians(45))) ** -0.35
 
-# Steady discharge: fit the hopper mass between 0.2 s (flow established) and 1.0 s.
-window = (t >= 0.2) & (t <= 1.0)
+# Steady discharge: fit the hopper mass between 0.2 s (flow established) and 1.0 s, or
+# from the first snapshot of a series that starts later.
+# A snapshot falls within a step of its nominal time (0.19999 s for 0.2 s): 1 ms of slack.
+window = (t >= 0.2 - 1e-3) & (t <= 1.0 + 1e-3)
 if window.sum() < 2:
     sys.exit(f"analyse.py: {out} holds {window.sum()} snapshot(s) between 0.2 and 1.0 s "
              f"(the run ends at {t[-1]:.3g} s): the fit needs the full discharge (time.end 1.2)")
@@ -60,8 +81,11 @@ w_measured = -slope
 rate_t = 0.5 * (t[1:] + t[:-1])
 rate = -np.diff(mass) / np.diff(t)
 
-print(f"bulk solid fraction {phi:.3f}, bulk density {rho_b:.0f} kg/m3, d = {1e3 * d:.2f} mm")
-print(f"measured discharge rate {1e3 * w_measured:.2f} g/s (fit over 0.2-1.0 s)")
+print(f"bulk solid fraction {phi:.3f}, bulk density {rho_b:.0f} kg/m3, d = {1e3 * d:.2f} mm"
+      + (f" (the bed at t = 0: {bed})" if args.bed else ""))
+print(f"measured discharge rate {1e3 * w_measured:.2f} g/s (fit over {t[window][0]:.2f}-"
+      f"{t[window][-1]:.2f} s" + (f"; the series starts at {t[0]:.3g} s" if t[0] > 0.2 else "")
+      + ")")
 print(f"Beverloo (C = 0.58, k = 1.5) {1e3 * w_beverloo:.2f} g/s; "
       f"ratio measured/Beverloo {w_measured / w_beverloo:.2f}; "
       f"Rose-Tanaka hopper factor {F:.2f} -> {1e3 * F * w_beverloo:.2f} g/s")

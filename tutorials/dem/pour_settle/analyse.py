@@ -7,7 +7,6 @@ packing range of frictional, monodisperse-like spheres: random loose packing
 ~0.55-0.60 (Onoda & Liniger 1990, PRL 64:2727) up to random close packing ~0.64
 (Scott & Kilgour 1969). With friction 0.5 a poured bed sits near the loose end.
 """
-import csv
 import math
 import os
 import sys
@@ -20,25 +19,17 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from run_index import run_snapshots  # noqa: E402 (tutorials/run_index.py)
+from run_index import log_columns, run_snapshots  # noqa: E402 (tutorials/run_index.py)
 
 out = sys.argv[1] if len(sys.argv) > 1 else "output"
 if not os.path.isdir(out):
     sys.exit(f"analyse.py: no output folder {out} (run ./Allrun first, or give the folder "
              "`grain run` wrote)")
-log = os.path.join(out, "log.csv")
-try:
-    with open(log, newline="") as f:
-        rows = list(csv.DictReader(f))
-    t = np.array([float(r["time_s"]) for r in rows])
-    ke = np.array([float(r["ke_trans_J"]) + float(r["ke_rot_J"]) for r in rows])
-except OSError as e:
-    sys.exit(f"analyse.py: cannot read {log}, the run's log table: {e.strerror or e}")
-except (KeyError, TypeError, ValueError, csv.Error) as e:
-    sys.exit(f"analyse.py: {log} is not a grainflow log table (time_s, ke_trans_J, ke_rot_J): "
-             f"{type(e).__name__} {e}")
-if not len(t):
-    sys.exit(f"analyse.py: {log} holds no row")
+# The complete rows only: a last row cut short (a killed run, or a log read while the run
+# writes it) may have lost digits of its last field, e.g. the exponent of ke_rot_J.
+log = log_columns(out, "time_s", "ke_trans_J", "ke_rot_J")
+t = np.array(log["time_s"])
+ke = np.array(log["ke_trans_J"]) + np.array(log["ke_rot_J"])
 
 last = run_snapshots(out)[-1]
 with h5py.File(last, "r") as f:
@@ -61,7 +52,7 @@ for xi, ri in zip(x, r):
 phi = solid / vol
 print(f"settled bed: {len(r)} particles, top at {top*1e3:.1f} mm, core solid fraction {phi:.3f} "
       f"(random loose 0.55-0.60, random close 0.64)")
-print(f"final kinetic energy {ke[-1]:.3e} J (peak {ke.max():.3e} J)")
+print(f"final kinetic energy {ke[-1]:.3e} J at t = {t[-1]:.6g} s (peak {ke.max():.3e} J)")
 
 fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
 a1.semilogy(t, np.maximum(ke, 1e-16))

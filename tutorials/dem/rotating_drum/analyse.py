@@ -43,6 +43,10 @@ for path in run_snapshots(out):
     angles.append(math.degrees(math.atan(abs(slope))))
 times, angles = np.array(times), np.array(angles)
 steady = angles[times >= 2.0]
+if not len(steady):
+    sys.exit(f"analyse.py: no snapshot of {out} at t >= 2 s with a surface to fit (the "
+             + (f"series ends at {times[-1]:.3g} s" if len(times) else "bed fills no 5 bins")
+             + "): the steady angle needs the rotation from 2 s on (run to time.end)")
 mean = steady.mean() if len(steady) else float("nan")
 print(f"dynamic angle of repose (t >= 2 s): {mean:.1f} deg "
       f"(min {steady.min() if len(steady) else float('nan'):.1f}, "
