@@ -167,6 +167,23 @@ DemLink::DemLink(const std::string& scene_file, double fluid_density, double flu
       why << where << ": error: output." << key << " is not used by a coupled run: " << instead
           << "; remove it (grainFoam honours output.directory and output.snapshot_interval)\n";
   }
+  // The DEM's processor grid and cut planes are the fluid mesh's (DESIGN.md §2): a grid or
+  // a load balancing of the scene's own cannot apply (balancing moved the DEM's planes off
+  // the fluid's, and the particles beyond them deposited nothing).
+  for (const auto& [key, where] : m.scene.parallel.given) {
+    if (key == "grid")
+      why << where
+          << ": error: parallel.grid is not used by a coupled run: the DEM's processor grid "
+             "is the fluid's decomposition (system/decomposeParDict: numberOfSubdomains and "
+             "the method's n), read off the processor meshes at start-up; remove it and set "
+             "the grid in system/decomposeParDict\n";
+    else if (key == "balance" && m.scene.parallel.balance)
+      why << where
+          << ": error: parallel.balance: true cannot apply to a coupled run: the DEM follows "
+             "the fluid's decomposition (system/decomposeParDict), so its cut planes stay the "
+             "mesh's; remove it (to share a bed's particles evenly, place the mesh's cut "
+             "planes with scripts/balanced_decomposition.py, docs/parallel.md)\n";
+  }
   if (!why.str().empty()) throw std::runtime_error(why.str());
   // Checks the force list against the coupled solver (pressure without hydrostatics).
   try {

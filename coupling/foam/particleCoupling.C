@@ -24,6 +24,7 @@
 #include "dem/io/output_directory.hpp"
 #include "extrapolatedCalculatedFvPatchField.H"
 #include "processorFvPatch.H"
+#include "stringOps.H"
 #include "uniformDimensionedFields.H"
 #include "volPointInterpolation.H"
 #include "wallFvPatch.H"
@@ -164,6 +165,31 @@ void Stopwatch::restart() {
 double Stopwatch::wall() const { return std::chrono::duration<double>(Clock::now() - wall0_).count(); }
 double Stopwatch::cpu() const { return processCpuSeconds() - cpu0_; }
 
+namespace {
+// The line of a couplingProperties key, for its error's "file: ... at line N" (OpenFOAM's
+// FatalIOErrorInFunction(dict) names the dictionary's whole line range); the range when the
+// key is not in the file (its default was taken).
+std::pair<Foam::label, Foam::label> keyLines(const Foam::dictionary& dict, const char* key) {
+  const Foam::entry* e = dict.findEntry(key, Foam::keyType::LITERAL);
+  if (e) return {e->startLineNumber(), e->startLineNumber()};
+  return {dict.startLineNumber(), dict.endLineNumber()};
+}
+// A value as typed (12 digits: 0.1, not the case's writePrecision 0.10000000000000001).
+std::string typed(double x) {
+  std::ostringstream s;
+  s.precision(12);
+  s << x;
+  return s.str();
+}
+}  // namespace
+
+// FatalIOErrorInFunction(dict) at the line of `key` (the dictionary's name is its file's path;
+// an IOdictionary's own name() is the object's).
+#define FatalKeyError(dict, key)                                                             \
+  FatalIOError(FUNCTION_NAME, __FILE__, __LINE__,                                            \
+               static_cast<const Foam::dictionary&>(dict).name(), keyLines(dict, key).first, \
+               keyLines(dict, key).second)
+
 ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVectorField& U,
                                    const Foam::volScalarField& p, double rho, double nu)
     : mesh_(mesh),
@@ -245,14 +271,30 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
             "unknown key '" + std::string(key) + "'" +
             (e ? " at line " + std::to_string(e->startLineNumber()) : std::string()) +
             grainflow::suggestion(key, names) + "; allowed: " + list;
-        FatalIOErrorInFunction(dict) << text.c_str() << exit(FatalIOError);
+        FatalKeyError(dict, key.c_str()) << text.c_str() << exit(FatalIOError);
       }
   }
-  // The scene, relative to the case folder (not processorN/).
+  // The scene, relative to the case folder (not processorN/), expanded as OpenFOAM expands a
+  // file name (stringOps::inplaceExpand: $VAR and ${VAR} from the environment, a leading
+  // <case>/, <constant>/, <system>/ or ~/), except a leading "./", which OpenFOAM takes from
+  // the working directory and grainFoam, as any relative path, from the case folder.
+  const fileName caseDir = mesh.time().rootPath() / mesh.time().globalCaseName();
   const fileName scene = dict.get<fileName>("scene");
-  fileName sceneFile = scene.isAbsolute()
-                           ? scene
-                           : mesh.time().rootPath() / mesh.time().globalCaseName() / scene;
+  std::string expanded = scene;
+  std::string expandError;  // OpenFOAM's message for a variable it cannot expand
+  if (expanded.rfind("./", 0) == 0) expanded.erase(0, 2);
+  {
+    const bool wasThrowing = FatalError.throwExceptions();
+    try {
+      stringOps::inplaceExpand(expanded, false);
+    } catch (const error& e) {
+      expandError = e.message();
+      expandError.erase(expandError.find_last_not_of(" \n\t") + 1);
+    }
+    FatalError.throwExceptions(wasThrowing);
+  }
+  fileName sceneFile(expanded);
+  if (!sceneFile.isAbsolute()) sceneFile = caseDir / sceneFile;
 
   const word method = dict.lookupOrDefault<word>("voidFraction", "divided");
   coupling::VoidFractionMethod vf = coupling::VoidFractionMethod::divided;
@@ -260,29 +302,32 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
     vf = coupling::parse_void_fraction_method(method);
     voidFractionMethod_ = method;
   } catch (const std::invalid_argument& e) {
-    FatalIOErrorInFunction(dict) << "voidFraction: " << e.what() << exit(FatalIOError);
+    FatalKeyError(dict, "voidFraction") << "voidFraction: " << e.what() << exit(FatalIOError);
   }
   const label resolution = dict.lookupOrDefault<label>("dividedResolution", 5);
   const scalar smoothing = dict.lookupOrDefault<scalar>("smoothingFactor", 2.0);
   if (resolution < 2 || resolution > 15)
-    FatalIOErrorInFunction(dict) << "dividedResolution " << resolution
-                                 << " is outside [2, 15] (points across a diameter)"
-                                 << exit(FatalIOError);
+    FatalKeyError(dict, "dividedResolution")
+        << "dividedResolution " << resolution << " is outside [2, 15] (points across a diameter)"
+        << exit(FatalIOError);
   if (smoothing < 1 || smoothing > 2)
-    FatalIOErrorInFunction(dict) << "smoothingFactor " << smoothing
-                                 << " is outside [1, 2] (kernel radius in particle radii; "
-                                    "the ghost range covers at most 2 radii)"
-                                 << exit(FatalIOError);
+    FatalKeyError(dict, "smoothingFactor")
+        << "smoothingFactor " << typed(smoothing).c_str()
+        << " is outside [1, 2] (kernel radius in particle radii; "
+           "the ghost range covers at most 2 radii)"
+        << exit(FatalIOError);
   // A key of another method is a setting with no effect: said (a sweep over the methods may
   // keep one case's keys).
   if (dict.found("dividedResolution") && vf != coupling::VoidFractionMethod::divided)
-    Info << "grainFoam coupling: warning: dividedResolution (constant/couplingProperties) is a "
-            "setting of voidFraction divided and has no effect with voidFraction "
-         << method << endl;
+    Info << "grainFoam coupling: warning: dividedResolution (constant/couplingProperties line "
+         << keyLines(dict, "dividedResolution").first
+         << ") is a setting of voidFraction divided and has no effect with voidFraction " << method
+         << endl;
   if (dict.found("smoothingFactor") && vf != coupling::VoidFractionMethod::smoothed)
-    Info << "grainFoam coupling: warning: smoothingFactor (constant/couplingProperties) is a "
-            "setting of voidFraction smoothed and has no effect with voidFraction "
-         << method << endl;
+    Info << "grainFoam coupling: warning: smoothingFactor (constant/couplingProperties line "
+         << keyLines(dict, "smoothingFactor").first
+         << ") is a setting of voidFraction smoothed and has no effect with voidFraction " << method
+         << endl;
   footprint_ = coupling::Footprint(vf, static_cast<int>(resolution), smoothing);
   {
     // The footprint's spread per axis in particle radii: its points' standard deviation.
@@ -300,39 +345,42 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
   else if (sampling == "cellPoint")
     sampling_ = Sampling::cellPoint;
   else
-    FatalIOErrorInFunction(dict) << "sampling " << sampling
-                                 << " is not one of: cell (footprint-weighted cell values), "
-                                    "cellPoint (interpolated at the particle centre; the "
-                                    "exchange is balanced with either, docs/coupling.md)"
-                                 << exit(FatalIOError);
+    FatalKeyError(dict, "sampling") << "sampling " << sampling
+                                    << " is not one of: cell (footprint-weighted cell values), "
+                                       "cellPoint (interpolated at the particle centre; the "
+                                       "exchange is balanced with either, docs/coupling.md)"
+                                    << exit(FatalIOError);
   minVoidFraction_ = dict.lookupOrDefault<scalar>("minVoidFraction", 0.2);
   if (minVoidFraction_ < 0.2 || minVoidFraction_ >= 1)
-    FatalIOErrorInFunction(dict) << "minVoidFraction " << minVoidFraction_
-                                 << " is outside [0.2, 1) (the drag laws are tested down to "
-                                    "0.2)"
-                                 << exit(FatalIOError);
+    FatalKeyError(dict, "minVoidFraction")
+        << "minVoidFraction " << typed(minVoidFraction_).c_str()
+        << " is outside [0.2, 1) (the drag laws are tested down to "
+           "0.2)"
+        << exit(FatalIOError);
   ddtVoidFraction_ = dict.lookupOrDefault<Switch>("ddtVoidFraction", true);
   const word undisturbed = dict.lookupOrDefault<word>("undisturbedVelocity", "off");
   if (undisturbed == "oseenBrinkman")
     undisturbed_ = true;
   else if (undisturbed != "off")
-    FatalIOErrorInFunction(dict) << "undisturbedVelocity " << undisturbed
-                                 << " is not one of: off (drag on the sampled velocity), "
-                                    "oseenBrinkman (drag on the sampled velocity minus the "
-                                    "particle's own disturbance, docs/models/"
-                                    "undisturbed-velocity.md)"
-                                 << exit(FatalIOError);
+    FatalKeyError(dict, "undisturbedVelocity")
+        << "undisturbedVelocity " << undisturbed
+        << " is not one of: off (drag on the sampled velocity), "
+           "oseenBrinkman (drag on the sampled velocity minus the "
+           "particle's own disturbance, docs/models/"
+           "undisturbed-velocity.md)"
+        << exit(FatalIOError);
 
   const word meanGradP = dict.lookupOrDefault<word>("meanPressureGradient", "off");
   if (meanGradP == "suspensionWeight")
     meanGradPOn_ = true;
   else if (meanGradP != "off")
-    FatalIOErrorInFunction(dict) << "meanPressureGradient " << meanGradP
-                                 << " is not one of: off (the pressure gradient is the "
-                                    "solved one), suspensionWeight (a uniform pressure "
-                                    "gradient carries the particles' buoyant weight, for a "
-                                    "domain periodic along gravity; docs/coupling.md)"
-                                 << exit(FatalIOError);
+    FatalKeyError(dict, "meanPressureGradient")
+        << "meanPressureGradient " << meanGradP
+        << " is not one of: off (the pressure gradient is the "
+           "solved one), suspensionWeight (a uniform pressure "
+           "gradient carries the particles' buoyant weight, for a "
+           "domain periodic along gravity; docs/coupling.md)"
+        << exit(FatalIOError);
 
   // A DEM step the time-step check refuses stops grainFoam at start-up, as `grain run`
   // without --allow-large-dt; `allowLargeTimeStep yes` starts it anyway.
@@ -342,47 +390,53 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
   if (dragEps == "sharpInterface")
     sharpInterface_ = true;
   else if (dragEps != "cell")
-    FatalIOErrorInFunction(dict) << "dragVoidFraction " << dragEps
-                                 << " is not one of: cell (the drag sees the cell's void "
-                                    "fraction and velocity), sharpInterface (a cell between a "
-                                    "denser and a more dilute neighbour is read as two layers "
-                                    "of their states: the drag sees the layers' solid-weighted "
-                                    "void fraction and the velocity at the cell's superficial "
-                                    "velocity, docs/models/bed-surface.md)"
-                                 << exit(FatalIOError);
+    FatalKeyError(dict, "dragVoidFraction")
+        << "dragVoidFraction " << dragEps
+        << " is not one of: cell (the drag sees the cell's void "
+           "fraction and velocity), sharpInterface (a cell between a "
+           "denser and a more dilute neighbour is read as two layers "
+           "of their states: the drag sees the layers' solid-weighted "
+           "void fraction and the velocity at the cell's superficial "
+           "velocity, docs/models/bed-surface.md)"
+        << exit(FatalIOError);
   if (sharpInterface_ && sampling_ != Sampling::cell)
-    FatalIOErrorInFunction(dict) << "dragVoidFraction sharpInterface needs sampling cell (it "
-                                    "scales the cells' velocities before the footprint-weighted "
-                                    "average); set sampling cell or dragVoidFraction cell"
-                                 << exit(FatalIOError);
+    FatalKeyError(dict, "dragVoidFraction")
+        << "dragVoidFraction sharpInterface needs sampling cell (it "
+           "scales the cells' velocities before the footprint-weighted "
+           "average); set sampling cell or dragVoidFraction cell"
+        << exit(FatalIOError);
   if (sharpInterface_ && undisturbed_)
-    FatalIOErrorInFunction(dict) << "dragVoidFraction sharpInterface and undisturbedVelocity "
-                                    "oseenBrinkman are not combined (the disturbance model "
-                                    "reads the cells' unscaled Ksl); switch one of them off"
-                                 << exit(FatalIOError);
+    FatalKeyError(dict, "dragVoidFraction")
+        << "dragVoidFraction sharpInterface and undisturbedVelocity "
+           "oseenBrinkman are not combined (the disturbance model "
+           "reads the cells' unscaled Ksl); switch one of them off"
+        << exit(FatalIOError);
 
   const word facePressure = dict.lookupOrDefault<word>("facePressure", "linear");
   if (facePressure == "dragSeries")
     dragSeriesPressure_ = true;
   else if (facePressure != "linear")
-    FatalIOErrorInFunction(dict) << "facePressure " << facePressure
-                                 << " is not one of: linear (the momentum equation's cell "
-                                    "pressure gradient is Gauss linear), dragSeries (the face "
-                                    "pressure between two cells crossed in series with their "
-                                    "drag resistances, docs/models/bed-surface.md)"
-                                 << exit(FatalIOError);
+    FatalKeyError(dict, "facePressure")
+        << "facePressure " << facePressure
+        << " is not one of: linear (the momentum equation's cell "
+           "pressure gradient is Gauss linear), dragSeries (the face "
+           "pressure between two cells crossed in series with their "
+           "drag resistances, docs/models/bed-surface.md)"
+        << exit(FatalIOError);
 
   const scalar bandwidth = dict.lookupOrDefault<scalar>("diffusionBandwidth", 0.0);
   if (bandwidth < 0)
-    FatalIOErrorInFunction(dict) << "diffusionBandwidth " << bandwidth
-                                 << " is negative; it is the bandwidth b [m] of the "
-                                    "diffusion-based averaging (Gaussian exp(-r^2/b^2)), 0 "
-                                    "for none"
-                                 << exit(FatalIOError);
+    FatalKeyError(dict, "diffusionBandwidth")
+        << "diffusionBandwidth " << typed(bandwidth).c_str()
+        << " is negative; it is the bandwidth b [m] of the "
+           "diffusion-based averaging (Gaussian exp(-r^2/b^2)), 0 "
+           "for none"
+        << exit(FatalIOError);
   if (bandwidth > 0) {
     if (sharpInterface_)
-      FatalIOErrorInFunction(dict)
-          << "diffusionBandwidth " << bandwidth << " is not combined with dragVoidFraction "
+      FatalKeyError(dict, "diffusionBandwidth")
+          << "diffusionBandwidth " << bandwidth
+          << " is not combined with dragVoidFraction "
              "sharpInterface (the layers are read from the cells' own void fractions, which "
              "the averaging spreads); set diffusionBandwidth 0 or dragVoidFraction cell"
           << exit(FatalIOError);
@@ -399,7 +453,7 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
         << std::floor(largest / unit) * unit << " m (at most " << kMaxSmoothingSteps
         << " steps; b is a length in metres, typically a few particle diameters: 2.83 d is "
            "the tested value)";
-      FatalIOErrorInFunction(dict) << m.str().c_str() << exit(FatalIOError);
+      FatalKeyError(dict, "diffusionBandwidth") << m.str().c_str() << exit(FatalIOError);
     }
     Info << "grainFoam coupling: diffusionBandwidth b = " << bandwidth
          << " m: eps, Ksl, KslUs, fParticles and the fluid the particles read are averaged "
@@ -432,15 +486,43 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
 
   // --- the DEM ----------------------------------------------------------------------
   if (!sceneFile.isAbsolute()) sceneFile = cwd() / sceneFile;
-  if (!isFile(sceneFile)) {
+  if (!expandError.empty() || !isFile(sceneFile)) {
     const entry* e = dict.findEntry("scene", keyType::LITERAL);
-    const std::string text =
-        "scene \"" + std::string(scene) + "\"" +
-        (e ? " (line " + std::to_string(e->startLineNumber()) + ")" : std::string()) +
-        ": no such file " + std::string(sceneFile) +
-        "; the scene's path is taken from the case folder (" +
-        std::string(mesh.time().rootPath() / mesh.time().globalCaseName()) + ")";
-    FatalIOErrorInFunction(dict) << text.c_str() << exit(FatalIOError);
+    std::string text = "scene \"" + std::string(scene) + "\"" +
+                       (e ? " (line " + std::to_string(e->startLineNumber()) + ")" : std::string());
+    const std::string expansion =
+        "OpenFOAM's file-name expansion takes $NAME and ${NAME} from the environment, and a "
+        "leading <case>/, <constant>/, <system>/ or ~/";
+    if (!expandError.empty()) {
+      // OpenFOAM's "Unknown variable 'NAME'": the name.
+      const std::string::size_type a = expandError.find('\''), b = expandError.rfind('\'');
+      text += ": cannot be expanded: " +
+              (a != std::string::npos && b > a ? "variable " + expandError.substr(a, b - a + 1) +
+                                                     " is not set in the environment"
+                                               : expandError) +
+              " (" + expansion + ")";
+    } else {
+      const std::string shown =
+          std::string(sceneFile) + (expanded != std::string(scene)
+                                        ? " (expanded from \"" + std::string(scene) + "\")"
+                                        : std::string());
+      if (isDir(sceneFile)) {
+        std::string yaml;
+        for (const fileName& f : readDir(sceneFile, fileName::FILE))
+          if (f.ext() == "yaml" || f.ext() == "yml")
+            yaml += (yaml.empty() ? "" : ", ") + std::string(f);
+        text += ": " + shown + " is a directory, not a scene file; name the scene's YAML file " +
+                (yaml.empty() ? std::string("(it holds no .yaml file)")
+                              : "in it (it holds " + yaml + ")");
+      } else {
+        text += ": no such file " + shown;
+        if (expanded.find('$') != std::string::npos)
+          text += "; the path still holds a '$' after expansion (" + expansion +
+                  "; a malformed name such as $(NAME) is left as it is)";
+      }
+    }
+    text += "; a relative path is taken from the case folder (" + std::string(caseDir) + ")";
+    FatalKeyError(dict, "scene") << text.c_str() << exit(FatalIOError);
   }
   try {
     dem_ = std::make_unique<coupling::DemLink>(sceneFile, rho_, rho_ * nu_, MPI_COMM_WORLD);
@@ -449,10 +531,11 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
     FatalErrorInFunction << "\n" << e.what() << exit(FatalError);
   }
   if (smoothing_ && dem_->heat_on())
-    FatalIOErrorInFunction(dict) << "diffusionBandwidth is not combined with the scene's heat: "
-                                    "block (the heat exchange is deposited and sampled "
-                                    "without the averaging); set diffusionBandwidth 0"
-                                 << exit(FatalIOError);
+    FatalKeyError(dict, "diffusionBandwidth")
+        << "diffusionBandwidth is not combined with the scene's heat: "
+           "block (the heat exchange is deposited and sampled "
+           "without the averaging); set diffusionBandwidth 0"
+        << exit(FatalIOError);
   // OpenFOAM's own place for gravity: grainFoam takes it from the scene, so a constant/g that
   // says otherwise would be a setting with no effect.
   {
@@ -491,9 +574,9 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
     static const char* axis = "xyz";
     for (int a = 0; a < 3; ++a)
       if (g[a] != 0 && !periodic_[a])
-        FatalIOErrorInFunction(dict)
-            << "meanPressureGradient suspensionWeight: gravity has a component along "
-            << axis[a] << " but the scene's domain is not periodic along " << axis[a]
+        FatalKeyError(dict, "meanPressureGradient")
+            << "meanPressureGradient suspensionWeight: gravity has a component along " << axis[a]
+            << " but the scene's domain is not periodic along " << axis[a]
             << " (domain.periodic); there the walls carry the weight through the solved "
                "pressure. Set meanPressureGradient off, or make the domain and the mesh "
                "periodic along every axis gravity has a component on"
@@ -504,9 +587,10 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
       const vectorField n(fp.nf());
       for (const vector& v : n)
         if (std::abs(v[0] * g[0] + v[1] * g[1] + v[2] * g[2]) > 1e-6 * gMag)
-          FatalIOErrorInFunction(dict)
+          FatalKeyError(dict, "meanPressureGradient")
               << "meanPressureGradient suspensionWeight: patch " << fp.name() << " (type "
-              << fp.type() << ") has faces across gravity; the uniform pressure gradient "
+              << fp.type()
+              << ") has faces across gravity; the uniform pressure gradient "
                  "needs a mesh periodic (cyclic) along gravity. Set meanPressureGradient off, "
                  "or make that patch cyclic"
               << exit(FatalIOError);
@@ -549,7 +633,6 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
   // The scene's output.directory, relative to the case folder (not processorN/), or
   // <case>/particles.
   {
-    const fileName caseDir = mesh.time().rootPath() / mesh.time().globalCaseName();
     const fileName given(dem_->output_directory());
     snapshotDir_ = given.empty() ? caseDir / "particles" : given.isAbsolute() ? given : caseDir / given;
   }
@@ -669,13 +752,7 @@ ParticleCoupling::ParticleCoupling(const Foam::fvMesh& mesh, const Foam::volVect
         << exit(FatalIOError);
   const double dtFluid = time.deltaTValue(), dtDem = dem_->time_step();
   const double ratio = dtFluid / dtDem;
-  // As one types them back (12 digits: 3 x 1e-05 is 3e-05, not 3.0000000000000004e-05).
-  const auto typed = [](double x) {
-    std::ostringstream s;
-    s.precision(12);
-    s << x;
-    return s.str();
-  };
+  // As one types them back (typed: 12 digits, 3 x 1e-05 is 3e-05, not 3.0000000000000004e-05).
   if (!(dtFluid > 0))
     FatalIOErrorInFunction(time.controlDict())
         << "deltaT " << typed(dtFluid).c_str() << " s must be positive: a whole number of DEM "

@@ -696,6 +696,9 @@ double Simulation::load_imbalance() const {
 }
 
 void Simulation::balance_cuts() {
+  // Imposed planes (a coupled run's: the fluid mesh's) are not the DEM's to move: off them,
+  // a particle would be owned by a rank that does not hold its cell.
+  if (cuts_imposed_) return;
   // Per axis with several ranks: a global histogram of particle coordinates gives
   // the planes that split the particles evenly. Each plane moves at most half the
   // narrower of its two boxes per call, so that no particle ends up more than one

@@ -239,7 +239,9 @@ class Simulation {
 
  private:
   void rebuild(bool keep_drag = false);
-  void balance_cuts();  // moves cut planes toward equal particle counts (collective)
+  // Moves cut planes toward equal particle counts (collective); never planes imposed by
+  // set_cut_planes().
+  void balance_cuts();
   // The bins of the neighbour search: over this rank's box widened by the interaction range,
   // or with parallel.reproducible the lattice anchored at the domain (BinGrid::anchored),
   // the same on every rank, whose bins are the particles' keys (canonical_order.hpp).

@@ -259,6 +259,9 @@ struct ParallelSettings {
   // Sum every particle's contact forces in a canonical order (by partner key), so that the
   // trajectory does not depend on the rank count or grid (dem/engine/canonical_order.hpp).
   bool reproducible = false;
+  // The keys the scene gives, with their "file:line" (grainFoam, whose decomposition is the
+  // fluid mesh's, refuses grid and balance naming where they are).
+  std::vector<std::pair<std::string, std::string>> given;
 };
 
 // Heat transfer (docs/models/heat-transfer.md): present when the scene switches it on

@@ -398,6 +398,9 @@ std::string existing_file(const Field& file, const std::string& what,
 ParallelSettings parse_parallel(const Field& f) {
   const Map m = f.map({"grid", "balance", "reproducible"});
   ParallelSettings par;
+  for (const char* key : {"grid", "balance", "reproducible"})
+    if (const auto v = m.find(key))
+      par.given.emplace_back(key, f.source().label + ":" + std::to_string(v->key_mark().line + 1));
   if (const auto g = m.find("grid")) {
     const std::vector<Field> items = g->items();
     if (items.size() != 3)

@@ -35,6 +35,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -46,6 +47,7 @@
 #include "coupling/foam/fluxReconstruction.H"
 #include "coupling/foam/particleCoupling.H"
 #include "coupling/written_files.hpp"
+#include "dem/core/suggestion.hpp"
 #include "dem/engine/stop_signals.hpp"
 #include "fileOperation.H"
 #include "fixedFluxPressureFvPatchScalarField.H"
@@ -247,6 +249,91 @@ void checkWrittenFiles(const Foam::Time& runTime) {
          << ": its fields are read unchecked" << endl;
 }
 
+// grainFoam solves a Newtonian fluid of constant rho and nu (with heat, constant Cp and
+// kappa): another viscosity model, its coefficients or a misspelt key would run as if they
+// were not there. Each is refused at its line, all in one message.
+void checkTransportKeys(const Foam::dictionary& transport) {
+  using namespace Foam;
+  std::string problems;
+  label first = -1;  // the first refused key's line, for the message's "file:" line
+  const auto lineOf = [&transport, &first](const word& key) {
+    const entry* e = transport.findEntry(key, keyType::LITERAL);
+    if (!e) return std::string();
+    if (first < 0) first = e->startLineNumber();
+    return " at line " + std::to_string(e->startLineNumber());
+  };
+  const word model = transport.lookupOrDefault<word>("transportModel", "Newtonian");
+  if (model != "Newtonian")
+    problems += "transportModel " + std::string(model) + lineOf("transportModel") +
+                ": grainFoam solves a Newtonian fluid (constant nu); set transportModel "
+                "Newtonian or remove it\n";
+  const std::vector<std::string> allowed{"transportModel", "rho", "nu", "Cp", "kappa"};
+  for (const word& key : transport.toc())
+    if (std::find(allowed.begin(), allowed.end(), std::string(key)) == allowed.end())
+      problems += "unknown key '" + std::string(key) + "'" + lineOf(key) +
+                  grainflow::suggestion(key, allowed) +
+                  " (grainFoam does not read it); allowed: transportModel (Newtonian), rho, nu, "
+                  "and with the scene's heat Cp and kappa\n";
+  if (problems.empty()) return;
+  problems.pop_back();
+  FatalIOError(FUNCTION_NAME, __FILE__, __LINE__, transport.name(), first, first)
+      << problems.c_str() << exit(FatalIOError);
+}
+
+// Where a run from `start` to `end` in steps of dt stops: OpenFOAM's Time::run() goes on while
+// t < end - dt/2 and each step adds dt to t, so the run takes the whole number of steps
+// nearest (end - start)/dt, and stops after or before `end` when that is not whole. The same
+// sums as OpenFOAM's, so the time is the one the run reaches (a closed form beyond 1e8 steps).
+struct RunEnd {
+  double time = 0;  // the last step's time
+  long steps = 0;
+  bool whole = true;  // time = end to 1e-3 of a step: (end - start)/dt is whole
+};
+RunEnd runEnd(double start, double end, double dt) {
+  RunEnd r;
+  r.time = start;
+  if ((end - start) / dt > 1e8) {
+    r.steps = static_cast<long>(std::ceil((end - start) / dt - 0.5));
+    r.time = start + static_cast<double>(r.steps) * dt;
+  } else {
+    while (r.time < end - 0.5 * dt) {
+      r.time += dt;
+      ++r.steps;
+    }
+  }
+  r.whole = std::abs(r.time - end) <= 1e-3 * dt;
+  return r;
+}
+
+// Times as typed (6 digits), not at the case's writePrecision.
+std::string typed(double x) {
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
+
+// The start-up note when the run's end is not a whole number of fluid steps from its start:
+// which time it ends at, and the two nearest ends that are whole (12 digits, so that a value
+// typed back is whole to round-off).
+std::string endNote(const std::string& which, const std::string& source, const std::string& key,
+                    double start, double end, double dt, const RunEnd& r) {
+  std::ostringstream s;
+  s << "grainFoam: note: " << which << " " << typed(end) << " s"
+    << (source.empty() ? std::string() : " (" + source + ")") << " is " << std::setprecision(6)
+    << (end - start) / dt << " fluid steps of deltaT " << typed(dt)
+    << " s from the start (t = " << typed(start) << " s), not a whole number: the run takes "
+    << r.steps << (r.steps == 1 ? " step" : " steps")
+    << ", the nearest whole number, and ends at t = " << typed(r.time) << " s, "
+    << (r.time > end ? "after" : "before") << " it. To end exactly at " << key
+    << ", set it to a whole number of steps from the "
+       "start, e.g. ";
+  const long low = static_cast<long>(std::floor((end - start) / dt));
+  s << std::setprecision(12);
+  if (low >= 1) s << start + static_cast<double>(low) * dt << " (" << low << " steps) or ";
+  s << start + static_cast<double>(low + 1) * dt << " (" << low + 1 << " steps)";
+  return s.str();
+}
+
 // With runTimeModifiable, OpenFOAM re-reads system/controlDict (and any dictionary registered
 // MUST_READ_IF_MODIFIED) at the start of each step, in Time::run(). What the coupling fixed at
 // start-up must survive it: deltaT is a whole number of DEM steps (the DEM's sub-steps and a
@@ -286,10 +373,12 @@ class RunTimeEdits {
       foamEnd_ = runTime_.endTime().value();
       const scalar before = end_;
       setEnd();
-      if (end_ != before && foamEnd_ < 0.1 * GREAT)
+      if (end_ != before && foamEnd_ < 0.1 * GREAT) {
+        const RunEnd r = runEnd(runTime_.value(), end_, runTime_.deltaTValue());
         Info << "grainFoam: system/controlDict re-read: endTime " << text(foamEnd_).c_str()
-             << " s; the run ends at t = " << text(end_).c_str() << " s, " << endName().c_str()
-             << endl;
+             << " s; the run ends at t = " << text(r.time).c_str() << " s, "
+             << (r.whole ? "" : "the fluid step nearest ") << endName().c_str() << endl;
+      }
     }
     const scalar dt = runTime_.controlDict().lookupOrDefault<scalar>("deltaT", deltaT_);
     if (dt != seenDeltaT_ && dt != deltaT_)
@@ -316,14 +405,24 @@ class RunTimeEdits {
       }
     return runTime_.value() >= end_ - 0.5 * runTime_.deltaTValue();
   }
-  // The last line when the scene's end stopped the run (empty otherwise); true where it is.
+  // The last line when the run reached its end and that was the scene's time.end, or a time
+  // other than the end (the end not a whole number of steps from the start); empty
+  // otherwise. It states the time the run reached.
   std::string finalLine() const {
-    if (!(sceneEnd_ < foamEnd_) ||
-        std::abs(runTime_.value() - sceneEnd_) > 0.5 * runTime_.deltaTValue())
-      return std::string();
-    return "grainFoam: stopped at the scene's time.end, t = " + text(sceneEnd_) + " s (" +
-           sceneEndSource_ + "), before system/controlDict's endTime " + text(foamEnd_) +
-           " s; to run longer, raise both";
+    const double t = runTime_.value(), dt = runTime_.deltaTValue();
+    if (t < end_ - 0.5 * dt) return std::string();  // stopped before its end
+    const bool whole = std::abs(t - end_) <= 1e-3 * dt;
+    if (sceneEnd_ < foamEnd_)
+      return whole ? "grainFoam: stopped at the scene's time.end, t = " + text(t) + " s (" +
+                         sceneEndSource_ + "), before system/controlDict's endTime " +
+                         text(foamEnd_) + " s; to run longer, raise both"
+                   : "grainFoam: stopped at t = " + text(t) +
+                         " s, the fluid step nearest the scene's time.end " + text(sceneEnd_) +
+                         " s (" + sceneEndSource_ + "), before system/controlDict's endTime " +
+                         text(foamEnd_) + " s; to run longer, raise both";
+    if (whole) return std::string();
+    return "grainFoam: stopped at t = " + text(t) +
+           " s, the fluid step nearest system/controlDict's endTime " + text(foamEnd_) + " s";
   }
 
  private:
@@ -392,6 +491,7 @@ void solve(const Foam::argList& args) {
 
   IOdictionary transport(IOobject("transportProperties", runTime.constant(), mesh,
                                   IOobject::MUST_READ_IF_MODIFIED, IOobject::NO_WRITE));
+  checkTransportKeys(transport);
   const dimensionedScalar rho("rho", dimDensity, transport);
   const dimensionedScalar nu("nu", dimViscosity, transport);
 
@@ -431,7 +531,11 @@ void solve(const Foam::argList& args) {
                                          mesh));
     checkStartingTemperature(*temperature, startTime);
     particles.setTemperature(*temperature, rhoCp.value(), kappa.value(), transport.objectPath());
-  }
+  } else
+    for (const char* key : {"Cp", "kappa"})
+      if (transport.found(key))
+        Info << "grainFoam: warning: " << key << " (constant/transportProperties) has no effect: "
+             << "the scene has no heat: block, so no fluid temperature is solved" << endl;
   const bool modelA = particles.model() == 'A';
   const bool meanGradP = particles.meanPressureGradientOn();
 
@@ -450,26 +554,34 @@ void solve(const Foam::argList& args) {
   // not look like a run to controlDict's endTime.
   {
     const scalar sceneEnd = particles.sceneEndTime(), foamEnd = runTime.endTime().value();
-    // As typed (6 digits), not at the case's writePrecision.
-    const auto text = [](double x) {
-      std::ostringstream s;
-      s << x;
-      return s.str();
-    };
+    const auto text = typed;
+    const scalar end = min(sceneEnd, foamEnd), start = runTime.value();
+    const scalar half = 0.5 * runTime.deltaTValue();
+    // OpenFOAM ends at the fluid step nearest the end: said when that is not the end itself.
+    const RunEnd reach = end > start + half ? runEnd(start, end, runTime.deltaTValue()) : RunEnd{};
+    const std::string nearest = reach.whole ? "" : "the fluid step nearest ";
     if (sceneEnd < foamEnd) {
-      Info << "grainFoam: ends at t = " << text(sceneEnd).c_str() << " s, the scene's time.end ("
+      Info << "grainFoam: ends at t = " << text(reach.whole ? sceneEnd : reach.time).c_str()
+           << " s, " << nearest.c_str() << "the scene's time.end "
+           << (reach.whole ? "" : text(sceneEnd) + " s ").c_str() << "("
            << particles.sceneEndTimeSource().c_str() << "), before system/controlDict's endTime "
            << text(foamEnd).c_str() << " s" << endl;
     } else {
-      Info << "grainFoam: ends at t = " << text(foamEnd).c_str()
-           << " s, system/controlDict's endTime (the scene's time.end, "
+      Info << "grainFoam: ends at t = " << text(reach.whole ? foamEnd : reach.time).c_str()
+           << " s, " << nearest.c_str() << "system/controlDict's endTime "
+           << (reach.whole ? "" : text(foamEnd) + " s ").c_str() << "(the scene's time.end, "
            << particles.sceneEndTimeSource().c_str() << ", is " << text(sceneEnd).c_str() << " s)"
            << endl;
     }
+    if (!reach.whole)
+      Info << endNote(sceneEnd < foamEnd ? "the scene's time.end" : "system/controlDict's endTime",
+                      sceneEnd < foamEnd ? particles.sceneEndTimeSource() : std::string(),
+                      sceneEnd < foamEnd ? "time.end" : "endTime", start, end,
+                      runTime.deltaTValue(), reach)
+                  .c_str()
+           << endl;
     // An end before the start is a typo (or a scene from another case): nothing would run
     // and the run would still end as if done.
-    const scalar end = min(sceneEnd, foamEnd), start = runTime.value();
-    const scalar half = 0.5 * runTime.deltaTValue();
     const std::string which = sceneEnd < foamEnd
                                   ? "the scene's time.end (" + particles.sceneEndTimeSource() + ")"
                                   : std::string("system/controlDict's endTime");

@@ -141,7 +141,7 @@ def void_fraction_volume(runner, checks):
             ("system/controlDict", "endTime         0.1;", "endTime         0.002;")])
         log = runner.solve(case, 1)
         # smoothingFactor, a key of voidFraction smoothed, has no effect here: said.
-        checks.expect("warning: smoothingFactor (constant/couplingProperties) is a setting of "
+        checks.expect("warning: smoothingFactor (constant/couplingProperties line 11) is a setting of "
                       f"voidFraction smoothed and has no effect with voidFraction {method}" in log,
                       f"smoothingFactor with voidFraction {method}: warned")
         said = ("warning: particles up to 0.003 m across are wider than the smallest fluid cell "
@@ -2193,6 +2193,195 @@ def setup_messages(runner, checks):
         checks.expect(True, "the printed rho*nu typed as fluid.viscosity runs")
 
 
+# --- coupling.coupled_inputs -------------------------------------------------------------
+
+def run_refused(runner, checks, case, what, ranks=1, log="grainFoam"):
+    """grainFoam on a set-up it must refuse; returns its log. A run that ends with exit 0 is a
+    failed check (the later checks of the test still run)."""
+    try:
+        return runner.run(case, log, runner.solver, ranks=ranks, expect_failure=True)
+    except RuntimeError:
+        checks.expect(False, f"{what}: refused (it ran, exit 0)")
+        with open(os.path.join(case, "log." + log)) as f:
+            return f.read()
+
+
+def coupled_inputs(runner, checks):
+    """Inputs grainFoam took without a word, and messages that did not say where or what.
+
+    1. The scene's `parallel` block: the DEM's decomposition is the fluid mesh's. On 2 ranks
+       `parallel: {balance: true}` moved the DEM's cut planes off the mesh's (45 % of a bed's
+       volume then went undeposited, exit 0) and `grid` was replaced silently: both refused
+       at particles.yaml's line naming system/decomposeParDict; the advice (remove it) runs,
+       and the void fraction holds the particles' volume (relative difference <= 1e-12 at
+       every report, docs/coupling.md). `reproducible: true` and `balance: false` apply and run.
+    2. constant/transportProperties: `transportModel BirdCarreau;` with its coefficients ran
+       as Newtonian: both refused at their lines (12 and 13); `transportModel Newtonian;` runs, and Cp
+       without the scene's heat is named as having no effect.
+    3. An end that is not a whole number of fluid steps from the start (deltaT 1e-3 s,
+       time.end 0.0056 s): OpenFOAM takes the nearest whole number of steps (6) and ends at
+       0.006 s; the start-up and the last line said 0.0056. Now both say 0.006 s, which the
+       last Time line and the last snapshot's time confirm, and the note's advice (time.end
+       0.006) ends exactly there. The same for controlDict's endTime 0.0054 (ends at 0.005).
+    4. couplingProperties values out of range or unknown are refused with the key's line
+       (the file: line said "from line 9 to line 13").
+    5. The scene's path is expanded as OpenFOAM expands file names: "$FOAM_CASE/..." and
+       "<case>/..." run (also on 2 ranks); an unset variable, a '$' left after expansion and
+       a directory are each refused saying so."""
+    # 1. parallel
+    case = runner.fresh_case("periodic_box", "parallel_balance", [
+        ("particles.yaml", "fluid:\n", "parallel: {balance: true}\nfluid:\n")])
+    runner.run(case, "blockMesh", "blockMesh")
+    runner.run(case, "decomposePar", "decomposePar")
+    log = run_refused(runner, checks, case, "parallel.balance: true on 2 ranks", ranks=2)
+    checks.expect(re.search(r"particles\.yaml:31: error: parallel\.balance: true cannot apply to a "
+                            r"coupled run: the DEM follows the fluid's decomposition "
+                            r"\(system/decomposeParDict\)", log) is not None,
+                  "parallel.balance: true on 2 ranks: refused at particles.yaml:31, naming "
+                  "system/decomposeParDict")
+    with open(os.path.join(case, "particles.yaml")) as f:
+        text = f.read()
+    with open(os.path.join(case, "particles.yaml"), "w") as f:
+        f.write(text.replace("parallel: {balance: true}\n", ""))
+    log = runner.run(case, "grainFoam.advised", runner.solver, ranks=2)
+    diffs = [v[-1] for v in void_lines(log)]
+    checks.expect(len(diffs) >= 2 and max(diffs) <= 1e-12,
+                  f"the advice (remove it) runs on 2 ranks with every particle's volume "
+                  f"deposited: relative differences {diffs} (<= 1e-12)")
+    case = runner.fresh_case("neutral_particle", "parallel_grid", SHORT + [
+        ("particle.yaml", "fluid:\n", "parallel:\n  grid: [2, 1, 1]\nfluid:\n")])
+    runner.run(case, "blockMesh", "blockMesh")
+    log = run_refused(runner, checks, case, "parallel.grid [2, 1, 1]")
+    checks.expect(re.search(r"particle\.yaml:17: error: parallel\.grid is not used by a coupled "
+                            r"run: the DEM's processor grid is the fluid's decomposition "
+                            r"\(system/decomposeParDict", log) is not None,
+                  "parallel.grid (serial): refused at particle.yaml:17, naming "
+                  "system/decomposeParDict")
+    case = runner.fresh_case("neutral_particle", "parallel_allowed", SHORT + [
+        ("particle.yaml", "fluid:\n", "parallel: {reproducible: true, balance: false}\nfluid:\n")])
+    runner.solve(case, 1)  # raises unless it runs to its end
+    checks.expect(True, "parallel: {reproducible: true, balance: false} runs")
+
+    # 2. transportProperties
+    model = ("constant/transportProperties", "nu      1e-6;",
+             "nu      1e-6;\ntransportModel BirdCarreau;\n"
+             "BirdCarreauCoeffs { nu0 1e-06; nuInf 1e-06; k 0; n 1; }")
+    case = runner.fresh_case("neutral_particle", "transport_model", SHORT + [model])
+    runner.run(case, "blockMesh", "blockMesh")
+    log = run_refused(runner, checks, case, "transportModel BirdCarreau")
+    checks.expect(re.search(r"transportModel BirdCarreau at line 12: grainFoam solves a Newtonian "
+                            r"fluid \(constant nu\); set transportModel Newtonian or remove it\n"
+                            r"unknown key 'BirdCarreauCoeffs' at line 13 \(grainFoam does not "
+                            r"read it\); allowed: transportModel \(Newtonian\), rho, nu", log)
+                  is not None and re.search(r"transportProperties at line 12\.", log) is not None,
+                  "transportModel BirdCarreau and its coefficients: refused at lines 12 and 13")
+    case = runner.fresh_case("neutral_particle", "transport_newtonian", SHORT + [
+        ("constant/transportProperties", "nu      1e-6;",
+         "nu      1e-6;\ntransportModel Newtonian;\nCp      4180;")])
+    log = runner.solve(case, 1)
+    checks.expect("grainFoam: warning: Cp (constant/transportProperties) has no effect: the "
+                  "scene has no heat: block" in log,
+                  "transportModel Newtonian runs; Cp without heat named as having no effect")
+
+    # 3. an end between two fluid steps (deltaT 1e-3 s)
+    for label, edits, says, last_line, advice in (
+            ("end_scene", [("particle.yaml", "  end: 1\n", "  end: 0.0056\n")],
+             r"grainFoam: ends at t = 0\.006 s, the fluid step nearest the scene's time\.end "
+             r"0\.0056 s \(\S*particle\.yaml:9\), before system/controlDict's endTime 0\.1 s",
+             r"grainFoam: stopped at t = 0\.006 s, the fluid step nearest the scene's time\.end "
+             r"0\.0056 s \(\S*particle\.yaml:9\), before system/controlDict's endTime 0\.1 s; to "
+             r"run longer, raise both\nEnd",
+             r"grainFoam: note: the scene's time\.end 0\.0056 s \(\S*particle\.yaml:9\) is 5\.6 "
+             r"fluid steps of deltaT 0\.001 s from the start \(t = 0 s\), not a whole number: the "
+             r"run takes 6 steps, the nearest whole number, and ends at t = 0\.006 s, after it\. "
+             r"To end exactly at time\.end, set it to a whole number of steps from the start, "
+             r"e\.g\. 0\.005 \(5 steps\) or (\S+) \(6 steps\)"),
+            ("end_control", [("system/controlDict", "endTime         0.1;",
+                              "endTime         0.0054;")],
+             r"grainFoam: ends at t = 0\.005 s, the fluid step nearest system/controlDict's "
+             r"endTime 0\.0054 s \(the scene's time\.end",
+             r"grainFoam: stopped at t = 0\.005 s, the fluid step nearest system/controlDict's "
+             r"endTime 0\.0054 s\nEnd",
+             r"the run takes 5 steps, the nearest whole number, and ends at t = 0\.005 s, before "
+             r"it\. To end exactly at endTime, set it to a whole number of steps from the start, "
+             r"e\.g\. (\S+) \(5 steps\) or 0\.006 \(6 steps\)")):
+        case = runner.fresh_case("neutral_particle", label, edits + [
+            ("particle.yaml", "fluid:\n", "output: {snapshot_interval: 0.001}\nfluid:\n")])
+        log = runner.solve(case, 1)
+        steps = re.findall(r"^Time = (\S+)$", log, re.MULTILINE)
+        end = 0.006 if label == "end_scene" else 0.005
+        snaps = snapshots(case)
+        checks.expect(steps and abs(float(steps[-1]) - end) < 1e-12 and snaps
+                      and abs(snaps[-1][0] - end) < 1e-12,
+                      f"{label}: the last fluid step and snapshot at t = "
+                      f"{steps[-1] if steps else None}, {snaps[-1][0] if snaps else None} ({end})")
+        checks.expect(re.search(says, log) is not None,
+                      f"{label}: the start-up says the run ends at t = {end} s, the step nearest")
+        checks.expect(re.search(last_line, log) is not None,
+                      f"{label}: the last line says it stopped at t = {end} s")
+        m = re.search(advice, log)
+        checks.expect(m is not None, f"{label}: a note says the end is not whole, and how to "
+                                     f"end exactly there ({m.group(1) if m else None})")
+        if label == "end_scene" and m:
+            again = runner.fresh_case("neutral_particle", "end_advised", [
+                ("particle.yaml", "  end: 1\n", f"  end: {m.group(1)}\n")])
+            log = runner.solve(again, 1)
+            checks.expect(re.search(r"grainFoam: stopped at the scene's time\.end, t = 0\.006 s",
+                                    log) is not None and "grainFoam: note:" not in log
+                          and "nearest" not in log,
+                          f"the advice, time.end {m.group(1)}, ends exactly there, without a note")
+
+    # 4. couplingProperties values: refused at the key's line.
+    for label, old, new, words, line in (
+            ("min_void_fraction", "minVoidFraction 0.2;", "minVoidFraction 0.1;",
+             "minVoidFraction 0.1 is outside [0.2, 1)", 12),
+            ("divided_resolution", "ddtVoidFraction on;", "ddtVoidFraction on;\ndividedResolution 16;",
+             "dividedResolution 16 is outside [2, 15]", 14),
+            ("void_fraction_method", "voidFraction    divided;", "voidFraction    Divided;",
+             "voidFraction: ", 10)):
+        case = runner.fresh_case("neutral_particle", label, [
+            ("constant/couplingProperties", old, new)])
+        runner.run(case, "blockMesh", "blockMesh")
+        log = run_refused(runner, checks, case, label)
+        checks.expect(words in log and re.search(
+            rf"file: \S*constant/couplingProperties at line {line}\.", log) is not None,
+                      f"{label}: refused, naming couplingProperties at line {line}")
+    # The message of an unknown method names the allowed ones; the original, as advised, runs
+    # (refuses_bad_setup and the other tests run it).
+
+    # 5. The scene's path.
+    for label, path, ranks in (("scene_foam_case", "$FOAM_CASE/particle.yaml", 1),
+                               ("scene_case_tag", "<case>/particle.yaml", 1),
+                               ("scene_foam_case_ranks", "$FOAM_CASE/particles.yaml", 2)):
+        source = "periodic_box" if ranks == 2 else "neutral_particle"
+        scene = "particles.yaml" if ranks == 2 else "particle.yaml"
+        case = runner.fresh_case(source, label, (SHORT if ranks == 1 else []) + [
+            ("constant/couplingProperties", f'"{scene}"', f'"{path}"')])
+        try:
+            log = runner.solve(case, ranks)
+        except RuntimeError as e:  # main's grainFoam: "no such file .../$FOAM_CASE/..."
+            log = str(e)
+        checks.expect(re.search(r"grainFoam coupling: scene \"?" + re.escape(case) + "/" +
+                                re.escape(scene), log) is not None,
+                      f"scene \"{path}\" on {ranks} rank(s): expanded to the case's {scene}, runs")
+    for label, path, words in (
+            ("scene_unset", "$GRAINFLOW_UNSET_VARIABLE/particle.yaml",
+             "scene \"$GRAINFLOW_UNSET_VARIABLE/particle.yaml\" (line 9): cannot be expanded: "
+             "variable 'GRAINFLOW_UNSET_VARIABLE' is not set in the environment"),
+            ("scene_dollar_left", "$(FOAM_CASE)/particle.yaml",
+             "; the path still holds a '$' after expansion"),
+            ("scene_directory", "constant",
+             "is a directory, not a scene file; name the scene's YAML file (it holds no .yaml "
+             "file)")):
+        case = runner.fresh_case("neutral_particle", label, [
+            ("constant/couplingProperties", '"particle.yaml"', f'"{path}"')])
+        runner.run(case, "blockMesh", "blockMesh")
+        log = run_refused(runner, checks, case, label)
+        checks.expect(words in log and re.search(
+            r"file: \S*constant/couplingProperties at line 9\.", log) is not None,
+                      f"scene \"{path}\": refused at line 9 saying so")
+
+
 TESTS = {f.__name__: f for f in (void_fraction_volume, exchange_balance, neutrally_buoyant,
                                   cellpoint_ranks,
                                  refuses_bad_setup, hostile_fields, restart, restart_files, restart_bed_surface, stop_signal, nan_guard,
@@ -2200,7 +2389,7 @@ TESTS = {f.__name__: f for f in (void_fraction_volume, exchange_balance, neutral
                                  heat_front, balanced_decomposition,
                                  diffusion_smoothing, restart_unwritten_time, run_time_edits,
                                  restart_time_step, checkpoint_keeping, setup_messages,
-                                 restart_lost_snapshots)}
+                                 restart_lost_snapshots, coupled_inputs)}
 
 
 if __name__ == "__main__":

@@ -99,6 +99,16 @@
 #   coupling.restart_lost_snapshots  snapshots 1 and 2 (the one at the checkpoint) deleted
 #       before a restart: named as gaps, the restart's snapshots keep the uninterrupted run's
 #       numbers 3 and 4 (t = n * 0.005 s).
+#   coupling.coupled_inputs        inputs taken without a word before: the scene's
+#       parallel.balance: true (2 ranks) and parallel.grid refused at their line naming
+#       system/decomposeParDict, the advice (removed) running with every particle's volume
+#       deposited (1e-12); transportModel BirdCarreau and its coefficients refused at their
+#       lines, Newtonian running; an end 5.6 fluid steps from the start said to end at the
+#       6th step (0.006 s: the last Time line and snapshot) at start-up and in the last line,
+#       whose advice ends exactly there, and likewise an endTime of 5.4 steps; out-of-range
+#       couplingProperties values refused at the key's line; the scene path expanded as
+#       OpenFOAM expands file names ($FOAM_CASE, <case>; also on 2 ranks), an unset variable,
+#       a '$' left and a directory each refused saying so. About 40 s.
 if(NOT TARGET grainFoam)
   return()
 endif()
@@ -241,6 +251,7 @@ grainflow_coupling_test(restart_time_step 1)
 grainflow_coupling_test(checkpoint_keeping 1)
 grainflow_coupling_test(setup_messages 2)
 grainflow_coupling_test(restart_lost_snapshots 1)
+grainflow_coupling_test(coupled_inputs 2)
 set_tests_properties(coupling.balanced_decomposition PROPERTIES TIMEOUT 300)  # ~40 s loaded
 set_tests_properties(coupling.stop_signal PROPERTIES TIMEOUT 600)  # ~25 s on a quiet machine
 

@@ -4,9 +4,12 @@
 // holds everything (imbalance 2); with it, the imbalance must fall below 1.15 — the
 // plane lands within one histogram bin (domain/128) of the median, which holds a
 // few percent of the particles. The particle count is conserved throughout.
+// Imposed planes (set_cut_planes, a coupled run's: the fluid mesh's) are never moved, even
+// with balance on: the plane stays at z = 0.04 exactly and the imbalance stays 2.
 #include <gtest/gtest.h>
 
 #include <random>
+#include <vector>
 
 #include "tests/dem/parallel/support.hpp"
 #include "tests/dem/support/test_scene.hpp"
@@ -14,7 +17,8 @@
 namespace grainflow {
 namespace {
 
-double imbalance_after(bool balance, long* particles) {
+double imbalance_after(bool balance, long* particles, bool impose = false,
+                       std::vector<double>* z_cuts = nullptr) {
   Scene s = test::one_material_scene(1e7, 0.3, 2500, 0.9, 0.3);
   s.domain.lo = Vec3(0, 0, 0);
   s.domain.hi = Vec3(0.02, 0.02, 0.08);
@@ -32,6 +36,7 @@ double imbalance_after(bool balance, long* particles) {
   fill.source = "test";
   s.insertions.push_back(fill);
   Simulation sim(s);
+  if (impose) sim.set_cut_planes(2, {0.0, 0.04, 0.08});
   std::mt19937_64 rng(2);
   std::uniform_real_distribution<double> u(-1, 1);
   for (auto& v : sim.particles().v) v = 0.2 * Vec3(u(rng), u(rng), u(rng));
@@ -39,6 +44,7 @@ double imbalance_after(bool balance, long* particles) {
   sim.initialise();
   sim.advance_to(0.08);
   *particles = sim.global_state().particles;
+  if (z_cuts) *z_cuts = sim.decomposition().cuts(2);
   EXPECT_GT(sim.counters().rebuilds, 30);
   return sim.load_imbalance();
 }
@@ -54,6 +60,15 @@ TEST(LoadBalance, CutPlanesFollowTheBed) {
   EXPECT_EQ(n_on, 600);
   EXPECT_GT(off, 1.9);
   EXPECT_LT(on, 1.15);
+}
+
+TEST(LoadBalance, ImposedCutPlanesStay) {
+  long n = 0;
+  std::vector<double> cuts;
+  const double imbalance = imbalance_after(true, &n, true, &cuts);
+  EXPECT_EQ(n, 600);
+  EXPECT_EQ(cuts, (std::vector<double>{0.0, 0.04, 0.08}));
+  EXPECT_GT(imbalance, 1.9);
 }
 
 }  // namespace
