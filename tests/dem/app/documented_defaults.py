@@ -172,6 +172,8 @@ def normalised_report(text):
         line = re.sub(r", [0-9.e+-]+ s wall, [0-9.e+-]+ particle-steps/s", ", <wall>", line)
         # The particle files read, by their folder (each run has its own) and time written.
         line = re.sub(r"^(input: \S+ reads ).*/([^/]+) \(modified [^)]*\)$", r"\1\2", line)
+        # A note's place in the file: a key written out moves the lines after it.
+        line = re.sub(r"^scene\.yaml:\d+:\d+: note:", "scene.yaml:<line>: note:", line)
         out.append(line)
     return "\n".join(out)
 
