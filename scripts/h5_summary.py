@@ -58,6 +58,21 @@ class Unreadable(Exception):
     """A file or folder that cannot be summarised; the message names it."""
 
 
+
+def restart_advice(folder):
+    """How to have a folder's particles.xdmf rewritten: a restart of the run that wrote it.
+    A grainFoam case's folder (system/controlDict beside or above it) is restarted by
+    grainFoam; `grain run --restart` would run its scene without the fluid over its files."""
+    folder = os.path.abspath(str(folder))
+    for up in (folder, os.path.dirname(folder), os.path.dirname(os.path.dirname(folder))):
+        if os.path.isfile(os.path.join(up, "system", "controlDict")):
+            return ("A restart of grainFoam (startFrom latestTime in system/controlDict of " + up
+                    + ") from a time before the run's end rewrites the index from the snapshot "
+                    "files (and runs on from there); not grain run --restart, which would run "
+                    "the coupled scene without its fluid over these files")
+    return ("A restart (grain run --restart) from one of the folder's checkpoints before the "
+            "run's end rewrites the index from the snapshot files (and runs on from there)")
+
 def attr(f, name, default=None):
     v = f.attrs.get(name, default)
     if isinstance(v, bytes):
@@ -188,9 +203,7 @@ def folder_files(folder):
         except ET.ParseError as e:
             notes.append(f"{index} cannot be read ({e}): damaged, e.g. by a power loss or an "
                          "operating-system crash during an append (docs/reliability.md); the "
-                         "snapshots are chosen as without it. A restart (grain run --restart) "
-                         "from one of the folder's checkpoints before the run's end rewrites "
-                         "the index from the snapshot files (and runs on from there)")
+                         "snapshots are chosen as without it. " + restart_advice(folder))
     # Files listed are summarised whatever their state (an error each if damaged); of the
     # others, the unreadable ones are said to be so, not taken for another run's.
     heads = {p: snapshot_head(p) for p in snapshots if listed is None or p not in listed}

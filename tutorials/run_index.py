@@ -18,6 +18,21 @@ import xml.etree.ElementTree as ET
 SNAPSHOT = re.compile(r"particles_(\d+)\.h5$")
 
 
+
+def restart_advice(folder):
+    """How to have a folder's particles.xdmf rewritten: a restart of the run that wrote it.
+    A grainFoam case's folder (system/controlDict beside or above it) is restarted by
+    grainFoam; `grain run --restart` would run its scene without the fluid over its files."""
+    folder = os.path.abspath(str(folder))
+    for up in (folder, os.path.dirname(folder), os.path.dirname(os.path.dirname(folder))):
+        if os.path.isfile(os.path.join(up, "system", "controlDict")):
+            return ("A restart of grainFoam (startFrom latestTime in system/controlDict of " + up
+                    + ") from a time before the run's end rewrites the index from the snapshot "
+                    "files (and runs on from there); not grain run --restart, which would run "
+                    "the coupled scene without its fluid over these files")
+    return ("A restart (grain run --restart) from one of the folder's checkpoints before the "
+            "run's end rewrites the index from the snapshot files (and runs on from there)")
+
 def note(message):
     print(f"analyse.py: note: {message}", file=sys.stderr)
 
@@ -127,8 +142,7 @@ def _without_index(folder, index, why):
     note(f"{index} {why}; using the {len(series)} snapshot(s) {series[0] if series else ''}"
          f"{' ... ' + series[-1] if len(series) > 1 else ''} chosen without it (the scene_"
          f"fingerprint of the newest snapshot{', up to the end of log.csv' if end else ''}). "
-         "A restart (grain run --restart) from one of the folder's checkpoints before the "
-         "run's end rewrites the index from the snapshot files (and runs on from there)")
+         + restart_advice(folder))
     if other:
         note(f"{len(other)} snapshot(s) in {folder} are left over from other runs (another "
              "scene_fingerprint, or a series that starts over), not used: " + ", ".join(other))

@@ -157,6 +157,23 @@ Start parse_command(const std::string& program, const std::vector<std::string>& 
   } catch (const SceneError& e) {
     return finished(2, std::string(e.what()) + "\n");
   }
+  // A checkpoint of a grainFoam case (its folder, or the one above, holds system/controlDict
+  // and constant/couplingProperties): `grain run` would run the coupled scene without its
+  // fluid and write over the case's particle output.
+  if (s.options.restart && cmd == "run") {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    fs::path up = fs::weakly_canonical(fs::absolute(*s.options.restart, ec), ec).parent_path();
+    for (int level = 0; level < 2 && !up.empty(); ++level, up = up.parent_path())
+      if (fs::is_regular_file(up / "system" / "controlDict", ec) &&
+          fs::is_regular_file(up / "constant" / "couplingProperties", ec))
+        return usage_error("--restart " + *s.options.restart +
+                           " is a checkpoint of the grainFoam case " + up.string() +
+                           " (system/controlDict, constant/couplingProperties): restart it "
+                           "with grainFoam (startFrom latestTime in system/controlDict); "
+                           "grain run would run its scene without the fluid and write over the "
+                           "case's particle output");
+  }
   return s;
 }
 

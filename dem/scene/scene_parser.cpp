@@ -1483,9 +1483,31 @@ void note_unused_settings(const Map& top, Scene& s) {
     }
     // The mirror: a rolling or cohesion model named while every pair's coefficient is 0 (the
     // default) does nothing, though the contact law line names it.
+    // Pairs that can touch: a particle material with another or with a wall's (a CSV or
+    // snapshot file may hold any material: then every one counts as a particle's). A
+    // coefficient on a pair of wall materials only acts nowhere.
+    const std::size_t n = s.materials.size();
+    std::vector<char> particle(n, 0), wall(n, 0);
+    bool any_material = s.insertions.empty();
+    for (const Insertion& ins : s.insertions) {
+      if (ins.kind == Insertion::Kind::csv || ins.kind == Insertion::Kind::snapshot)
+        any_material = true;
+      else if (ins.material >= 0 && static_cast<std::size_t>(ins.material) < n)
+        particle[static_cast<std::size_t>(ins.material)] = 1;
+    }
+    if (any_material) std::fill(particle.begin(), particle.end(), 1);
+    for (const Wall& w : s.walls)
+      if (w.material >= 0 && static_cast<std::size_t>(w.material) < n)
+        wall[static_cast<std::size_t>(w.material)] = 1;
+    const auto can_touch = [&](const MaterialPair& q) {
+      const auto a = static_cast<std::size_t>(q.a), b = static_cast<std::size_t>(q.b);
+      if (a >= n || b >= n) return true;
+      return (particle[a] && (particle[b] || wall[b])) || (particle[b] && wall[a]);
+    };
     const auto none_positive = [&](double MaterialPair::*coefficient) {
-      return std::none_of(s.pairs.begin(), s.pairs.end(),
-                          [&](const MaterialPair& q) { return q.*coefficient > 0; });
+      return std::none_of(s.pairs.begin(), s.pairs.end(), [&](const MaterialPair& q) {
+        return can_touch(q) && q.*coefficient > 0;
+      });
     };
     const auto model_key = [&](const char* key) -> std::optional<Field> {
       const auto c = top.find("contact");
@@ -1496,7 +1518,8 @@ void note_unused_settings(const Map& top, Scene& s) {
         s.notes.push_back(k->note_at_key(
             k->node().Scalar() +
             " has no effect: no pair of materials has a rolling_friction above 0 (the default "
-            "is 0), so contacts resist no rolling; give `rolling_friction: <mu_r>` in "
+            "is 0) among the pairs that can touch (particles with particles or walls), so "
+            "contacts resist no rolling; give `rolling_friction: <mu_r>` in "
             "interaction_defaults or interactions"));
     if (s.contact.cohesion != CohesionModel::none &&
         none_positive(&MaterialPair::cohesion_energy_density))
@@ -1504,7 +1527,8 @@ void note_unused_settings(const Map& top, Scene& s) {
         s.notes.push_back(k->note_at_key(
             k->node().Scalar() +
             " has no effect: no pair of materials has a cohesion_energy_density above 0 (the "
-            "default is 0), so contacts do not attract; give `cohesion_energy_density: "
+            "default is 0) among the pairs that can touch (particles with particles or walls), so "
+            "contacts do not attract; give `cohesion_energy_density: "
             "<J/m^3>` in interaction_defaults or interactions"));
   }
   if (const auto o = top.find("output")) {

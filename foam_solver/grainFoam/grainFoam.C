@@ -250,8 +250,8 @@ void checkWrittenFiles(const Foam::Time& runTime) {
 }
 
 // grainFoam solves a Newtonian fluid of constant rho and nu (with heat, constant Cp and
-// kappa): another viscosity model, its coefficients or a misspelt key would run as if they
-// were not there. Each is refused at its line, all in one message.
+// kappa): another viscosity model would run as if it were not there, and is refused at its
+// line; the other keys are named as not read.
 void checkTransportKeys(const Foam::dictionary& transport) {
   using namespace Foam;
   std::string problems;
@@ -267,13 +267,20 @@ void checkTransportKeys(const Foam::dictionary& transport) {
     problems += "transportModel " + std::string(model) + lineOf("transportModel") +
                 ": grainFoam solves a Newtonian fluid (constant nu); set transportModel "
                 "Newtonian or remove it\n";
+  // Other keys are said, not refused: the unused coefficient blocks of other models that
+  // OpenFOAM's tutorials keep beside `transportModel Newtonian`, and helper values a `$name`
+  // refers to, are inert.
   const std::vector<std::string> allowed{"transportModel", "rho", "nu", "Cp", "kappa"};
   for (const word& key : transport.toc())
-    if (std::find(allowed.begin(), allowed.end(), std::string(key)) == allowed.end())
-      problems += "unknown key '" + std::string(key) + "'" + lineOf(key) +
-                  grainflow::suggestion(key, allowed) +
-                  " (grainFoam does not read it); allowed: transportModel (Newtonian), rho, nu, "
-                  "and with the scene's heat Cp and kappa\n";
+    if (std::find(allowed.begin(), allowed.end(), std::string(key)) == allowed.end()) {
+      const entry* e = transport.findEntry(key, keyType::LITERAL);
+      Info << "grainFoam: note: constant/transportProperties: '" << key.c_str() << "'"
+           << (e ? " at line " + std::to_string(e->startLineNumber()) : std::string()).c_str()
+           << grainflow::suggestion(key, allowed).c_str()
+           << " is not read by grainFoam, which reads transportModel (Newtonian), rho, nu, and "
+              "with the scene's heat Cp and kappa"
+           << endl;
+    }
   if (problems.empty()) return;
   problems.pop_back();
   FatalIOError(FUNCTION_NAME, __FILE__, __LINE__, transport.name(), first, first)

@@ -2270,18 +2270,23 @@ def coupled_inputs(runner, checks):
     runner.run(case, "blockMesh", "blockMesh")
     log = run_refused(runner, checks, case, "transportModel BirdCarreau")
     checks.expect(re.search(r"transportModel BirdCarreau at line 12: grainFoam solves a Newtonian "
-                            r"fluid \(constant nu\); set transportModel Newtonian or remove it\n"
-                            r"unknown key 'BirdCarreauCoeffs' at line 13 \(grainFoam does not "
-                            r"read it\); allowed: transportModel \(Newtonian\), rho, nu", log)
-                  is not None and re.search(r"transportProperties at line 12\.", log) is not None,
-                  "transportModel BirdCarreau and its coefficients: refused at lines 12 and 13")
+                            r"fluid \(constant nu\); set transportModel Newtonian or remove it",
+                            log) is not None
+                  and re.search(r"transportProperties at line 12\.", log) is not None,
+                  "transportModel BirdCarreau: refused at line 12")
+    # Newtonian, with the inert coefficient block of another model (as OpenFOAM's tutorials
+    # keep it) and a helper value a $name refers to: runs, each other key named as not read.
     case = runner.fresh_case("neutral_particle", "transport_newtonian", SHORT + [
         ("constant/transportProperties", "nu      1e-6;",
-         "nu      1e-6;\ntransportModel Newtonian;\nCp      4180;")])
+         "nuWater 1e-6;\nnu      $nuWater;\ntransportModel Newtonian;\nCp      4180;\n"
+         "BirdCarreauCoeffs { nu0 1e-06; nuInf 1e-06; k 0; n 1; }")])
     log = runner.solve(case, 1)
     checks.expect("grainFoam: warning: Cp (constant/transportProperties) has no effect: the "
-                  "scene has no heat: block" in log,
-                  "transportModel Newtonian runs; Cp without heat named as having no effect")
+                  "scene has no heat: block" in log
+                  and "'BirdCarreauCoeffs' at line 15 is not read by grainFoam" in log
+                  and "'nuWater' at line 11 is not read by grainFoam" in log,
+                  "transportModel Newtonian with another model's coefficients and a $name "
+                  "runs; Cp without heat named as having no effect, the other keys as not read")
 
     # 3. an end between two fluid steps (deltaT 1e-3 s)
     for label, edits, says, last_line, advice in (

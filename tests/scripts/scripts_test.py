@@ -311,6 +311,21 @@ def h5_summary_no_index(args):
     grain_restart(args, single, "damaged", checkpoint)
     check(listed(args, "damaged") == own, "the remedy holds: a restart from "
           f"{checkpoint} rewrote particles.xdmf, which lists {own[0]} ... {own[-1]}")
+    # The same folder as a grainFoam case's particles/ (system/controlDict beside it): the
+    # remedy is a grainFoam restart; `grain run --restart` there ran the coupled scene without
+    # its fluid over the case's snapshots.
+    case = os.path.join(args.work, "foam_case")
+    shutil.rmtree(case, ignore_errors=True)
+    shutil.copytree(os.path.join(args.work, "damaged"), os.path.join(case, "particles"))
+    os.makedirs(os.path.join(case, "system"))
+    with open(os.path.join(case, "system", "controlDict"), "w") as f:
+        f.write("// a grainFoam case\n")
+    with open(os.path.join(case, "particles", "particles.xdmf"), "wb") as f:
+        f.write(intact[:len(intact) // 2])
+    code, text = script(args, "h5_summary.py", os.path.join("foam_case", "particles"))
+    check(code == 0 and "A restart of grainFoam (startFrom latestTime in system/controlDict of "
+          in text and "not grain run --restart" in text,
+          "damaged index of a grainFoam case: the remedy is a grainFoam restart", text)
 
 
 def h5_summary_unreadable_snapshot(args):

@@ -444,6 +444,31 @@ def second_document():
     expect(case, grain(d, "check", "scene.yaml"), 0, r"")
 
 
+def coupled_checkpoint():
+    """`grain run --restart` of a checkpoint in a grainFoam case (system/controlDict and
+    constant/couplingProperties beside its folder): refused, saying to restart with grainFoam.
+    Followed, as h5_summary.py once advised for a damaged index, it ran the coupled scene
+    without its fluid and wrote hundreds of DEM-only snapshots over the case's."""
+    case = "coupled_checkpoint"
+    d = fresh(case)
+    scene(d, extra=", checkpoint_interval: 0.002")
+    expect(case, grain(d, "run", "scene.yaml"), 0, r"done:")
+    for sub, name in (("system", "controlDict"), ("constant", "couplingProperties")):
+        os.makedirs(os.path.join(d, sub), exist_ok=True)
+        with open(os.path.join(d, sub, name), "w") as f:
+            f.write("// a grainFoam case\n")
+    before = sorted(os.listdir(os.path.join(d, "out")))
+    checkpoint = first_checkpoint(d)
+    expect(case, grain(d, "run", "scene.yaml", "--restart", checkpoint), 2,
+           r"--restart \S+ is a checkpoint of the grainFoam case \S+ \(system/controlDict, "
+           r"constant/couplingProperties\): restart it with grainFoam")
+    if sorted(os.listdir(os.path.join(d, "out"))) != before:
+        fail(case, "the refused restart changed the output folder")
+    # Without the case's files it is an ordinary grain checkpoint again.
+    shutil.rmtree(os.path.join(d, "constant"))
+    expect(case, grain(d, "run", "scene.yaml", "--restart", checkpoint), 0, r"done:")
+
+
 def end_beyond_count():
     """time.end of 1e14 s at a step of about 3.5e-6 s is 2.9e19 steps, beyond what a run
     counts: it had wrapped to one step, which `grain check` called "the nearest whole number"
@@ -886,7 +911,7 @@ if __name__ == "__main__":
     os.makedirs(WORK, exist_ok=True)
     for check in (overwrite_csv, overwrite_snapshot, overwrite_scene, hard_linked_backup,
                   failed_start_writes_nothing, signal_during_start,
-                  second_document, end_beyond_count, tilde, input_named,
+                  second_document, end_beyond_count, coupled_checkpoint, tilde, input_named,
                   help_option, restart_at_end, restart_other_step_setting, restart_other_domain,
                   check_restart,
                   restart_missing_csv, restart_mesh,

@@ -752,6 +752,28 @@ TEST(SceneNotes, SettingsWithoutEffectAreNamed) {
   EXPECT_THAT(models.notes[1],
               HasSubstr(":18:3: note: contact.cohesion: sjkr has no effect: no pair of "
                         "materials has a cohesion_energy_density above 0"));
+  // Coefficients only on a pair of wall materials (walls never touch each other): the
+  // same notes.
+  const std::string walls_only =
+      with("    density: 2500\n",
+           "    density: 2500\n  - {name: steel, youngs_modulus: 5e6, poisson_ratio: 0.3, "
+           "density: 7800}\n") +
+      "  rolling: epsd\n  cohesion: sjkr\n"
+      "walls: [{type: plane, point: [0, 0, 0], normal: [0, 0, 1], material: steel}]\n"
+      "interaction_defaults: {restitution: 0.5}\n"
+      "insert: [{type: fill, region: {box: {min: [0, 0, 0], max: [1, 1, 1]}}, count: 10, "
+      "material: glass, radius: 0.01}]\n";
+  std::string walls_pair = walls_only;
+  walls_pair.replace(walls_pair.find("  - materials: [glass, glass]\n"), 30,
+                     "  - {materials: [steel, steel], restitution: 0.5, rolling_friction: 0.1, "
+                     "cohesion_energy_density: 1e5}\n  - materials: [glass, glass]\n");
+  const Scene only_walls = parse_scene(walls_pair, kLabel);
+  EXPECT_EQ(only_walls.notes.size(), 2u) << (only_walls.notes.empty() ? "" : only_walls.notes[0]);
+  // On the pair of the particles' and the floor's materials: used, no note.
+  std::string floor_pair = walls_pair;
+  floor_pair.replace(floor_pair.find("[steel, steel]"), 14, "[glass, steel]");
+  EXPECT_TRUE(parse_scene(floor_pair, kLabel).notes.empty())
+      << parse_scene(floor_pair, kLabel).notes[0];
   EXPECT_TRUE(parse_scene(with("    restitution: 0.9\n",
                                "    restitution: 0.9\n    rolling_friction: 0.1\n"
                                "    cohesion_energy_density: 1e4\n") +
