@@ -1673,9 +1673,11 @@ YAML::Node load_yaml(const std::string& text, const Source& src) {
         YAML::Mark at = start_of_file();
         at.line = ended;
         raise(src, at,
-              "the YAML document ends here (a '...' line), and the keys after it, from line " +
+              std::string("the YAML document ends here (a '...' line), and ") +
+                  (marker ? "a second one starts at line " : "the keys after it, from line ") +
                   std::to_string(n + 1) +
-                  ", would not be read: a scene is one document; remove the '...' line");
+                  ", would not be read: a scene is one document; remove the '...' line" +
+                  (marker ? " and the '---' line" : ""));
       }
       if (is_marker(line, "...")) {
         ended = n;

@@ -567,7 +567,9 @@ void solve(const Foam::argList& args) {
     // OpenFOAM ends at the fluid step nearest the end: said when that is not the end itself.
     const RunEnd reach = end > start + half ? runEnd(start, end, runTime.deltaTValue()) : RunEnd{};
     const std::string nearest = reach.whole ? "" : "the fluid step nearest ";
-    if (sceneEnd < foamEnd) {
+    const bool nothing = end < start + half;  // said below
+    if (nothing) {
+    } else if (sceneEnd < foamEnd) {
       Info << "grainFoam: ends at t = " << text(reach.whole ? sceneEnd : reach.time).c_str()
            << " s, " << nearest.c_str() << "the scene's time.end "
            << (reach.whole ? "" : text(sceneEnd) + " s ").c_str() << "("
@@ -580,7 +582,7 @@ void solve(const Foam::argList& args) {
            << particles.sceneEndTimeSource().c_str() << ", is " << text(sceneEnd).c_str() << " s)"
            << endl;
     }
-    if (!reach.whole)
+    if (!nothing && !reach.whole)
       Info << endNote(sceneEnd < foamEnd ? "the scene's time.end" : "system/controlDict's endTime",
                       sceneEnd < foamEnd ? particles.sceneEndTimeSource() : std::string(),
                       sceneEnd < foamEnd ? "time.end" : "endTime", start, end,
@@ -599,10 +601,13 @@ void solve(const Foam::argList& args) {
                            << " s (time folder " << runTime.timeName()
                            << ", system/controlDict's startFrom): nothing to run; raise "
                            << which.c_str() << exit(FatalError);
-    if (end < start + half)
+    if (nothing)
       Info << "grainFoam: nothing to run: the run starts at t = " << text(start).c_str()
-           << " s, where it ends (" << which.c_str() << "); to run longer, raise both "
-           << "system/controlDict's endTime and the scene's time.end" << endl;
+           << " s, at its end, t = " << text(end).c_str() << " s, " << which.c_str()
+           << " (the run ends at the earlier of system/controlDict's endTime, "
+           << text(foamEnd).c_str() << " s, and the scene's time.end, " << text(sceneEnd).c_str()
+           << " s); to run longer, raise " << which.c_str()
+           << (std::max(sceneEnd, foamEnd) < start + half ? " and the other" : "") << endl;
   }
   RunTimeEdits edits(runTime, particles.sceneEndTime(), particles.sceneEndTimeSource());
   particles.checkStartingFlow();

@@ -2302,7 +2302,9 @@ def coupled_inputs(runner, checks):
              r"To end exactly at time\.end, set it to a whole number of steps from the start, "
              r"e\.g\. 0\.005 \(5 steps\) or (\S+) \(6 steps\)"),
             ("end_control", [("system/controlDict", "endTime         0.1;",
-                              "endTime         0.0054;")],
+                              "endTime         0.0054;"),
+                             ("system/controlDict", "writeInterval   0.05;",
+                              "writeInterval   0.001;")],
              r"grainFoam: ends at t = 0\.005 s, the fluid step nearest system/controlDict's "
              r"endTime 0\.0054 s \(the scene's time\.end",
              r"grainFoam: stopped at t = 0\.005 s, the fluid step nearest system/controlDict's "
@@ -2335,6 +2337,15 @@ def coupled_inputs(runner, checks):
                                     log) is not None and "grainFoam: note:" not in log
                           and "nearest" not in log,
                           f"the advice, time.end {m.group(1)}, ends exactly there, without a note")
+        if label == "end_control":
+            # Started again from its last time (0.005, past endTime 0.0054 by less than half
+            # a step): nothing to run, said once; it had also said it "ends at t = 0.0054 s".
+            set_keys(case, "system/controlDict", startFrom="latestTime")
+            log = runner.run(case, "grainFoam.again", runner.solver)
+            checks.expect("grainFoam: nothing to run: the run starts at t = 0.005 s, at its end, "
+                          "t = 0.0054 s, system/controlDict's endTime" in log
+                          and "grainFoam: ends at" not in log,
+                          "end_control again from latestTime: 'nothing to run', no 'ends at' line")
 
     # 4. couplingProperties values: refused at the key's line.
     for label, old, new, words, line in (
