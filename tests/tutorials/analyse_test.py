@@ -142,6 +142,13 @@ def hopper_restarted_folder(args):
           and "(fit over 0.32-1.00 s; the series starts at 0.32 s)" in text,
           f"--bed: the t = 0 solid fraction {phi:.3f} and Beverloo {1e3 * beverloo:.2f} g/s, the "
           "fit labelled 0.32-1.00 s", text)
+    # A part-emptied bed given as the bed (the restarted series' own last snapshot): refused.
+    last = sorted(n for n in os.listdir(os.path.join(args.work, "restart"))
+                  if n.endswith(".h5"))[-1]
+    code, text = run(args, "dem/hopper/analyse.py", "restart", "--bed", f"restart/{last}")
+    check(code == 1 and "it is not the settled bed the discharge started from" in text
+          and "bulk solid fraction" not in text,
+          "--bed with a part-emptied bed: refused, no numbers", text)
 
 
 def pour_settle_cut_log(args):

@@ -59,6 +59,16 @@ if args.bed is None and t[0] > 0:
              "the folder the run started in")
 with h5py.File(bed, "r") as f:
     x, r, m = f["position"][:], f["radius"][:], f["mass"][:]
+# A bed given with --bed must be the settled bed: no fewer particles above the orifice than
+# the series' first snapshot holds (a part-emptied bed would give another bulk density).
+if args.bed is not None:
+    with h5py.File(files[0], "r") as f:
+        first = int((f["position"][:, 2] > 0).sum())
+    if int((x[:, 2] > 0).sum()) < first:
+        sys.exit(f"analyse.py: --bed {bed} holds {int((x[:, 2] > 0).sum())} particles above the "
+                 f"orifice, fewer than the series' first snapshot ({files[0]}, t = {t[0]:.6g} s: "
+                 f"{first}): it is not the settled bed the discharge started from; give "
+                 "output/settled.h5 or the first snapshot of the folder the run started in")
 rho_p = float(np.mean(m / (4 / 3 * math.pi * r**3)))
 inside = (np.hypot(x[:, 0], x[:, 1]) < 0.005) & (x[:, 2] > 0.010) & (x[:, 2] < 0.025)
 phi = float((4 / 3 * math.pi * r[inside] ** 3).sum() / (math.pi * 0.005**2 * 0.015))
