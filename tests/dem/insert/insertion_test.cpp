@@ -537,6 +537,18 @@ TEST(FillInsertion, AVolumeFractionOvershotByItsLastParticleIsReported) {
   EXPECT_TRUE(notes_of(0.02, 0.2, 5e-4).empty());
 }
 
+// The InsertionError that inserting the scene's particles throws ("no error" if none).
+std::string insertion_error(const Scene& s) {
+  try {
+    Particles p;
+    GlobalId next = 1;
+    insert_particles(s, p, next, nullptr, nullptr);
+  } catch (const InsertionError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
 // A box region around a drum (a cylinder wall of radius 6 mm in a 20 mm box): the walls leave
 // the particles pi R^2 / (20 mm)^2 = 0.2827 of the region's volume, and `volume_fraction`
 // counts the whole region, so 0.05 asked stood as 0.18 in the drum, without a word. The note
@@ -598,42 +610,17 @@ TEST(FillInsertion, AVolumeFractionOfARegionWallsMostlyTakeIsSaidInTheSpaceLeft)
     EXPECT_GT(in_drum / drum, 0.17);  // 0.05 of the region: 3.5 times that in the drum
     EXPECT_NEAR(there, in_drum / drum, 0.03 * in_drum / drum);  // what the note says it is
   }
-  const std::string error = [&] {
-    try {
-      const Scene s = scene(0.115, "");
-      Particles p;
-      GlobalId next = 1;
-      insert_particles(s, p, next, nullptr, nullptr);
-    } catch (const InsertionError& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
-  }();
+  const std::string error = insertion_error(scene(0.115, ""));
   std::printf("[ measured ] %s\n", error.c_str());
   EXPECT_THAT(error, HasSubstr("`volume_fraction` counts the whole region, so 0.115 of it is"));
   std::smatch fits;
   ASSERT_TRUE(std::regex_search(error, fits, std::regex("a `volume_fraction` of ([0-9.]+) fits")));
-  {
-    const Scene s = scene(std::stod(fits[1]), "");
-    Particles p;
-    GlobalId next = 1;
-    EXPECT_NO_THROW(insert_particles(s, p, next, nullptr, nullptr)) << fits[1];
-  }
+  EXPECT_EQ(insertion_error(scene(std::stod(fits[1]), "")), "no error") << fits[1];
   // Earlier particles: a first fill of 0.06 in the same region, then 0.1 more.
-  const std::string crowded = [&] {
-    try {
-      const Scene s = scene(0.1,
-                            "  - {type: fill, region: {box: {min: [0, 0, 0], max: [0.02, "
-                            "0.02, 0.02]}}, volume_fraction: 0.06, material: glass, "
-                            "radius: 5e-4}\n");
-      Particles p;
-      GlobalId next = 1;
-      insert_particles(s, p, next, nullptr, nullptr);
-    } catch (const InsertionError& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
-  }();
+  const std::string crowded = insertion_error(
+      scene(0.1,
+            "  - {type: fill, region: {box: {min: [0, 0, 0], max: [0.02, 0.02, 0.02]}}, "
+            "volume_fraction: 0.06, material: glass, radius: 5e-4}\n"));
   std::printf("[ measured ] %s\n", crowded.c_str());
   EXPECT_THAT(crowded, HasSubstr("earlier insertions already fill 0.06"));
 }
@@ -708,20 +695,13 @@ TEST(FillInsertion, AFillLargerThanMemoryIsRefusedBeforeItIsDrawn) {
         "  - {type: fill, region: {box: {min: [0, 0, 0], max: [0.02, 0.02, 0.02]}}, " +
             amount + ", material: glass, radius: 1e-7}\n",
         "huge.yaml");
-    try {
-      Particles p;
-      GlobalId next = 1;
-      insert_particles(s, p, next, nullptr, nullptr);
-    } catch (const InsertionError& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
+    return insertion_error(s);
   };
   const std::string by_count = error_of("count: 1e11"),
                     by_fraction = error_of("volume_fraction: 0.2");
   std::printf("[ measured ] %s\n[ measured ] %s\n", by_count.c_str(), by_fraction.c_str());
   EXPECT_THAT(by_count, HasSubstr("huge.yaml:7: error: this fill would insert 1e+11 particles"));
-  EXPECT_THAT(by_count, HasSubstr("coarse_grain"));
+  EXPECT_THAT(by_count, HasSubstr("`count` counts parcels, so with `coarse_grain: k`"));
   // 0.2 x 8e-6 m^3 / (4/3 pi 1e-21 m^3) = 3.82e14
   EXPECT_THAT(by_fraction, HasSubstr("this fill would insert about 3.82e+14 particles"));
 }
