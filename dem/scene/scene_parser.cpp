@@ -930,7 +930,8 @@ void parse_stream(const Map& m, const Scene& scene, Insertion& ins) {
   ins.start = m.number_or("start", 0.0, kNonNegative);
   ins.stop = m.maybe_number("stop", kPositive);
   if (ins.stop && *ins.stop <= ins.start)
-    m.get("stop").fail("stop must be later than start (" + format_number(ins.start) + " s)");
+    m.get("stop").fail("stop " + exact_number(*ins.stop) + " s must be later than start (" +
+                       exact_number(ins.start) + " s)");
   ins.material = material_ref(m, "material", scene.materials);
   ins.radius = parse_size_distribution(m.get("radius",
                                              "add `radius: <m>` (or a distribution: `radius: "
@@ -989,8 +990,8 @@ void parse_stream(const Map& m, const Scene& scene, Insertion& ins) {
     }
   }
   if (ins.start >= scene.time.end)
-    m.get("start").fail("start " + format_number(ins.start) + " s is not before time.end (" +
-                        format_number(scene.time.end) +
+    m.get("start").fail("start " + exact_number(ins.start) + " s is not before time.end (" +
+                        exact_number(scene.time.end) +
                         " s): the stream would insert nothing; lower start or raise time.end");
   ins.velocity = m.vec3_or("velocity", Vec3::Zero());
   if (const auto s = m.find("seed"))
@@ -1203,8 +1204,8 @@ OutputSettings parse_output(const Field& f, const TimeSettings& time, bool heat)
                        " s) must be after output.start (" + format_number(*o.start) +
                        " s); snapshots are written at times in [start, stop]");
   if (o.start && *o.start > time.end)
-    m.get("start").fail("output.start (" + format_number(*o.start) +
-                        " s) is after time.end (" + format_number(time.end) +
+    m.get("start").fail("output.start (" + exact_number(*o.start) + " s) is after time.end (" +
+                        exact_number(time.end) +
                         " s): no snapshot would be written; give a start <= time.end");
   return o;
 }

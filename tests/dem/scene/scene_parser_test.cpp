@@ -1150,6 +1150,12 @@ TEST(SceneErrors, StreamsThatCannotDeliver) {
                     HasSubstr("Move the face's centre to y between 0.2 and 0.8 m")));
   EXPECT_THAT(error_of(stream("[0.5, 0.5, 0.9]", ", start: 0.5")).what(),
               HasSubstr("insert[0].start: start 0.5 s is not before time.end (0.5 s)"));
+  // Values 1e-12 apart are printed with every digit (12 digits showed "0.5 s is not before
+  // 0.5 s"; the stop's message did not give the stop).
+  EXPECT_THAT(error_of(stream("[0.5, 0.5, 0.9]", ", start: 0.5000000000005")).what(),
+              HasSubstr("start 0.5000000000005 s is not before time.end (0.5 s)"));
+  EXPECT_THAT(error_of(stream("[0.5, 0.5, 0.9]", ", start: 0.1, stop: 0.0999999999999")).what(),
+              HasSubstr("insert[0].stop: stop 0.0999999999999 s must be later than start (0.1 s)"));
   EXPECT_NO_THROW(
       parse_scene(with("  max: [1, 1, 1]\n", "  max: [1, 1, 1]\n  periodic: [false, true, false]\n",
                        stream("[0.5, 0.1, 0.9]", "")),
