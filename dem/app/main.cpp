@@ -157,19 +157,40 @@ Start parse_command(const std::string& program, const std::vector<std::string>& 
   } catch (const SceneError& e) {
     return finished(2, std::string(e.what()) + "\n");
   }
-  // A checkpoint of a grainFoam case (its folder, or the one above, holds system/controlDict
-  // and constant/couplingProperties): `grain run` would run the coupled scene without its
-  // fluid and write over the case's particle output.
+  // A checkpoint grainFoam wrote (a time folder of the case its folder is in, or the one
+  // above, names it in uniform/grainflowCheckpoint): `grain run` would run the coupled scene
+  // without its fluid and write over the case's particle output. A checkpoint of a DEM run
+  // kept in a grainFoam case (a pour before the fluid) is named by no time folder.
   if (s.options.restart && cmd == "run") {
     namespace fs = std::filesystem;
     std::error_code ec;
-    fs::path up = fs::weakly_canonical(fs::absolute(*s.options.restart, ec), ec).parent_path();
+    const fs::path checkpoint = fs::weakly_canonical(fs::absolute(*s.options.restart, ec), ec);
+    const std::string name = checkpoint.filename().string();
+    const auto names_it = [&](const fs::path& record) {
+      std::ifstream in(record);
+      for (std::string line; std::getline(in, line);)
+        if (line.find("checkpoint") != std::string::npos && line.find(name) != std::string::npos)
+          return true;
+      return false;
+    };
+    const auto written_by_grainfoam = [&](const fs::path& case_dir) {
+      if (!fs::is_regular_file(case_dir / "system" / "controlDict", ec)) return false;
+      std::vector<fs::path> folders{case_dir};
+      for (const auto& e : fs::directory_iterator(case_dir, ec))
+        if (e.path().filename().string().starts_with("processor")) folders.push_back(e.path());
+      for (const fs::path& folder : folders)
+        for (const auto& e : fs::directory_iterator(folder, ec))
+          if (fs::is_regular_file(e.path() / "uniform" / "grainflowCheckpoint", ec) &&
+              names_it(e.path() / "uniform" / "grainflowCheckpoint"))
+            return true;
+      return false;
+    };
+    fs::path up = checkpoint.parent_path();
     for (int level = 0; level < 2 && !up.empty(); ++level, up = up.parent_path())
-      if (fs::is_regular_file(up / "system" / "controlDict", ec) &&
-          fs::is_regular_file(up / "constant" / "couplingProperties", ec))
+      if (written_by_grainfoam(up))
         return usage_error("--restart " + *s.options.restart +
-                           " is a checkpoint of the grainFoam case " + up.string() +
-                           " (system/controlDict, constant/couplingProperties): restart it "
+                           " is a checkpoint grainFoam wrote in the case " + up.string() +
+                           " (a time folder's uniform/grainflowCheckpoint names it): restart it "
                            "with grainFoam (startFrom latestTime in system/controlDict); "
                            "grain run would run its scene without the fluid and write over the "
                            "case's particle output");

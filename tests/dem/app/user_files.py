@@ -445,10 +445,11 @@ def second_document():
 
 
 def coupled_checkpoint():
-    """`grain run --restart` of a checkpoint in a grainFoam case (system/controlDict and
-    constant/couplingProperties beside its folder): refused, saying to restart with grainFoam.
-    Followed, as h5_summary.py once advised for a damaged index, it ran the coupled scene
-    without its fluid and wrote hundreds of DEM-only snapshots over the case's."""
+    """`grain run --restart` of a checkpoint grainFoam wrote (a time folder of the case names it
+    in uniform/grainflowCheckpoint): refused, saying to restart with grainFoam. Followed, as
+    h5_summary.py once advised for a damaged index, it ran the coupled scene without its fluid
+    and wrote hundreds of DEM-only snapshots over the case's. A DEM run's checkpoint kept in a
+    grainFoam case (a pour before the fluid), which no time folder names, restarts."""
     case = "coupled_checkpoint"
     d = fresh(case)
     scene(d, extra=", checkpoint_interval: 0.002")
@@ -457,16 +458,18 @@ def coupled_checkpoint():
         os.makedirs(os.path.join(d, sub), exist_ok=True)
         with open(os.path.join(d, sub, name), "w") as f:
             f.write("// a grainFoam case\n")
-    before = sorted(os.listdir(os.path.join(d, "out")))
     checkpoint = first_checkpoint(d)
+    # The pour: no time folder names the checkpoint.
+    expect(case, grain(d, "run", "scene.yaml", "--restart", checkpoint), 0, r"done:")
+    os.makedirs(os.path.join(d, "0.002", "uniform"))
+    with open(os.path.join(d, "0.002", "uniform", "grainflowCheckpoint"), "w") as f:
+        f.write(f"checkpoint      {os.path.basename(checkpoint)};\n")
+    before = sorted(os.listdir(os.path.join(d, "out")))
     expect(case, grain(d, "run", "scene.yaml", "--restart", checkpoint), 2,
-           r"--restart \S+ is a checkpoint of the grainFoam case \S+ \(system/controlDict, "
-           r"constant/couplingProperties\): restart it with grainFoam")
+           r"--restart \S+ is a checkpoint grainFoam wrote in the case \S+ \(a time folder's "
+           r"uniform/grainflowCheckpoint names it\): restart it with grainFoam")
     if sorted(os.listdir(os.path.join(d, "out"))) != before:
         fail(case, "the refused restart changed the output folder")
-    # Without the case's files it is an ordinary grain checkpoint again.
-    shutil.rmtree(os.path.join(d, "constant"))
-    expect(case, grain(d, "run", "scene.yaml", "--restart", checkpoint), 0, r"done:")
 
 
 def end_beyond_count():
